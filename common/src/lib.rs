@@ -1,0 +1,41 @@
+//! sepval common library: the store-separation 6DOF model of `../shared/MODEL.md`, the 17
+//! factors and their binary encoding, telemetry files, goals, and the evaluation interface
+//! shared by the coordinator and the workers.
+//!
+//! Module map (mirrors MODEL.md):
+//! - [`scenario`]: section 1, the scenario file and the embedded default;
+//! - [`frames`]: section 2, quaternions, direction cosines, Euler angles;
+//! - [`model`]: sections 2 and 3, forces, moments and equations of motion;
+//! - [`propagator`]: section 3a, RK4 with located switching events and sampling;
+//! - [`factors`], [`encoding`]: section 4;
+//! - [`goals`]: section 5;
+//! - [`telemetry`]: section 6;
+//! - [`effects`]: section 7, the effect catalogue;
+//! - [`noise`]: the measurement noise of the synthetic flight test (section 4).
+
+#![warn(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod atmosphere;
+pub mod atomic_file;
+pub mod effects;
+pub mod elementary;
+pub mod encoding;
+pub mod factors;
+pub mod frames;
+pub mod goals;
+pub mod model;
+pub mod noise;
+pub mod propagator;
+pub mod scenario;
+pub mod simulation;
+pub mod synthetic;
+pub mod telemetry;
+pub mod units;
+
+pub use effects::EffectSet;
+pub use factors::{Factor, FactorTable, Factors};
+pub use goals::Goals;
+pub use scenario::Scenario;
+pub use simulation::Simulator;
+pub use telemetry::Trajectory;

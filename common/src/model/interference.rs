@@ -1,0 +1,63 @@
+//! Aircraft interference decay with distance from carriage.
+//!
+//! Source: `../shared/MODEL.md` section 1:
+//!
+//! ```text
+//! f(s) = (exp(-s/lambda) - exp(-s_end/lambda)) / (1 - exp(-s_end/lambda))   for s < s_end
+//! f(s) = 0                                                                    for s >= s_end
+//! ```
+
+/// Precomputed constants of f(s) for one lambda and s_end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InterferenceDecay {
+    /// Decay length lambda [m].
+    pub lambda_m: f64,
+    /// Cut-off distance [m].
+    pub s_end_m: f64,
+    inv_lambda_per_m: f64,
+    exp_end: f64,
+    inv_denominator: f64,
+}
+
+impl InterferenceDecay {
+    /// Constants for decay length `lambda_m` and cut-off `s_end_m`.
+    pub fn new(lambda_m: f64, s_end_m: f64) -> Self {
+        let exp_end = (-s_end_m / lambda_m).exp();
+        InterferenceDecay {
+            lambda_m,
+            s_end_m,
+            inv_lambda_per_m: 1.0 / lambda_m,
+            exp_end,
+            inv_denominator: 1.0 / (1.0 - exp_end),
+        }
+    }
+
+    /// f(s) for the CG distance `s_m` from carriage.
+    #[inline(always)]
+    pub fn factor(&self, s_m: f64) -> f64 {
+        if s_m < self.s_end_m {
+            (crate::elementary::exp(-s_m * self.inv_lambda_per_m) - self.exp_end)
+                * self.inv_denominator
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::float_cmp)] // these tests check exact values on purpose
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_at_carriage_zero_at_the_end() {
+        let d = InterferenceDecay::new(0.6, 9.144);
+        assert!((d.factor(0.0) - 1.0).abs() < 1e-15);
+        assert_eq!(d.factor(9.144), 0.0);
+        assert_eq!(d.factor(20.0), 0.0);
+        let s: f64 = 1.3;
+        let e_end = (-9.144f64 / 0.6).exp();
+        let expected = ((-s / 0.6).exp() - e_end) / (1.0 - e_end);
+        assert!((d.factor(s) - expected).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,544 @@
+//! The store-separation model: one scenario set up once ([`Model`]), one run's constants
+//! ([`RunSetup`]: factors and effects applied), and the equations of motion
+//! ([`RunSetup::derivative`]).
+//!
+//! Source: `../shared/MODEL.md` sections 1 to 3. The tree mirrors the physics:
+//! [`ejector`] (force-versus-displacement table), [`interference`] (decay with distance),
+//! [`aero`] (coefficients and the flow state the catalogue's terms see).
+//!
+//! Equations of motion (MODEL.md section 2), implemented in [`RunSetup::derivative`]:
+//!
+//! ```text
+//! dr/dt     = v
+//! dv/dt     = g_L + (C_LB F_aero_B + F_ej_L) / m
+//! dq/dt     = 0.5 * q (x) (0, omega)
+//! domega/dt = I^-1 (M_B - omega x (I omega))
+//! ```
+//!
+//! Generalisations of the contract, used by the effect catalogue (section 7) and neutral by
+//! default so the baseline is exactly the contract: a full inertia tensor (`inertia_product_xz`),
+//! an aerodynamic moment reference point away from the CG (`cg_offset`), an ejector force
+//! direction in L (`ejector_cant`), an ejector start time (`ejector_delay`), initial rates
+//! (`release_rates`), and the measurement knobs (time offset, attitude bias, tracked point).
+
+pub mod aero;
+pub mod ejector;
+pub mod interference;
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::atmosphere::isa_troposphere;
+use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
+use crate::elementary::{asin, atan2};
+use crate::factors::{Factor, FactorError, Factors};
+use crate::frames::quaternion_rate;
+use crate::scenario::Scenario;
+
+pub use aero::{Coefficients, Flow};
+pub use ejector::EjectorCurve;
+pub use interference::InterferenceDecay;
+
+/// Standard gravity [m/s^2] (MODEL.md section 1).
+pub const G_M_S2: f64 = 9.80665;
+
+/// Length of the state vector: r (3), v (3), q (4), omega (3).
+pub const STATE_LEN: usize = 13;
+
+/// The state `[r_L (m), v_L (m/s), q (scalar first), omega_B (rad/s)]` (MODEL.md section 2).
+pub type StateVector = [f64; STATE_LEN];
+
+/// Errors building a run.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// A factor is non-finite or out of bounds.
+    #[error(transparent)]
+    Factor(#[from] FactorError),
+    /// An effect's parameters are invalid.
+    #[error(transparent)]
+    Effect(#[from] EffectError),
+    /// The resulting inertia tensor is not positive definite.
+    #[error("inertia tensor is not positive definite (xz block determinant {det_kg2_m4} <= 0)")]
+    InertiaNotPositiveDefinite {
+        /// Ixx Izz - Ixz^2.
+        det_kg2_m4: f64,
+    },
+}
+
+/// One scenario, set up once: every constant derived from its file (MODEL.md section 1).
+#[derive(Debug, Clone)]
+pub struct Model {
+    scenario: Scenario,
+    /// Mass [kg].
+    pub mass_kg: f64,
+    /// Nominal principal inertias (Ixx, Iyy, Izz) [kg m^2].
+    pub inertia_kg_m2: [f64; 3],
+    /// Reference diameter [m].
+    pub diameter_m: f64,
+    /// Reference area pi d^2 / 4 [m^2].
+    pub area_m2: f64,
+    /// Body x of the (forward, aft) ejector feet relative to the nominal CG [m].
+    pub feet_x_m: [f64; 2],
+    /// Ejector stroke [m].
+    pub stroke_m: f64,
+    /// Nominal ejector force curve.
+    pub curve: EjectorCurve,
+    /// Air density at the flight condition [kg/m^3].
+    pub density_kg_m3: f64,
+    /// Free-stream speed V_inf = Mach a [m/s].
+    pub v_inf_m_s: f64,
+    /// Aircraft velocity relative to the air in L:
+    /// V_inf (cos a cos b, sin b, sin a cos b) (MODEL.md section 2).
+    pub v_aircraft_air_l_m_s: Vector3<f64>,
+    /// Gravity in L: g (-sin theta_a, 0, cos theta_a), theta_a = alpha + gamma.
+    pub gravity_l_m_s2: Vector3<f64>,
+    /// Fixed RK4 step [s].
+    pub dt_s: f64,
+    /// Initial velocity relative to L [m/s].
+    pub initial_velocity_m_s: Vector3<f64>,
+    /// Initial body rates [rad/s].
+    pub initial_rates_rad_s: Vector3<f64>,
+}
+
+impl Model {
+    /// Sets up a validated scenario.
+    pub fn new(scenario: &Scenario) -> Model {
+        let s = &scenario.store;
+        let f = &scenario.flight;
+        let air = isa_troposphere(f.altitude_m);
+        let v_inf = f.mach * air.speed_of_sound_m_s;
+        let (a, b) = (f.alpha_deg.to_radians(), f.beta_deg.to_radians());
+        let theta_a = (f.alpha_deg + f.gamma_deg).to_radians();
+        Model {
+            scenario: scenario.clone(),
+            mass_kg: s.mass_kg,
+            inertia_kg_m2: [s.ixx_kg_m2, s.iyy_kg_m2, s.izz_kg_m2],
+            diameter_m: s.diameter_m,
+            area_m2: std::f64::consts::PI * s.diameter_m * s.diameter_m / 4.0,
+            feet_x_m: [s.fwd_foot_x_m, s.aft_foot_x_m],
+            stroke_m: s.stroke_m,
+            curve: EjectorCurve::new(&scenario.ejector.curve),
+            density_kg_m3: air.density_kg_m3,
+            v_inf_m_s: v_inf,
+            v_aircraft_air_l_m_s: Vector3::new(
+                v_inf * a.cos() * b.cos(),
+                v_inf * b.sin(),
+                v_inf * a.sin() * b.cos(),
+            ),
+            gravity_l_m_s2: Vector3::new(-G_M_S2 * theta_a.sin(), 0.0, G_M_S2 * theta_a.cos()),
+            dt_s: scenario.integrator.dt_s,
+            initial_velocity_m_s: Vector3::from(scenario.initial.velocity_m_s),
+            initial_rates_rad_s: Vector3::from(scenario.initial.rates_deg_s.map(f64::to_radians)),
+        }
+    }
+
+    /// The scenario this model was set up from.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+}
+
+/// An extra term of the aerodynamic coefficients contributed by an effect (for example
+/// `Cl += Cl_beta beta`), called once per force evaluation.
+pub type CoefficientFn = fn(&[f64; MAX_EFFECT_PARAMS], &Flow, &mut Coefficients);
+
+/// Most coefficient terms one run can carry.
+pub const MAX_COEFFICIENT_TERMS: usize = 8;
+
+/// One ejector foot of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Foot {
+    /// Body x of the foot relative to the (true) CG [m].
+    pub x_m: f64,
+    /// Force multiplier (fwdfac or aftfac).
+    pub fac: f64,
+}
+
+/// The constants of one run: the model with one factor set and one effect set applied.
+/// Built per evaluation (cheap, no allocation) and then used for every force evaluation.
+#[derive(Clone, Copy)]
+pub struct RunSetup {
+    /// 1 / m [1/kg].
+    pub inv_mass_per_kg: f64,
+    /// Inertia tensor about the CG, body axes [kg m^2].
+    pub inertia_kg_m2: Matrix3<f64>,
+    /// Its inverse (set when the run is built, after the effects).
+    pub inertia_inv: Matrix3<f64>,
+    /// Whether the tensor is diagonal (the contract's case; a shorter path).
+    pub inertia_diagonal: bool,
+    /// Its diagonal (Ixx, Iyy, Izz) [kg m^2].
+    pub inertia_principal: [f64; 3],
+    /// Reciprocals of the diagonal (valid when `inertia_diagonal`).
+    pub inertia_principal_inv: [f64; 3],
+    /// 0.5 rho S [kg/m]: multiplied by V^2 gives qbar S.
+    pub half_rho_area: f64,
+    /// Reference diameter d [m].
+    pub diameter_m: f64,
+    /// d / 2 [m], for the non-dimensional rates.
+    pub half_diameter_m: f64,
+    /// Aircraft velocity relative to the air in L [m/s].
+    pub v_aircraft_air_l_m_s: Vector3<f64>,
+    /// Gravity in L [m/s^2].
+    pub gravity_l_m_s2: Vector3<f64>,
+    /// Freestream coefficients with the factor offsets applied.
+    pub aero: aero::AeroConstants,
+    /// Interference increments times their multipliers: (dCX, dCY, dCZ, dCl, dCm, dCn).
+    pub interference_increments: [f64; 6],
+    /// Interference decay f(s).
+    pub decay: InterferenceDecay,
+    /// Forward and aft feet.
+    pub feet: [Foot; 2],
+    /// Ejector stroke [m].
+    pub stroke_m: f64,
+    /// Unit direction of each foot's force in L (MODEL.md: +z of L).
+    pub ejector_direction_l: Vector3<f64>,
+    /// Time at which the feet start pushing [s] (0: at release).
+    pub ejector_start_s: f64,
+    /// Body x of the aerodynamic moment reference point relative to the CG [m] (0: the CG);
+    /// moments about the CG are M_ref + (x_ref, 0, 0) x F_aero.
+    pub aero_reference_x_m: f64,
+    /// Initial velocity relative to L [m/s].
+    pub initial_velocity_m_s: Vector3<f64>,
+    /// Initial body rates [rad/s].
+    pub initial_rates_rad_s: Vector3<f64>,
+    /// Extra coefficient terms (effects), `coefficient_term_count` of them in use.
+    pub coefficient_terms: [(CoefficientFn, [f64; MAX_EFFECT_PARAMS]); MAX_COEFFICIENT_TERMS],
+    /// Number of entries of `coefficient_terms` in use.
+    pub coefficient_term_count: usize,
+    /// Measurement: the sample labelled t shows the store at t + offset [s].
+    pub time_offset_s: f64,
+    /// Measurement: constant Euler angle biases (roll, pitch, yaw) [rad].
+    pub attitude_bias_rad: [f64; 3],
+    /// Measurement: the tracked body point relative to the CG, body axes [m].
+    pub tracked_point_b_m: Vector3<f64>,
+}
+
+fn no_term(_: &[f64; MAX_EFFECT_PARAMS], _: &Flow, _: &mut Coefficients) {}
+
+impl RunSetup {
+    /// The run of `model` with `factors` (checked against the scenario's factor table) and
+    /// `effects` applied.
+    pub fn new(model: &Model, factors: &Factors, effects: &EffectSet) -> Result<Self, ModelError> {
+        model.scenario.factors.check(factors)?;
+        Self::new_unchecked_bounds(model, factors, effects)
+    }
+
+    /// As [`RunSetup::new`], but factors need only be finite (not within the table's bounds):
+    /// for studies that step outside the search box on purpose.
+    pub fn new_unchecked_bounds(
+        model: &Model,
+        factors: &Factors,
+        effects: &EffectSet,
+    ) -> Result<Self, ModelError> {
+        for (i, &value) in factors.0.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(FactorError::NotFinite {
+                    name: crate::factors::Factor::NAMES[i],
+                    value,
+                }
+                .into());
+            }
+        }
+        let sc = &model.scenario;
+        let fx = |f: Factor| factors.get(f);
+        let ia = model.inertia_kg_m2;
+        let inertia = Matrix3::from_diagonal(&Vector3::new(
+            ia[0] * fx(Factor::Xinerfac),
+            ia[1] * fx(Factor::Yinerfac),
+            ia[2] * fx(Factor::Zinerfac),
+        ));
+        let i = &sc.interference;
+        let mut run = RunSetup {
+            inv_mass_per_kg: 1.0 / model.mass_kg,
+            inertia_kg_m2: inertia,
+            inertia_inv: Matrix3::identity(),
+            inertia_diagonal: true,
+            inertia_principal: [0.0; 3],
+            inertia_principal_inv: [0.0; 3],
+            half_rho_area: 0.5 * model.density_kg_m3 * model.area_m2,
+            diameter_m: model.diameter_m,
+            half_diameter_m: 0.5 * model.diameter_m,
+            v_aircraft_air_l_m_s: model.v_aircraft_air_l_m_s,
+            gravity_l_m_s2: model.gravity_l_m_s2,
+            aero: aero::AeroConstants::new(&sc.aero, factors),
+            interference_increments: [
+                fx(Factor::Caintfac) * i.dcx0,
+                fx(Factor::Cyintfac) * i.dcy0,
+                fx(Factor::Czintfac) * i.dcz0,
+                fx(Factor::Clintfac) * i.dcl0,
+                fx(Factor::Cmintfac) * i.dcm0,
+                fx(Factor::Cnintfac) * i.dcn0,
+            ],
+            decay: InterferenceDecay::new(i.lambda_m, i.s_end_m),
+            feet: [
+                Foot {
+                    x_m: model.feet_x_m[0],
+                    fac: fx(Factor::Fwdfac),
+                },
+                Foot {
+                    x_m: model.feet_x_m[1],
+                    fac: fx(Factor::Aftfac),
+                },
+            ],
+            stroke_m: model.stroke_m,
+            ejector_direction_l: Vector3::new(0.0, 0.0, 1.0),
+            ejector_start_s: 0.0,
+            aero_reference_x_m: 0.0,
+            initial_velocity_m_s: model.initial_velocity_m_s,
+            initial_rates_rad_s: model.initial_rates_rad_s,
+            coefficient_terms: [(no_term as CoefficientFn, [0.0; MAX_EFFECT_PARAMS]);
+                MAX_COEFFICIENT_TERMS],
+            coefficient_term_count: 0,
+            time_offset_s: 0.0,
+            attitude_bias_rad: [0.0; 3],
+            tracked_point_b_m: Vector3::zeros(),
+        };
+        effects.apply(&mut run)?;
+        run.inertia_inv = invert_inertia(&run.inertia_kg_m2)?;
+        run.inertia_diagonal = is_diagonal(&run.inertia_kg_m2);
+        let i = &run.inertia_kg_m2;
+        run.inertia_principal = [i[(0, 0)], i[(1, 1)], i[(2, 2)]];
+        run.inertia_principal_inv = run.inertia_principal.map(|d| 1.0 / d);
+        Ok(run)
+    }
+
+    /// Adds a coefficient term (used by effects).
+    pub fn add_coefficient_term(
+        &mut self,
+        term: CoefficientFn,
+        params: [f64; MAX_EFFECT_PARAMS],
+    ) -> Result<(), EffectError> {
+        if self.coefficient_term_count == MAX_COEFFICIENT_TERMS {
+            return Err(EffectError::TooManyCoefficientTerms {
+                max: MAX_COEFFICIENT_TERMS,
+            });
+        }
+        self.coefficient_terms[self.coefficient_term_count] = (term, params);
+        self.coefficient_term_count += 1;
+        Ok(())
+    }
+
+    /// The initial state: carriage position and attitude, initial velocity and rates.
+    pub fn initial_state(&self) -> StateVector {
+        let v = &self.initial_velocity_m_s;
+        let w = &self.initial_rates_rad_s;
+        [
+            0.0, 0.0, 0.0, v.x, v.y, v.z, 1.0, 0.0, 0.0, 0.0, w.x, w.y, w.z,
+        ]
+    }
+
+    /// Stroke displacement of foot `i`: the L-frame z of its body point (MODEL.md section 3),
+    /// `s_i = (r + C_LB (x_i, 0, 0))_z`, given `c20 = C_LB[2][0]`.
+    #[inline(always)]
+    pub fn foot_displacement_m(&self, i: usize, r_z: f64, c20: f64) -> f64 {
+        r_z + c20 * self.feet[i].x_m
+    }
+
+    /// The state derivative (MODEL.md sections 2 and 3) with the ejector feet in the given
+    /// modes (`on[i]`: foot i pushes).
+    ///
+    /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
+    /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
+    /// allocation. Each block cites the MODEL.md line it implements.
+    #[inline(always)]
+    pub fn derivative(&self, curve: &EjectorCurve, x: &StateVector, on: [bool; 2]) -> StateVector {
+        let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
+        // Section 2: C_LB of the stage's quaternion (one DCM per stage).
+        let c = Dcm::from_quaternion(q0, q1, q2, q3);
+
+        // Section 2: v_air = v + V_inf (cos a cos b, sin b, sin a cos b) in L;
+        // (u, v, w) = C_BL v_air.
+        let va = &self.v_aircraft_air_l_m_s;
+        let air = [vx + va.x, vy + va.y, vz + va.z];
+        let [u, v, w] = c.to_body(air);
+        // Section 3: V = |v_air| (rotation-invariant, so taken in L), qbar = 0.5 rho V^2,
+        // alpha = atan2(w, u), beta = asin(v / V), p^ = p d / 2V (likewise q^, r^).
+        let speed2 = air[0] * air[0] + air[1] * air[1] + air[2] * air[2];
+        let inv_speed = 1.0 / speed2.sqrt();
+        let qbar_area = self.half_rho_area * speed2;
+        let alpha = atan2(w, u);
+        let beta = asin(v * inv_speed);
+        let rate_scale = self.half_diameter_m * inv_speed;
+        // Section 1: interference decay with s = |r|.
+        let f_s = self.decay.factor((rx * rx + ry * ry + rz * rz).sqrt());
+        let flow = Flow {
+            alpha_rad: alpha,
+            beta_rad: beta,
+            p_hat: p * rate_scale,
+            q_hat: q * rate_scale,
+            r_hat: r * rate_scale,
+            speed_m_s: speed2 * inv_speed,
+            interference_factor: f_s,
+        };
+        // Section 3: the six coefficients, then the catalogue's extra terms (section 7).
+        let mut k = self.aero.coefficients(&flow, &self.interference_increments);
+        for (term, params) in &self.coefficient_terms[..self.coefficient_term_count] {
+            term(params, &flow, &mut k);
+        }
+        // Section 3: F_aero_B = qbar S (CX, CY, CZ); M_aero_B = qbar S d (Cl, Cm, Cn), moved
+        // from the moment reference point (x_ref, 0, 0) to the CG: M += (x_ref, 0, 0) x F.
+        let (fx, fy, fz) = (qbar_area * k.cx, qbar_area * k.cy, qbar_area * k.cz);
+        let qbar_area_d = qbar_area * self.diameter_m;
+        let x_ref = self.aero_reference_x_m;
+        let mx = qbar_area_d * k.cl;
+        let mut my = qbar_area_d * k.cm - x_ref * fz;
+        let mut mz = qbar_area_d * k.cn + x_ref * fy;
+        // Section 3: F_L = C_LB F_aero_B.
+        let [mut ax, mut ay, mut az] = c.to_launch([fx, fy, fz]);
+
+        // Section 3: each foot pushes along its L direction with
+        // fac_i F_ej(clamp(s_i, 0, stroke)), s_i = (r + C_LB (x_i, 0, 0))_z; its moment about
+        // the CG is (x_i, 0, 0) x (C_BL F_i).
+        if on[0] || on[1] {
+            let d = &self.ejector_direction_l;
+            for (foot, _) in self.feet.iter().zip(on).filter(|(_, on)| *on) {
+                let s_i = rz + c.m[2][0] * foot.x_m;
+                let force_n = foot.fac * curve.force_n(s_i.clamp(0.0, self.stroke_m));
+                let f_l = [force_n * d.x, force_n * d.y, force_n * d.z];
+                ax += f_l[0];
+                ay += f_l[1];
+                az += f_l[2];
+                let [_, by, bz] = c.to_body(f_l);
+                // (x, 0, 0) x (bx, by, bz) = (0, -x bz, x by)
+                my -= foot.x_m * bz;
+                mz += foot.x_m * by;
+            }
+        }
+
+        // Section 2: dv/dt = g_L + (C_LB F_aero_B + F_ej_L) / m.
+        let g = &self.gravity_l_m_s2;
+        let inv_m = self.inv_mass_per_kg;
+        // Section 2: dq/dt = 0.5 q (x) (0, omega).
+        let [dq0, dq1, dq2, dq3] = quaternion_rate([q0, q1, q2, q3], p, q, r);
+        // Section 2: domega/dt = I^-1 (M_B - omega x (I omega)).
+        let [dp, dq, dr] = self.angular_acceleration([mx, my, mz], [p, q, r]);
+        [
+            vx,
+            vy,
+            vz,
+            g.x + ax * inv_m,
+            g.y + ay * inv_m,
+            g.z + az * inv_m,
+            dq0,
+            dq1,
+            dq2,
+            dq3,
+            dp,
+            dq,
+            dr,
+        ]
+    }
+
+    /// I^-1 (M - omega x (I omega)) (MODEL.md section 2), with a short path for the diagonal
+    /// tensor of the contract.
+    #[inline(always)]
+    fn angular_acceleration(&self, m: [f64; 3], w: [f64; 3]) -> [f64; 3] {
+        let [p, q, r] = w;
+        if self.inertia_diagonal {
+            let [ixx, iyy, izz] = self.inertia_principal;
+            let [jx, jy, jz] = self.inertia_principal_inv;
+            // omega x (I omega) for diagonal I.
+            return [
+                (m[0] - (izz - iyy) * q * r) * jx,
+                (m[1] - (ixx - izz) * r * p) * jy,
+                (m[2] - (iyy - ixx) * p * q) * jz,
+            ];
+        }
+        let i = &self.inertia_kg_m2;
+        let h = [
+            i[(0, 0)] * p + i[(0, 1)] * q + i[(0, 2)] * r,
+            i[(1, 0)] * p + i[(1, 1)] * q + i[(1, 2)] * r,
+            i[(2, 0)] * p + i[(2, 1)] * q + i[(2, 2)] * r,
+        ];
+        let t = [
+            m[0] - (q * h[2] - r * h[1]),
+            m[1] - (r * h[0] - p * h[2]),
+            m[2] - (p * h[1] - q * h[0]),
+        ];
+        let j = &self.inertia_inv;
+        [
+            j[(0, 0)] * t[0] + j[(0, 1)] * t[1] + j[(0, 2)] * t[2],
+            j[(1, 0)] * t[0] + j[(1, 1)] * t[1] + j[(1, 2)] * t[2],
+            j[(2, 0)] * t[0] + j[(2, 1)] * t[1] + j[(2, 2)] * t[2],
+        ]
+    }
+}
+
+/// The direction-cosine matrix C_LB of one stage, row-major (`m[i][j]` = C_LB(i, j)).
+#[derive(Debug, Clone, Copy)]
+pub struct Dcm {
+    /// The matrix.
+    pub m: [[f64; 3]; 3],
+}
+
+impl Dcm {
+    /// C_LB of the quaternion (q0, q1, q2, q3) scaled to unit length (see [`crate::frames`]).
+    #[inline(always)]
+    pub fn from_quaternion(q0: f64, q1: f64, q2: f64, q3: f64) -> Dcm {
+        let (s00, s11, s22, s33) = (q0 * q0, q1 * q1, q2 * q2, q3 * q3);
+        let inv_n2 = 1.0 / ((s00 + s11) + (s22 + s33));
+        let two = 2.0 * inv_n2;
+        let (q0q1, q0q2, q0q3) = (q0 * q1, q0 * q2, q0 * q3);
+        let (q1q2, q1q3, q2q3) = (q1 * q2, q1 * q3, q2 * q3);
+        Dcm {
+            m: [
+                [
+                    ((s00 + s11) - (s22 + s33)) * inv_n2,
+                    two * (q1q2 - q0q3),
+                    two * (q1q3 + q0q2),
+                ],
+                [
+                    two * (q1q2 + q0q3),
+                    ((s00 - s11) + (s22 - s33)) * inv_n2,
+                    two * (q2q3 - q0q1),
+                ],
+                [
+                    two * (q1q3 - q0q2),
+                    two * (q2q3 + q0q1),
+                    ((s00 - s11) - (s22 - s33)) * inv_n2,
+                ],
+            ],
+        }
+    }
+
+    /// C_BL a: a launch-frame vector in body axes.
+    #[inline(always)]
+    pub fn to_body(&self, a: [f64; 3]) -> [f64; 3] {
+        let m = &self.m;
+        [
+            m[0][0] * a[0] + m[1][0] * a[1] + m[2][0] * a[2],
+            m[0][1] * a[0] + m[1][1] * a[1] + m[2][1] * a[2],
+            m[0][2] * a[0] + m[1][2] * a[1] + m[2][2] * a[2],
+        ]
+    }
+
+    /// C_LB b: a body vector in launch-frame axes.
+    #[inline(always)]
+    pub fn to_launch(&self, b: [f64; 3]) -> [f64; 3] {
+        let m = &self.m;
+        [
+            m[0][0] * b[0] + m[0][1] * b[1] + m[0][2] * b[2],
+            m[1][0] * b[0] + m[1][1] * b[1] + m[1][2] * b[2],
+            m[2][0] * b[0] + m[2][1] * b[1] + m[2][2] * b[2],
+        ]
+    }
+}
+
+/// Inverse of a symmetric inertia tensor, refusing one that is not positive definite.
+fn invert_inertia(i: &Matrix3<f64>) -> Result<Matrix3<f64>, ModelError> {
+    // Principal minors (Sylvester's criterion) for a clear message in the common xz case.
+    let det_xz = i[(0, 0)] * i[(2, 2)] - i[(0, 2)] * i[(2, 0)];
+    if det_xz <= 0.0 || i.determinant() <= 0.0 || i[(0, 0)] <= 0.0 {
+        return Err(ModelError::InertiaNotPositiveDefinite { det_kg2_m4: det_xz });
+    }
+    if is_diagonal(i) {
+        // Exact reciprocals for the diagonal tensor of the contract.
+        return Ok(Matrix3::from_diagonal(&i.diagonal().map(|d| 1.0 / d)));
+    }
+    i.try_inverse()
+        .ok_or(ModelError::InertiaNotPositiveDefinite { det_kg2_m4: det_xz })
+}
+
+fn is_diagonal(i: &Matrix3<f64>) -> bool {
+    (0..3).all(|r| (0..3).all(|c| r == c || i[(r, c)] == 0.0))
+}

@@ -1,0 +1,376 @@
+//! Classic RK4 with located switching events, and sampling at telemetry times.
+//!
+//! Source: `../shared/MODEL.md` sections 1 (integrator), 2 (renormalisation), 3 (divergence)
+//! and 3a (switching events and sample times):
+//! - the nominal grid is `t_k = k dt`; a step never straddles a switch: when the trial step
+//!   from `t_k` (modes held) carries an "on" foot's `s_i` past the stroke, or crosses the
+//!   ejector start time `tau`, the switch time is located, the step is taken to it, the mode
+//!   flips, and a second step completes the interval; two switches in one interval are taken in
+//!   time order;
+//! - q is renormalised after every step, part-steps included, never inside the stages;
+//! - a run diverges when, after any step (part-steps included), a state is non-finite or
+//!   |omega| > 100 rad/s;
+//! - the state at a sample time within 1e-9 s of a grid time is that grid state; at a time
+//!   between grid times it is one RK4 step (split at a switch inside it) from the grid state
+//!   before it.
+//!
+//! Choices made here (MODEL.md leaves them open):
+//! - Stroke-end times are located by the Illinois variant of regula falsi on the length of the
+//!   trial step, safeguarded by bisection, until the bracket is at most 1e-12 s wide; the step
+//!   is taken to the bracket's upper end, where the foot's displacement has just exceeded the
+//!   stroke (the foot "turns off the first time s_i exceeds the stroke").
+//! - A foot already past the stroke at the start of a (part-)step turns off at once (this
+//!   happens only when two feet end their stroke within 1e-12 s of each other).
+//! - The ejector start time is matched to within 1e-12 s: a step that would end within that
+//!   of tau ends at tau.
+//! - A telemetry time before release (t < 0, or t + dt_tm < 0 with a time offset) shows the
+//!   carriage state.
+
+use nalgebra::Vector3;
+
+use crate::frames::{dcm_from_quaternion, euler_321_deg, wrap_deg};
+use crate::model::{EjectorCurve, Model, RunSetup, StateVector};
+
+/// Tolerance to which switch times are located [s] (MODEL.md section 3a).
+pub const SWITCH_TOLERANCE_S: f64 = 1e-12;
+/// A sample time this close to a grid time takes the grid state [s] (MODEL.md section 3a).
+pub const GRID_MATCH_TOLERANCE_S: f64 = 1e-9;
+/// Divergence threshold on |omega| [rad/s] (MODEL.md section 3).
+pub const MAX_RATE_RAD_S: f64 = 100.0;
+
+/// The run diverged at `t_s` (MODEL.md section 3): reported as such, never as a number.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("diverged at t = {t_s} s (non-finite state or |omega| > 100 rad/s)")]
+pub struct Diverged {
+    /// Time of the step after which the state failed the test [s].
+    pub t_s: f64,
+}
+
+/// One simulated telemetry sample, as measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation {
+    /// Launch-frame position (x downrange, y crossrange, z down) [m].
+    pub pos_m: [f64; 3],
+    /// Euler angles (roll, pitch, yaw) [deg].
+    pub att_deg: [f64; 3],
+}
+
+/// Receives the simulated samples of a run, in time order.
+pub trait SampleSink {
+    /// Sample `index` (of the requested times) is `obs`, observed from the state `x` (for a
+    /// time before release, the carriage state).
+    fn record(&mut self, index: usize, obs: &Observation, x: &StateVector);
+}
+
+impl SampleSink for Vec<Observation> {
+    fn record(&mut self, _index: usize, obs: &Observation, _x: &StateVector) {
+        self.push(*obs);
+    }
+}
+
+impl SampleSink for Vec<(Observation, StateVector)> {
+    fn record(&mut self, _index: usize, obs: &Observation, x: &StateVector) {
+        self.push((*obs, *x));
+    }
+}
+
+/// Mode of one ejector foot (MODEL.md section 3a).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FootMode {
+    /// Before the ejector start time: not pushing yet.
+    Waiting,
+    /// Pushing.
+    On,
+    /// Stroke ended (or never started): never pushes again.
+    Off,
+}
+
+/// What happened during a run, for tests and reports.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RunLog {
+    /// Time each foot (forward, aft) turned on [s].
+    pub foot_on_s: [Option<f64>; 2],
+    /// Time each foot (forward, aft) turned off [s].
+    pub foot_off_s: [Option<f64>; 2],
+    /// Full and part RK4 steps taken on the main trajectory.
+    pub steps: u64,
+}
+
+/// The integrator state between grid points.
+#[derive(Clone, Copy)]
+struct Cursor {
+    t_s: f64,
+    x: StateVector,
+    modes: [FootMode; 2],
+}
+
+/// Propagates one run and records the observation at each of `times_s` (strictly increasing,
+/// as telemetry times are) into `sink`.
+pub fn propagate<S: SampleSink>(
+    model: &Model,
+    run: &RunSetup,
+    times_s: &[f64],
+    sink: &mut S,
+) -> Result<RunLog, Diverged> {
+    let mut engine = Engine {
+        run,
+        curve: &model.curve,
+        dt_s: model.dt_s,
+        log: RunLog::default(),
+    };
+    let start_mode = if run.ejector_start_s > 0.0 {
+        FootMode::Waiting
+    } else {
+        FootMode::On
+    };
+    let initial = run.initial_state();
+    let mut cursor = Cursor {
+        t_s: 0.0,
+        x: initial,
+        modes: [start_mode; 2],
+    };
+    if start_mode == FootMode::On {
+        engine.log.foot_on_s = [Some(0.0); 2];
+    }
+    let mut k: u64 = 0;
+    for (index, &t_label) in times_s.iter().enumerate() {
+        let t = t_label + run.time_offset_s;
+        if t < -GRID_MATCH_TOLERANCE_S {
+            sink.record(index, &observe(run, &initial), &initial);
+            continue;
+        }
+        let nearest = (t / engine.dt_s).round().max(0.0);
+        let on_grid = (t - nearest * engine.dt_s).abs() <= GRID_MATCH_TOLERANCE_S;
+        let target_k = if on_grid {
+            nearest as u64
+        } else {
+            (t / engine.dt_s).floor().max(0.0) as u64
+        };
+        while k < target_k {
+            let t_next = (k + 1) as f64 * engine.dt_s;
+            cursor = engine.advance(cursor, t_next, true)?;
+            k += 1;
+        }
+        if on_grid {
+            sink.record(index, &observe(run, &cursor.x), &cursor.x);
+        } else {
+            // One step (split at any switch inside it) from the grid state, off the main
+            // trajectory.
+            let off_grid = engine.advance(cursor, t, false)?;
+            sink.record(index, &observe(run, &off_grid.x), &off_grid.x);
+        }
+    }
+    Ok(engine.log)
+}
+
+/// The observation of a state, with the measurement knobs applied (tracked point, attitude
+/// bias).
+#[inline]
+pub fn observe(run: &RunSetup, x: &StateVector) -> Observation {
+    let c_lb = dcm_from_quaternion([x[6], x[7], x[8], x[9]]);
+    let r = Vector3::new(x[0], x[1], x[2]);
+    let l = run.tracked_point_b_m;
+    let pos = r + c_lb * l - l;
+    let [roll, pitch, yaw] = euler_321_deg(&c_lb);
+    let [b_roll, b_pitch, b_yaw] = run.attitude_bias_rad;
+    Observation {
+        pos_m: [pos.x, pos.y, pos.z],
+        att_deg: [
+            wrap_deg(roll + b_roll.to_degrees()),
+            pitch + b_pitch.to_degrees(),
+            wrap_deg(yaw + b_yaw.to_degrees()),
+        ],
+    }
+}
+
+struct Engine<'a> {
+    run: &'a RunSetup,
+    curve: &'a EjectorCurve,
+    dt_s: f64,
+    log: RunLog,
+}
+
+impl Engine<'_> {
+    /// One classic RK4 step of length `h` from `x` with the modes held, q renormalised.
+    #[inline(always)]
+    fn rk4(&self, x: &StateVector, h: f64, modes: [FootMode; 2]) -> StateVector {
+        let on = [modes[0] == FootMode::On, modes[1] == FootMode::On];
+        let f = |y: &StateVector| self.run.derivative(self.curve, y, on);
+        let half = 0.5 * h;
+        let sixth = h / 6.0;
+        let k1 = f(x);
+        let k2 = f(&axpy(x, half, &k1));
+        let k3 = f(&axpy(x, half, &k2));
+        let k4 = f(&axpy(x, h, &k3));
+        let mut y = *x;
+        for j in 0..y.len() {
+            y[j] += sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
+        }
+        let inv_norm = 1.0 / (y[6] * y[6] + y[7] * y[7] + y[8] * y[8] + y[9] * y[9]).sqrt();
+        for v in &mut y[6..10] {
+            *v *= inv_norm;
+        }
+        y
+    }
+
+    /// s_i - stroke of foot `i` at state `x`.
+    #[inline(always)]
+    fn stroke_excess(&self, x: &StateVector, i: usize) -> f64 {
+        let q = [x[6], x[7], x[8], x[9]];
+        let n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+        let c20 = 2.0 * (q[1] * q[3] - q[0] * q[2]) / n2;
+        self.run.foot_displacement_m(i, x[2], c20) - self.run.stroke_m
+    }
+
+    /// Advances `from` to `t_target` (within one grid interval), splitting at switches.
+    /// `main` says whether this is the main trajectory (whose switches are logged).
+    fn advance(&mut self, from: Cursor, t_target: f64, main: bool) -> Result<Cursor, Diverged> {
+        let mut c = from;
+        loop {
+            self.switch_due_modes(&mut c, main);
+            let mut h = t_target - c.t_s;
+            if h <= 0.0 {
+                return Ok(c);
+            }
+            let tau = self.run.ejector_start_s;
+            let waiting = c.modes.contains(&FootMode::Waiting);
+            // The ejector start time falls inside this step: end the step there. (Within
+            // 1e-12 s after the target it is taken at the target, by the next call.)
+            let to_tau = waiting && tau - c.t_s < h - SWITCH_TOLERANCE_S;
+            if to_tau {
+                h = tau - c.t_s;
+            }
+            let trial = self.rk4(&c.x, h, c.modes);
+            // Earliest stroke end inside the trial step.
+            let mut first: Option<(usize, f64, StateVector)> = None;
+            for i in 0..2 {
+                if c.modes[i] == FootMode::On && self.stroke_excess(&trial, i) > 0.0 {
+                    let (h_i, x_i) = self.locate_stroke_end(&c, h, &trial, i);
+                    if first.as_ref().is_none_or(|(_, h_best, _)| h_i < *h_best) {
+                        first = Some((i, h_i, x_i));
+                    }
+                }
+            }
+            let (t_new, x_new, switched_foot) = match first {
+                Some((i, h_i, x_i)) => (c.t_s + h_i, x_i, Some(i)),
+                None if to_tau => (tau, trial, None),
+                None => (t_target, trial, None),
+            };
+            c = Cursor {
+                t_s: t_new,
+                x: x_new,
+                modes: c.modes,
+            };
+            if main {
+                self.log.steps += 1;
+            }
+            check_divergence(&c.x, c.t_s)?;
+            if let Some(i) = switched_foot {
+                c.modes[i] = FootMode::Off;
+                if main {
+                    self.log.foot_off_s[i] = Some(c.t_s);
+                }
+            }
+            if (t_target - c.t_s).abs() <= SWITCH_TOLERANCE_S {
+                // The target is reached; modes due there are settled by the next call (or by
+                // the next loop of this one, for a sample taken off the grid).
+                c.t_s = t_target;
+                return Ok(c);
+            }
+        }
+    }
+
+    /// Switches the modes that are due at the cursor's time: waiting feet at the ejector start
+    /// time, "on" feet already past the stroke.
+    fn switch_due_modes(&mut self, c: &mut Cursor, main: bool) {
+        let tau = self.run.ejector_start_s;
+        for i in 0..2 {
+            if c.modes[i] == FootMode::Waiting && c.t_s >= tau - SWITCH_TOLERANCE_S {
+                // MODEL.md 3a: at t = tau each foot whose s_i <= stroke turns on.
+                c.modes[i] = if self.stroke_excess(&c.x, i) <= 0.0 {
+                    if main {
+                        self.log.foot_on_s[i] = Some(c.t_s);
+                    }
+                    FootMode::On
+                } else {
+                    FootMode::Off
+                };
+            }
+            if c.modes[i] == FootMode::On && self.stroke_excess(&c.x, i) > 0.0 {
+                c.modes[i] = FootMode::Off;
+                if main {
+                    self.log.foot_off_s[i] = Some(c.t_s);
+                }
+            }
+        }
+    }
+
+    /// Locates the step length in (0, h] at which foot `i`'s displacement reaches the stroke
+    /// (trial steps from `c` with the modes held) and returns it with the state there.
+    fn locate_stroke_end(
+        &self,
+        c: &Cursor,
+        h: f64,
+        trial: &StateVector,
+        i: usize,
+    ) -> (f64, StateVector) {
+        let g = |x: &StateVector| self.stroke_excess(x, i);
+        let (mut lo, mut g_lo) = (0.0, g(&c.x));
+        let (mut hi, mut g_hi, mut x_hi) = (h, g(trial), *trial);
+        // Which end the last secant point replaced (Illinois: halve the other end's value
+        // when the same end is kept twice).
+        let mut side = 0i8;
+        let mut iterations = 0;
+        while hi - lo > SWITCH_TOLERANCE_S {
+            iterations += 1;
+            let secant = hi - g_hi * (hi - lo) / (g_hi - g_lo);
+            // Safeguard: bisect every fourth iteration or when the secant point is unusable.
+            let mid = if iterations % 4 == 0 || !(secant > lo && secant < hi) {
+                0.5 * (lo + hi)
+            } else {
+                secant
+            };
+            let x_mid = self.rk4(&c.x, mid, c.modes);
+            let g_mid = g(&x_mid);
+            if g_mid > 0.0 {
+                hi = mid;
+                g_hi = g_mid;
+                x_hi = x_mid;
+                if side == 1 {
+                    g_lo *= 0.5;
+                }
+                side = 1;
+            } else {
+                lo = mid;
+                g_lo = g_mid;
+                if side == -1 {
+                    g_hi *= 0.5;
+                }
+                side = -1;
+            }
+            if iterations > 200 {
+                break;
+            }
+        }
+        (hi, x_hi)
+    }
+}
+
+/// x + a k, component by component.
+#[inline(always)]
+fn axpy(x: &StateVector, a: f64, k: &StateVector) -> StateVector {
+    let mut y = *x;
+    for j in 0..y.len() {
+        y[j] += a * k[j];
+    }
+    y
+}
+
+#[inline]
+fn check_divergence(x: &StateVector, t_s: f64) -> Result<(), Diverged> {
+    let rate2 = x[10] * x[10] + x[11] * x[11] + x[12] * x[12];
+    if !x.iter().all(|v| v.is_finite()) || rate2 > MAX_RATE_RAD_S * MAX_RATE_RAD_S {
+        return Err(Diverged { t_s });
+    }
+    Ok(())
+}

@@ -1,0 +1,537 @@
+//! Scenarios: the store, its ejector, aerodynamics, interference, flight condition, integrator
+//! settings and factor table, loaded from TOML.
+//!
+//! Source: `../shared/MODEL.md` section 1 (the embedded default, `scenarios/eglin_default.toml`)
+//! and section 4 (the factor table). Files are SI (m, kg, N, s) with angles in degrees, like
+//! every file sepval reads; each field name carries its unit.
+//!
+//! Choices MODEL.md leaves open, made here:
+//! - `[factors]` may list any subset of the 17 factors; the rest keep Anderson's Table 1.
+//! - `[initial]` (optional) sets the store's velocity relative to the launch frame and its body
+//!   rates at t = 0 (MODEL.md section 2: "All zero at t = 0 unless a scenario says otherwise").
+//!   Position and attitude at t = 0 are the carriage position and attitude by definition of the
+//!   launch frame.
+//! - The atmosphere is the ISA troposphere of section 1; a flight condition above 11 000 m is
+//!   refused instead of extrapolated.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::atmosphere::TROPOPAUSE_M;
+use crate::factors::{Factor, FactorSpec, FactorTable};
+
+/// The embedded default scenario text (MODEL.md section 1).
+pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../scenarios/eglin_default.toml");
+
+/// Mass properties and ejector geometry of the store (MODEL.md section 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Store {
+    /// Mass [kg].
+    pub mass_kg: f64,
+    /// Roll inertia about the CG [kg m^2].
+    pub ixx_kg_m2: f64,
+    /// Pitch inertia about the CG [kg m^2].
+    pub iyy_kg_m2: f64,
+    /// Yaw inertia about the CG [kg m^2].
+    pub izz_kg_m2: f64,
+    /// Reference diameter d [m]; the reference area is pi d^2 / 4.
+    pub diameter_m: f64,
+    /// Body x of the forward ejector foot [m], positive ahead of the CG.
+    pub fwd_foot_x_m: f64,
+    /// Body x of the aft ejector foot [m], negative aft of the CG.
+    pub aft_foot_x_m: f64,
+    /// Ejector stroke [m].
+    pub stroke_m: f64,
+}
+
+/// The nominal ejector force curve per foot (MODEL.md section 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ejector {
+    /// (stroke displacement [m], force [N]) points, displacement strictly increasing, linear
+    /// between points, covering [0, stroke].
+    pub curve: Vec<[f64; 2]>,
+}
+
+/// Freestream aerodynamic database, body axes (MODEL.md section 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct Aero {
+    pub ca0: f64,
+    pub cz_alpha_per_rad: f64,
+    pub cy_beta_per_rad: f64,
+    pub cm_alpha_per_rad: f64,
+    pub cn_beta_per_rad: f64,
+    /// Roll damping, per rad of p d / 2V.
+    pub cl_p_per_rad: f64,
+    /// Pitch damping, per rad of q d / 2V.
+    pub cm_q_per_rad: f64,
+    /// Yaw damping, per rad of r d / 2V.
+    pub cn_r_per_rad: f64,
+}
+
+/// Aircraft interference increments at carriage and their decay (MODEL.md section 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct Interference {
+    pub dcx0: f64,
+    pub dcy0: f64,
+    pub dcz0: f64,
+    pub dcl0: f64,
+    pub dcm0: f64,
+    pub dcn0: f64,
+    /// Decay length lambda [m].
+    pub lambda_m: f64,
+    /// Distance beyond which the interference is zero [m].
+    pub s_end_m: f64,
+}
+
+/// Flight condition of the aircraft at release (MODEL.md sections 1 and 2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Flight {
+    /// Free-stream Mach number.
+    pub mach: f64,
+    /// Altitude [m] (ISA troposphere).
+    pub altitude_m: f64,
+    /// Aircraft angle of attack [deg].
+    #[serde(default)]
+    pub alpha_deg: f64,
+    /// Aircraft sideslip [deg].
+    #[serde(default)]
+    pub beta_deg: f64,
+    /// Flight-path angle [deg].
+    #[serde(default)]
+    pub gamma_deg: f64,
+}
+
+/// Integrator and telemetry settings (MODEL.md sections 1 and 3a).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Integrator {
+    /// Fixed RK4 step [s].
+    pub dt_s: f64,
+    /// Event length [s].
+    pub t_end_s: f64,
+    /// Telemetry rate of simulated trajectories [Hz].
+    pub rate_hz: f64,
+}
+
+/// Initial motion relative to the launch frame (optional; zero by default).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    /// Velocity relative to the launch frame, L axes [m/s].
+    #[serde(default)]
+    pub velocity_m_s: [f64; 3],
+    /// Body rates (p, q, r) [deg/s].
+    #[serde(default)]
+    pub rates_deg_s: [f64; 3],
+}
+
+/// A complete scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name (used in reports).
+    pub name: String,
+    /// One line on what this scenario is.
+    #[serde(default)]
+    pub description: String,
+    /// Mass properties and ejector geometry.
+    pub store: Store,
+    /// Ejector force curve.
+    pub ejector: Ejector,
+    /// Freestream aerodynamic database.
+    pub aero: Aero,
+    /// Interference model.
+    pub interference: Interference,
+    /// Flight condition.
+    pub flight: Flight,
+    /// Integrator settings.
+    pub integrator: Integrator,
+    /// Initial motion.
+    #[serde(default, skip_serializing_if = "is_default_initial")]
+    pub initial: Initial,
+    /// Factor table overrides by factor name.
+    #[serde(default, with = "factor_table_serde")]
+    pub factors: FactorTable,
+}
+
+fn is_default_initial(i: &Initial) -> bool {
+    *i == Initial::default()
+}
+
+mod factor_table_serde {
+    use super::*;
+
+    pub fn serialize<S: serde::Serializer>(t: &FactorTable, s: S) -> Result<S::Ok, S::Error> {
+        let map: BTreeMap<&str, FactorSpec> = Factor::ALL
+            .iter()
+            .map(|f| (f.name(), *t.spec(*f)))
+            .collect();
+        map.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<FactorTable, D::Error> {
+        let map = BTreeMap::<String, FactorSpec>::deserialize(d)?;
+        let mut table = FactorTable::default();
+        for (name, spec) in map {
+            let factor = Factor::from_name(&name).ok_or_else(|| {
+                serde::de::Error::custom(format!(
+                    "unknown factor `{name}` (expected one of: {})",
+                    Factor::NAMES.join(", ")
+                ))
+            })?;
+            table.0[factor.index()] = spec;
+        }
+        Ok(table)
+    }
+}
+
+/// Errors loading or validating a scenario.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("cannot read scenario {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The TOML does not parse or does not have the expected fields.
+    #[error("scenario {origin}: {message}")]
+    Parse {
+        /// The file, or "embedded default".
+        origin: String,
+        /// The parser's message (it names line and column).
+        message: String,
+    },
+    /// A value is out of its physical range.
+    #[error("scenario {origin}: `{field}` {reason}")]
+    Invalid {
+        /// The file, or "embedded default".
+        origin: String,
+        /// The field, as a TOML path.
+        field: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+impl Scenario {
+    /// The embedded default scenario (MODEL.md section 1).
+    pub fn embedded_default() -> Scenario {
+        Scenario::from_toml_str(DEFAULT_SCENARIO_TOML, "embedded default")
+            .expect("the embedded default scenario is valid (checked by tests)")
+    }
+
+    /// Parses and validates scenario TOML; `origin` names the source in errors.
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
+        let scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        scenario.validate(origin)?;
+        Ok(scenario)
+    }
+
+    /// Loads and validates a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Scenario::from_toml_str(&text, &path.display().to_string())
+    }
+
+    /// The scenario as TOML (values round-trip exactly).
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string(self).expect("a scenario always serialises")
+    }
+
+    /// SHA-256 of the scenario's canonical form (its JSON serialisation), hex. Two scenarios
+    /// with the same content have the same hash whatever their file layout or comments.
+    pub fn content_hash(&self) -> String {
+        let json = serde_json::to_vec(self).expect("a scenario always serialises");
+        hex_sha256(&json)
+    }
+
+    /// Checks every value for its physical range.
+    pub fn validate(&self, origin: &str) -> Result<(), ScenarioError> {
+        let bad = |field: &str, reason: String| ScenarioError::Invalid {
+            origin: origin.to_string(),
+            field: field.to_string(),
+            reason,
+        };
+        let positive = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(bad(field, format!("= {v}: expected a finite value > 0")))
+            }
+        };
+        let finite = |field: &str, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(field, format!("= {v}: expected a finite value")))
+            }
+        };
+        let s = &self.store;
+        positive("store.mass_kg", s.mass_kg)?;
+        positive("store.ixx_kg_m2", s.ixx_kg_m2)?;
+        positive("store.iyy_kg_m2", s.iyy_kg_m2)?;
+        positive("store.izz_kg_m2", s.izz_kg_m2)?;
+        positive("store.diameter_m", s.diameter_m)?;
+        positive("store.stroke_m", s.stroke_m)?;
+        finite("store.fwd_foot_x_m", s.fwd_foot_x_m)?;
+        finite("store.aft_foot_x_m", s.aft_foot_x_m)?;
+
+        let curve = &self.ejector.curve;
+        if curve.len() < 2 {
+            return Err(bad(
+                "ejector.curve",
+                format!(
+                    "has {} point(s): expected at least 2 (s_m, force_N) points",
+                    curve.len()
+                ),
+            ));
+        }
+        for (i, [x, f]) in curve.iter().enumerate() {
+            if !x.is_finite() || !f.is_finite() {
+                return Err(bad(
+                    &format!("ejector.curve[{i}]"),
+                    format!("= [{x}, {f}]: expected finite numbers"),
+                ));
+            }
+            if i > 0 && *x <= curve[i - 1][0] {
+                return Err(bad(
+                    &format!("ejector.curve[{i}]"),
+                    format!(
+                        "displacement {x} m: expected strictly increasing displacements (previous {} m)",
+                        curve[i - 1][0]
+                    ),
+                ));
+            }
+        }
+        let (first, last) = (curve[0][0], curve[curve.len() - 1][0]);
+        if first > 0.0 || last < s.stroke_m {
+            return Err(bad(
+                "ejector.curve",
+                format!(
+                    "covers [{first}, {last}] m: it must cover [0, stroke] = [0, {}] m",
+                    s.stroke_m
+                ),
+            ));
+        }
+
+        let a = &self.aero;
+        for (field, v) in [
+            ("aero.ca0", a.ca0),
+            ("aero.cz_alpha_per_rad", a.cz_alpha_per_rad),
+            ("aero.cy_beta_per_rad", a.cy_beta_per_rad),
+            ("aero.cm_alpha_per_rad", a.cm_alpha_per_rad),
+            ("aero.cn_beta_per_rad", a.cn_beta_per_rad),
+            ("aero.cl_p_per_rad", a.cl_p_per_rad),
+            ("aero.cm_q_per_rad", a.cm_q_per_rad),
+            ("aero.cn_r_per_rad", a.cn_r_per_rad),
+        ] {
+            finite(field, v)?;
+        }
+        let i = &self.interference;
+        for (field, v) in [
+            ("interference.dcx0", i.dcx0),
+            ("interference.dcy0", i.dcy0),
+            ("interference.dcz0", i.dcz0),
+            ("interference.dcl0", i.dcl0),
+            ("interference.dcm0", i.dcm0),
+            ("interference.dcn0", i.dcn0),
+        ] {
+            finite(field, v)?;
+        }
+        positive("interference.lambda_m", i.lambda_m)?;
+        positive("interference.s_end_m", i.s_end_m)?;
+
+        let f = &self.flight;
+        positive("flight.mach", f.mach)?;
+        if !(f.altitude_m.is_finite() && f.altitude_m < TROPOPAUSE_M) {
+            return Err(bad(
+                "flight.altitude_m",
+                format!(
+                    "= {}: expected a finite altitude below {TROPOPAUSE_M} m (ISA troposphere)",
+                    f.altitude_m
+                ),
+            ));
+        }
+        for (field, v) in [
+            ("flight.alpha_deg", f.alpha_deg),
+            ("flight.beta_deg", f.beta_deg),
+            ("flight.gamma_deg", f.gamma_deg),
+        ] {
+            if !(v.is_finite() && v.abs() < 90.0) {
+                return Err(bad(
+                    field,
+                    format!("= {v}: expected a finite angle within +-90 deg"),
+                ));
+            }
+        }
+
+        let n = &self.integrator;
+        positive("integrator.dt_s", n.dt_s)?;
+        positive("integrator.t_end_s", n.t_end_s)?;
+        positive("integrator.rate_hz", n.rate_hz)?;
+        if n.dt_s > n.t_end_s {
+            return Err(bad(
+                "integrator.dt_s",
+                format!(
+                    "= {}: longer than the event (t_end_s = {})",
+                    n.dt_s, n.t_end_s
+                ),
+            ));
+        }
+        if n.t_end_s / n.dt_s > 1e8 {
+            return Err(bad(
+                "integrator.dt_s",
+                format!(
+                    "= {}: more than 1e8 steps for t_end_s = {}",
+                    n.dt_s, n.t_end_s
+                ),
+            ));
+        }
+        for (k, v) in self.initial.velocity_m_s.iter().enumerate() {
+            finite(&format!("initial.velocity_m_s[{k}]"), *v)?;
+        }
+        for (k, v) in self.initial.rates_deg_s.iter().enumerate() {
+            finite(&format!("initial.rates_deg_s[{k}]"), *v)?;
+        }
+        self.factors
+            .validate()
+            .map_err(|e| ScenarioError::Invalid {
+                origin: origin.to_string(),
+                field: "factors".to_string(),
+                reason: e.to_string(),
+            })?;
+        Ok(())
+    }
+}
+
+/// SHA-256 of `bytes`, lower-case hex.
+pub fn hex_sha256(bytes: &[u8]) -> String {
+    let digest = Sha256::digest(bytes);
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::*;
+
+    #[test]
+    fn embedded_default_is_the_exact_conversion() {
+        let s = Scenario::embedded_default();
+        assert_eq!(s.store.mass_kg.to_bits(), (2000.0 * KG_PER_LB).to_bits());
+        assert_eq!(
+            s.store.ixx_kg_m2.to_bits(),
+            (20.0 * KG_M2_PER_SLUG_FT2).to_bits()
+        );
+        assert_eq!(
+            s.store.iyy_kg_m2.to_bits(),
+            (360.0 * KG_M2_PER_SLUG_FT2).to_bits()
+        );
+        assert_eq!(
+            s.store.izz_kg_m2.to_bits(),
+            (360.0 * KG_M2_PER_SLUG_FT2).to_bits()
+        );
+        assert_eq!(s.store.diameter_m.to_bits(), (20.0 * M_PER_IN).to_bits());
+        assert_eq!(s.store.fwd_foot_x_m.to_bits(), (0.59 * M_PER_FT).to_bits());
+        assert_eq!(s.store.aft_foot_x_m.to_bits(), (-1.08 * M_PER_FT).to_bits());
+        assert_eq!(s.store.stroke_m.to_bits(), (0.33 * M_PER_FT).to_bits());
+        let f = 12_000.0 * N_PER_LBF;
+        assert_eq!(s.ejector.curve, vec![[0.0, f], [0.33 * M_PER_FT, f]]);
+        assert_eq!(
+            s.flight.altitude_m.to_bits(),
+            (26_000.0 * M_PER_FT).to_bits()
+        );
+        assert_eq!(
+            s.interference.s_end_m.to_bits(),
+            (30.0 * M_PER_FT).to_bits()
+        );
+        assert_eq!(s.factors, FactorTable::default());
+    }
+
+    #[test]
+    fn toml_round_trip_is_exact() {
+        let s = Scenario::embedded_default();
+        let back = Scenario::from_toml_str(&s.to_toml_string(), "round trip").unwrap();
+        assert_eq!(back, s);
+        assert_eq!(back.content_hash(), s.content_hash());
+    }
+
+    #[test]
+    fn refusals_name_the_field() {
+        let text = DEFAULT_SCENARIO_TOML.replace("stroke_m = 0.100584", "stroke_m = 0.2");
+        let e = Scenario::from_toml_str(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "scenario x.toml: `ejector.curve` covers [0, 0.100584] m: it must cover [0, stroke] = [0, 0.2] m"
+        );
+        let text = DEFAULT_SCENARIO_TOML.replace("mass_kg = 907.18474", "mass_kg = -1.0");
+        let e = Scenario::from_toml_str(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "scenario x.toml: `store.mass_kg` = -1: expected a finite value > 0"
+        );
+        let text = DEFAULT_SCENARIO_TOML.replace("mach = 0.95", "mach = 0.95\nmahc = 1");
+        let e = Scenario::from_toml_str(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unknown field `mahc`") && e.contains("line"),
+            "{e}"
+        );
+        let text = DEFAULT_SCENARIO_TOML.replace("cloff = {", "clof = {");
+        let e = Scenario::from_toml_str(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown factor `clof`"), "{e}");
+        let text = DEFAULT_SCENARIO_TOML.replace(
+            "fwdfac = { min = 0.2, max = 1.0, bits = 5 }",
+            "fwdfac = { min = 1.2, max = 1.0, bits = 5 }",
+        );
+        let e = Scenario::from_toml_str(&text, "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "scenario x.toml: `factors` factor `fwdfac`: min 1.2 must be below max 1"
+        );
+    }
+
+    #[test]
+    fn partial_factor_table_keeps_table_one_for_the_rest() {
+        let start = DEFAULT_SCENARIO_TOML.find("[factors]").unwrap();
+        let text = format!(
+            "{}[factors]\ncmoff = {{ min = -0.3, max = 0.3, bits = 8 }}\n",
+            &DEFAULT_SCENARIO_TOML[..start]
+        );
+        let s = Scenario::from_toml_str(&text, "x.toml").unwrap();
+        assert_eq!(s.factors.spec(Factor::Cmoff).bits, 8);
+        assert_eq!(
+            s.factors.spec(Factor::Fwdfac),
+            FactorTable::default().spec(Factor::Fwdfac)
+        );
+    }
+}

@@ -1,0 +1,121 @@
+//! The simulator as users call it: a scenario set up once, then trajectories and goals for
+//! factor and effect sets.
+
+use crate::effects::EffectSet;
+use crate::factors::Factors;
+use crate::goals::{GoalAccumulator, GoalSums, Goals};
+use crate::model::{Model, ModelError, RunSetup};
+use crate::propagator::{Diverged, Observation, RunLog, propagate};
+use crate::scenario::Scenario;
+use crate::telemetry::Trajectory;
+
+/// Errors of one simulation.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
+pub enum SimError {
+    /// The factors or effects are invalid.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The run diverged.
+    #[error(transparent)]
+    Diverged(#[from] Diverged),
+}
+
+/// A scenario set up for simulation.
+#[derive(Debug, Clone)]
+pub struct Simulator {
+    model: Model,
+}
+
+impl Simulator {
+    /// Sets up a (validated) scenario.
+    pub fn new(scenario: &Scenario) -> Self {
+        Simulator {
+            model: Model::new(scenario),
+        }
+    }
+
+    /// The embedded default scenario, set up.
+    pub fn embedded_default() -> Self {
+        Simulator::new(&Scenario::embedded_default())
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The scenario.
+    pub fn scenario(&self) -> &Scenario {
+        self.model.scenario()
+    }
+
+    /// The scenario's telemetry times: 0, 1/rate, ..., t_end.
+    pub fn default_times(&self) -> Vec<f64> {
+        let n = &self.scenario().integrator;
+        sample_times(n.t_end_s, n.rate_hz)
+    }
+
+    /// The run of `factors` (checked against the factor table) and `effects`.
+    pub fn run_setup(
+        &self,
+        factors: &Factors,
+        effects: &EffectSet,
+    ) -> Result<RunSetup, ModelError> {
+        RunSetup::new(&self.model, factors, effects)
+    }
+
+    /// Simulates at `times_s` (strictly increasing) and returns the trajectory with its log.
+    pub fn simulate_logged(
+        &self,
+        factors: &Factors,
+        effects: &EffectSet,
+        times_s: &[f64],
+    ) -> Result<(Trajectory, RunLog), SimError> {
+        let run = self.run_setup(factors, effects)?;
+        let mut samples: Vec<Observation> = Vec::with_capacity(times_s.len());
+        let log = propagate(&self.model, &run, times_s, &mut samples)?;
+        let traj = Trajectory {
+            times_s: times_s.to_vec(),
+            pos_m: samples.iter().map(|o| o.pos_m).collect(),
+            att_deg: samples.iter().map(|o| o.att_deg).collect(),
+            ..Trajectory::default()
+        };
+        Ok((traj, log))
+    }
+
+    /// Simulates at `times_s` (strictly increasing).
+    pub fn simulate(
+        &self,
+        factors: &Factors,
+        effects: &EffectSet,
+        times_s: &[f64],
+    ) -> Result<Trajectory, SimError> {
+        self.simulate_logged(factors, effects, times_s)
+            .map(|(t, _)| t)
+    }
+
+    /// Goal sums of one run against `measured` (no trajectory is stored).
+    pub fn goal_sums(&self, run: &RunSetup, measured: &Trajectory) -> Result<GoalSums, Diverged> {
+        let mut acc = GoalAccumulator::new(measured);
+        propagate(&self.model, run, &measured.times_s, &mut acc)?;
+        Ok(acc.sums)
+    }
+
+    /// Goals of `factors` and `effects` against `measured`.
+    pub fn goals(
+        &self,
+        factors: &Factors,
+        effects: &EffectSet,
+        measured: &Trajectory,
+    ) -> Result<Goals, SimError> {
+        let run = self.run_setup(factors, effects)?;
+        Ok(self.goal_sums(&run, measured)?.goals())
+    }
+}
+
+/// Telemetry times 0, 1/rate, ..., up to t_end (inclusive within 1e-9 s).
+pub fn sample_times(t_end_s: f64, rate_hz: f64) -> Vec<f64> {
+    let n = (t_end_s * rate_hz + 1e-9).floor() as usize + 1;
+    (0..n).map(|j| j as f64 / rate_hz).collect()
+}
