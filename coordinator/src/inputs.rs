@@ -1,0 +1,67 @@
+//! Turning command-line inputs (scenario, factors, effects, data files) into validated values,
+//! with errors that name the file and the problem.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use sepval_common::effects::EffectSet;
+use sepval_common::factors::{FactorTable, Factors};
+use sepval_common::scenario::Scenario;
+use sepval_common::synthetic::default_flight_test;
+use sepval_common::telemetry::Trajectory;
+
+/// The scenario of `--scenario FILE`, or the embedded default.
+pub fn scenario(path: Option<&Path>) -> Result<Scenario> {
+    match path {
+        Some(p) => Ok(Scenario::load(p)?),
+        None => Ok(Scenario::embedded_default()),
+    }
+}
+
+/// The factors of `--factors truth|nominal|FILE.json`, checked against `table`.
+pub fn factors(spec: &str, table: &FactorTable) -> Result<Factors> {
+    let factors = match spec {
+        "truth" => Factors::TRUTH,
+        "nominal" => Factors::NOMINAL,
+        path => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read factors file {path}"))?;
+            return Factors::from_json_str(&text, table)
+                .with_context(|| format!("factors file {path}"));
+        }
+    };
+    table
+        .check(&factors)
+        .with_context(|| format!("the {spec} factors do not fit this scenario's factor table"))?;
+    Ok(factors)
+}
+
+/// The effects of repeated `--effect ID=V1,V2,...` flags.
+pub fn effects(specs: &[String]) -> Result<EffectSet> {
+    let mut set = EffectSet::NONE;
+    for spec in specs {
+        set.push_spec(spec)
+            .with_context(|| format!("--effect {spec}"))?;
+    }
+    Ok(set)
+}
+
+/// The measured data of `--data FILE` (several allowed), or the embedded default synthetic
+/// flight test when none is given.
+pub fn data(paths: &[std::path::PathBuf]) -> Result<Vec<Trajectory>> {
+    if paths.is_empty() {
+        return Ok(vec![default_flight_test()]);
+    }
+    paths
+        .iter()
+        .map(|p| Trajectory::read(p).map_err(anyhow::Error::from))
+        .collect()
+}
+
+/// A strictly positive, finite number given on the command line.
+pub fn positive(name: &str, value: f64) -> Result<f64> {
+    if !(value.is_finite() && value > 0.0) {
+        bail!("{name} = {value}: expected a finite number > 0");
+    }
+    Ok(value)
+}

@@ -1,0 +1,12 @@
+//! The worker binary describes itself (and this test makes `cargo test` build it for the
+//! end-to-end tests of the `tests` crate).
+
+#[test]
+fn help_describes_the_worker() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sepval-worker"))
+        .arg("--help")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("sepval coordinator"));
+}
