@@ -65,8 +65,14 @@ impl Chromosome {
 
     /// Encodes `factors` on the grid of `table` (each value rounded to its nearest grid point).
     pub fn encode(table: &FactorTable, factors: &Factors) -> Chromosome {
-        let mut bits = Vec::with_capacity(table.total_bits());
-        for (spec, &value) in table.0.iter().zip(factors.0.iter()) {
+        Chromosome::encode_values(&table.0, &factors.0)
+    }
+
+    /// Encodes `values` on the grid of `genes` (any number of genes, each value rounded to its
+    /// nearest grid point).
+    pub fn encode_values(genes: &[FactorSpec], values: &[f64]) -> Chromosome {
+        let mut bits = Vec::with_capacity(genes.iter().map(|g| g.bits as usize).sum());
+        for (spec, &value) in genes.iter().zip(values) {
             let k = nearest_gene(spec, value);
             for b in (0..spec.bits).rev() {
                 bits.push((k >> b) & 1 == 1);
@@ -77,14 +83,20 @@ impl Chromosome {
 
     /// Gene integers of all factors, in table order.
     pub fn genes(&self, table: &FactorTable) -> [u64; FACTOR_COUNT] {
-        let mut out = [0u64; FACTOR_COUNT];
+        let all = self.gene_integers(&table.0);
+        std::array::from_fn(|i| all[i])
+    }
+
+    /// Gene integers for the layout `genes`.
+    pub fn gene_integers(&self, genes: &[FactorSpec]) -> Vec<u64> {
+        let mut out = Vec::with_capacity(genes.len());
         let mut pos = 0;
-        for (g, spec) in out.iter_mut().zip(table.0.iter()) {
+        for spec in genes {
             let mut k = 0u64;
             for &bit in &self.bits[pos..pos + spec.bits as usize] {
                 k = (k << 1) | u64::from(bit);
             }
-            *g = k;
+            out.push(k);
             pos += spec.bits as usize;
         }
         out
@@ -92,9 +104,14 @@ impl Chromosome {
 
     /// Writes gene `index` as the integer `k` (which must fit the gene's bits).
     pub fn set_gene(&mut self, table: &FactorTable, index: usize, k: u64) {
-        let start: usize = table.0[..index].iter().map(|s| s.bits as usize).sum();
-        let bits = table.0[index].bits;
-        debug_assert!(k <= table.0[index].levels_minus_one());
+        self.set_gene_integer(&table.0, index, k);
+    }
+
+    /// Writes gene `index` of the layout `genes` as the integer `k`.
+    pub fn set_gene_integer(&mut self, genes: &[FactorSpec], index: usize, k: u64) {
+        let start: usize = genes[..index].iter().map(|s| s.bits as usize).sum();
+        let bits = genes[index].bits;
+        debug_assert!(k <= genes[index].levels_minus_one());
         for (j, b) in (0..bits).rev().enumerate() {
             self.bits[start + j] = (k >> b) & 1 == 1;
         }
@@ -102,12 +119,17 @@ impl Chromosome {
 
     /// Decodes the factor values.
     pub fn decode(&self, table: &FactorTable) -> Factors {
-        let genes = self.genes(table);
-        let mut out = [0.0; FACTOR_COUNT];
-        for ((v, spec), &k) in out.iter_mut().zip(table.0.iter()).zip(genes.iter()) {
-            *v = decode_gene(spec, k);
-        }
-        Factors(out)
+        let v = self.decode_values(&table.0);
+        Factors(std::array::from_fn(|i| v[i]))
+    }
+
+    /// Decodes the values of the layout `genes`.
+    pub fn decode_values(&self, genes: &[FactorSpec]) -> Vec<f64> {
+        self.gene_integers(genes)
+            .iter()
+            .zip(genes)
+            .map(|(&k, spec)| decode_gene(spec, k))
+            .collect()
     }
 }
 

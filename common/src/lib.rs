@@ -21,6 +21,7 @@ pub mod atomic_file;
 pub mod effects;
 pub mod elementary;
 pub mod encoding;
+pub mod evaluation;
 pub mod factors;
 pub mod frames;
 pub mod goals;

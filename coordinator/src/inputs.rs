@@ -65,3 +65,39 @@ pub fn positive(name: &str, value: f64) -> Result<f64> {
     }
     Ok(value)
 }
+
+/// The job of a fit: each data file (or the embedded default flight test) with the scenario,
+/// and the record of where they came from.
+pub fn job(
+    data_paths: &[std::path::PathBuf],
+    scenario_path: Option<&Path>,
+) -> Result<(
+    sepval_common::evaluation::Job,
+    crate::checkpoint::InputsRecord,
+)> {
+    use sepval_common::evaluation::{Event, Job};
+    use sepval_common::simulation::Simulator;
+    let scen = scenario(scenario_path)?;
+    let data = data(data_paths)?;
+    let names: Vec<String> = if data_paths.is_empty() {
+        vec!["embedded default synthetic flight test".to_string()]
+    } else {
+        data_paths.iter().map(|p| p.display().to_string()).collect()
+    };
+    let simulator = Simulator::new(&scen);
+    let events = names
+        .into_iter()
+        .zip(data)
+        .map(|(name, data)| Event {
+            name,
+            simulator: simulator.clone(),
+            data,
+        })
+        .collect();
+    let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    let record = crate::checkpoint::InputsRecord {
+        data: data_paths.iter().map(|p| absolute(p)).collect(),
+        scenario: scenario_path.map(absolute),
+    };
+    Ok((Job::new(events)?, record))
+}

@@ -4,4 +4,11 @@
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod checkpoint;
+pub mod fit;
 pub mod inputs;
+pub mod problem;
+pub mod rerun;
+pub mod results;
+pub mod rng;
+pub mod search;

@@ -14,7 +14,14 @@ use sepval_common::scenario::Scenario;
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
 use sepval_common::telemetry::Trajectory;
+use std::sync::Arc;
+
+use sepval_common::evaluation::{Evaluator, InProcess, Job};
+use sepval_coordinator::checkpoint::Checkpoint;
+use sepval_coordinator::fit::{FitOptions, FitOutput, Method, Sigma, run_fit};
 use sepval_coordinator::inputs;
+use sepval_coordinator::search::ga::GaSettings;
+use sepval_coordinator::search::hill::HillSettings;
 
 #[derive(Parser)]
 #[command(
@@ -39,6 +46,89 @@ enum Command {
     Goals(GoalsArgs),
     /// Write a scenario file (the embedded default unless --scenario is given) as TOML.
     Scenario(ScenarioArgs),
+    /// Fit the 17 factors to measured data: Anderson's genetic algorithm and hill climber.
+    Fit(Box<FitArgs>),
+    /// Re-evaluate a saved generation and check every goal bit for bit.
+    Rerun(RerunArgs),
+}
+
+#[derive(clap::Args)]
+struct FitArgs {
+    /// Measured trajectory (CSV; repeatable for several releases). Default: the embedded
+    /// synthetic flight test (truth factors plus noise).
+    #[arg(long, value_name = "FILE.csv")]
+    data: Vec<PathBuf>,
+    /// Scenario file (TOML); the embedded default when absent.
+    #[arg(long, value_name = "FILE")]
+    scenario: Option<PathBuf>,
+    /// Searches to run [default: both; when resuming: the checkpoint's].
+    #[arg(long, value_name = "ga|hill|both")]
+    method: Option<String>,
+    /// Seed of the genetic algorithm's generator.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Generations (evaluated populations, the initial one included) [default: 500; when
+    /// resuming: the checkpoint's].
+    #[arg(long)]
+    generations: Option<usize>,
+    /// Population size (even).
+    #[arg(long, default_value_t = 100)]
+    population: usize,
+    /// Probability of single-point crossover.
+    #[arg(long, default_value_t = 0.9)]
+    p_crossover: f64,
+    /// Probability of a jump mutation per bit.
+    #[arg(long, default_value_t = 0.005)]
+    p_jump: f64,
+    /// Probability of a creep mutation per parameter.
+    #[arg(long, default_value_t = 0.05)]
+    p_creep: f64,
+    /// Simulation budget of the hill climber.
+    #[arg(long, default_value_t = 500)]
+    hill_budget: usize,
+    /// How simulations are run.
+    #[arg(long, default_value = "inproc", value_name = "inproc")]
+    evaluator: String,
+    /// Threads of the in-process evaluator (default: the number of cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Position noise [m] weighting J_pos (default: estimated from the data).
+    #[arg(long)]
+    sigma_pos_m: Option<f64>,
+    /// Attitude noise [deg] weighting J_att (default: estimated from the data).
+    #[arg(long)]
+    sigma_att_deg: Option<f64>,
+    /// The true factors (JSON), for Figure 7; the embedded truth is used with the default data.
+    #[arg(long, value_name = "FILE.json")]
+    truth_factors: Option<PathBuf>,
+    /// Continue from a checkpoint (DIR/generations/gen-NNNN.json).
+    #[arg(long, value_name = "CHECKPOINT")]
+    resume: Option<PathBuf>,
+    /// Skip the figures.
+    #[arg(long)]
+    no_figures: bool,
+    /// Run directory (result.json, generations/, figures/).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct RerunArgs {
+    /// Checkpoint of the generation to re-evaluate.
+    #[arg(value_name = "CHECKPOINT")]
+    checkpoint: PathBuf,
+    /// Data files (default: those recorded in the checkpoint).
+    #[arg(long, value_name = "FILE.csv")]
+    data: Vec<PathBuf>,
+    /// Scenario file (default: the one recorded in the checkpoint).
+    #[arg(long, value_name = "FILE")]
+    scenario: Option<PathBuf>,
+    /// How simulations are run.
+    #[arg(long, default_value = "inproc", value_name = "inproc")]
+    evaluator: String,
+    /// Threads of the in-process evaluator (default: the number of cores).
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 #[derive(clap::Args)]
@@ -97,6 +187,8 @@ fn main() -> ExitCode {
         }
         Command::Goals(args) => goals(args),
         Command::Scenario(args) => scenario(args),
+        Command::Fit(args) => fit(*args),
+        Command::Rerun(args) => rerun(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -174,4 +266,168 @@ fn scenario(args: ScenarioArgs) -> Result<()> {
     sepval_common::atomic_file::write_atomically(&args.out, text.as_bytes())?;
     eprintln!("wrote {}", args.out.display());
     Ok(())
+}
+
+fn threads(requested: Option<usize>) -> Result<usize> {
+    match requested {
+        Some(0) => anyhow::bail!("--threads 0: expected at least 1"),
+        Some(n) => Ok(n),
+        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
+    }
+}
+
+fn evaluator(kind: &str, job: Job, threads: usize) -> Result<Box<dyn Evaluator>> {
+    match kind {
+        "inproc" => Ok(Box::new(InProcess::new(Arc::new(job), threads))),
+        other => anyhow::bail!("--evaluator {other}: expected inproc"),
+    }
+}
+
+fn fit(args: FitArgs) -> Result<()> {
+    let resume = match &args.resume {
+        Some(p) => Some(Checkpoint::load(p)?),
+        None => None,
+    };
+    // Inputs: the flags, or (when resuming without them) those recorded in the checkpoint.
+    let (data_paths, scenario_path) = match (&resume, args.data.is_empty(), &args.scenario) {
+        (Some(c), true, None) => (c.inputs.data.clone(), c.inputs.scenario.clone()),
+        _ => (args.data.clone(), args.scenario.clone()),
+    };
+    let (job, inputs) = inputs::job(&data_paths, scenario_path.as_deref())?;
+    let method = match (&args.method, &resume) {
+        (Some(m), _) => Method::parse(m)?,
+        (None, Some(c)) => Method::parse(&c.method)?,
+        (None, None) => Method::Both,
+    };
+    let (ga, hill, sigma) = match &resume {
+        Some(c) => {
+            let path = args.resume.as_deref().expect("resume path");
+            c.check_job(&job, path)?;
+            let mut ga = c.settings.clone();
+            if let Some(g) = args.generations {
+                if g < c.state.generation {
+                    anyhow::bail!(
+                        "--generations {g}: the checkpoint is already at generation {}",
+                        c.state.generation
+                    );
+                }
+                ga.generations = g;
+            }
+            (ga, c.hill.clone(), c.sigma.clone())
+        }
+        None => {
+            let ga = GaSettings {
+                population: args.population,
+                generations: args.generations.unwrap_or(500),
+                p_crossover: args.p_crossover,
+                p_jump: args.p_jump,
+                p_creep: args.p_creep,
+                seed: args.seed,
+            };
+            let hill = HillSettings {
+                budget: args.hill_budget,
+                ..HillSettings::default()
+            };
+            (
+                ga,
+                hill,
+                Sigma::resolve(&job, args.sigma_pos_m, args.sigma_att_deg)?,
+            )
+        }
+    };
+    ga.validate()?;
+    let truth = match &args.truth_factors {
+        Some(p) => Some(inputs::factors(
+            &p.display().to_string(),
+            job.factor_table(),
+        )?),
+        None if data_paths.is_empty() => Some(sepval_common::factors::Factors::TRUTH),
+        None => None,
+    };
+    let mut evaluator = evaluator(&args.evaluator, job, threads(args.threads)?)?;
+    let options = FitOptions {
+        method,
+        ga,
+        hill,
+        sigma,
+        truth,
+        out: args.out.clone(),
+        resume,
+        inputs,
+        progress: true,
+    };
+    let output = run_fit(&options, evaluator.as_mut())?;
+    let r = &output.result;
+    println!(
+        "fit of {} ({} samples), sigma_pos {:.4} m, sigma_att {:.4} deg ({})",
+        r.events
+            .iter()
+            .map(|e| e.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        r.events.iter().map(|e| e.samples).sum::<usize>(),
+        r.sigma_pos_m,
+        r.sigma_att_deg,
+        r.sigma_source
+    );
+    println!(
+        "{:<6} {:>12} {:>12} {:>10} {:>12} {:>9}",
+        "method", "J_pos [m]", "J_att [deg]", "weighted", "simulations", "wall [s]"
+    );
+    for (name, m) in &r.methods {
+        println!(
+            "{:<6} {:>12.6} {:>12.5} {:>10.3} {:>12} {:>9.1}",
+            name,
+            m.best.j_pos_m,
+            m.best.j_att_deg,
+            m.best.weighted,
+            m.best.evaluations,
+            m.best.wall_s
+        );
+    }
+    if !args.no_figures {
+        figures(&args.out, evaluator.job(), &output)?;
+    }
+    println!("results in {}", args.out.join("result.json").display());
+    Ok(())
+}
+
+fn figures(_dir: &std::path::Path, _job: &Job, _output: &FitOutput) -> Result<()> {
+    Ok(())
+}
+
+fn rerun(args: RerunArgs) -> Result<()> {
+    let checkpoint = Checkpoint::load(&args.checkpoint)?;
+    let (data_paths, scenario_path) = if args.data.is_empty() && args.scenario.is_none() {
+        (
+            checkpoint.inputs.data.clone(),
+            checkpoint.inputs.scenario.clone(),
+        )
+    } else {
+        (args.data.clone(), args.scenario.clone())
+    };
+    let (job, _) = inputs::job(&data_paths, scenario_path.as_deref())?;
+    let mut evaluator = evaluator(&args.evaluator, job, threads(args.threads)?)?;
+    let mismatches =
+        sepval_coordinator::rerun::rerun(&checkpoint, &args.checkpoint, evaluator.as_mut())?;
+    let n = checkpoint.state.population.len();
+    if mismatches.is_empty() {
+        println!(
+            "generation {}: all {n} members reproduce their goals bit for bit ({})",
+            checkpoint.state.generation,
+            evaluator.describe()
+        );
+        return Ok(());
+    }
+    for m in &mismatches {
+        println!(
+            "member {}: saved {:?}, rerun {:?}",
+            m.member, m.saved, m.rerun
+        );
+    }
+    anyhow::bail!(
+        "generation {}: {} of {n} members do not reproduce their goals bit for bit",
+        checkpoint.state.generation,
+        mismatches.len()
+    )
 }

@@ -1,0 +1,407 @@
+//! The batch evaluation interface between a search and the simulations.
+//!
+//! A search (genetic algorithm, hill climber, Levenberg-Marquardt, diagnosis) sees evaluations
+//! only through [`Evaluator`]: a batch of [`Candidate`]s (17 factors plus the values of a model
+//! variant's effects) in, one typed [`Evaluation`] per candidate out, in order. How the batch
+//! travels (a thread pool here, shared memory to worker processes elsewhere) is invisible to
+//! the search, and every evaluator gives bit-identical outcomes: an evaluation is a pure
+//! function of the job and the candidate.
+//!
+//! A [`Job`] is what every evaluator needs once: the events (scenario and measured data of each
+//! release of the store). Goals are pooled over all samples of all events (MODEL.md section 5).
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use serde::{Deserialize, Serialize};
+
+use crate::effects::EffectSet;
+use crate::factors::{FactorTable, Factors};
+use crate::goals::{GoalAccumulator, GoalSums, Goals};
+use crate::propagator::{Observation, propagate};
+use crate::scenario::{Scenario, hex_sha256};
+use crate::simulation::Simulator;
+use crate::telemetry::Trajectory;
+
+/// One release: its scenario and its measured trajectory.
+#[derive(Debug, Clone)]
+pub struct Event {
+    /// Name for reports (the data file, usually).
+    pub name: String,
+    /// The scenario, set up.
+    pub simulator: Simulator,
+    /// The measured trajectory.
+    pub data: Trajectory,
+}
+
+/// Errors building a job.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
+pub enum JobError {
+    /// No events.
+    #[error("a job needs at least one event (measured trajectory)")]
+    NoEvents,
+    /// Events whose scenarios have different factor tables.
+    #[error(
+        "event `{event}` has a different factor table from event `{first}`: the 17 factors are shared, so their bounds and bits must be too"
+    )]
+    FactorTables {
+        /// The first event.
+        first: String,
+        /// The differing event.
+        event: String,
+    },
+}
+
+/// Everything an evaluator needs once: the events of a fit.
+#[derive(Debug, Clone)]
+pub struct Job {
+    events: Vec<Event>,
+    data_sha256: String,
+    scenario_sha256: String,
+}
+
+impl Job {
+    /// A job of `events` (at least one; all with the same factor table).
+    pub fn new(events: Vec<Event>) -> Result<Job, JobError> {
+        let first = events.first().ok_or(JobError::NoEvents)?;
+        for e in &events[1..] {
+            if e.simulator.scenario().factors != first.simulator.scenario().factors {
+                return Err(JobError::FactorTables {
+                    first: first.name.clone(),
+                    event: e.name.clone(),
+                });
+            }
+        }
+        let mut data = String::new();
+        let mut scen = String::new();
+        for e in &events {
+            let numbers = Trajectory {
+                comments: Vec::new(),
+                metadata: Vec::new(),
+                ..e.data.clone()
+            };
+            data.push_str(&numbers.to_csv_string());
+            data.push('\u{1e}');
+            scen.push_str(&e.simulator.scenario().content_hash());
+            scen.push('\u{1e}');
+        }
+        Ok(Job {
+            data_sha256: hex_sha256(data.as_bytes()),
+            scenario_sha256: hex_sha256(scen.as_bytes()),
+            events,
+        })
+    }
+
+    /// A job of one event.
+    pub fn single(name: &str, scenario: &Scenario, data: Trajectory) -> Job {
+        Job::new(vec![Event {
+            name: name.to_string(),
+            simulator: Simulator::new(scenario),
+            data,
+        }])
+        .expect("one event is a valid job")
+    }
+
+    /// The events.
+    pub fn events(&self) -> &[Event] {
+        &self.events
+    }
+
+    /// The factor table shared by all events.
+    pub fn factor_table(&self) -> &FactorTable {
+        &self.events[0].simulator.scenario().factors
+    }
+
+    /// SHA-256 of the measured data (sample values of every event, in order).
+    pub fn data_sha256(&self) -> &str {
+        &self.data_sha256
+    }
+
+    /// SHA-256 of the scenarios (content hashes of every event's scenario, in order).
+    pub fn scenario_sha256(&self) -> &str {
+        &self.scenario_sha256
+    }
+
+    /// Total number of samples over all events.
+    pub fn sample_count(&self) -> usize {
+        self.events.iter().map(|e| e.data.len()).sum()
+    }
+
+    /// Evaluates one candidate (goals pooled over all events).
+    pub fn evaluate(&self, c: &Candidate) -> Evaluation {
+        self.run(c, false)
+    }
+
+    /// Evaluates one candidate and keeps the simulated samples of every event.
+    pub fn evaluate_with_samples(&self, c: &Candidate) -> Evaluation {
+        self.run(c, true)
+    }
+
+    fn run(&self, c: &Candidate, keep: bool) -> Evaluation {
+        let mut sums = GoalSums::default();
+        let mut samples = Vec::new();
+        for (k, event) in self.events.iter().enumerate() {
+            let run = match event.simulator.run_setup(&c.factors, &c.effects) {
+                Ok(run) => run,
+                Err(e) => {
+                    return Evaluation::from(Outcome::Failed {
+                        reason: e.to_string(),
+                    });
+                }
+            };
+            let model = event.simulator.model();
+            let result = if keep {
+                let mut obs: Vec<Observation> = Vec::with_capacity(event.data.len());
+                let r = propagate(model, &run, &event.data.times_s, &mut obs);
+                if r.is_ok() {
+                    for (i, o) in obs.iter().enumerate() {
+                        sums.add(o, &event.data.pos_m[i], &event.data.att_deg[i]);
+                    }
+                    samples.push(obs);
+                }
+                r
+            } else {
+                let mut acc = GoalAccumulator::new(&event.data);
+                let r = propagate(model, &run, &event.data.times_s, &mut acc);
+                sums.merge(&acc.sums);
+                r
+            };
+            if let Err(d) = result {
+                return Evaluation::from(Outcome::Diverged {
+                    t_s: d.t_s,
+                    event: k,
+                });
+            }
+        }
+        let g = sums.goals();
+        Evaluation {
+            outcome: Outcome::Goals {
+                j_pos_m: g.j_pos_m,
+                j_att_deg: g.j_att_deg,
+            },
+            samples: keep.then_some(samples),
+        }
+    }
+}
+
+/// One point of a search: the 17 factors and the effects of the model variant with their
+/// parameter values. `Copy`, fixed size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// The factors.
+    pub factors: Factors,
+    /// The active effects and their values (empty for the baseline model).
+    pub effects: EffectSet,
+}
+
+impl Candidate {
+    /// A baseline-model candidate.
+    pub fn baseline(factors: Factors) -> Self {
+        Candidate {
+            factors,
+            effects: EffectSet::NONE,
+        }
+    }
+}
+
+/// The typed outcome of one evaluation: never a magic penalty hidden in a number.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum Outcome {
+    /// The run finished: its goals (MODEL.md section 5), pooled over all events.
+    Goals {
+        /// RMS position error [m].
+        j_pos_m: f64,
+        /// RMS attitude error [deg].
+        j_att_deg: f64,
+    },
+    /// The run diverged (MODEL.md section 3) in event `event` at `t_s`.
+    Diverged {
+        /// Time of divergence [s].
+        t_s: f64,
+        /// Index of the event that diverged.
+        event: usize,
+    },
+    /// The candidate could not be run (invalid parameters, a malformed request).
+    Failed {
+        /// Why.
+        reason: String,
+    },
+}
+
+impl Outcome {
+    /// The goals, if the run finished.
+    pub fn goals(&self) -> Option<Goals> {
+        match *self {
+            Outcome::Goals { j_pos_m, j_att_deg } => Some(Goals { j_pos_m, j_att_deg }),
+            _ => None,
+        }
+    }
+
+    /// The two objectives for a Pareto search: the goals, or (inf, inf) for a run that did not
+    /// finish, which every finished run dominates.
+    pub fn objectives(&self) -> [f64; 2] {
+        self.goals()
+            .map_or([f64::INFINITY; 2], |g| [g.j_pos_m, g.j_att_deg])
+    }
+}
+
+/// The result of evaluating one candidate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evaluation {
+    /// The outcome.
+    pub outcome: Outcome,
+    /// The simulated samples of each event, when asked for and the run finished.
+    pub samples: Option<Vec<Vec<Observation>>>,
+}
+
+impl From<Outcome> for Evaluation {
+    fn from(outcome: Outcome) -> Self {
+        Evaluation {
+            outcome,
+            samples: None,
+        }
+    }
+}
+
+/// Errors of an evaluator (the transport, not the simulations: those are [`Outcome`]s).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum EvalError {
+    /// The evaluator cannot go on (for example every worker is gone).
+    #[error("evaluator failed: {0}")]
+    Transport(String),
+}
+
+/// Evaluates batches of candidates for one job.
+pub trait Evaluator {
+    /// Evaluates `batch` and returns one evaluation per candidate, in order. With
+    /// `with_samples`, finished runs also return their simulated samples.
+    fn evaluate(
+        &mut self,
+        batch: &[Candidate],
+        with_samples: bool,
+    ) -> Result<Vec<Evaluation>, EvalError>;
+
+    /// The job.
+    fn job(&self) -> &Job;
+
+    /// A short description for reports ("inproc, 2 threads").
+    fn describe(&self) -> String;
+}
+
+/// The in-process evaluator: a batch is shared among `threads` threads of this process.
+pub struct InProcess {
+    job: Arc<Job>,
+    threads: usize,
+}
+
+impl InProcess {
+    /// An evaluator on `threads` threads (at least one).
+    pub fn new(job: Arc<Job>, threads: usize) -> Self {
+        InProcess {
+            job,
+            threads: threads.max(1),
+        }
+    }
+}
+
+impl Evaluator for InProcess {
+    fn evaluate(
+        &mut self,
+        batch: &[Candidate],
+        with_samples: bool,
+    ) -> Result<Vec<Evaluation>, EvalError> {
+        let job = &*self.job;
+        let eval = |c: &Candidate| {
+            if with_samples {
+                job.evaluate_with_samples(c)
+            } else {
+                job.evaluate(c)
+            }
+        };
+        let threads = self.threads.min(batch.len());
+        if threads <= 1 {
+            return Ok(batch.iter().map(eval).collect());
+        }
+        // Threads take the next index until the batch is done; each result goes to its own
+        // slot, so the order (and every bit) is independent of the thread count.
+        let next = AtomicUsize::new(0);
+        let mut slots: Vec<Option<Evaluation>> = vec![None; batch.len()];
+        let results: Vec<Vec<(usize, Evaluation)>> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..threads)
+                .map(|_| {
+                    s.spawn(|| {
+                        let mut mine = Vec::new();
+                        loop {
+                            let i = next.fetch_add(1, Ordering::Relaxed);
+                            if i >= batch.len() {
+                                break mine;
+                            }
+                            mine.push((i, eval(&batch[i])));
+                        }
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("evaluation threads do not panic"))
+                .collect()
+        });
+        for (i, e) in results.into_iter().flatten() {
+            slots[i] = Some(e);
+        }
+        Ok(slots
+            .into_iter()
+            .map(|e| e.expect("every index was evaluated"))
+            .collect())
+    }
+
+    fn job(&self) -> &Job {
+        &self.job
+    }
+
+    fn describe(&self) -> String {
+        format!("inproc, {} thread(s)", self.threads)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synthetic::default_flight_test;
+
+    #[test]
+    fn thread_count_does_not_change_any_bit() {
+        let job = Arc::new(Job::single(
+            "default",
+            &Scenario::embedded_default(),
+            default_flight_test(),
+        ));
+        let mut batch: Vec<Candidate> = (0..7)
+            .map(|k| {
+                let mut f = Factors::NOMINAL;
+                f.0[0] = 0.2 + 0.1 * k as f64;
+                Candidate::baseline(f)
+            })
+            .collect();
+        let mut bad = Factors::NOMINAL;
+        bad.0[2] = 5.0;
+        batch.push(Candidate::baseline(bad));
+        let one = InProcess::new(job.clone(), 1)
+            .evaluate(&batch, false)
+            .unwrap();
+        let three = InProcess::new(job.clone(), 3)
+            .evaluate(&batch, false)
+            .unwrap();
+        assert_eq!(one, three);
+        match &one[7].outcome {
+            Outcome::Failed { reason } => assert!(reason.contains("xinerfac"), "{reason}"),
+            other => panic!("{other:?}"),
+        }
+        let with = InProcess::new(job, 2).evaluate(&batch[..2], true).unwrap();
+        assert_eq!(with[0].outcome, one[0].outcome);
+        assert_eq!(with[0].samples.as_ref().unwrap()[0].len(), 201);
+    }
+}

@@ -1,0 +1,186 @@
+//! The fit's results file, DIR/result.json, and the per-channel residual summary.
+
+use std::collections::BTreeMap;
+
+use sepval_common::evaluation::Job;
+use sepval_common::factors::Factors;
+use sepval_common::goals::residual;
+use sepval_common::propagator::Observation;
+use serde::{Deserialize, Serialize};
+
+/// Format tag of result files.
+pub const RESULT_FORMAT: &str = "sepval-fit-result/1";
+
+/// DIR/result.json. Everything except `run` and the `wall_s` fields is a deterministic function
+/// of the inputs and settings (whatever the evaluator and worker count).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitResult {
+    /// [`RESULT_FORMAT`].
+    pub format: String,
+    /// The events fitted.
+    pub events: Vec<EventInfo>,
+    /// SHA-256 of the measured data.
+    pub data_sha256: String,
+    /// SHA-256 of the scenario(s).
+    pub scenario_sha256: String,
+    /// Position noise used to weight J_pos [m].
+    pub sigma_pos_m: f64,
+    /// Attitude noise used to weight J_att [deg].
+    pub sigma_att_deg: f64,
+    /// Where the sigmas came from.
+    pub sigma_source: String,
+    /// The true factors, when known (synthetic data).
+    pub truth: Option<Factors>,
+    /// One entry per method run (`ga`, `hill`, ...).
+    pub methods: BTreeMap<String, MethodResult>,
+    /// How this run was executed (not part of the deterministic result).
+    pub run: RunInfo,
+}
+
+/// One event of the fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EventInfo {
+    /// Its name (data file).
+    pub name: String,
+    /// Its number of samples.
+    pub samples: usize,
+}
+
+/// How the run was executed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunInfo {
+    /// The evaluator ("inproc, 2 thread(s)").
+    pub evaluator: String,
+    /// Wall time of the whole fit [s].
+    pub wall_s: f64,
+    /// sepval version.
+    pub version: String,
+}
+
+/// The result of one method.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodResult {
+    /// The Pareto member with the smallest J_pos/sigma_pos + J_att/sigma_att.
+    pub best: Best,
+    /// The final Pareto front (non-dominated set of everything the method evaluated), by J_pos.
+    pub pareto_front: Vec<FrontPoint>,
+    /// The best goals per generation (GA) or iteration (hill climber).
+    pub history: Vec<HistoryPoint>,
+    /// Why the method stopped.
+    pub stop: String,
+}
+
+/// The best member of a method.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Best {
+    /// The 17 factors by name.
+    pub factors: Factors,
+    /// RMS position error [m].
+    pub j_pos_m: f64,
+    /// RMS attitude error [deg].
+    pub j_att_deg: f64,
+    /// J_pos/sigma_pos + J_att/sigma_att.
+    pub weighted: f64,
+    /// Simulations the method ran.
+    pub evaluations: u64,
+    /// Wall time of the method [s].
+    pub wall_s: f64,
+    /// RMS residual per channel.
+    pub channel_rms: ChannelRms,
+}
+
+/// One point of a Pareto front.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrontPoint {
+    /// The factors.
+    pub factors: Factors,
+    /// RMS position error [m].
+    pub j_pos_m: f64,
+    /// RMS attitude error [deg].
+    pub j_att_deg: f64,
+}
+
+/// The best goals after one generation or iteration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HistoryPoint {
+    /// Generation (GA) or iteration (hill climber) number.
+    pub step: usize,
+    /// Simulations so far.
+    pub evaluations: u64,
+    /// Smallest J_pos in the population (the point itself for the hill climber) [m].
+    pub best_j_pos_m: f64,
+    /// Smallest J_att [deg].
+    pub best_j_att_deg: f64,
+    /// Smallest weighted sum.
+    pub best_weighted: f64,
+}
+
+/// RMS residual (simulated minus measured) per channel, pooled over events.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ChannelRms {
+    /// Downrange [m].
+    pub x_m: f64,
+    /// Crossrange [m].
+    pub y_m: f64,
+    /// Down [m].
+    pub z_m: f64,
+    /// Roll [deg].
+    pub roll_deg: f64,
+    /// Pitch [deg].
+    pub pitch_deg: f64,
+    /// Yaw [deg].
+    pub yaw_deg: f64,
+}
+
+impl ChannelRms {
+    /// The six values in order x, y, z, roll, pitch, yaw.
+    pub fn as_array(&self) -> [f64; 6] {
+        [
+            self.x_m,
+            self.y_m,
+            self.z_m,
+            self.roll_deg,
+            self.pitch_deg,
+            self.yaw_deg,
+        ]
+    }
+}
+
+/// Residuals of simulated samples against the job's data, per event, per sample:
+/// (dx, dy, dz [m], droll, dpitch, dyaw [deg]), angle differences wrapped.
+pub fn residuals(job: &Job, samples: &[Vec<Observation>]) -> Vec<Vec<[f64; 6]>> {
+    job.events()
+        .iter()
+        .zip(samples)
+        .map(|(e, sim)| {
+            sim.iter()
+                .enumerate()
+                .map(|(k, o)| {
+                    let (p, a) = residual(o, &e.data.pos_m[k], &e.data.att_deg[k]);
+                    [p[0], p[1], p[2], a[0], a[1], a[2]]
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// RMS of each channel of residuals pooled over events.
+pub fn channel_rms(residuals: &[Vec<[f64; 6]>]) -> ChannelRms {
+    let mut sums = [0.0; 6];
+    let mut n = 0usize;
+    for r in residuals.iter().flatten() {
+        for j in 0..6 {
+            sums[j] += r[j] * r[j];
+        }
+        n += 1;
+    }
+    let v = sums.map(|s| (s / n.max(1) as f64).sqrt());
+    ChannelRms {
+        x_m: v[0],
+        y_m: v[1],
+        z_m: v[2],
+        roll_deg: v[3],
+        pitch_deg: v[4],
+        yaw_deg: v[5],
+    }
+}

@@ -1,0 +1,264 @@
+//! `sepval fit` and `sepval rerun` end to end, with reduced budgets.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn sepval(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sepval"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run sepval")
+}
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "sepval failed: {}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// result.json without what may differ between runs of the same fit (timings, evaluator).
+fn deterministic_part(path: &Path) -> Value {
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    v.as_object_mut().unwrap().remove("run");
+    for m in v["methods"].as_object_mut().unwrap().values_mut() {
+        m["best"].as_object_mut().unwrap().remove("wall_s");
+    }
+    v
+}
+
+const SMALL: [&str; 8] = [
+    "--generations",
+    "12",
+    "--population",
+    "20",
+    "--hill-budget",
+    "120",
+    "--no-figures",
+    "--seed",
+];
+
+#[test]
+fn a_reduced_fit_improves_on_the_nominal_start_by_a_wide_margin() {
+    let dir = tempfile::tempdir().unwrap();
+    ok(&sepval(
+        &[
+            "fit",
+            "--generations",
+            "25",
+            "--population",
+            "40",
+            "--hill-budget",
+            "500",
+            "--no-figures",
+            "--seed",
+            "7",
+            "--out",
+            "run",
+        ],
+        dir.path(),
+    ));
+    let r = deterministic_part(&dir.path().join("run/result.json"));
+    // The nominal factors' weighted goal on the default data, for comparison.
+    ok(&sepval(
+        &["simulate", "--factors", "nominal", "--out", "nominal.csv"],
+        dir.path(),
+    ));
+    ok(&sepval(
+        &["simulate", "--noise-seed", "20260101", "--out", "data.csv"],
+        dir.path(),
+    ));
+    let g = ok(&sepval(
+        &["goals", "--data", "data.csv", "--sim", "nominal.csv"],
+        dir.path(),
+    ));
+    let nums: Vec<f64> = g
+        .lines()
+        .map(|l| l.split_whitespace().nth(2).unwrap().parse().unwrap())
+        .collect();
+    let (sp, sa) = (
+        r["sigma_pos_m"].as_f64().unwrap(),
+        r["sigma_att_deg"].as_f64().unwrap(),
+    );
+    let nominal = nums[0] / sp + nums[1] / sa;
+    for method in ["ga", "hill"] {
+        let best = &r["methods"][method]["best"];
+        let w = best["weighted"].as_f64().unwrap();
+        assert!(w < nominal / 4.0, "{method}: {w} vs nominal {nominal}");
+        assert_eq!(best["factors"].as_object().unwrap().len(), 17);
+    }
+    assert_eq!(r["methods"]["ga"]["best"]["evaluations"], 1000);
+    assert!(
+        r["methods"]["hill"]["best"]["evaluations"]
+            .as_u64()
+            .unwrap()
+            <= 500
+    );
+    assert_eq!(r["methods"]["ga"]["history"].as_array().unwrap().len(), 25);
+    assert!(
+        !r["methods"]["ga"]["pareto_front"]
+            .as_array()
+            .unwrap()
+            .is_empty()
+    );
+    assert!(
+        r["truth"].is_object(),
+        "the default data's truth is reported"
+    );
+    for g in 1..=25 {
+        assert!(
+            dir.path()
+                .join(format!("run/generations/gen-{g:04}.json"))
+                .exists()
+        );
+    }
+}
+
+#[test]
+fn resuming_gives_the_uninterrupted_result_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut full = vec!["fit"];
+    full.extend(SMALL);
+    full.extend(["3", "--out", "full"]);
+    ok(&sepval(&full, dir.path()));
+    ok(&sepval(
+        &[
+            "fit",
+            "--resume",
+            "full/generations/gen-0005.json",
+            "--no-figures",
+            "--out",
+            "resumed",
+        ],
+        dir.path(),
+    ));
+    assert_eq!(
+        deterministic_part(&dir.path().join("full/result.json")),
+        deterministic_part(&dir.path().join("resumed/result.json"))
+    );
+    // A thread count changes nothing either.
+    let mut one = full.clone();
+    *one.last_mut().unwrap() = "one-thread";
+    one.extend(["--threads", "1"]);
+    ok(&sepval(&one, dir.path()));
+    assert_eq!(
+        deterministic_part(&dir.path().join("full/result.json")),
+        deterministic_part(&dir.path().join("one-thread/result.json"))
+    );
+}
+
+#[test]
+fn rerun_reproduces_a_generation_and_reports_any_member_that_does_not() {
+    let dir = tempfile::tempdir().unwrap();
+    ok(&sepval(
+        &[
+            "fit",
+            "--method",
+            "ga",
+            "--generations",
+            "3",
+            "--population",
+            "10",
+            "--no-figures",
+            "--out",
+            "r",
+        ],
+        dir.path(),
+    ));
+    let ckpt = dir.path().join("r/generations/gen-0003.json");
+    let out = ok(&sepval(&["rerun", ckpt.to_str().unwrap()], dir.path()));
+    assert!(
+        out.contains("all 10 members reproduce their goals bit for bit"),
+        "{out}"
+    );
+
+    // Tamper with one member's goal: rerun must name it and fail.
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(&ckpt).unwrap()).unwrap();
+    let j = v["state"]["population"][4]["outcome"]["j_pos_m"]
+        .as_f64()
+        .unwrap();
+    v["state"]["population"][4]["outcome"]["j_pos_m"] = Value::from(j * (1.0 + 1e-15));
+    let bad = dir.path().join("tampered.json");
+    std::fs::write(&bad, serde_json::to_string(&v).unwrap()).unwrap();
+    let out = sepval(&["rerun", bad.to_str().unwrap()], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("member 4:"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1 of 10 members do not reproduce"));
+}
+
+#[test]
+fn a_checkpoint_with_other_data_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    ok(&sepval(
+        &[
+            "fit",
+            "--method",
+            "ga",
+            "--generations",
+            "2",
+            "--population",
+            "10",
+            "--no-figures",
+            "--out",
+            "r",
+        ],
+        dir.path(),
+    ));
+    ok(&sepval(
+        &["simulate", "--noise-seed", "99", "--out", "other.csv"],
+        dir.path(),
+    ));
+    let ckpt = "r/generations/gen-0002.json";
+    for args in [
+        vec!["rerun", ckpt, "--data", "other.csv"],
+        vec!["fit", "--resume", ckpt, "--data", "other.csv", "--out", "x"],
+    ] {
+        let out = sepval(&args, dir.path());
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("was made with other data"), "{err}");
+    }
+    std::fs::write(dir.path().join("junk.json"), "{\"format\": 1}").unwrap();
+    let out = sepval(&["rerun", "junk.json"], dir.path());
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains("checkpoint junk.json is not a sepval checkpoint")
+    );
+}
+
+#[test]
+fn bad_fit_settings_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, expected) in [
+        (
+            vec!["--population", "7"],
+            "GA setting population = 7: expected an even number >= 2",
+        ),
+        (
+            vec!["--p-jump", "1.5"],
+            "GA setting p_jump = 1.5: expected a probability in [0, 1]",
+        ),
+        (
+            vec!["--method", "anneal"],
+            "--method anneal: expected ga, hill or both",
+        ),
+        (
+            vec!["--evaluator", "carrier-pigeon"],
+            "--evaluator carrier-pigeon",
+        ),
+        (vec!["--threads", "0"], "--threads 0: expected at least 1"),
+    ] {
+        let mut all = vec!["fit", "--out", "x", "--no-figures"];
+        all.extend(args);
+        let out = sepval(&all, dir.path());
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expected), "{err}");
+    }
+}
