@@ -25,6 +25,8 @@ pub mod evaluation;
 pub mod factors;
 pub mod frames;
 pub mod goals;
+pub mod ipc;
+pub mod messages;
 pub mod model;
 pub mod noise;
 pub mod propagator;

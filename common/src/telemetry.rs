@@ -22,7 +22,7 @@ use crate::atomic_file::{WriteError, write_atomically};
 use crate::units::M_PER_FT;
 
 /// A trajectory: samples of position and attitude against time.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Trajectory {
     /// Sample times [s], strictly increasing.
     pub times_s: Vec<f64>,

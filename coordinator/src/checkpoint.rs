@@ -57,7 +57,7 @@ impl Checkpoint {
 
     /// Writes the checkpoint atomically.
     pub fn save(&self, path: &Path) -> Result<()> {
-        let json = serde_json::to_vec_pretty(self).context("serialising a checkpoint")?;
+        let json = serde_json::to_vec(self).context("serialising a checkpoint")?;
         write_atomically(path, &json)?;
         Ok(())
     }

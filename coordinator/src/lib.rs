@@ -7,6 +7,7 @@
 pub mod checkpoint;
 pub mod fit;
 pub mod inputs;
+pub mod ipc;
 pub mod problem;
 pub mod rerun;
 pub mod results;

@@ -15,6 +15,9 @@ use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
 use sepval_common::telemetry::Trajectory;
 use std::sync::Arc;
+use std::time::Duration;
+
+use sepval_coordinator::ipc::{IpcEvaluator, IpcOptions, Launch};
 
 use sepval_common::evaluation::{Evaluator, InProcess, Job};
 use sepval_coordinator::checkpoint::Checkpoint;
@@ -86,12 +89,8 @@ struct FitArgs {
     /// Simulation budget of the hill climber.
     #[arg(long, default_value_t = 500)]
     hill_budget: usize,
-    /// How simulations are run.
-    #[arg(long, default_value = "inproc", value_name = "inproc")]
-    evaluator: String,
-    /// Threads of the in-process evaluator (default: the number of cores).
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    eval: EvalArgs,
     /// Position noise [m] weighting J_pos (default: estimated from the data).
     #[arg(long)]
     sigma_pos_m: Option<f64>,
@@ -123,12 +122,35 @@ struct RerunArgs {
     /// Scenario file (default: the one recorded in the checkpoint).
     #[arg(long, value_name = "FILE")]
     scenario: Option<PathBuf>,
-    /// How simulations are run.
-    #[arg(long, default_value = "inproc", value_name = "inproc")]
+    #[command(flatten)]
+    eval: EvalArgs,
+}
+
+/// How simulations are run (shared by every search command).
+#[derive(clap::Args)]
+struct EvalArgs {
+    /// `ipc`: worker processes over iceoryx2 shared memory; `inproc`: threads of this process.
+    #[arg(long, default_value = "ipc", value_name = "ipc|inproc")]
     evaluator: String,
-    /// Threads of the in-process evaluator (default: the number of cores).
+    /// Worker processes (ipc) [default: the number of cores].
+    #[arg(long)]
+    workers: Option<usize>,
+    /// Threads (inproc) [default: the number of cores].
     #[arg(long)]
     threads: Option<usize>,
+    /// Do not start workers: create run RUN_ID and wait for --workers externally started
+    /// `sepval-worker --run RUN_ID`.
+    #[arg(long, value_name = "RUN_ID")]
+    attach: Option<String>,
+    /// Run id of spawned workers [default: a fresh one].
+    #[arg(long, value_name = "RUN_ID")]
+    run_id: Option<String>,
+    /// A worker that holds a chunk longer than this [s] is killed and replaced.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    worker_timeout: f64,
+    /// How long to wait for workers to join [s].
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    join_timeout: f64,
 }
 
 #[derive(clap::Args)]
@@ -179,6 +201,7 @@ struct ScenarioArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    iceoryx2::prelude::set_log_level(iceoryx2::prelude::LogLevel::Error);
     let result = match cli.command {
         Command::Simulate(args) => simulate(args),
         Command::Effects => {
@@ -268,19 +291,65 @@ fn scenario(args: ScenarioArgs) -> Result<()> {
     Ok(())
 }
 
-fn threads(requested: Option<usize>) -> Result<usize> {
+fn count(flag: &str, requested: Option<usize>) -> Result<usize> {
     match requested {
-        Some(0) => anyhow::bail!("--threads 0: expected at least 1"),
+        Some(0) => anyhow::bail!("{flag} 0: expected at least 1"),
         Some(n) => Ok(n),
         None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
     }
 }
 
-fn evaluator(kind: &str, job: Job, threads: usize) -> Result<Box<dyn Evaluator>> {
-    match kind {
-        "inproc" => Ok(Box::new(InProcess::new(Arc::new(job), threads))),
-        other => anyhow::bail!("--evaluator {other}: expected inproc"),
+fn evaluator(args: &EvalArgs, job: Job) -> Result<Box<dyn Evaluator>> {
+    let job = Arc::new(job);
+    match args.evaluator.as_str() {
+        "inproc" => Ok(Box::new(InProcess::new(
+            job,
+            count("--threads", args.threads)?,
+        ))),
+        "ipc" => {
+            let workers = count("--workers", args.workers)?;
+            let (run_id, launch) = match &args.attach {
+                Some(id) => (id.clone(), Launch::Attach),
+                None => (
+                    args.run_id
+                        .clone()
+                        .unwrap_or_else(sepval_common::ipc::new_run_id),
+                    Launch::Spawn {
+                        executable: worker_executable()?,
+                    },
+                ),
+            };
+            let secs = |flag: &str, v: f64| -> Result<Duration> {
+                inputs::positive(flag, v).map(Duration::from_secs_f64)
+            };
+            let options = IpcOptions {
+                run_id,
+                workers,
+                launch,
+                chunk_deadline: secs("--worker-timeout", args.worker_timeout)?,
+                join_timeout: secs("--join-timeout", args.join_timeout)?,
+                max_respawns: 2 * workers + 2,
+            };
+            Ok(Box::new(IpcEvaluator::start(job, options)?))
+        }
+        other => anyhow::bail!("--evaluator {other}: expected ipc or inproc"),
     }
+}
+
+/// The worker executable: $SEPVAL_WORKER, or `sepval-worker` beside this executable.
+fn worker_executable() -> Result<PathBuf> {
+    if let Some(p) = std::env::var_os("SEPVAL_WORKER") {
+        return Ok(PathBuf::from(p));
+    }
+    let me = std::env::current_exe().context("cannot locate the sepval executable")?;
+    let worker = me.with_file_name(format!("sepval-worker{}", std::env::consts::EXE_SUFFIX));
+    if !worker.exists() {
+        anyhow::bail!(
+            "cannot find the worker executable {} (build it with `cargo build --release`, or set SEPVAL_WORKER)",
+            worker.display()
+        );
+    }
+    Ok(worker)
 }
 
 fn fit(args: FitArgs) -> Result<()> {
@@ -344,7 +413,7 @@ fn fit(args: FitArgs) -> Result<()> {
         None if data_paths.is_empty() => Some(sepval_common::factors::Factors::TRUTH),
         None => None,
     };
-    let mut evaluator = evaluator(&args.evaluator, job, threads(args.threads)?)?;
+    let mut evaluator = evaluator(&args.eval, job)?;
     let options = FitOptions {
         method,
         ga,
@@ -407,7 +476,7 @@ fn rerun(args: RerunArgs) -> Result<()> {
         (args.data.clone(), args.scenario.clone())
     };
     let (job, _) = inputs::job(&data_paths, scenario_path.as_deref())?;
-    let mut evaluator = evaluator(&args.evaluator, job, threads(args.threads)?)?;
+    let mut evaluator = evaluator(&args.eval, job)?;
     let mismatches =
         sepval_coordinator::rerun::rerun(&checkpoint, &args.checkpoint, evaluator.as_mut())?;
     let n = checkpoint.state.population.len();

@@ -142,10 +142,10 @@ fn resuming_gives_the_uninterrupted_result_bit_for_bit() {
         deterministic_part(&dir.path().join("full/result.json")),
         deterministic_part(&dir.path().join("resumed/result.json"))
     );
-    // A thread count changes nothing either.
+    // Neither does the evaluator: in-process on one thread against worker processes.
     let mut one = full.clone();
     *one.last_mut().unwrap() = "one-thread";
-    one.extend(["--threads", "1"]);
+    one.extend(["--evaluator", "inproc", "--threads", "1"]);
     ok(&sepval(&one, dir.path()));
     assert_eq!(
         deterministic_part(&dir.path().join("full/result.json")),
@@ -252,7 +252,11 @@ fn bad_fit_settings_are_refused() {
             vec!["--evaluator", "carrier-pigeon"],
             "--evaluator carrier-pigeon",
         ),
-        (vec!["--threads", "0"], "--threads 0: expected at least 1"),
+        (
+            vec!["--evaluator", "inproc", "--threads", "0"],
+            "--threads 0: expected at least 1",
+        ),
+        (vec!["--workers", "0"], "--workers 0: expected at least 1"),
     ] {
         let mut all = vec!["fit", "--out", "x", "--no-figures"];
         all.extend(args);

@@ -1,25 +1,338 @@
-//! `sepval-worker`: the simulation server of a distributed fit. It receives the job setup
-//! (scenario and measured data) and batches of factor sets from a coordinator and answers with
-//! goals. The transport arrives with the iceoryx2 issue; until then this binary only
-//! describes itself.
+//! `sepval-worker`: the simulation server of a distributed fit.
+//!
+//! A worker joins the run it is told (`--run RUN_ID`: the run's own iceoryx2 prefix), creates
+//! its request, response, sample and wake-up services (named by its node id), announces itself
+//! on `sepval/run/hello`, reads the job setup (scenarios and measured data, with their SHA-256
+//! and protocol version) from `sepval/run/setup`, and then serves chunks of candidates until the
+//! coordinator is gone, it receives SIGINT/SIGTERM, or the setup is refused.
+//!
+//! It blocks on a WaitSet between chunks (an idle worker uses no CPU), validates every request
+//! (counts, indices, finite values; factor bounds when it runs) and answers a bad one with a
+//! typed failure instead of crashing. Run `iox2 service list` with the run's configuration to
+//! see its services (see the README).
 
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
+use anyhow::{Context, Result, bail};
 use clap::Parser;
+use iceoryx2::prelude::*;
+use iceoryx2::waitset::WaitSetRunResult;
+use sepval_common::evaluation::{Candidate, Evaluation, Job, Outcome};
+use sepval_common::ipc::{self as sipc, COORDINATOR_NODE, REQUEST_BUFFER, WORKER_NODE, names};
+use sepval_common::messages::{
+    ChunkHeader, Hello, MAGIC, PROTOCOL_VERSION, SetupHeader, WireObservation, WireRequest,
+    WireResponse, check_setup_header, decode_setup, setup_hash_hex,
+};
 
 #[derive(Parser)]
 #[command(
     name = "sepval-worker",
     version,
     about = "Runs store-separation simulations for a sepval coordinator",
-    long_about = "Runs store-separation simulations for a sepval coordinator. Workers are started \
-                  by `sepval fit --workers N`; the shared-memory transport that connects them \
-                  is not built yet, so this binary has no work mode."
+    long_about = "Runs store-separation simulations for a sepval coordinator. `sepval fit \
+                  --workers N` starts workers itself; to start them yourself (as a job scheduler \
+                  would), run `sepval fit --attach RUN_ID --workers N` and then N times \
+                  `sepval-worker --run RUN_ID`."
 )]
-struct Cli {}
+struct Cli {
+    /// The run to join (the coordinator prints it).
+    #[arg(long, value_name = "RUN_ID")]
+    run: String,
+    /// How long to wait for the coordinator's job setup [s].
+    #[arg(long, default_value_t = 30.0, value_name = "S")]
+    setup_timeout: f64,
+    /// Announce this protocol version instead of our own (compatibility testing only).
+    #[arg(long, hide = true)]
+    announce_protocol: Option<u32>,
+}
+
+/// How often an idle worker checks that its coordinator is still alive.
+const LIVENESS_TICK: Duration = Duration::from_millis(500);
 
 fn main() -> ExitCode {
-    let _ = Cli::parse();
-    eprintln!("sepval-worker: no transport is built yet; start workers through `sepval fit`.");
-    ExitCode::from(2)
+    let cli = Cli::parse();
+    iceoryx2::prelude::set_log_level(LogLevel::Error);
+    match serve(&cli) {
+        Ok(Some(reason)) => {
+            eprintln!("sepval-worker: {reason}");
+            ExitCode::SUCCESS
+        }
+        Ok(None) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("sepval-worker: error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Serves the run; returns why it stopped, when that is worth saying (not for the
+/// coordinator's own SIGTERM at the end of a run).
+fn serve(cli: &Cli) -> Result<Option<String>> {
+    let cfg = sipc::run_config(&cli.run)?;
+    let node = NodeBuilder::new()
+        .config(&cfg)
+        .name(&NodeName::new(WORKER_NODE).map_err(sipc::iox("node name"))?)
+        .create::<ipc::Service>()
+        .map_err(sipc::iox("creating the worker node"))?;
+    let id = node.id().value();
+    let svc = |name: &str| sipc::service_name(name);
+
+    // Our own services, created before we announce ourselves.
+    let requests = node
+        .service_builder(&svc(&names::requests(id))?)
+        .publish_subscribe::<[WireRequest]>()
+        .user_header::<ChunkHeader>()
+        .max_publishers(1)
+        .max_subscribers(1)
+        .subscriber_max_buffer_size(REQUEST_BUFFER)
+        .enable_safe_overflow(false)
+        .history_size(0)
+        .create()
+        .map_err(sipc::iox("creating the request service"))?;
+    let request_sub = requests
+        .subscriber_builder()
+        .buffer_size(REQUEST_BUFFER)
+        .create()
+        .map_err(sipc::iox("subscribing to requests"))?;
+    let responses = node
+        .service_builder(&svc(&names::responses(id))?)
+        .publish_subscribe::<[WireResponse]>()
+        .user_header::<ChunkHeader>()
+        .max_publishers(1)
+        .max_subscribers(1)
+        .subscriber_max_buffer_size(REQUEST_BUFFER)
+        .enable_safe_overflow(false)
+        .history_size(0)
+        .create()
+        .map_err(sipc::iox("creating the response service"))?;
+    let response_pub = responses
+        .publisher_builder()
+        .initial_max_slice_len(64)
+        .allocation_strategy(AllocationStrategy::PowerOfTwo)
+        .create()
+        .map_err(sipc::iox("publishing responses"))?;
+    let samples = node
+        .service_builder(&svc(&names::samples(id))?)
+        .publish_subscribe::<[WireObservation]>()
+        .user_header::<ChunkHeader>()
+        .max_publishers(1)
+        .max_subscribers(1)
+        .subscriber_max_buffer_size(REQUEST_BUFFER)
+        .enable_safe_overflow(false)
+        .history_size(0)
+        .create()
+        .map_err(sipc::iox("creating the sample service"))?;
+    let sample_pub = samples
+        .publisher_builder()
+        .initial_max_slice_len(1024)
+        .allocation_strategy(AllocationStrategy::PowerOfTwo)
+        .create()
+        .map_err(sipc::iox("publishing samples"))?;
+    let wake = node
+        .service_builder(&svc(&names::wake(id))?)
+        .event()
+        .max_notifiers(1)
+        .max_listeners(1)
+        .create()
+        .map_err(sipc::iox("creating the wake-up service"))?;
+    let wake_listener = wake
+        .listener_builder()
+        .create()
+        .map_err(sipc::iox("listening for wake-ups"))?;
+
+    // The run's services (the coordinator creates them).
+    let open_deadline = Instant::now() + Duration::from_secs_f64(cli.setup_timeout.max(0.1));
+    let setup_service = retry_until(open_deadline, || {
+        node.service_builder(&svc(names::SETUP)?)
+            .publish_subscribe::<[u8]>()
+            .user_header::<SetupHeader>()
+            .open()
+            .map_err(|e| anyhow::Error::from(sipc::iox("opening the setup service")(e)))
+    })
+    .with_context(|| {
+        format!(
+            "no coordinator serves run {} (is the run id right?)",
+            cli.run
+        )
+    })?;
+    let setup_sub = setup_service
+        .subscriber_builder()
+        .history_request(1)
+        .create()
+        .map_err(sipc::iox("subscribing to the setup"))?;
+    let coordinator_wake = node
+        .service_builder(&svc(names::COORDINATOR_WAKE)?)
+        .event()
+        .open()
+        .map_err(sipc::iox("opening the coordinator's wake-up service"))?
+        .notifier_builder()
+        .create()
+        .map_err(sipc::iox("notifying the coordinator"))?;
+    let hello_pub = node
+        .service_builder(&svc(names::HELLO)?)
+        .publish_subscribe::<Hello>()
+        .open()
+        .map_err(sipc::iox("opening the hello service"))?
+        .publisher_builder()
+        .create()
+        .map_err(sipc::iox("publishing hello"))?;
+    hello_pub
+        .send_copy(Hello {
+            magic: MAGIC,
+            protocol: cli.announce_protocol.unwrap_or(PROTOCOL_VERSION),
+            pid: std::process::id(),
+            node_id: id,
+        })
+        .map_err(sipc::iox("sending hello"))?;
+    let _ = coordinator_wake.notify();
+
+    // The job setup (delivered from the service's history).
+    let job = retry_until(open_deadline, || {
+        match setup_sub
+            .receive()
+            .map_err(sipc::iox("receiving the setup"))?
+        {
+            Some(sample) => {
+                let header: SetupHeader = *sample.user_header();
+                check_setup_header(&header)
+                    .map_err(|e| anyhow::anyhow!("refusing the setup of run {}: {e}", cli.run))?;
+                let job = decode_setup(&header, sample.payload()).with_context(|| {
+                    format!(
+                        "refusing the setup {} of run {}",
+                        setup_hash_hex(&header),
+                        cli.run
+                    )
+                })?;
+                Ok(Some(job))
+            }
+            None => Ok(None),
+        }
+        .and_then(|j: Option<Job>| j.ok_or_else(|| anyhow::anyhow!("no setup yet")))
+    })
+    .context("no job setup arrived")?;
+
+    let waitset = WaitSetBuilder::new()
+        .create::<ipc::Service>()
+        .map_err(sipc::iox("creating the wait set"))?;
+    let _wake_guard = waitset
+        .attach_notification(&wake_listener)
+        .map_err(sipc::iox("waiting for wake-ups"))?;
+    let tick = waitset
+        .attach_interval(LIVENESS_TICK)
+        .map_err(sipc::iox("attaching the liveness tick"))?;
+
+    loop {
+        // Serve everything waiting (events are not latched: drain before every wait).
+        while let Some(chunk) = request_sub
+            .receive()
+            .map_err(sipc::iox("receiving requests"))?
+        {
+            let header = *chunk.user_header();
+            let evaluations: Vec<(u64, Evaluation)> = chunk
+                .payload()
+                .iter()
+                .map(|r| (r.index, evaluate(&job, r, header.with_samples != 0)))
+                .collect();
+            drop(chunk);
+            publish(&response_pub, &sample_pub, &job, header, &evaluations)?;
+            let _ = coordinator_wake.notify();
+        }
+        let mut ticked = false;
+        let outcome = waitset.wait_and_process_once(|attachment| {
+            if attachment.has_event_from(&tick) {
+                ticked = true;
+            }
+            CallbackProgression::Stop
+        });
+        match outcome {
+            Ok(WaitSetRunResult::TerminationRequest) | Ok(WaitSetRunResult::Interrupt) => {
+                return Ok(None);
+            }
+            Ok(_) => {}
+            Err(e) => bail!("waiting for requests: {e:?}"),
+        }
+        wake_listener
+            .try_wait(|_| {})
+            .map_err(sipc::iox("draining wake-ups"))?;
+        if ticked && sipc::presence(&cfg, COORDINATOR_NODE)?.alive == 0 {
+            return Ok(Some(format!(
+                "the coordinator of run {} is gone; exiting",
+                cli.run
+            )));
+        }
+    }
+}
+
+/// Evaluates one request; a malformed one becomes a typed failure.
+fn evaluate(job: &Job, r: &WireRequest, with_samples: bool) -> Evaluation {
+    let candidate: Candidate = match r.candidate() {
+        Ok(c) => c,
+        Err(reason) => {
+            return Evaluation::from(Outcome::Failed {
+                reason: format!("malformed request: {reason}"),
+            });
+        }
+    };
+    if with_samples {
+        job.evaluate_with_samples(&candidate)
+    } else {
+        job.evaluate(&candidate)
+    }
+}
+
+/// Publishes one chunk's responses (and samples when asked for).
+fn publish(
+    response_pub: &iceoryx2::port::publisher::Publisher<ipc::Service, [WireResponse], ChunkHeader>,
+    sample_pub: &iceoryx2::port::publisher::Publisher<ipc::Service, [WireObservation], ChunkHeader>,
+    job: &Job,
+    header: ChunkHeader,
+    evaluations: &[(u64, Evaluation)],
+) -> Result<()> {
+    let n = evaluations.len();
+    if header.with_samples != 0 {
+        let per = job.sample_count();
+        let nan = WireObservation {
+            pos_m: [f64::NAN; 3],
+            att_deg: [f64::NAN; 3],
+        };
+        let mut sample = sample_pub
+            .loan_slice_uninit(n * per)
+            .map_err(sipc::iox("loaning a sample chunk"))?;
+        *sample.user_header_mut() = ChunkHeader {
+            count: n as u32,
+            ..header
+        };
+        let flat: Vec<WireObservation> = evaluations
+            .iter()
+            .flat_map(|(_, e)| match &e.samples {
+                Some(events) => events.iter().flatten().map(WireObservation::from).collect(),
+                None => vec![nan; per],
+            })
+            .collect();
+        let sample = sample.write_from_fn(|i| flat[i]);
+        sample.send().map_err(sipc::iox("sending samples"))?;
+    }
+    let mut sample = response_pub
+        .loan_slice_uninit(n)
+        .map_err(sipc::iox("loaning a response chunk"))?;
+    *sample.user_header_mut() = ChunkHeader {
+        count: n as u32,
+        ..header
+    };
+    let sample =
+        sample.write_from_fn(|i| WireResponse::new(evaluations[i].0, &evaluations[i].1.outcome));
+    sample.send().map_err(sipc::iox("sending responses"))?;
+    Ok(())
+}
+
+/// Retries `f` until it succeeds or `deadline` passes (then returns its last error).
+fn retry_until<T>(deadline: Instant, mut f: impl FnMut() -> Result<T>) -> Result<T> {
+    loop {
+        match f() {
+            Ok(v) => return Ok(v),
+            Err(e) if Instant::now() >= deadline => return Err(e),
+            Err(_) => std::thread::sleep(Duration::from_millis(20)),
+        }
+    }
 }
