@@ -15,6 +15,10 @@
 //! sqrt((1 - a)/2) above, peak relative error 2.5e-16; exp as 2^n exp(r), |r| <= ln 2 / 2,
 //! exp(r) = 1 + 2 r P(r^2) / (Q(r^2) - r P(r^2)), peak relative error 2.2e-16. The tests
 //! check both against the standard library to a few units in the last place.
+//!
+//! The polynomials are evaluated by Horner's rule with fused multiply-adds (`f64::mul_add`,
+//! one rounding per step): exactly the same bits with or without an FMA unit (see
+//! [`crate::propagator::propagate`] for the build that uses one).
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -34,19 +38,34 @@ fn atan_nonnegative(x: f64) -> f64 {
         (0.0, 0.0, x)
     };
     let z = t * t;
-    let p = (((-8.750_608_600_031_904e-1 * z - 1.615_753_718_733_365e1) * z
-        - 7.500_855_792_314_705e1)
-        * z
-        - 1.228_866_684_490_136_2e2)
-        * z
-        - 6.485_021_904_942_025e1;
-    let q = ((((z + 2.485_846_490_142_306_3e1) * z + 1.650_270_098_316_988_6e2) * z
-        + 4.328_810_604_912_903e2)
-        * z
-        + 4.853_903_996_359_137e2)
-        * z
-        + 1.945_506_571_482_614e2;
-    offset + (t + (t * z * p / q + extra))
+    let p = horner(
+        z,
+        -8.750_608_600_031_904e-1,
+        &[
+            -1.615_753_718_733_365e1,
+            -7.500_855_792_314_705e1,
+            -1.228_866_684_490_136_2e2,
+            -6.485_021_904_942_025e1,
+        ],
+    );
+    let q = horner(
+        z,
+        1.0,
+        &[
+            2.485_846_490_142_306_3e1,
+            1.650_270_098_316_988_6e2,
+            4.328_810_604_912_903e2,
+            4.853_903_996_359_137e2,
+            1.945_506_571_482_614e2,
+        ],
+    );
+    offset + (t + t.mul_add(z * p / q, extra))
+}
+
+/// `c0 x^n + c[0] x^(n-1) + ... + c[n-1]` by Horner's rule with fused multiply-adds.
+#[inline(always)]
+fn horner<const N: usize>(x: f64, c0: f64, c: &[f64; N]) -> f64 {
+    c.iter().fold(c0, |acc, &ci| acc.mul_add(x, ci))
 }
 
 /// Four-quadrant arc tangent of y / x, as `f64::atan2` (to within a few ulp), in [-pi, pi].
@@ -91,15 +110,20 @@ pub fn exp(x: f64) -> f64 {
     }
     // n = round(x / ln 2), by the 1.5 * 2^52 trick (exact for |x / ln 2| < 2^51).
     const ROUND: f64 = 6_755_399_441_055_744.0;
-    let n = (LOG2E * x + ROUND) - ROUND;
-    let r = (x - n * C1) - n * C2;
+    let n = LOG2E.mul_add(x, ROUND) - ROUND;
+    let r = (-n).mul_add(C2, (-n).mul_add(C1, x));
     let rr = r * r;
-    let p = r * ((1.261_771_930_748_105_9e-4 * rr + 3.029_944_077_074_419_6e-2) * rr + 1.0);
-    let q = ((3.001_985_051_386_644_5e-6 * rr + 2.524_483_403_496_841e-3) * rr
-        + 2.272_655_482_081_550_3e-1)
-        * rr
-        + 2.0;
-    let e = 1.0 + 2.0 * (p / (q - p));
+    let p = r * horner(
+        rr,
+        1.261_771_930_748_105_9e-4,
+        &[3.029_944_077_074_419_6e-2, 1.0],
+    );
+    let q = horner(
+        rr,
+        3.001_985_051_386_644_5e-6,
+        &[2.524_483_403_496_841e-3, 2.272_655_482_081_550_3e-1, 2.0],
+    );
+    let e = 2.0f64.mul_add(p / (q - p), 1.0);
     // Scale by 2^n through the exponent bits (n is within the normal range here).
     e * f64::from_bits(((n as i64 + 1023) as u64) << 52)
 }
@@ -113,21 +137,29 @@ pub fn asin(x: f64) -> f64 {
     }
     // Cephes asin.c: asin(a) = a + a^3 P(a^2) / Q(a^2) for a <= 0.625.
     let z = a * a;
-    let p = ((((4.253_011_369_004_428e-3 * z - 6.019_598_008_014_124e-1) * z
-        + 5.444_622_390_564_711)
-        * z
-        - 1.626_247_967_210_700_2e1)
-        * z
-        + 1.956_261_983_317_594_8e1)
-        * z
-        - 8.198_089_802_484_825;
-    let q = ((((z - 1.474_091_372_988_853_8e1) * z + 7.049_610_280_856_842e1) * z
-        - 1.471_791_292_232_726e2)
-        * z
-        + 1.395_105_614_657_485_7e2)
-        * z
-        - 4.918_853_881_490_881e1;
-    let r = a + a * (z * p / q);
+    let p = horner(
+        z,
+        4.253_011_369_004_428e-3,
+        &[
+            -6.019_598_008_014_124e-1,
+            5.444_622_390_564_711,
+            -1.626_247_967_210_700_2e1,
+            1.956_261_983_317_594_8e1,
+            -8.198_089_802_484_825,
+        ],
+    );
+    let q = horner(
+        z,
+        1.0,
+        &[
+            -1.474_091_372_988_853_8e1,
+            7.049_610_280_856_842e1,
+            -1.471_791_292_232_726e2,
+            1.395_105_614_657_485_7e2,
+            -4.918_853_881_490_881e1,
+        ],
+    );
+    let r = a.mul_add(z * p / q, a);
     if x < 0.0 { -r } else { r }
 }
 

@@ -102,19 +102,31 @@ impl AeroConstants {
     #[inline(always)]
     pub fn coefficients(&self, flow: &Flow, increments: &[f64; 6]) -> Coefficients {
         let f = flow.interference_factor;
+        // Each sum as fused multiply-adds, interference term innermost.
+        let lin = |slope: f64, x: f64, rest: f64| slope.mul_add(x, rest);
         Coefficients {
-            cx: self.cx0 + increments[0] * f,
-            cy: self.cy_beta * flow.beta_rad + self.cy0 + increments[1] * f,
-            cz: self.cz_alpha * flow.alpha_rad + self.cz0 + increments[2] * f,
-            cl: self.cl_p * flow.p_hat + self.cl0 + increments[3] * f,
-            cm: self.cm_alpha * flow.alpha_rad
-                + self.cm_q * flow.q_hat
-                + self.cm0
-                + increments[4] * f,
-            cn: self.cn_beta * flow.beta_rad
-                + self.cn_r * flow.r_hat
-                + self.cn0
-                + increments[5] * f,
+            cx: increments[0].mul_add(f, self.cx0),
+            cy: lin(
+                self.cy_beta,
+                flow.beta_rad,
+                increments[1].mul_add(f, self.cy0),
+            ),
+            cz: lin(
+                self.cz_alpha,
+                flow.alpha_rad,
+                increments[2].mul_add(f, self.cz0),
+            ),
+            cl: lin(self.cl_p, flow.p_hat, increments[3].mul_add(f, self.cl0)),
+            cm: lin(
+                self.cm_alpha,
+                flow.alpha_rad,
+                lin(self.cm_q, flow.q_hat, increments[4].mul_add(f, self.cm0)),
+            ),
+            cn: lin(
+                self.cn_beta,
+                flow.beta_rad,
+                lin(self.cn_r, flow.r_hat, increments[5].mul_add(f, self.cn0)),
+            ),
         }
     }
 }

@@ -31,7 +31,6 @@ use crate::atmosphere::isa_troposphere;
 use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
 use crate::elementary::{asin, atan2};
 use crate::factors::{Factor, FactorError, Factors};
-use crate::frames::quaternion_rate;
 use crate::scenario::Scenario;
 
 pub use aero::{Coefficients, Flow};
@@ -170,6 +169,8 @@ pub struct RunSetup {
     pub inertia_principal: [f64; 3],
     /// Reciprocals of the diagonal (valid when `inertia_diagonal`).
     pub inertia_principal_inv: [f64; 3],
+    /// (Izz - Iyy, Ixx - Izz, Iyy - Ixx), for omega x (I omega) with a diagonal tensor.
+    pub inertia_principal_differences: [f64; 3],
     /// 0.5 rho S [kg/m]: multiplied by V^2 gives qbar S.
     pub half_rho_area: f64,
     /// Reference diameter d [m].
@@ -255,6 +256,7 @@ impl RunSetup {
             inertia_diagonal: true,
             inertia_principal: [0.0; 3],
             inertia_principal_inv: [0.0; 3],
+            inertia_principal_differences: [0.0; 3],
             half_rho_area: 0.5 * model.density_kg_m3 * model.area_m2,
             diameter_m: model.diameter_m,
             half_diameter_m: 0.5 * model.diameter_m,
@@ -299,6 +301,8 @@ impl RunSetup {
         let i = &run.inertia_kg_m2;
         run.inertia_principal = [i[(0, 0)], i[(1, 1)], i[(2, 2)]];
         run.inertia_principal_inv = run.inertia_principal.map(|d| 1.0 / d);
+        let [ixx, iyy, izz] = run.inertia_principal;
+        run.inertia_principal_differences = [izz - iyy, ixx - izz, iyy - ixx];
         Ok(run)
     }
 
@@ -340,6 +344,9 @@ impl RunSetup {
     /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
     /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
     /// allocation. Each block cites the MODEL.md line it implements.
+    ///
+    /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
+    /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
     #[inline(always)]
     pub fn derivative(&self, curve: &EjectorCurve, x: &StateVector, on: [bool; 2]) -> StateVector {
         let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
@@ -353,14 +360,14 @@ impl RunSetup {
         let [u, v, w] = c.to_body(air);
         // Section 3: V = |v_air| (rotation-invariant, so taken in L), qbar = 0.5 rho V^2,
         // alpha = atan2(w, u), beta = asin(v / V), p^ = p d / 2V (likewise q^, r^).
-        let speed2 = air[0] * air[0] + air[1] * air[1] + air[2] * air[2];
+        let speed2 = dot(air, air);
         let inv_speed = 1.0 / speed2.sqrt();
         let qbar_area = self.half_rho_area * speed2;
         let alpha = atan2(w, u);
         let beta = asin(v * inv_speed);
         let rate_scale = self.half_diameter_m * inv_speed;
         // Section 1: interference decay with s = |r|.
-        let f_s = self.decay.factor((rx * rx + ry * ry + rz * rz).sqrt());
+        let f_s = self.decay.factor(dot([rx, ry, rz], [rx, ry, rz]).sqrt());
         let flow = Flow {
             alpha_rad: alpha,
             beta_rad: beta,
@@ -381,8 +388,8 @@ impl RunSetup {
         let qbar_area_d = qbar_area * self.diameter_m;
         let x_ref = self.aero_reference_x_m;
         let mx = qbar_area_d * k.cl;
-        let mut my = qbar_area_d * k.cm - x_ref * fz;
-        let mut mz = qbar_area_d * k.cn + x_ref * fy;
+        let mut my = (-x_ref).mul_add(fz, qbar_area_d * k.cm);
+        let mut mz = x_ref.mul_add(fy, qbar_area_d * k.cn);
         // Section 3: F_L = C_LB F_aero_B.
         let [mut ax, mut ay, mut az] = c.to_launch([fx, fy, fz]);
 
@@ -392,7 +399,7 @@ impl RunSetup {
         if on[0] || on[1] {
             let d = &self.ejector_direction_l;
             for (foot, _) in self.feet.iter().zip(on).filter(|(_, on)| *on) {
-                let s_i = rz + c.m[2][0] * foot.x_m;
+                let s_i = c.m[2][0].mul_add(foot.x_m, rz);
                 let force_n = foot.fac * curve.force_n(s_i.clamp(0.0, self.stroke_m));
                 let f_l = [force_n * d.x, force_n * d.y, force_n * d.z];
                 ax += f_l[0];
@@ -400,8 +407,8 @@ impl RunSetup {
                 az += f_l[2];
                 let [_, by, bz] = c.to_body(f_l);
                 // (x, 0, 0) x (bx, by, bz) = (0, -x bz, x by)
-                my -= foot.x_m * bz;
-                mz += foot.x_m * by;
+                my = (-foot.x_m).mul_add(bz, my);
+                mz = foot.x_m.mul_add(by, mz);
             }
         }
 
@@ -416,9 +423,9 @@ impl RunSetup {
             vx,
             vy,
             vz,
-            g.x + ax * inv_m,
-            g.y + ay * inv_m,
-            g.z + az * inv_m,
+            ax.mul_add(inv_m, g.x),
+            ay.mul_add(inv_m, g.y),
+            az.mul_add(inv_m, g.z),
             dq0,
             dq1,
             dq2,
@@ -435,33 +442,49 @@ impl RunSetup {
     fn angular_acceleration(&self, m: [f64; 3], w: [f64; 3]) -> [f64; 3] {
         let [p, q, r] = w;
         if self.inertia_diagonal {
-            let [ixx, iyy, izz] = self.inertia_principal;
+            let [dyz, dzx, dxy] = self.inertia_principal_differences;
             let [jx, jy, jz] = self.inertia_principal_inv;
-            // omega x (I omega) for diagonal I.
+            // omega x (I omega) for diagonal I: ((Izz - Iyy) q r, (Ixx - Izz) r p,
+            // (Iyy - Ixx) p q).
             return [
-                (m[0] - (izz - iyy) * q * r) * jx,
-                (m[1] - (ixx - izz) * r * p) * jy,
-                (m[2] - (iyy - ixx) * p * q) * jz,
+                (-dyz * q).mul_add(r, m[0]) * jx,
+                (-dzx * r).mul_add(p, m[1]) * jy,
+                (-dxy * p).mul_add(q, m[2]) * jz,
             ];
         }
         let i = &self.inertia_kg_m2;
-        let h = [
-            i[(0, 0)] * p + i[(0, 1)] * q + i[(0, 2)] * r,
-            i[(1, 0)] * p + i[(1, 1)] * q + i[(1, 2)] * r,
-            i[(2, 0)] * p + i[(2, 1)] * q + i[(2, 2)] * r,
-        ];
+        let row = |k: usize| [i[(k, 0)], i[(k, 1)], i[(k, 2)]];
+        let h = [dot(row(0), w), dot(row(1), w), dot(row(2), w)];
         let t = [
-            m[0] - (q * h[2] - r * h[1]),
-            m[1] - (r * h[0] - p * h[2]),
-            m[2] - (p * h[1] - q * h[0]),
+            m[0] - q.mul_add(h[2], -r * h[1]),
+            m[1] - r.mul_add(h[0], -p * h[2]),
+            m[2] - p.mul_add(h[1], -q * h[0]),
         ];
         let j = &self.inertia_inv;
-        [
-            j[(0, 0)] * t[0] + j[(0, 1)] * t[1] + j[(0, 2)] * t[2],
-            j[(1, 0)] * t[0] + j[(1, 1)] * t[1] + j[(1, 2)] * t[2],
-            j[(2, 0)] * t[0] + j[(2, 1)] * t[1] + j[(2, 2)] * t[2],
-        ]
+        let row = |k: usize| [j[(k, 0)], j[(k, 1)], j[(k, 2)]];
+        [dot(row(0), t), dot(row(1), t), dot(row(2), t)]
     }
+}
+
+/// a . b with fused multiply-adds.
+#[inline(always)]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0].mul_add(b[0], a[1].mul_add(b[1], a[2] * b[2]))
+}
+
+/// Quaternion kinematics `dq/dt = 0.5 q (x) (0, omega)` (MODEL.md section 2), as
+/// [`crate::frames::quaternion_rate`] with fused multiply-adds.
+#[inline(always)]
+fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {
+    let [q0, q1, q2, q3] = q;
+    // Halving is exact: 0.5 (a p + b q + c r) = a (p/2) + b (q/2) + c (r/2).
+    let (hp, hq, hr) = (0.5 * p, 0.5 * qq, 0.5 * r);
+    [
+        -q1.mul_add(hp, q2.mul_add(hq, q3 * hr)),
+        q0.mul_add(hp, q2.mul_add(hr, -q3 * hq)),
+        q0.mul_add(hq, q3.mul_add(hp, -q1 * hr)),
+        q0.mul_add(hr, q1.mul_add(hq, -q2 * hp)),
+    ]
 }
 
 /// The direction-cosine matrix C_LB of one stage, row-major (`m[i][j]` = C_LB(i, j)).
@@ -472,30 +495,32 @@ pub struct Dcm {
 }
 
 impl Dcm {
-    /// C_LB of the quaternion (q0, q1, q2, q3) scaled to unit length (see [`crate::frames`]).
+    /// C_LB of the quaternion (q0, q1, q2, q3) scaled to unit length (see [`crate::frames`]):
+    /// the diagonal as 1 - 2 (qj^2 + qk^2) / |q|^2, the rest as 2 (qi qj -+ q0 qk) / |q|^2.
     #[inline(always)]
     pub fn from_quaternion(q0: f64, q1: f64, q2: f64, q3: f64) -> Dcm {
-        let (s00, s11, s22, s33) = (q0 * q0, q1 * q1, q2 * q2, q3 * q3);
-        let inv_n2 = 1.0 / ((s00 + s11) + (s22 + s33));
+        let (s11, s22, s33) = (q1 * q1, q2 * q2, q3 * q3);
+        let inv_n2 = 1.0 / q0.mul_add(q0, (s11 + s22) + s33);
         let two = 2.0 * inv_n2;
-        let (q0q1, q0q2, q0q3) = (q0 * q1, q0 * q2, q0 * q3);
-        let (q1q2, q1q3, q2q3) = (q1 * q2, q1 * q3, q2 * q3);
+        let m_two = -two;
+        // 2 (a b + c d) / |q|^2 with one rounding inside.
+        let off = |a: f64, b: f64, c: f64, d: f64| two * a.mul_add(b, c * d);
         Dcm {
             m: [
                 [
-                    ((s00 + s11) - (s22 + s33)) * inv_n2,
-                    two * (q1q2 - q0q3),
-                    two * (q1q3 + q0q2),
+                    m_two.mul_add(s22 + s33, 1.0),
+                    off(q1, q2, -q0, q3),
+                    off(q1, q3, q0, q2),
                 ],
                 [
-                    two * (q1q2 + q0q3),
-                    ((s00 - s11) + (s22 - s33)) * inv_n2,
-                    two * (q2q3 - q0q1),
+                    off(q1, q2, q0, q3),
+                    m_two.mul_add(s11 + s33, 1.0),
+                    off(q2, q3, -q0, q1),
                 ],
                 [
-                    two * (q1q3 - q0q2),
-                    two * (q2q3 + q0q1),
-                    ((s00 - s11) - (s22 - s33)) * inv_n2,
+                    off(q1, q3, -q0, q2),
+                    off(q2, q3, q0, q1),
+                    m_two.mul_add(s11 + s22, 1.0),
                 ],
             ],
         }
@@ -506,9 +531,9 @@ impl Dcm {
     pub fn to_body(&self, a: [f64; 3]) -> [f64; 3] {
         let m = &self.m;
         [
-            m[0][0] * a[0] + m[1][0] * a[1] + m[2][0] * a[2],
-            m[0][1] * a[0] + m[1][1] * a[1] + m[2][1] * a[2],
-            m[0][2] * a[0] + m[1][2] * a[1] + m[2][2] * a[2],
+            dot([m[0][0], m[1][0], m[2][0]], a),
+            dot([m[0][1], m[1][1], m[2][1]], a),
+            dot([m[0][2], m[1][2], m[2][2]], a),
         ]
     }
 
@@ -516,11 +541,7 @@ impl Dcm {
     #[inline(always)]
     pub fn to_launch(&self, b: [f64; 3]) -> [f64; 3] {
         let m = &self.m;
-        [
-            m[0][0] * b[0] + m[0][1] * b[1] + m[0][2] * b[2],
-            m[1][0] * b[0] + m[1][1] * b[1] + m[1][2] * b[2],
-            m[2][0] * b[0] + m[2][1] * b[1] + m[2][2] * b[2],
-        ]
+        [dot(m[0], b), dot(m[1], b), dot(m[2], b)]
     }
 }
 
