@@ -30,14 +30,22 @@ const MOREBITS: f64 = 6.123_233_995_736_766e-17;
 fn atan_nonnegative(x: f64) -> f64 {
     // Cephes atan.c: reduce to [0, 0.66].
     const T3P8: f64 = 2.414_213_562_373_095; // tan(3 pi / 8)
+    if x <= 0.66 {
+        // The store's case (|alpha| < 33 deg): no reduction.
+        return x.mul_add(atan_ratio(x * x), x);
+    }
     let (offset, extra, t) = if x > T3P8 {
         (FRAC_PI_2, MOREBITS, -1.0 / x)
-    } else if x > 0.66 {
-        (FRAC_PI_4, 0.5 * MOREBITS, (x - 1.0) / (x + 1.0))
     } else {
-        (0.0, 0.0, x)
+        (FRAC_PI_4, 0.5 * MOREBITS, (x - 1.0) / (x + 1.0))
     };
-    let z = t * t;
+    offset + (t + t.mul_add(atan_ratio(t * t), extra))
+}
+
+/// Cephes atan.c's rational part: atan(t) = t + t z P(z) / Q(z), z = t^2 <= 0.66^2; returns
+/// z P(z) / Q(z).
+#[inline(always)]
+fn atan_ratio(z: f64) -> f64 {
     let p = horner(
         z,
         -8.750_608_600_031_904e-1,
@@ -59,7 +67,7 @@ fn atan_nonnegative(x: f64) -> f64 {
             1.945_506_571_482_614e2,
         ],
     );
-    offset + (t + t.mul_add(z * p / q, extra))
+    z * p / q
 }
 
 /// `c0 x^n + c[0] x^(n-1) + ... + c[n-1]` by Horner's rule with fused multiply-adds.

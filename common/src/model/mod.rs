@@ -379,8 +379,8 @@ impl RunSetup {
         };
         // Section 3: the six coefficients, then the catalogue's extra terms (section 7).
         let mut k = self.aero.coefficients(&flow, &self.interference_increments);
-        for (term, params) in &self.coefficient_terms[..self.coefficient_term_count] {
-            term(params, &flow, &mut k);
+        if self.coefficient_term_count > 0 {
+            self.add_coefficient_terms(&flow, &mut k);
         }
         // Section 3: F_aero_B = qbar S (CX, CY, CZ); M_aero_B = qbar S d (Cl, Cm, Cn), moved
         // from the moment reference point (x_ref, 0, 0) to the CG: M += (x_ref, 0, 0) x F.
@@ -434,6 +434,15 @@ impl RunSetup {
             dq,
             dr,
         ]
+    }
+
+    /// Adds the catalogue's coefficient terms (section 7). Out of line, so that the flow and
+    /// the coefficients go through memory only when there are terms.
+    #[inline(never)]
+    fn add_coefficient_terms(&self, flow: &Flow, k: &mut Coefficients) {
+        for (term, params) in &self.coefficient_terms[..self.coefficient_term_count] {
+            term(params, flow, k);
+        }
     }
 
     /// I^-1 (M - omega x (I omega)) (MODEL.md section 2), with a short path for the diagonal
