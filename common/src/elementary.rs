@@ -82,7 +82,8 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     if x > 0.0 {
         // The store's case: flying forward. One division, no quadrant logic.
         let a = atan_nonnegative((y / x).abs());
-        return if y < 0.0 { -a } else { a };
+        // The sign of y, as f64::atan2 (which keeps that of a zero y too).
+        return a.copysign(y);
     }
     atan2_other_quadrants(y, x)
 }
@@ -118,7 +119,8 @@ pub fn exp(x: f64) -> f64 {
     }
     // n = round(x / ln 2), by the 1.5 * 2^52 trick (exact for |x / ln 2| < 2^51).
     const ROUND: f64 = 6_755_399_441_055_744.0;
-    let n = LOG2E.mul_add(x, ROUND) - ROUND;
+    let shifted = LOG2E.mul_add(x, ROUND);
+    let n = shifted - ROUND;
     let r = (-n).mul_add(C2, (-n).mul_add(C1, x));
     let rr = r * r;
     let p = r * horner(
@@ -133,7 +135,9 @@ pub fn exp(x: f64) -> f64 {
     );
     let e = 2.0f64.mul_add(p / (q - p), 1.0);
     // Scale by 2^n through the exponent bits (n is within the normal range here).
-    e * f64::from_bits(((n as i64 + 1023) as u64) << 52)
+    // n sits in the low bits of `shifted` (two's complement, |n| < 2^51), so the exponent
+    // field (n + 1023) << 52 is formed without a float-to-integer conversion.
+    e * f64::from_bits(shifted.to_bits().wrapping_add(1023) << 52)
 }
 
 /// Arc sine, as `f64::asin` (to within a few ulp), for x in [-1, 1]; NaN outside.
@@ -168,7 +172,8 @@ pub fn asin(x: f64) -> f64 {
         ],
     );
     let r = a.mul_add(z * p / q, a);
-    if x < 0.0 { -r } else { r }
+    // The sign of x, as f64::asin (which keeps that of a zero x too).
+    r.copysign(x)
 }
 
 #[cold]

@@ -350,6 +350,9 @@ impl RunSetup {
     #[inline(always)]
     pub fn derivative(&self, curve: &EjectorCurve, x: &StateVector, on: [bool; 2]) -> StateVector {
         let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
+        // Section 1: interference decay with s = |r|. First: its input is ready long before
+        // the stage's velocity and attitude, so the exponential overlaps the rest.
+        let f_s = self.decay.factor(dot([rx, ry, rz], [rx, ry, rz]).sqrt());
         // Section 2: C_LB of the stage's quaternion (one DCM per stage).
         let c = Dcm::from_quaternion(q0, q1, q2, q3);
 
@@ -366,8 +369,6 @@ impl RunSetup {
         let alpha = atan2(w, u);
         let beta = asin(v * inv_speed);
         let rate_scale = self.half_diameter_m * inv_speed;
-        // Section 1: interference decay with s = |r|.
-        let f_s = self.decay.factor(dot([rx, ry, rz], [rx, ry, rz]).sqrt());
         let flow = Flow {
             alpha_rad: alpha,
             beta_rad: beta,
