@@ -5,6 +5,7 @@
 #![deny(clippy::float_cmp)]
 
 pub mod checkpoint;
+pub mod figures;
 pub mod fit;
 pub mod inputs;
 pub mod ipc;
