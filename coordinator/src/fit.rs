@@ -379,3 +379,103 @@ fn progress_bar(enabled: bool, len: u64) -> ProgressBar {
     );
     bar
 }
+
+/// Writes the fit's figures into DIR/figures: the study's Figures 1-6 (trajectories of the
+/// first event against each method's best), Figure 7 (factors beside the truth, when known),
+/// the Pareto fronts and the convergence histories. Returns the files written.
+pub fn write_fit_figures(dir: &Path, job: &Job, output: &FitOutput) -> Result<Vec<PathBuf>> {
+    use crate::figures::{
+        Series, convergence_figure, factor_figure, pareto_figure, trajectory_figures,
+    };
+    use sepval_common::factors::Factor;
+    let fig_dir = dir.join("figures");
+    std::fs::create_dir_all(&fig_dir)
+        .with_context(|| format!("cannot create {}", fig_dir.display()))?;
+    let r = &output.result;
+    fn label(m: &str) -> String {
+        match m {
+            "ga" => "genetic algorithm".to_string(),
+            "hill" => "hill climber".to_string(),
+            other => other.to_string(),
+        }
+    }
+    let first = &job.events()[0];
+    let fits: Vec<(String, sepval_common::telemetry::Trajectory)> = output
+        .best_samples
+        .iter()
+        .map(|(m, samples)| {
+            let obs = &samples[0];
+            let traj = sepval_common::telemetry::Trajectory {
+                times_s: first.data.times_s.clone(),
+                pos_m: obs.iter().map(|o| o.pos_m).collect(),
+                att_deg: obs.iter().map(|o| o.att_deg).collect(),
+                ..Default::default()
+            };
+            (label(m), traj)
+        })
+        .collect();
+    let series: Vec<Series> = fits
+        .iter()
+        .map(|(l, t)| Series { label: l, traj: t })
+        .collect();
+    let mut written = trajectory_figures(&fig_dir, &first.data, &series)?;
+
+    let table = job.factor_table();
+    let ranges: Vec<(f64, f64)> = table.0.iter().map(|s| (s.min, s.max)).collect();
+    let method_values: Vec<(String, Vec<f64>)> = r
+        .methods
+        .iter()
+        .map(|(m, v)| (label(m), v.best.factors.0.to_vec()))
+        .collect();
+    let methods: Vec<(&str, &[f64])> = method_values
+        .iter()
+        .map(|(l, v)| (l.as_str(), v.as_slice()))
+        .collect();
+    let truth = r.truth.map(|t| t.0.to_vec());
+    let path = fig_dir.join("fig7_factors.png");
+    factor_figure(&path, &Factor::NAMES, &ranges, &methods, truth.as_deref())?;
+    written.push(path);
+
+    let fronts_data: Vec<(String, Vec<[f64; 2]>)> = r
+        .methods
+        .iter()
+        .map(|(m, v)| {
+            (
+                label(m),
+                v.pareto_front
+                    .iter()
+                    .map(|p| [p.j_pos_m, p.j_att_deg])
+                    .collect(),
+            )
+        })
+        .collect();
+    let fronts: Vec<(&str, &[[f64; 2]])> = fronts_data
+        .iter()
+        .map(|(l, v)| (l.as_str(), v.as_slice()))
+        .collect();
+    let path = fig_dir.join("pareto_front.png");
+    pareto_figure(&path, &fronts, Some((r.sigma_pos_m, r.sigma_att_deg)))?;
+    written.push(path);
+
+    let hist_data: Vec<(String, Vec<(u64, f64)>)> = r
+        .methods
+        .iter()
+        .map(|(m, v)| {
+            (
+                label(m),
+                v.history
+                    .iter()
+                    .map(|h| (h.evaluations, h.best_weighted))
+                    .collect(),
+            )
+        })
+        .collect();
+    let hists: Vec<(&str, &[(u64, f64)])> = hist_data
+        .iter()
+        .map(|(l, v)| (l.as_str(), v.as_slice()))
+        .collect();
+    let path = fig_dir.join("convergence.png");
+    convergence_figure(&path, &hists, Some(2.0))?;
+    written.push(path);
+    Ok(written)
+}

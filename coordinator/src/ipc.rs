@@ -75,6 +75,8 @@ pub struct IpcOptions {
     pub join_timeout: Duration,
     /// Most replacement workers spawned over the run.
     pub max_respawns: usize,
+    /// Protocol version to announce in the setup instead of ours (compatibility testing).
+    pub announce_protocol: Option<u32>,
 }
 
 /// One connected worker.
@@ -163,7 +165,10 @@ impl Connection {
             )));
         }
         let svc = |n: &str| sipc::service_name(n).map_err(transport);
-        let (header, bytes) = encode_setup(&job);
+        let (mut header, bytes) = encode_setup(&job);
+        if let Some(v) = options.announce_protocol {
+            header.protocol = v;
+        }
         let setup = node
             .service_builder(&svc(names::SETUP)?)
             .publish_subscribe::<[u8]>()
@@ -767,7 +772,13 @@ impl IpcEvaluator {
             eprintln!("sepval: cleaned the stale iceoryx2 resources of run {id}");
         }
         let run_id = options.run_id.clone();
-        let connection = Connection::start(Arc::clone(&job), options)?;
+        let connection = match Connection::start(Arc::clone(&job), options) {
+            Ok(c) => c,
+            Err(e) => {
+                let _ = sipc::clean_run_if_stale(&run_id);
+                return Err(e);
+            }
+        };
         Ok(IpcEvaluator {
             connection: Some(connection),
             job,

@@ -53,6 +53,8 @@ enum Command {
     Fit(Box<FitArgs>),
     /// Re-evaluate a saved generation and check every goal bit for bit.
     Rerun(RerunArgs),
+    /// Remove the shared-memory resources of sepval runs whose processes are all gone.
+    CleanIpc,
 }
 
 #[derive(clap::Args)]
@@ -151,6 +153,9 @@ struct EvalArgs {
     /// How long to wait for workers to join [s].
     #[arg(long, default_value_t = 60.0, value_name = "S")]
     join_timeout: f64,
+    /// Announce this protocol version in the job setup (compatibility testing only).
+    #[arg(long, hide = true)]
+    announce_protocol: Option<u32>,
 }
 
 #[derive(clap::Args)]
@@ -212,6 +217,15 @@ fn main() -> ExitCode {
         Command::Scenario(args) => scenario(args),
         Command::Fit(args) => fit(*args),
         Command::Rerun(args) => rerun(args),
+        Command::CleanIpc => {
+            let cleaned = sepval_common::ipc::clean_stale_runs("");
+            println!(
+                "cleaned {} stale run(s) {}",
+                cleaned.len(),
+                cleaned.join(" ")
+            );
+            Ok(())
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -329,6 +343,7 @@ fn evaluator(args: &EvalArgs, job: Job) -> Result<Box<dyn Evaluator>> {
                 chunk_deadline: secs("--worker-timeout", args.worker_timeout)?,
                 join_timeout: secs("--join-timeout", args.join_timeout)?,
                 max_respawns: 2 * workers + 2,
+                announce_protocol: args.announce_protocol,
             };
             Ok(Box::new(IpcEvaluator::start(job, options)?))
         }
@@ -461,7 +476,13 @@ fn fit(args: FitArgs) -> Result<()> {
     Ok(())
 }
 
-fn figures(_dir: &std::path::Path, _job: &Job, _output: &FitOutput) -> Result<()> {
+fn figures(dir: &std::path::Path, job: &Job, output: &FitOutput) -> Result<()> {
+    let written = sepval_coordinator::fit::write_fit_figures(dir, job, output)?;
+    println!(
+        "{} figures in {}",
+        written.len(),
+        dir.join("figures").display()
+    );
     Ok(())
 }
 

@@ -56,7 +56,6 @@ fn a_reduced_fit_improves_on_the_nominal_start_by_a_wide_margin() {
             "40",
             "--hill-budget",
             "500",
-            "--no-figures",
             "--seed",
             "7",
             "--out",
@@ -111,6 +110,20 @@ fn a_reduced_fit_improves_on_the_nominal_start_by_a_wide_margin() {
         r["truth"].is_object(),
         "the default data's truth is reported"
     );
+    for f in [
+        "fig1_pitch",
+        "fig2_yaw",
+        "fig3_roll",
+        "fig4_downrange",
+        "fig5_crossrange",
+        "fig6_altitude",
+        "fig7_factors",
+        "pareto_front",
+        "convergence",
+    ] {
+        let png = std::fs::read(dir.path().join(format!("run/figures/{f}.png"))).unwrap();
+        assert_eq!(&png[1..4], b"PNG", "{f}");
+    }
     for g in 1..=25 {
         assert!(
             dir.path()

@@ -1,2 +1,206 @@
-//! End-to-end tests of sepval live in `tests/`; this library is empty on purpose: the crate
-//! exists to run the `sepval` and `sepval-worker` binaries as a user would.
+//! Shared fixtures of the end-to-end tests: the binaries under test, unique run ids, process
+//! lookup by run id, and waits that always have a deadline.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+/// Path of a binary built beside the tests (`sepval`, `sepval-worker`). `cargo test
+/// --workspace` builds them (their packages have integration tests).
+pub fn binary(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable");
+    let dir = exe.parent().and_then(Path::parent).expect("target dir");
+    let path = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
+    assert!(
+        path.exists(),
+        "{} is missing: run the tests with `cargo test --release --workspace`",
+        path.display()
+    );
+    path
+}
+
+/// A run id unique to this test process and call.
+pub fn run_id(tag: &str) -> String {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    format!(
+        "t{}-{tag}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    )
+}
+
+/// Runs `sepval` to completion.
+pub fn sepval(args: &[&str], dir: &Path) -> Output {
+    Command::new(binary("sepval"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run sepval")
+}
+
+/// Starts `sepval` in the background (stdout and stderr captured).
+pub fn spawn_sepval(args: &[&str], dir: &Path) -> Child {
+    Command::new(binary("sepval"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start sepval")
+}
+
+/// Starts a worker of `run` (stderr captured).
+pub fn spawn_worker(run: &str, extra: &[&str]) -> Child {
+    Command::new(binary("sepval-worker"))
+        .args(["--run", run])
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start sepval-worker")
+}
+
+/// Asserts success and returns stdout.
+pub fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "sepval failed: {}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Polls `condition` until it holds or `deadline` passes (then panics with `what`).
+pub fn wait_for(what: &str, deadline: Duration, mut condition: impl FnMut() -> bool) {
+    let end = Instant::now() + deadline;
+    while !condition() {
+        assert!(
+            Instant::now() < end,
+            "timed out after {deadline:?} waiting for {what}"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// Waits for a child to exit, killing it and panicking if it has not within `deadline`.
+pub fn wait_exit(child: &mut Child, what: &str, deadline: Duration) -> Output {
+    let end = Instant::now() + deadline;
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            break;
+        }
+        if Instant::now() >= end {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{what} did not exit within {deadline:?}");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let mut out = Output {
+        status: child.wait().expect("wait"),
+        stdout: Vec::new(),
+        stderr: Vec::new(),
+    };
+    use std::io::Read;
+    if let Some(mut s) = child.stdout.take() {
+        let _ = s.read_to_end(&mut out.stdout);
+    }
+    if let Some(mut s) = child.stderr.take() {
+        let _ = s.read_to_end(&mut out.stderr);
+    }
+    out
+}
+
+/// Process ids whose command line mentions run `run` (workers: `--run RUN`; coordinators:
+/// `--run-id RUN` or `--attach RUN`).
+pub fn processes_of_run(run: &str) -> Vec<i32> {
+    let mut pids = Vec::new();
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return pids;
+    };
+    for e in entries.flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else {
+            continue;
+        };
+        let Ok(cmd) = std::fs::read(e.path().join("cmdline")) else {
+            continue;
+        };
+        let args: Vec<String> = cmd
+            .split(|b| *b == 0)
+            .map(|a| String::from_utf8_lossy(a).into_owned())
+            .collect();
+        let mentions = args
+            .windows(2)
+            .any(|w| (w[0] == "--run" || w[0] == "--run-id" || w[0] == "--attach") && w[1] == run);
+        // Skip zombies: they hold no resources and are reaped by their parent.
+        let zombie = std::fs::read_to_string(e.path().join("stat"))
+            .map(|s| s.split_whitespace().nth(2) == Some("Z"))
+            .unwrap_or(false);
+        if mentions && !zombie {
+            pids.push(pid);
+        }
+    }
+    pids
+}
+
+/// Worker process ids of `run`.
+pub fn workers_of_run(run: &str) -> Vec<i32> {
+    processes_of_run(run)
+        .into_iter()
+        .filter(|pid| {
+            std::fs::read(format!("/proc/{pid}/cmdline"))
+                .map(|c| String::from_utf8_lossy(&c).contains("sepval-worker"))
+                .unwrap_or(false)
+        })
+        .collect()
+}
+
+/// Sends `signal` to `pid`.
+pub fn signal(pid: i32, signal: i32) {
+    // SAFETY: kill(2) on a process id we found; a vanished process only makes it fail.
+    unsafe {
+        libc::kill(pid, signal);
+    }
+}
+
+/// Shared-memory files of run `run` in /dev/shm.
+pub fn shm_files_of_run(run: &str) -> Vec<String> {
+    let prefix = format!("sepval_{run}_");
+    std::fs::read_dir("/dev/shm")
+        .map(|d| {
+            d.flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.starts_with(&prefix))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Asserts that run `run` left no process and no shared memory behind (processes get a few
+/// seconds to notice that their coordinator is gone).
+pub fn assert_run_gone(run: &str) {
+    wait_for(
+        &format!("the processes of run {run} to exit"),
+        Duration::from_secs(10),
+        || processes_of_run(run).is_empty(),
+    );
+    let files = shm_files_of_run(run);
+    assert!(
+        files.is_empty(),
+        "run {run} left shared memory behind: {files:?}"
+    );
+}
+
+/// The deterministic part of a result.json (without timings and the evaluator description).
+pub fn deterministic_part(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let mut v: serde_json::Value = serde_json::from_str(&text).expect("json");
+    v.as_object_mut().expect("object").remove("run");
+    for m in v["methods"].as_object_mut().expect("methods").values_mut() {
+        m["best"].as_object_mut().expect("best").remove("wall_s");
+    }
+    v
+}

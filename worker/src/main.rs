@@ -53,7 +53,10 @@ const LIVENESS_TICK: Duration = Duration::from_millis(500);
 fn main() -> ExitCode {
     let cli = Cli::parse();
     iceoryx2::prelude::set_log_level(LogLevel::Error);
-    match serve(&cli) {
+    let result = serve(&cli);
+    // The last process of a run leaves nothing behind on the host.
+    let _ = sipc::clean_run_if_stale(&cli.run);
+    match result {
         Ok(Some(reason)) => {
             eprintln!("sepval-worker: {reason}");
             ExitCode::SUCCESS
@@ -169,6 +172,33 @@ fn serve(cli: &Cli) -> Result<Option<String>> {
         .notifier_builder()
         .create()
         .map_err(sipc::iox("notifying the coordinator"))?;
+    // The job setup (delivered from the service's history). A setup we refuse ends the
+    // worker at once; we announce ourselves only once we have accepted it.
+    let job = loop {
+        if let Some(sample) = setup_sub
+            .receive()
+            .map_err(sipc::iox("receiving the setup"))?
+        {
+            let header: SetupHeader = *sample.user_header();
+            check_setup_header(&header)
+                .map_err(|e| anyhow::anyhow!("refusing the setup of run {}: {e}", cli.run))?;
+            break decode_setup(&header, sample.payload()).with_context(|| {
+                format!(
+                    "refusing the setup {} of run {}",
+                    setup_hash_hex(&header),
+                    cli.run
+                )
+            })?;
+        }
+        if Instant::now() >= open_deadline {
+            bail!(
+                "no job setup arrived from run {} within {} s",
+                cli.run,
+                cli.setup_timeout
+            );
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
     let hello_pub = node
         .service_builder(&svc(names::HELLO)?)
         .publish_subscribe::<Hello>()
@@ -186,31 +216,6 @@ fn serve(cli: &Cli) -> Result<Option<String>> {
         })
         .map_err(sipc::iox("sending hello"))?;
     let _ = coordinator_wake.notify();
-
-    // The job setup (delivered from the service's history).
-    let job = retry_until(open_deadline, || {
-        match setup_sub
-            .receive()
-            .map_err(sipc::iox("receiving the setup"))?
-        {
-            Some(sample) => {
-                let header: SetupHeader = *sample.user_header();
-                check_setup_header(&header)
-                    .map_err(|e| anyhow::anyhow!("refusing the setup of run {}: {e}", cli.run))?;
-                let job = decode_setup(&header, sample.payload()).with_context(|| {
-                    format!(
-                        "refusing the setup {} of run {}",
-                        setup_hash_hex(&header),
-                        cli.run
-                    )
-                })?;
-                Ok(Some(job))
-            }
-            None => Ok(None),
-        }
-        .and_then(|j: Option<Job>| j.ok_or_else(|| anyhow::anyhow!("no setup yet")))
-    })
-    .context("no job setup arrived")?;
 
     let waitset = WaitSetBuilder::new()
         .create::<ipc::Service>()
