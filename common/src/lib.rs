@@ -34,6 +34,7 @@ pub mod scenario;
 pub mod simulation;
 pub mod synthetic;
 pub mod telemetry;
+pub mod uds;
 pub mod units;
 
 pub use effects::EffectSet;

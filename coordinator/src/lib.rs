@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod bench;
 pub mod checkpoint;
 pub mod figures;
 pub mod fit;
@@ -14,3 +15,4 @@ pub mod rerun;
 pub mod results;
 pub mod rng;
 pub mod search;
+pub mod uds;

@@ -53,6 +53,8 @@ enum Command {
     Fit(Box<FitArgs>),
     /// Re-evaluate a saved generation and check every goal bit for bit.
     Rerun(RerunArgs),
+    /// Measure simulations per second against worker count for each transport.
+    Bench(BenchArgs),
     /// Remove the shared-memory resources of sepval runs whose processes are all gone.
     CleanIpc,
 }
@@ -109,6 +111,22 @@ struct FitArgs {
     #[arg(long)]
     no_figures: bool,
     /// Run directory (result.json, generations/, figures/).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Worker counts, comma-separated.
+    #[arg(long, default_value = "1,2,4", value_delimiter = ',')]
+    workers: Vec<usize>,
+    /// Simulations per measurement.
+    #[arg(long, default_value_t = 2000)]
+    evals: usize,
+    /// Transports, comma-separated (single, pool, ipc, uds).
+    #[arg(long, default_value = "single,pool,ipc,uds", value_delimiter = ',')]
+    transports: Vec<String>,
+    /// Output directory (bench.csv, bench.png).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
 }
@@ -217,6 +235,7 @@ fn main() -> ExitCode {
         Command::Scenario(args) => scenario(args),
         Command::Fit(args) => fit(*args),
         Command::Rerun(args) => rerun(args),
+        Command::Bench(args) => bench(args),
         Command::CleanIpc => {
             let cleaned = sepval_common::ipc::clean_stale_runs("");
             println!(
@@ -345,7 +364,12 @@ fn evaluator(args: &EvalArgs, job: Job) -> Result<Box<dyn Evaluator>> {
                 max_respawns: 2 * workers + 2,
                 announce_protocol: args.announce_protocol,
             };
-            Ok(Box::new(IpcEvaluator::start(job, options)?))
+            let evaluator = IpcEvaluator::start(job, options)?;
+            eprintln!(
+                "sepval: run {} with {workers} worker process(es)",
+                evaluator.run_id()
+            );
+            Ok(Box::new(evaluator))
         }
         other => anyhow::bail!("--evaluator {other}: expected ipc or inproc"),
     }
@@ -520,4 +544,39 @@ fn rerun(args: RerunArgs) -> Result<()> {
         checkpoint.state.generation,
         mismatches.len()
     )
+}
+
+fn bench(args: BenchArgs) -> Result<()> {
+    use sepval_coordinator::bench::{BenchOptions, run_bench, table, write_outputs};
+    if let Some(w) = args.workers.iter().find(|w| **w == 0 || **w > 64) {
+        anyhow::bail!("--workers {w}: expected 1 to 64");
+    }
+    let (job, _) = inputs::job(&[], None)?;
+    let options = BenchOptions {
+        workers: args.workers.clone(),
+        evals: args.evals,
+        transports: args.transports.clone(),
+        worker_executable: worker_executable()?,
+    };
+    eprintln!(
+        "benchmarking {} simulations of the default event per measurement on {} core(s)",
+        args.evals,
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    );
+    let rows = run_bench(Arc::new(job), &options, &mut |r| {
+        eprintln!(
+            "  {:<6} {} worker(s): {:.0} simulations/s",
+            r.transport,
+            r.workers,
+            r.evals_per_s()
+        );
+    })?;
+    print!("{}", table(&rows));
+    write_outputs(&args.out, &rows)?;
+    println!(
+        "wrote {} and {}",
+        args.out.join("bench.csv").display(),
+        args.out.join("bench.png").display()
+    );
+    Ok(())
 }

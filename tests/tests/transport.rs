@@ -329,3 +329,28 @@ fn a_worker_outlives_its_coordinator_by_at_most_a_few_seconds() {
     assert_run_gone(&run);
     ok(&sepval(&["clean-ipc"], dir.path()));
 }
+
+#[test]
+fn bench_writes_its_table_csv_and_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = ok(&sepval(
+        &["bench", "--workers", "1,2", "--evals", "16", "--out", "b"],
+        dir.path(),
+    ));
+    for t in ["single", "pool", "ipc", "uds"] {
+        assert!(out.contains(t), "{out}");
+    }
+    let csv = std::fs::read_to_string(dir.path().join("b/bench.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("transport,workers,evals,wall_s,evals_per_s")
+    );
+    // single once, pool/ipc/uds for 1 and 2 workers.
+    assert_eq!(lines.count(), 7);
+    let png = std::fs::read(dir.path().join("b/bench.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    let bad = sepval(&["bench", "--workers", "0", "--out", "c"], dir.path());
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--workers 0: expected 1 to 64"));
+}

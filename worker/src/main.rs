@@ -35,10 +35,14 @@ use sepval_common::messages::{
                   would), run `sepval fit --attach RUN_ID --workers N` and then N times \
                   `sepval-worker --run RUN_ID`."
 )]
+#[command(group(clap::ArgGroup::new("transport").required(true).args(["run", "uds"])))]
 struct Cli {
     /// The run to join (the coordinator prints it).
     #[arg(long, value_name = "RUN_ID")]
-    run: String,
+    run: Option<String>,
+    /// Serve over this Unix domain socket instead (the throughput benchmark's comparison).
+    #[arg(long, value_name = "PATH")]
+    uds: Option<std::path::PathBuf>,
     /// How long to wait for the coordinator's job setup [s].
     #[arg(long, default_value_t = 30.0, value_name = "S")]
     setup_timeout: f64,
@@ -53,9 +57,16 @@ const LIVENESS_TICK: Duration = Duration::from_millis(500);
 fn main() -> ExitCode {
     let cli = Cli::parse();
     iceoryx2::prelude::set_log_level(LogLevel::Error);
-    let result = serve(&cli);
-    // The last process of a run leaves nothing behind on the host.
-    let _ = sipc::clean_run_if_stale(&cli.run);
+    let result = match (&cli.run, &cli.uds) {
+        (Some(run), _) => {
+            let r = serve(&cli, run);
+            // The last process of a run leaves nothing behind on the host.
+            let _ = sipc::clean_run_if_stale(run);
+            r
+        }
+        (None, Some(path)) => serve_uds(path).map(|()| None),
+        (None, None) => unreachable!("clap requires one transport"),
+    };
     match result {
         Ok(Some(reason)) => {
             eprintln!("sepval-worker: {reason}");
@@ -71,8 +82,8 @@ fn main() -> ExitCode {
 
 /// Serves the run; returns why it stopped, when that is worth saying (not for the
 /// coordinator's own SIGTERM at the end of a run).
-fn serve(cli: &Cli) -> Result<Option<String>> {
-    let cfg = sipc::run_config(&cli.run)?;
+fn serve(cli: &Cli, run: &str) -> Result<Option<String>> {
+    let cfg = sipc::run_config(run)?;
     let node = NodeBuilder::new()
         .config(&cfg)
         .name(&NodeName::new(WORKER_NODE).map_err(sipc::iox("node name"))?)
@@ -153,12 +164,7 @@ fn serve(cli: &Cli) -> Result<Option<String>> {
             .open()
             .map_err(|e| anyhow::Error::from(sipc::iox("opening the setup service")(e)))
     })
-    .with_context(|| {
-        format!(
-            "no coordinator serves run {} (is the run id right?)",
-            cli.run
-        )
-    })?;
+    .with_context(|| format!("no coordinator serves run {} (is the run id right?)", run))?;
     let setup_sub = setup_service
         .subscriber_builder()
         .history_request(1)
@@ -181,19 +187,19 @@ fn serve(cli: &Cli) -> Result<Option<String>> {
         {
             let header: SetupHeader = *sample.user_header();
             check_setup_header(&header)
-                .map_err(|e| anyhow::anyhow!("refusing the setup of run {}: {e}", cli.run))?;
+                .map_err(|e| anyhow::anyhow!("refusing the setup of run {}: {e}", run))?;
             break decode_setup(&header, sample.payload()).with_context(|| {
                 format!(
                     "refusing the setup {} of run {}",
                     setup_hash_hex(&header),
-                    cli.run
+                    run
                 )
             })?;
         }
         if Instant::now() >= open_deadline {
             bail!(
                 "no job setup arrived from run {} within {} s",
-                cli.run,
+                run,
                 cli.setup_timeout
             );
         }
@@ -263,7 +269,7 @@ fn serve(cli: &Cli) -> Result<Option<String>> {
         if ticked && sipc::presence(&cfg, COORDINATOR_NODE)?.alive == 0 {
             return Ok(Some(format!(
                 "the coordinator of run {} is gone; exiting",
-                cli.run
+                run
             )));
         }
     }
@@ -329,6 +335,61 @@ fn publish(
         sample.write_from_fn(|i| WireResponse::new(evaluations[i].0, &evaluations[i].1.outcome));
     sample.send().map_err(sipc::iox("sending responses"))?;
     Ok(())
+}
+
+/// Serves chunks received as postcard frames over a Unix domain socket until the coordinator
+/// closes it.
+fn serve_uds(path: &std::path::Path) -> Result<()> {
+    use sepval_common::uds::{self, FromWorker, ToWorker, read_frame, write_frame};
+    let mut stream = std::os::unix::net::UnixStream::connect(path)
+        .with_context(|| format!("cannot connect to {}", path.display()))?;
+    let job = match read_frame::<ToWorker>(&mut stream)? {
+        ToWorker::Setup {
+            protocol,
+            sha256,
+            catalogue,
+            bytes,
+        } => {
+            let header = uds::setup_header(protocol, sha256, catalogue, bytes.len());
+            decode_setup(&header, &bytes).context("refusing the setup")?
+        }
+        ToWorker::Chunk { .. } => bail!("expected the job setup first, received a chunk"),
+    };
+    loop {
+        let frame = match read_frame::<ToWorker>(&mut stream) {
+            Ok(f) => f,
+            Err(uds::UdsError::Io(e)) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+                return Ok(());
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let ToWorker::Chunk {
+            chunk_id,
+            with_samples,
+            items,
+        } = frame
+        else {
+            bail!("received a second setup");
+        };
+        let items = items
+            .iter()
+            .map(|(index, factors, effects)| {
+                let e = match uds::candidate(factors, effects) {
+                    Ok(c) if with_samples => job.evaluate_with_samples(&c),
+                    Ok(c) => job.evaluate(&c),
+                    Err(reason) => Evaluation::from(Outcome::Failed {
+                        reason: format!("malformed request: {reason}"),
+                    }),
+                };
+                (
+                    *index,
+                    uds::OutcomeFrame::from(&e.outcome),
+                    e.samples.as_deref().map(uds::samples_out),
+                )
+            })
+            .collect();
+        write_frame(&mut stream, &FromWorker { chunk_id, items })?;
+    }
 }
 
 /// Retries `f` until it succeeds or `deadline` passes (then returns its last error).
