@@ -46,6 +46,9 @@ pub struct Checkpoint {
     pub inputs: InputsRecord,
     /// The search state after this generation.
     pub state: GaState,
+    /// Refinement attempts made so far (ga+lm).
+    #[serde(default)]
+    pub probes: Vec<crate::results::Probe>,
 }
 
 impl Checkpoint {

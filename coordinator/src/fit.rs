@@ -15,13 +15,16 @@ use sepval_common::noise::estimate_noise;
 use sepval_common::propagator::Observation;
 
 use crate::checkpoint::{CHECKPOINT_FORMAT, Checkpoint, InputsRecord};
+use crate::identifiability::identifiability;
 use crate::problem::{FactorProblem, factors_of};
+use crate::refine::{LmResult, LmSettings, Noise, ParamSpace, levenberg_marquardt};
 use crate::results::{
-    Best, ChannelRms, EventInfo, FitResult, FrontPoint, HistoryPoint, MethodResult, RESULT_FORMAT,
-    RunInfo, channel_rms, residuals,
+    Best, ChannelRms, EventInfo, FitResult, FloorInfo, FrontPoint, HistoryPoint, MethodResult,
+    Probe, RESULT_FORMAT, Refinement, ResolutionRow, RunInfo, channel_rms, residuals,
 };
-use crate::search::ga::{Control, GaSettings, GaState, GeneticAlgorithm, Member, update_archive};
+use crate::search::ga::{GaSettings, GaState, GeneticAlgorithm, Member, update_archive};
 use crate::search::hill::{HillSettings, HillStop, climb};
+use sepval_common::goals::residual;
 
 /// Which searches to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -32,6 +35,10 @@ pub enum Method {
     Hill,
     /// Both, as in the study's comparison.
     Both,
+    /// The genetic algorithm, then Levenberg-Marquardt refinement to the noise floor.
+    GaLm,
+    /// The hill climber, then Levenberg-Marquardt refinement.
+    HillLm,
 }
 
 impl Method {
@@ -41,7 +48,9 @@ impl Method {
             "ga" => Method::Ga,
             "hill" => Method::Hill,
             "both" => Method::Both,
-            other => bail!("--method {other}: expected ga, hill or both"),
+            "ga+lm" => Method::GaLm,
+            "hill+lm" => Method::HillLm,
+            other => bail!("--method {other}: expected ga, hill, both, ga+lm or hill+lm"),
         })
     }
 
@@ -51,15 +60,21 @@ impl Method {
             Method::Ga => "ga",
             Method::Hill => "hill",
             Method::Both => "both",
+            Method::GaLm => "ga+lm",
+            Method::HillLm => "hill+lm",
         }
     }
 
     fn runs_ga(self) -> bool {
-        matches!(self, Method::Ga | Method::Both)
+        matches!(self, Method::Ga | Method::Both | Method::GaLm)
     }
 
     fn runs_hill(self) -> bool {
-        matches!(self, Method::Hill | Method::Both)
+        matches!(self, Method::Hill | Method::Both | Method::HillLm)
+    }
+
+    fn refines(self) -> bool {
+        matches!(self, Method::GaLm | Method::HillLm)
     }
 }
 
@@ -142,7 +157,14 @@ pub struct FitOptions {
     pub inputs: InputsRecord,
     /// Show a progress bar (when stderr is a terminal).
     pub progress: bool,
+    /// The final refinement (`+lm` methods).
+    pub lm: LmSettings,
+    /// Refinement attempts during a genetic search (`ga+lm`).
+    pub lm_probe: LmSettings,
 }
+
+/// The floor is reached when both goals are within this factor of their noise sigma.
+pub const FLOOR_FACTOR: f64 = 1.1;
 
 /// A finished fit: the result file's content and the best trajectories for figures.
 pub struct FitOutput {
@@ -159,8 +181,19 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
         .with_context(|| format!("cannot create run directory {}", options.out.display()))?;
     let weights = options.sigma.weights();
     let table = *evaluator.job().factor_table();
+    let noise = Noise {
+        pos_m: options.sigma.pos_m,
+        att_deg: options.sigma.att_deg,
+    };
+    let floor = FloorInfo {
+        j_pos_m: FLOOR_FACTOR * noise.pos_m,
+        j_att_deg: FLOOR_FACTOR * noise.att_deg,
+    };
+    let at_floor = |g: [f64; 2]| g[0] <= floor.j_pos_m && g[1] <= floor.j_att_deg;
+    let space = ParamSpace::new(&table, &sepval_common::effects::EffectSet::NONE);
     let mut methods = BTreeMap::new();
     let mut best_samples = BTreeMap::new();
+    let mut refined: Vec<(String, LmResult)> = Vec::new();
 
     if options.method.runs_hill() {
         let t0 = Instant::now();
@@ -168,7 +201,7 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
         let start_values = table.clamp(&Factors::NOMINAL).0.to_vec();
         let r = climb(&mut problem, &start_values, weights, &options.hill)?;
         let front = update_archive(&[], &r.visited);
-        let history = r
+        let history: Vec<HistoryPoint> = r
             .history
             .iter()
             .enumerate()
@@ -180,27 +213,50 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
                 best_weighted: w,
             })
             .collect();
-        let wall_s = t0.elapsed().as_secs_f64();
-        let (rms, samples) = best_samples_of(evaluator, &r.best)?;
-        best_samples.insert("hill".to_string(), samples);
+        let mut to_floor = first_at_floor(&history, &at_floor);
         let stop = match r.stop {
             HillStop::Budget => "budget spent",
             HillStop::LocalOptimum => "local optimum (no downhill step above the minimum)",
             HillStop::StartFailed => "the start did not simulate",
         };
-        methods.insert(
-            "hill".to_string(),
-            method_result(
-                &r.best,
-                &front,
-                history,
-                r.evaluations,
-                wall_s,
-                weights,
+        let name = if options.method.refines() {
+            "hill+lm"
+        } else {
+            "hill"
+        };
+        let (best, rms, samples, refinement, evaluations) = if options.method.refines() {
+            let lm = refine_from(evaluator, &space, &r.best.values, noise, &options.lm)?;
+            if to_floor.is_none() {
+                to_floor = lm_first_at_floor(&lm, r.evaluations, &at_floor);
+            }
+            let (member, rms, samples, refinement) =
+                refined_member(evaluator, &space, &lm, &r.best, Vec::new());
+            refined.push((name.to_string(), lm.clone()));
+            (
+                member,
                 rms,
-                stop.into(),
-            ),
+                samples,
+                Some(refinement),
+                r.evaluations + lm.evaluations,
+            )
+        } else {
+            let (rms, samples) = best_samples_of(evaluator, &r.best)?;
+            (r.best.clone(), rms, samples, None, r.evaluations)
+        };
+        best_samples.insert(name.to_string(), samples);
+        let mut m = method_result(
+            &best,
+            &front,
+            history,
+            evaluations,
+            t0.elapsed().as_secs_f64(),
+            weights,
+            rms,
+            stop.into(),
         );
+        m.evaluations_to_floor = to_floor;
+        m.refinement = refinement;
+        methods.insert(name.to_string(), m);
     }
 
     if options.method.runs_ga() {
@@ -212,12 +268,7 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
             job.scenario_sha256().to_string(),
         );
         let bar = progress_bar(options.progress, options.ga.generations as u64);
-        let resume_state = options.resume.as_ref().map(|c| c.state.clone());
-        if let Some(s) = &resume_state {
-            bar.set_position(s.generation as u64);
-        }
-        let mut problem = FactorProblem::new(evaluator);
-        let mut observe = |state: &GaState| -> Result<Control> {
+        let save = |state: &GaState, probes: &[Probe]| -> Result<()> {
             let checkpoint = Checkpoint {
                 format: CHECKPOINT_FORMAT.to_string(),
                 method: options.method.name().to_string(),
@@ -228,28 +279,72 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
                 scenario_sha256: job_hashes.1.clone(),
                 inputs: options.inputs.clone(),
                 state: state.clone(),
+                probes: probes.to_vec(),
             };
             checkpoint.save(&Checkpoint::path(&options.out, state.generation))?;
             let h = state
                 .history
                 .last()
                 .expect("every state has its generation's stats");
-            let rate = state.evaluations as f64 / t0.elapsed().as_secs_f64().max(1e-9);
             bar.set_position(state.generation as u64);
             bar.set_message(format!(
                 "J_pos {:.4} m  J_att {:.3} deg  {:.0} sims/s",
-                h.best_j_pos_m, h.best_j_att_deg, rate
+                h.best_j_pos_m,
+                h.best_j_att_deg,
+                state.evaluations as f64 / t0.elapsed().as_secs_f64().max(1e-9)
             ));
-            Ok(Control::Continue)
+            Ok(())
         };
-        let state = ga.run(&mut problem, resume_state, &mut observe)?;
+        let (mut state, mut probes) = match &options.resume {
+            Some(c) => (c.state.clone(), c.probes.clone()),
+            None => {
+                let s = ga.initialize(&mut FactorProblem::new(evaluator))?;
+                save(&s, &[])?;
+                (s, Vec::new())
+            }
+        };
+        let mut reached: Option<(LmResult, u64)> = None;
+        let stop = loop {
+            if state.generation >= options.ga.generations {
+                break format!("{} generations", state.generation);
+            }
+            // ga+lm: when the search stagnates (or on a doubling schedule), try to refine its
+            // best member; once a refinement reaches the floor, further generations are
+            // pointless.
+            if options.method.refines() && refinement_due(&state, &probes) {
+                let best = state
+                    .best(weights)
+                    .cloned()
+                    .context("no finished member to refine")?;
+                let before: u64 =
+                    state.evaluations + probes.iter().map(|p| p.evaluations).sum::<u64>();
+                let lm = refine_from(evaluator, &space, &best.values, noise, &options.lm_probe)?;
+                let g = lm.goals.as_array();
+                probes.push(Probe {
+                    generation: state.generation,
+                    evaluations_before: before,
+                    evaluations: lm.evaluations,
+                    goals: g,
+                    reached_floor: at_floor(g),
+                });
+                if at_floor(g) {
+                    reached = Some((lm, before));
+                    break format!(
+                        "refinement after generation {} reached the noise floor",
+                        state.generation
+                    );
+                }
+            }
+            state = ga.step(&mut FactorProblem::new(evaluator), &state)?;
+            save(&state, &probes)?;
+        };
         bar.finish_and_clear();
         let best = state
             .best(weights)
             .cloned()
             .context("no member of the final population finished its simulation")?;
         let front = state.archive.clone();
-        let history = state
+        let history: Vec<HistoryPoint> = state
             .history
             .iter()
             .map(|h| HistoryPoint {
@@ -260,26 +355,73 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
                 best_weighted: h.best_weighted,
             })
             .collect();
-        let wall_s = t0.elapsed().as_secs_f64();
-        let (rms, samples) = best_samples_of(evaluator, &best)?;
-        best_samples.insert("ga".to_string(), samples);
-        let stop = format!("{} generations", state.generation);
-        methods.insert(
-            "ga".to_string(),
-            method_result(
-                &best,
-                &front,
-                history,
-                state.evaluations,
-                wall_s,
-                weights,
-                rms,
-                stop,
-            ),
+        let probe_evals: u64 = probes.iter().map(|p| p.evaluations).sum();
+        let mut to_floor = first_at_floor(&history, &at_floor);
+        let name = if options.method.refines() {
+            "ga+lm"
+        } else {
+            "ga"
+        };
+        let (best, rms, samples, refinement, evaluations) = if options.method.refines() {
+            // Simulations before the refinement that counts (search and earlier attempts),
+            // and in all.
+            let (lm, before, total) = match reached {
+                Some((lm, before)) => (lm, before, state.evaluations + probe_evals),
+                None => {
+                    let before = state.evaluations + probe_evals;
+                    let lm = refine_from(evaluator, &space, &best.values, noise, &options.lm)?;
+                    let total = before + lm.evaluations;
+                    (lm, before, total)
+                }
+            };
+            if to_floor.is_none() {
+                to_floor = lm_first_at_floor(&lm, before, &at_floor);
+            }
+            let earlier: Vec<Probe> = probes.clone();
+            let (member, rms, samples, refinement) =
+                refined_member(evaluator, &space, &lm, &best, earlier);
+            refined.push((name.to_string(), lm.clone()));
+            (member, rms, samples, Some(refinement), total)
+        } else {
+            let (rms, samples) = best_samples_of(evaluator, &best)?;
+            (best.clone(), rms, samples, None, state.evaluations)
+        };
+        best_samples.insert(name.to_string(), samples);
+        let mut m = method_result(
+            &best,
+            &front,
+            history,
+            evaluations,
+            t0.elapsed().as_secs_f64(),
+            weights,
+            rms,
+            stop,
         );
+        m.evaluations_to_floor = to_floor;
+        m.refinement = refinement;
+        methods.insert(name.to_string(), m);
     }
 
-    let job = evaluator.job();
+    // How sure the parameters are, at the best refined fit.
+    let best_refined = refined
+        .iter()
+        .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
+        .map(|(_, lm)| lm.clone());
+    let job = evaluator.job().clone();
+    let event_samples: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
+    let identifiability = best_refined
+        .as_ref()
+        .map(|lm| identifiability(&space, &lm.x, &lm.residuals, &lm.jacobian, &event_samples));
+    // What one grid step of each factor does at the best fit.
+    let best_factors = methods
+        .values()
+        .min_by(|a, b| a.best.weighted.total_cmp(&b.best.weighted))
+        .map(|m| m.best.factors);
+    let resolution = match best_factors {
+        Some(f) => resolution_advice(evaluator, &table, &f, noise)?,
+        None => Vec::new(),
+    };
+
     let result = FitResult {
         format: RESULT_FORMAT.to_string(),
         events: job
@@ -296,7 +438,10 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
         sigma_att_deg: options.sigma.att_deg,
         sigma_source: options.sigma.source.clone(),
         truth: options.truth,
+        floor,
         methods,
+        identifiability,
+        resolution,
         run: RunInfo {
             evaluator: evaluator.describe(),
             wall_s: start.elapsed().as_secs_f64(),
@@ -308,6 +453,152 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
         result,
         best_samples,
     })
+}
+
+/// A refinement is tried during ga+lm when the search has stagnated (the best weighted goal
+/// improved by less than 1 % over the last 10 generations) or at generations 10, 20, 40, 80,
+/// ..., and at least 10 generations after the previous attempt.
+pub fn refinement_due(state: &GaState, probes: &[Probe]) -> bool {
+    let g = state.generation;
+    if g < 10 || probes.last().is_some_and(|p| g < p.generation + 10) {
+        return false;
+    }
+    let scheduled = (g % 10 == 0) && (g / 10).is_power_of_two();
+    let h = &state.history;
+    let stagnant = h.len() > 10 && {
+        let then = h[h.len() - 11].best_weighted;
+        let now = h[h.len() - 1].best_weighted;
+        then.is_finite() && (then - now) < 0.01 * then
+    };
+    scheduled || stagnant
+}
+
+fn refine_from(
+    evaluator: &mut dyn Evaluator,
+    space: &ParamSpace,
+    start: &[f64],
+    noise: Noise,
+    settings: &LmSettings,
+) -> Result<LmResult> {
+    levenberg_marquardt(evaluator, space, start, noise, settings, &mut |_, _| {})
+}
+
+/// Simulations at which the history first has both goals at the floor.
+fn first_at_floor(history: &[HistoryPoint], at_floor: &dyn Fn([f64; 2]) -> bool) -> Option<u64> {
+    history
+        .iter()
+        .find(|h| at_floor([h.best_j_pos_m, h.best_j_att_deg]))
+        .map(|h| h.evaluations)
+}
+
+fn lm_first_at_floor(
+    lm: &LmResult,
+    before: u64,
+    at_floor: &dyn Fn([f64; 2]) -> bool,
+) -> Option<u64> {
+    lm.history
+        .iter()
+        .find(|(_, g)| at_floor(g.as_array()))
+        .map(|(n, _)| before + n)
+}
+
+/// The refined member, its channel summary and samples, and the refinement record.
+fn refined_member(
+    evaluator: &mut dyn Evaluator,
+    space: &ParamSpace,
+    lm: &LmResult,
+    start: &Member,
+    probes: Vec<Probe>,
+) -> (Member, ChannelRms, Vec<Vec<Observation>>, Refinement) {
+    let values = lm.x[..sepval_common::factors::FACTOR_COUNT].to_vec();
+    let member = Member {
+        chromosome: sepval_common::encoding::Chromosome::encode_values(
+            &evaluator.job().factor_table().0,
+            &values,
+        ),
+        values,
+        outcome: sepval_common::evaluation::Outcome::Goals {
+            j_pos_m: lm.goals.j_pos_m,
+            j_att_deg: lm.goals.j_att_deg,
+        },
+    };
+    let _ = space;
+    let rms = channel_rms(&residuals(evaluator.job(), &lm.samples));
+    let refinement = Refinement {
+        start_goals: start.objectives(),
+        evaluations: lm.evaluations,
+        iterations: lm.iterations,
+        stop: lm.stop.clone(),
+        probes,
+    };
+    (member, rms, lm.samples.clone(), refinement)
+}
+
+/// One grid step of each factor at `factors` (inward at a bound): the change of the goals and
+/// of the simulated trajectory, coarse when the trajectory moves by more than the noise.
+pub fn resolution_advice(
+    evaluator: &mut dyn Evaluator,
+    table: &sepval_common::factors::FactorTable,
+    factors: &Factors,
+    noise: Noise,
+) -> Result<Vec<ResolutionRow>> {
+    use sepval_common::factors::Factor;
+    let mut batch = vec![Candidate::baseline(*factors)];
+    for (i, spec) in table.0.iter().enumerate() {
+        let mut f = *factors;
+        let step = spec.step();
+        f.0[i] = if f.0[i] + step <= spec.max {
+            f.0[i] + step
+        } else {
+            f.0[i] - step
+        };
+        batch.push(Candidate::baseline(f));
+    }
+    let out = evaluator.evaluate(&batch, true)?;
+    let base = out[0]
+        .samples
+        .clone()
+        .context("the best fit did not simulate")?;
+    let g0 = out[0].outcome.objectives();
+    let mut rows = Vec::new();
+    for (i, e) in out.iter().enumerate().skip(1) {
+        let name = Factor::NAMES[i - 1].to_string();
+        let step = table.0[i - 1].step();
+        let Some(s) = &e.samples else {
+            rows.push(ResolutionRow {
+                factor: name,
+                step,
+                d_j_pos_m: f64::INFINITY,
+                d_j_att_deg: f64::INFINITY,
+                traj_rms_pos_m: f64::INFINITY,
+                traj_rms_att_deg: f64::INFINITY,
+                coarse: true,
+            });
+            continue;
+        };
+        let (mut dp, mut da, mut n) = (0.0, 0.0, 0usize);
+        for (ev_a, ev_b) in s.iter().zip(&base) {
+            for (a, b) in ev_a.iter().zip(ev_b) {
+                let (p, q) = residual(a, &b.pos_m, &b.att_deg);
+                dp += p.iter().map(|v| v * v).sum::<f64>();
+                da += q.iter().map(|v| v * v).sum::<f64>();
+                n += 1;
+            }
+        }
+        let n3 = 3.0 * n.max(1) as f64;
+        let (rp, ra) = ((dp / n3).sqrt(), (da / n3).sqrt());
+        let g = e.outcome.objectives();
+        rows.push(ResolutionRow {
+            factor: name,
+            step,
+            d_j_pos_m: g[0] - g0[0],
+            d_j_att_deg: g[1] - g0[1],
+            traj_rms_pos_m: rp,
+            traj_rms_att_deg: ra,
+            coarse: rp > noise.pos_m || ra > noise.att_deg,
+        });
+    }
+    Ok(rows)
 }
 
 /// Re-evaluates a best member with its samples: its per-channel residual RMS and trajectory.
@@ -358,6 +649,8 @@ fn method_result(
             .collect(),
         history,
         stop,
+        evaluations_to_floor: None,
+        refinement: None,
     }
 }
 
@@ -477,5 +770,17 @@ pub fn write_fit_figures(dir: &Path, job: &Job, output: &FitOutput) -> Result<Ve
     let path = fig_dir.join("convergence.png");
     convergence_figure(&path, &hists, Some(2.0))?;
     written.push(path);
+
+    if let Some(id) = &r.identifiability {
+        let names: Vec<&str> = id.names.iter().map(String::as_str).collect();
+        let path = fig_dir.join("correlation.png");
+        crate::figures::correlation_figure(
+            &path,
+            &names,
+            &id.correlation,
+            "Correlation of the refined estimates (|rho| > 0.9: compensating)",
+        )?;
+        written.push(path);
+    }
     Ok(written)
 }

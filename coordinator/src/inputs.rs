@@ -84,20 +84,46 @@ pub fn job(
     } else {
         data_paths.iter().map(|p| p.display().to_string()).collect()
     };
-    let simulator = Simulator::new(&scen);
-    let events = names
-        .into_iter()
-        .zip(data)
-        .map(|(name, data)| Event {
+    let mut events = Vec::with_capacity(data.len());
+    for (name, data) in names.into_iter().zip(data) {
+        let scenario = event_scenario(&scen, &data, &name)?;
+        events.push(Event {
             name,
-            simulator: simulator.clone(),
+            simulator: Simulator::new(&scenario),
             data,
-        })
-        .collect();
+        });
+    }
     let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
     let record = crate::checkpoint::InputsRecord {
         data: data_paths.iter().map(|p| absolute(p)).collect(),
         scenario: scenario_path.map(absolute),
     };
     Ok((Job::new(events)?, record))
+}
+
+/// The scenario of one event: `base` with the flight condition named in the data's `#`
+/// metadata (`mach`, `altitude_m`, `alpha_deg`, `beta_deg`, `gamma_deg`; any subset), so that
+/// releases of the same store at different conditions can be fitted together.
+pub fn event_scenario(
+    base: &sepval_common::scenario::Scenario,
+    data: &Trajectory,
+    name: &str,
+) -> Result<sepval_common::scenario::Scenario> {
+    let mut s = base.clone();
+    let f = &mut s.flight;
+    for (key, field) in [
+        ("mach", &mut f.mach),
+        ("altitude_m", &mut f.altitude_m),
+        ("alpha_deg", &mut f.alpha_deg),
+        ("beta_deg", &mut f.beta_deg),
+        ("gamma_deg", &mut f.gamma_deg),
+    ] {
+        if let Some(text) = data.meta(key) {
+            *field = text
+                .parse()
+                .with_context(|| format!("{name}: metadata `# {key} = {text}` is not a number"))?;
+        }
+    }
+    s.validate(&format!("{name} (flight condition from its metadata)"))?;
+    Ok(s)
 }

@@ -3,14 +3,18 @@
 
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
+// Matrix and array code indexes by (row, column) as the equations it implements do.
+#![allow(clippy::needless_range_loop)]
 
 pub mod bench;
 pub mod checkpoint;
 pub mod figures;
 pub mod fit;
+pub mod identifiability;
 pub mod inputs;
 pub mod ipc;
 pub mod problem;
+pub mod refine;
 pub mod rerun;
 pub mod results;
 pub mod rng;

@@ -23,6 +23,7 @@ use sepval_common::evaluation::{Evaluator, InProcess, Job};
 use sepval_coordinator::checkpoint::Checkpoint;
 use sepval_coordinator::fit::{FitOptions, FitOutput, Method, Sigma, run_fit};
 use sepval_coordinator::inputs;
+use sepval_coordinator::refine::LmSettings;
 use sepval_coordinator::search::ga::GaSettings;
 use sepval_coordinator::search::hill::HillSettings;
 
@@ -69,7 +70,7 @@ struct FitArgs {
     #[arg(long, value_name = "FILE")]
     scenario: Option<PathBuf>,
     /// Searches to run [default: both; when resuming: the checkpoint's].
-    #[arg(long, value_name = "ga|hill|both")]
+    #[arg(long, value_name = "ga|hill|both|ga+lm|hill+lm")]
     method: Option<String>,
     /// Seed of the genetic algorithm's generator.
     #[arg(long, default_value_t = 1)]
@@ -93,6 +94,9 @@ struct FitArgs {
     /// Simulation budget of the hill climber.
     #[arg(long, default_value_t = 500)]
     hill_budget: usize,
+    /// Simulation budget of the Levenberg-Marquardt refinement (`+lm` methods).
+    #[arg(long, default_value_t = 5000)]
+    lm_budget: u64,
     #[command(flatten)]
     eval: EvalArgs,
     /// Position noise [m] weighting J_pos (default: estimated from the data).
@@ -463,6 +467,14 @@ fn fit(args: FitArgs) -> Result<()> {
         resume,
         inputs,
         progress: true,
+        lm: LmSettings {
+            budget: args.lm_budget,
+            ..LmSettings::default()
+        },
+        lm_probe: LmSettings {
+            budget: args.lm_budget.min(800),
+            ..LmSettings::default()
+        },
     };
     let output = run_fit(&options, evaluator.as_mut())?;
     let r = &output.result;

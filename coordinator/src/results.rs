@@ -31,10 +31,74 @@ pub struct FitResult {
     pub sigma_source: String,
     /// The true factors, when known (synthetic data).
     pub truth: Option<Factors>,
-    /// One entry per method run (`ga`, `hill`, ...).
+    /// The noise floor the refinement aims at: 1.1 sigma on each goal.
+    pub floor: FloorInfo,
+    /// One entry per method run (`ga`, `hill`, `ga+lm`, ...).
     pub methods: BTreeMap<String, MethodResult>,
+    /// How sure each parameter of the best refined fit is (refined methods only).
+    pub identifiability: Option<crate::identifiability::Identifiability>,
+    /// What one grid step of each factor does at the best fit.
+    pub resolution: Vec<ResolutionRow>,
     /// How this run was executed (not part of the deterministic result).
     pub run: RunInfo,
+}
+
+/// The noise floor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FloorInfo {
+    /// 1.1 sigma_pos [m].
+    pub j_pos_m: f64,
+    /// 1.1 sigma_att [deg].
+    pub j_att_deg: f64,
+}
+
+/// The effect of one grid step of one factor at the best fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResolutionRow {
+    /// The factor.
+    pub factor: String,
+    /// Its grid step ((max - min) / (2^bits - 1)).
+    pub step: f64,
+    /// Change of J_pos [m].
+    pub d_j_pos_m: f64,
+    /// Change of J_att [deg].
+    pub d_j_att_deg: f64,
+    /// RMS change of the simulated positions [m].
+    pub traj_rms_pos_m: f64,
+    /// RMS change of the simulated angles [deg].
+    pub traj_rms_att_deg: f64,
+    /// Whether one step moves the trajectory by more than the noise.
+    pub coarse: bool,
+}
+
+/// A refinement attempt during the genetic search (ga+lm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Probe {
+    /// Generation after which it ran.
+    pub generation: usize,
+    /// Simulations of the search before it.
+    pub evaluations_before: u64,
+    /// Its simulations.
+    pub evaluations: u64,
+    /// Goals it reached: J_pos [m], J_att [deg].
+    pub goals: [f64; 2],
+    /// Whether it reached the floor.
+    pub reached_floor: bool,
+}
+
+/// The refinement stage of a method.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Refinement {
+    /// Goals before it: J_pos [m], J_att [deg].
+    pub start_goals: [f64; 2],
+    /// Its simulations (final refinement only).
+    pub evaluations: u64,
+    /// Its iterations.
+    pub iterations: usize,
+    /// Why it stopped.
+    pub stop: String,
+    /// Attempts made during the search.
+    pub probes: Vec<Probe>,
 }
 
 /// One event of the fit.
@@ -68,6 +132,11 @@ pub struct MethodResult {
     pub history: Vec<HistoryPoint>,
     /// Why the method stopped.
     pub stop: String,
+    /// Simulations (search and refinement) needed to get within 1.1x of the noise floor on
+    /// both goals; null if it never did.
+    pub evaluations_to_floor: Option<u64>,
+    /// The refinement stage, for `+lm` methods.
+    pub refinement: Option<Refinement>,
 }
 
 /// The best member of a method.
