@@ -19,4 +19,5 @@ pub mod rerun;
 pub mod results;
 pub mod rng;
 pub mod search;
+pub mod selftest;
 pub mod uds;

@@ -56,6 +56,9 @@ enum Command {
     Rerun(RerunArgs),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
+    /// Check the Pareto machinery on problems with known fronts.
+    #[command(subcommand)]
+    Selftest(SelftestCommand),
     /// Remove the shared-memory resources of sepval runs whose processes are all gone.
     CleanIpc,
 }
@@ -117,6 +120,26 @@ struct FitArgs {
     /// Run directory (result.json, generations/, figures/).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+}
+
+#[derive(Subcommand)]
+enum SelftestCommand {
+    /// The genetic algorithm on ZDT1, ZDT2 or ZDT3 (30 variables): prints the hypervolume of
+    /// the final front with reference point (1.1, 1.1).
+    Zdt {
+        /// zdt1, zdt2 or zdt3.
+        #[arg(long)]
+        problem: String,
+        /// Evaluations (whole generations of 100).
+        #[arg(long, default_value_t = 25_000)]
+        evaluations: usize,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Bits per variable.
+        #[arg(long, default_value_t = 20)]
+        bits: u32,
+    },
 }
 
 #[derive(clap::Args)]
@@ -240,6 +263,24 @@ fn main() -> ExitCode {
         Command::Fit(args) => fit(*args),
         Command::Rerun(args) => rerun(args),
         Command::Bench(args) => bench(args),
+        Command::Selftest(SelftestCommand::Zdt {
+            problem,
+            evaluations,
+            seed,
+            bits,
+        }) => (|| {
+            use sepval_coordinator::selftest::{Zdt, run_zdt};
+            if !(1..=52).contains(&bits) {
+                anyhow::bail!("--bits {bits}: expected 1 to 52");
+            }
+            let (hv, front) = run_zdt(Zdt::parse(&problem)?, evaluations, seed, bits)?;
+            println!("{hv:.6}");
+            eprintln!(
+                "{problem}: {} points on the final front, seed {seed}",
+                front.len()
+            );
+            Ok(())
+        })(),
         Command::CleanIpc => {
             let cleaned = sepval_common::ipc::clean_stale_runs("");
             println!(

@@ -256,3 +256,43 @@ fn a_written_scenario_reproduces_the_default() {
         "scenario bad.toml:",
     );
 }
+
+#[test]
+fn selftest_zdt_prints_a_hypervolume() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = sepval(
+        &[
+            "selftest",
+            "zdt",
+            "--problem",
+            "zdt1",
+            "--evaluations",
+            "4000",
+            "--seed",
+            "3",
+        ],
+        dir.path(),
+    );
+    ok(&out);
+    let hv: f64 = String::from_utf8_lossy(&out.stdout).trim().parse().unwrap();
+    assert!(hv > 0.0 && hv < 0.8767, "{hv}");
+    // Same seed, same answer.
+    let again = sepval(
+        &[
+            "selftest",
+            "zdt",
+            "--problem",
+            "zdt1",
+            "--evaluations",
+            "4000",
+            "--seed",
+            "3",
+        ],
+        dir.path(),
+    );
+    assert_eq!(again.stdout, out.stdout);
+    refused(
+        &sepval(&["selftest", "zdt", "--problem", "zdt9"], dir.path()),
+        "--problem zdt9: expected zdt1, zdt2 or zdt3",
+    );
+}
