@@ -480,7 +480,7 @@ fn refine_from(
     noise: Noise,
     settings: &LmSettings,
 ) -> Result<LmResult> {
-    levenberg_marquardt(evaluator, space, start, noise, settings, &mut |_, _| {})
+    levenberg_marquardt(evaluator, space, start, noise, settings)
 }
 
 /// Simulations at which the history first has both goals at the floor.

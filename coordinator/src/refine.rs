@@ -185,119 +185,211 @@ pub struct LmResult {
     pub stop: String,
 }
 
-/// Runs parameter vectors and returns their samples (`None` for a run that did not finish).
-fn run(
-    evaluator: &mut dyn Evaluator,
-    space: &ParamSpace,
-    xs: &[Vec<f64>],
-    evaluations: &mut u64,
-) -> Result<Vec<Option<Vec<Vec<Observation>>>>> {
-    let batch: Vec<Candidate> = xs
-        .iter()
-        .map(|x| space.candidate(x))
-        .collect::<Result<_>>()?;
-    *evaluations += batch.len() as u64;
-    Ok(evaluator
-        .evaluate(&batch, true)?
-        .into_iter()
-        .map(|e: Evaluation| e.samples)
-        .collect())
-}
-
-/// The forward-difference Jacobian of the normalised residuals at `x` (residuals `r`): one
-/// batch, each step `fd_step` of the parameter's range, taken inward at the upper bound.
-#[allow(clippy::too_many_arguments)]
-fn jacobian(
-    evaluator: &mut dyn Evaluator,
-    space: &ParamSpace,
-    job: &Job,
-    x: &[f64],
-    r: &[f64],
-    noise: Noise,
-    fd_step: f64,
-    evaluations: &mut u64,
-) -> Result<DMatrix<f64>> {
-    let n = space.len();
-    let steps: Vec<f64> = (0..n)
+/// Forward-difference steps at `x`: `fd_step` of each range, inward at the upper bound.
+fn fd_steps(space: &ParamSpace, x: &[f64], fd_step: f64) -> Vec<f64> {
+    (0..space.len())
         .map(|i| {
             let h = fd_step * space.range(i);
             if x[i] + h <= space.hi[i] { h } else { -h }
         })
-        .collect();
-    let probes: Vec<Vec<f64>> = (0..n)
-        .map(|i| {
-            let mut p = x.to_vec();
-            p[i] += steps[i];
-            p
-        })
-        .collect();
-    let mut jac = DMatrix::zeros(r.len(), n);
-    for (i, s) in run(evaluator, space, &probes, evaluations)?
-        .into_iter()
-        .enumerate()
-    {
-        let s = s.with_context(|| {
-            format!(
-                "the derivative probe of {} did not simulate",
-                space.names[i]
-            )
-        })?;
-        let ri = residual_vector(job, &s, noise);
-        for (k, v) in ri.iter().enumerate() {
-            jac[(k, i)] = (v - r[k]) / steps[i];
-        }
-    }
-    Ok(jac)
+        .collect()
 }
 
-/// Refines `x0` (projected onto the bounds).
-pub fn levenberg_marquardt(
-    evaluator: &mut dyn Evaluator,
-    space: &ParamSpace,
-    x0: &[f64],
+/// What a refinement waits for.
+enum Stage {
+    /// The start point.
+    Start,
+    /// Derivative probes (then the final Jacobian is complete when `last`).
+    Jacobian { steps: Vec<f64>, last: bool },
+    /// Damped Gauss-Newton trials at three damping values.
+    Trials {
+        points: Vec<Vec<f64>>,
+        mus: [f64; 3],
+    },
+    /// Finished.
+    Done,
+}
+
+/// One refinement as a sequence of batches: [`LmRun::request`] gives the next parameter
+/// vectors to simulate, [`LmRun::absorb`] takes their samples. Several refinements can so share
+/// each batch sent to the workers ([`refine_together`]).
+pub struct LmRun {
+    space: ParamSpace,
+    job: std::sync::Arc<Job>,
     noise: Noise,
-    settings: &LmSettings,
-    observe: &mut dyn FnMut(u64, &Goals),
-) -> Result<LmResult> {
-    let n = space.len();
-    let mut evaluations = 0u64;
-    let mut x = space.clamp(x0);
-    let first = run(evaluator, space, std::slice::from_ref(&x), &mut evaluations)?.remove(0);
-    let Some(mut samples) = first else {
-        bail!("the refinement's start does not simulate (diverged or invalid)");
-    };
-    let job = evaluator.job().clone();
-    let mut r = residual_vector(&job, &samples, noise);
-    let mut cost: f64 = r.iter().map(|v| v * v).sum();
-    let mut history = vec![(evaluations, goals_of(&r, noise))];
-    observe(evaluations, &history[0].1);
-    let mut mu = 1e-3;
-    let mut iterations = 0;
-    let mut jac = DMatrix::zeros(r.len(), n);
-    let mut stale_jacobian = true;
-    let stop = loop {
-        if stale_jacobian {
-            jac = jacobian(
-                evaluator,
-                space,
-                &job,
-                &x,
-                &r,
-                noise,
-                settings.fd_step,
-                &mut evaluations,
-            )?;
-            stale_jacobian = false;
+    settings: LmSettings,
+    x: Vec<f64>,
+    r: Vec<f64>,
+    cost: f64,
+    samples: Vec<Vec<Observation>>,
+    jac: DMatrix<f64>,
+    mu: f64,
+    iterations: usize,
+    evaluations: u64,
+    history: Vec<(u64, Goals)>,
+    stage: Stage,
+    stop: String,
+}
+
+impl LmRun {
+    /// A refinement of `x0` (projected onto the bounds) in `space`.
+    pub fn new(
+        space: ParamSpace,
+        job: std::sync::Arc<Job>,
+        x0: &[f64],
+        noise: Noise,
+        settings: LmSettings,
+    ) -> Self {
+        let x = space.clamp(x0);
+        LmRun {
+            space,
+            job,
+            noise,
+            settings,
+            x,
+            r: Vec::new(),
+            cost: f64::INFINITY,
+            samples: Vec::new(),
+            jac: DMatrix::zeros(0, 0),
+            mu: 1e-3,
+            iterations: 0,
+            evaluations: 0,
+            history: Vec::new(),
+            stage: Stage::Start,
+            stop: String::new(),
         }
-        if iterations >= settings.max_iterations {
-            break "iteration limit".to_string();
+    }
+
+    /// The parameter space.
+    pub fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+
+    /// The candidates to simulate next (with samples), or `None` when finished.
+    pub fn request(&self) -> Result<Option<Vec<Candidate>>> {
+        let points: Vec<Vec<f64>> = match &self.stage {
+            Stage::Start => vec![self.x.clone()],
+            Stage::Jacobian { steps, .. } => (0..self.space.len())
+                .map(|i| {
+                    let mut p = self.x.clone();
+                    p[i] += steps[i];
+                    p
+                })
+                .collect(),
+            Stage::Trials { points, .. } => points.clone(),
+            Stage::Done => return Ok(None),
+        };
+        Ok(Some(
+            points
+                .iter()
+                .map(|x| self.space.candidate(x))
+                .collect::<Result<_>>()?,
+        ))
+    }
+
+    /// Takes the samples of the last request (`None` for runs that did not finish).
+    pub fn absorb(&mut self, out: Vec<Option<Vec<Vec<Observation>>>>) -> Result<()> {
+        self.evaluations += out.len() as u64;
+        match std::mem::replace(&mut self.stage, Stage::Done) {
+            Stage::Start => {
+                let s =
+                    out.into_iter().next().flatten().context(
+                        "the refinement's start does not simulate (diverged or invalid)",
+                    )?;
+                self.r = residual_vector(&self.job, &s, self.noise);
+                self.cost = self.r.iter().map(|v| v * v).sum();
+                self.samples = s;
+                self.history
+                    .push((self.evaluations, goals_of(&self.r, self.noise)));
+                self.begin_jacobian(false);
+            }
+            Stage::Jacobian { steps, last } => {
+                let n = self.space.len();
+                let mut jac = DMatrix::zeros(self.r.len(), n);
+                for (i, s) in out.into_iter().enumerate() {
+                    let s = s.with_context(|| {
+                        format!(
+                            "the derivative probe of {} did not simulate",
+                            self.space.names[i]
+                        )
+                    })?;
+                    let ri = residual_vector(&self.job, &s, self.noise);
+                    for (k, v) in ri.iter().enumerate() {
+                        jac[(k, i)] = (v - self.r[k]) / steps[i];
+                    }
+                }
+                self.jac = jac;
+                if !last {
+                    self.plan_trials();
+                }
+            }
+            Stage::Trials { points, mus } => {
+                let mut best: Option<(usize, f64, Vec<f64>)> = None;
+                let mut kept: Vec<Option<Vec<Vec<Observation>>>> = out;
+                for (k, s) in kept.iter().enumerate() {
+                    if let Some(s) = s {
+                        let rk = residual_vector(&self.job, s, self.noise);
+                        let ck: f64 = rk.iter().map(|v| v * v).sum();
+                        if best.as_ref().is_none_or(|b| ck < b.1) {
+                            best = Some((k, ck, rk));
+                        }
+                    }
+                }
+                match best {
+                    Some((k, ck, rk)) if ck < self.cost => {
+                        let gain = (self.cost - ck) / self.cost;
+                        self.x = points[k].clone();
+                        self.cost = ck;
+                        self.r = rk;
+                        self.samples = kept[k].take().expect("finished trial");
+                        self.mu = (mus[k] / 3.0).max(1e-12);
+                        self.history
+                            .push((self.evaluations, goals_of(&self.r, self.noise)));
+                        if gain < self.settings.rel_tolerance {
+                            self.stop = "converged (relative decrease below tolerance)".into();
+                            self.begin_jacobian(true);
+                        } else {
+                            self.begin_jacobian(false);
+                        }
+                    }
+                    _ => {
+                        self.mu *= 100.0;
+                        if self.mu > 1e12 {
+                            self.stop = "converged (no further decrease)".into();
+                        } else {
+                            self.plan_trials();
+                        }
+                    }
+                }
+            }
+            Stage::Done => bail!("a finished refinement received samples"),
         }
-        if evaluations + 3 + n as u64 > settings.budget {
-            break "simulation budget".to_string();
+        Ok(())
+    }
+
+    fn begin_jacobian(&mut self, last: bool) {
+        self.stage = Stage::Jacobian {
+            steps: fd_steps(&self.space, &self.x, self.settings.fd_step),
+            last,
+        };
+    }
+
+    /// Plans the next damped steps from the current Jacobian, or stops at a limit (the
+    /// Jacobian is then current).
+    fn plan_trials(&mut self) {
+        let n = self.space.len();
+        if self.iterations >= self.settings.max_iterations {
+            self.stop = "iteration limit".into();
+            return;
         }
-        iterations += 1;
-        let jtj = jac.tr_mul(&jac);
-        let g = jac.tr_mul(&DVector::from_column_slice(&r));
+        if self.evaluations + 3 + n as u64 > self.settings.budget {
+            self.stop = "simulation budget".into();
+            return;
+        }
+        self.iterations += 1;
+        let (x, space, mu) = (&self.x, &self.space, self.mu);
+        let jtj = self.jac.tr_mul(&self.jac);
+        let g = self.jac.tr_mul(&DVector::from_column_slice(&self.r));
         // Active set: a parameter on a bound whose descent direction points out of the box
         // stays there this iteration; the step is solved for the others.
         let free: Vec<usize> = (0..n)
@@ -309,7 +401,7 @@ pub fn levenberg_marquardt(
             .collect();
         let nf = free.len();
         let mus = [mu / 10.0, mu, mu * 10.0];
-        let trials: Vec<Vec<f64>> = mus
+        let points: Vec<Vec<f64>> = mus
             .iter()
             .map(|&m| {
                 let mut a = DMatrix::zeros(nf, nf);
@@ -337,65 +429,64 @@ pub fn levenberg_marquardt(
                 space.clamp(&xt)
             })
             .collect();
-        let out = run(evaluator, space, &trials, &mut evaluations)?;
-        // (trial index, cost, residuals, samples) of the best trial.
-        type Trial = (usize, f64, Vec<f64>, Vec<Vec<Observation>>);
-        let mut best: Option<Trial> = None;
-        for (k, s) in out.into_iter().enumerate() {
-            if let Some(s) = s {
-                let rk = residual_vector(&job, &s, noise);
-                let ck: f64 = rk.iter().map(|v| v * v).sum();
-                if best.as_ref().is_none_or(|b| ck < b.1) {
-                    best = Some((k, ck, rk, s));
-                }
-            }
-        }
-        match best {
-            Some((k, ck, rk, s)) if ck < cost => {
-                let gain = (cost - ck) / cost;
-                x = trials[k].clone();
-                cost = ck;
-                r = rk;
-                samples = s;
-                mu = (mus[k] / 3.0).max(1e-12);
-                stale_jacobian = true;
-                history.push((evaluations, goals_of(&r, noise)));
-                observe(evaluations, &history.last().expect("pushed").1);
-                if gain < settings.rel_tolerance {
-                    break "converged (relative decrease below tolerance)".to_string();
-                }
-            }
-            _ => {
-                mu *= 100.0;
-                if mu > 1e12 {
-                    break "converged (no further decrease)".to_string();
-                }
-            }
-        }
-    };
-    // The Jacobian at the final point (for identifiability), if the last step moved.
-    if stale_jacobian {
-        jac = jacobian(
-            evaluator,
-            space,
-            &job,
-            &x,
-            &r,
-            noise,
-            settings.fd_step,
-            &mut evaluations,
-        )?;
+        self.stage = Stage::Trials { points, mus };
     }
-    Ok(LmResult {
-        goals: goals_of(&r, noise),
-        x,
-        cost,
-        evaluations,
-        iterations,
-        residuals: r,
-        jacobian: jac,
-        samples,
-        history,
-        stop,
-    })
+
+    /// The result (after [`LmRun::request`] returned `None`).
+    pub fn finish(self) -> LmResult {
+        LmResult {
+            goals: goals_of(&self.r, self.noise),
+            x: self.x,
+            cost: self.cost,
+            evaluations: self.evaluations,
+            iterations: self.iterations,
+            residuals: self.r,
+            jacobian: self.jac,
+            samples: self.samples,
+            history: self.history,
+            stop: self.stop,
+        }
+    }
+}
+
+/// Drives several refinements together: each round, the requests of all unfinished runs go to
+/// the evaluator as one batch.
+pub fn refine_together(evaluator: &mut dyn Evaluator, runs: &mut [LmRun]) -> Result<()> {
+    loop {
+        let mut batch: Vec<Candidate> = Vec::new();
+        let mut owners: Vec<(usize, usize)> = Vec::new();
+        for (k, run) in runs.iter().enumerate() {
+            if let Some(c) = run.request()? {
+                owners.push((k, c.len()));
+                batch.extend(c);
+            }
+        }
+        if batch.is_empty() {
+            return Ok(());
+        }
+        let mut out = evaluator.evaluate(&batch, true)?.into_iter();
+        for (k, len) in owners {
+            let part: Vec<Option<Vec<Vec<Observation>>>> = out
+                .by_ref()
+                .take(len)
+                .map(|e: Evaluation| e.samples)
+                .collect();
+            runs[k].absorb(part)?;
+        }
+    }
+}
+
+/// Refines `x0` (projected onto the bounds).
+pub fn levenberg_marquardt(
+    evaluator: &mut dyn Evaluator,
+    space: &ParamSpace,
+    x0: &[f64],
+    noise: Noise,
+    settings: &LmSettings,
+) -> Result<LmResult> {
+    let job = std::sync::Arc::new(evaluator.job().clone());
+    let mut runs = [LmRun::new(space.clone(), job, x0, noise, settings.clone())];
+    refine_together(evaluator, &mut runs)?;
+    let [run] = runs;
+    Ok(run.finish())
 }
