@@ -1,4 +1,4 @@
-//! Elementary functions for the force evaluation: `atan2` and `exp`, inlined.
+//! Elementary functions for the force evaluation: `atan2`, `asin` and `exp`, inlined.
 //!
 //! Every force evaluation needs an `atan2` (angle of attack), an `asin` (sideslip) and an
 //! `exp` (interference decay); through the system math library they
@@ -25,6 +25,39 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 /// Extra bits of pi/2 beyond its double (Cephes `MOREBITS`).
 const MOREBITS: f64 = 6.123_233_995_736_766e-17;
 
+/// Cephes atan.c: atan(t) = t + t z P(z) / Q(z), z = t^2 (Q's leading coefficient is 1).
+const ATAN_P: [f64; 5] = [
+    -8.750_608_600_031_904e-1,
+    -1.615_753_718_733_365e1,
+    -7.500_855_792_314_705e1,
+    -1.228_866_684_490_136_2e2,
+    -6.485_021_904_942_025e1,
+];
+const ATAN_Q: [f64; 5] = [
+    2.485_846_490_142_306_3e1,
+    1.650_270_098_316_988_6e2,
+    4.328_810_604_912_903e2,
+    4.853_903_996_359_137e2,
+    1.945_506_571_482_614e2,
+];
+/// Cephes asin.c: asin(a) = a + a z P(z) / Q(z), z = a^2, |a| <= 0.625 (Q's leading
+/// coefficient is 1).
+const ASIN_P: [f64; 6] = [
+    4.253_011_369_004_428e-3,
+    -6.019_598_008_014_124e-1,
+    5.444_622_390_564_711,
+    -1.626_247_967_210_700_2e1,
+    1.956_261_983_317_594_8e1,
+    -8.198_089_802_484_825,
+];
+const ASIN_Q: [f64; 5] = [
+    -1.474_091_372_988_853_8e1,
+    7.049_610_280_856_842e1,
+    -1.471_791_292_232_726e2,
+    1.395_105_614_657_485_7e2,
+    -4.918_853_881_490_881e1,
+];
+
 /// atan(x) for x in [0, inf].
 #[inline(always)]
 fn atan_nonnegative(x: f64) -> f64 {
@@ -46,27 +79,8 @@ fn atan_nonnegative(x: f64) -> f64 {
 /// z P(z) / Q(z).
 #[inline(always)]
 fn atan_ratio(z: f64) -> f64 {
-    let p = horner(
-        z,
-        -8.750_608_600_031_904e-1,
-        &[
-            -1.615_753_718_733_365e1,
-            -7.500_855_792_314_705e1,
-            -1.228_866_684_490_136_2e2,
-            -6.485_021_904_942_025e1,
-        ],
-    );
-    let q = horner(
-        z,
-        1.0,
-        &[
-            2.485_846_490_142_306_3e1,
-            1.650_270_098_316_988_6e2,
-            4.328_810_604_912_903e2,
-            4.853_903_996_359_137e2,
-            1.945_506_571_482_614e2,
-        ],
-    );
+    let p = horner(z, ATAN_P[0], &[ATAN_P[1], ATAN_P[2], ATAN_P[3], ATAN_P[4]]);
+    let q = horner(z, 1.0, &ATAN_Q);
     z * p / q
 }
 
@@ -151,26 +165,10 @@ pub fn asin(x: f64) -> f64 {
     let z = a * a;
     let p = horner(
         z,
-        4.253_011_369_004_428e-3,
-        &[
-            -6.019_598_008_014_124e-1,
-            5.444_622_390_564_711,
-            -1.626_247_967_210_700_2e1,
-            1.956_261_983_317_594_8e1,
-            -8.198_089_802_484_825,
-        ],
+        ASIN_P[0],
+        &[ASIN_P[1], ASIN_P[2], ASIN_P[3], ASIN_P[4], ASIN_P[5]],
     );
-    let q = horner(
-        z,
-        1.0,
-        &[
-            -1.474_091_372_988_853_8e1,
-            7.049_610_280_856_842e1,
-            -1.471_791_292_232_726e2,
-            1.395_105_614_657_485_7e2,
-            -4.918_853_881_490_881e1,
-        ],
-    );
+    let q = horner(z, 1.0, &ASIN_Q);
     let r = a.mul_add(z * p / q, a);
     // The sign of x, as f64::asin (which keeps that of a zero x too).
     r.copysign(x)
@@ -199,6 +197,61 @@ fn asin_large(x: f64) -> f64 {
     let s = (zz + zz).sqrt();
     let r = FRAC_PI_4 - ((s * p - MOREBITS) - (FRAC_PI_4 - s));
     if x < 0.0 { -r } else { r }
+}
+
+/// The flow angles of the force evaluation together: `atan2(w, u)` and `asin(a)`, where the
+/// caller also passes `a^2` as the quotient `a2_num / a2_den` (so that it need not wait for
+/// `a` itself, which takes a square root and a division more).
+///
+/// In the store's range (u > 0, |w / u| <= 0.66, |a| <= 0.625: no range reduction) the two
+/// Cephes rationals of [`atan2`] and [`asin`] are evaluated side by side, lane by lane: one
+/// division gives `w / u` and `a^2`, one Horner pass the four polynomials (numerator and
+/// denominator of each; atan's shorter numerator has a zero leading coefficient, which is
+/// exact), one division both factors `1 + z P(z) / Q(z)`. Each lane is the same sequence of
+/// correctly rounded operations whether or not the compiler packs the lanes into one vector
+/// register, so every build gives the same bits. Outside that range this is [`atan2`] and
+/// [`asin`] (`a` then must be within [-1, 1]).
+#[inline(always)]
+pub fn atan2_asin(w: f64, u: f64, a: f64, a2_num: f64, a2_den: f64) -> (f64, f64) {
+    // Cephes's ranges without reduction: atan for |t| <= 0.66, asin for |a| <= 0.625.
+    const ATAN_Z_MAX: f64 = 0.66 * 0.66;
+    const ASIN_Z_MAX: f64 = 0.625 * 0.625;
+    let [t, z_asin] = lanes(|i| [w, a2_num][i] / [u, a2_den][i]);
+    let z_atan = t * t;
+    // NaN fails the comparisons too.
+    if !(u > 0.0 && z_atan <= ATAN_Z_MAX && z_asin <= ASIN_Z_MAX) {
+        return atan2_asin_reduced(w, u, a);
+    }
+    // Lanes: atan numerator, asin numerator, atan denominator, asin denominator.
+    const C: [[f64; 4]; 6] = [
+        [0.0, ASIN_P[0], 1.0, 1.0],
+        [ATAN_P[0], ASIN_P[1], ATAN_Q[0], ASIN_Q[0]],
+        [ATAN_P[1], ASIN_P[2], ATAN_Q[1], ASIN_Q[1]],
+        [ATAN_P[2], ASIN_P[3], ATAN_Q[2], ASIN_Q[2]],
+        [ATAN_P[3], ASIN_P[4], ATAN_Q[3], ASIN_Q[3]],
+        [ATAN_P[4], ASIN_P[5], ATAN_Q[4], ASIN_Q[4]],
+    ];
+    let z = [z_atan, z_asin, z_atan, z_asin];
+    let pq = C[1..]
+        .iter()
+        .fold(C[0], |acc, c| lanes(|i| acc[i].mul_add(z[i], c[i])));
+    // t (1 + z P(z) / Q(z)) = t (Q(z) + z P(z)) / Q(z), and likewise for a: the factor is
+    // positive, so a zero t or a keeps its sign (as f64::atan2 and f64::asin).
+    let factor: [f64; 2] = lanes(|i| z[i].mul_add(pq[i], pq[i + 2]) / pq[i + 2]);
+    let [alpha, beta] = lanes(|i| [t, a][i] * factor[i]);
+    (alpha, beta)
+}
+
+/// `[f(0), f(1), ...]`: lane-wise arithmetic written so the compiler may vectorise it.
+#[inline(always)]
+fn lanes<const N: usize>(f: impl FnMut(usize) -> f64) -> [f64; N] {
+    std::array::from_fn(f)
+}
+
+#[cold]
+#[inline(never)]
+fn atan2_asin_reduced(w: f64, u: f64, a: f64) -> (f64, f64) {
+    (atan2(w, u), asin(a))
 }
 
 #[cold]
@@ -255,6 +308,28 @@ mod tests {
         }
         assert!(worst <= 4.0, "worst {worst} ulp");
         assert!(asin(1.5).is_nan() && asin(f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn atan2_asin_matches_std_inside_and_outside_the_packed_range() {
+        let (mut worst_atan, mut worst_asin): (f64, f64) = (0.0, 0.0);
+        for i in 0..20_001 {
+            // Flow angles up to +-90 deg (the packed range ends at 33.4 deg of incidence and
+            // 38.7 deg of sideslip); a sideslip component v of a speed 293 m/s.
+            let angle = -FRAC_PI_2 + PI * i as f64 / 20_000.0;
+            let (w, u) = (293.0 * angle.sin(), 293.0 * angle.cos());
+            let v = 293.0 * (0.999_999 * angle).sin();
+            let a = v / 293.0;
+            let (alpha, beta) = atan2_asin(w, u, a, v * v, 293.0 * 293.0);
+            worst_atan = worst_atan.max(ulps(alpha, w.atan2(u)));
+            worst_asin = worst_asin.max(ulps(beta, a.asin()));
+        }
+        assert!(worst_atan <= 4.0, "atan2: worst {worst_atan} ulp");
+        assert!(worst_asin <= 4.0, "asin: worst {worst_asin} ulp");
+        let (alpha, beta) = atan2_asin(-0.0, 1.0, -0.0, 0.0, 1.0);
+        assert!(alpha == 0.0 && alpha.is_sign_negative() && beta.is_sign_negative());
+        let (alpha, beta) = atan2_asin(1.0, -1.0, 0.5, 0.25, 1.0);
+        assert_eq!((alpha, beta), (atan2(1.0, -1.0), asin(0.5)));
     }
 
     #[test]

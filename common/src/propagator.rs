@@ -29,7 +29,7 @@
 use nalgebra::Vector3;
 
 use crate::frames::{dcm_from_quaternion, euler_321_deg, wrap_deg};
-use crate::model::{EjectorCurve, Model, RunSetup, StateVector};
+use crate::model::{EquationsOfMotion, Model, RunSetup, StateVector};
 
 /// Tolerance to which switch times are located [s] (MODEL.md section 3a).
 pub const SWITCH_TOLERANCE_S: f64 = 1e-12;
@@ -162,7 +162,7 @@ fn propagate_inline<S: SampleSink>(
 ) -> Result<RunLog, Diverged> {
     let mut engine = Engine {
         run,
-        curve: &model.curve,
+        equations: EquationsOfMotion::new(run, &model.curve),
         dt_s: model.dt_s,
         log: RunLog::default(),
     };
@@ -233,7 +233,7 @@ pub fn observe(run: &RunSetup, x: &StateVector) -> Observation {
 
 struct Engine<'a> {
     run: &'a RunSetup,
-    curve: &'a EjectorCurve,
+    equations: EquationsOfMotion<'a>,
     dt_s: f64,
     log: RunLog,
 }
@@ -243,7 +243,7 @@ impl Engine<'_> {
     #[inline(always)]
     fn rk4(&self, x: &StateVector, h: f64, modes: [FootMode; 2]) -> StateVector {
         let on = [modes[0] == FootMode::On, modes[1] == FootMode::On];
-        let f = |y: &StateVector| self.run.derivative(self.curve, y, on);
+        let f = |y: &StateVector| self.equations.derivative(y, on);
         let half = 0.5 * h;
         let sixth = h / 6.0;
         let k1 = f(x);

@@ -29,7 +29,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::atmosphere::isa_troposphere;
 use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
-use crate::elementary::{asin, atan2};
+use crate::elementary::atan2_asin;
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
 
@@ -339,111 +339,21 @@ impl RunSetup {
     }
 
     /// The state derivative (MODEL.md sections 2 and 3) with the ejector feet in the given
-    /// modes (`on[i]`: foot i pushes).
-    ///
-    /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
-    /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
-    /// allocation. Each block cites the MODEL.md line it implements.
-    ///
-    /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
-    /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
+    /// modes (`on[i]`: foot i pushes). See [`EquationsOfMotion::derivative`], which the
+    /// propagator calls with the run's constant products formed once.
     #[inline(always)]
     pub fn derivative(&self, curve: &EjectorCurve, x: &StateVector, on: [bool; 2]) -> StateVector {
-        let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
-        // Section 1: interference decay with s = |r|. First: its input is ready long before
-        // the stage's velocity and attitude, so the exponential overlaps the rest.
-        let f_s = self.decay.factor(dot([rx, ry, rz], [rx, ry, rz]).sqrt());
-        // Section 2: C_LB of the stage's quaternion (one DCM per stage).
-        let c = Dcm::from_quaternion(q0, q1, q2, q3);
-
-        // Section 2: v_air = v + V_inf (cos a cos b, sin b, sin a cos b) in L;
-        // (u, v, w) = C_BL v_air.
-        let va = &self.v_aircraft_air_l_m_s;
-        let air = [vx + va.x, vy + va.y, vz + va.z];
-        let [u, v, w] = c.to_body(air);
-        // Section 3: V = |v_air| (rotation-invariant, so taken in L), qbar = 0.5 rho V^2,
-        // alpha = atan2(w, u), beta = asin(v / V), p^ = p d / 2V (likewise q^, r^).
-        let speed2 = dot(air, air);
-        let inv_speed = 1.0 / speed2.sqrt();
-        let qbar_area = self.half_rho_area * speed2;
-        let alpha = atan2(w, u);
-        let beta = asin(v * inv_speed);
-        let rate_scale = self.half_diameter_m * inv_speed;
-        let flow = Flow {
-            alpha_rad: alpha,
-            beta_rad: beta,
-            p_hat: p * rate_scale,
-            q_hat: q * rate_scale,
-            r_hat: r * rate_scale,
-            speed_m_s: speed2 * inv_speed,
-            interference_factor: f_s,
-        };
-        // Section 3: the six coefficients, then the catalogue's extra terms (section 7).
-        let mut k = self.aero.coefficients(&flow, &self.interference_increments);
-        if self.coefficient_term_count > 0 {
-            self.add_coefficient_terms(&flow, &mut k);
-        }
-        // Section 3: F_aero_B = qbar S (CX, CY, CZ); M_aero_B = qbar S d (Cl, Cm, Cn), moved
-        // from the moment reference point (x_ref, 0, 0) to the CG: M += (x_ref, 0, 0) x F.
-        let (fx, fy, fz) = (qbar_area * k.cx, qbar_area * k.cy, qbar_area * k.cz);
-        let qbar_area_d = qbar_area * self.diameter_m;
-        let x_ref = self.aero_reference_x_m;
-        let mx = qbar_area_d * k.cl;
-        let mut my = (-x_ref).mul_add(fz, qbar_area_d * k.cm);
-        let mut mz = x_ref.mul_add(fy, qbar_area_d * k.cn);
-        // Section 3: F_L = C_LB F_aero_B.
-        let [mut ax, mut ay, mut az] = c.to_launch([fx, fy, fz]);
-
-        // Section 3: each foot pushes along its L direction with
-        // fac_i F_ej(clamp(s_i, 0, stroke)), s_i = (r + C_LB (x_i, 0, 0))_z; its moment about
-        // the CG is (x_i, 0, 0) x (C_BL F_i).
-        if on[0] || on[1] {
-            let d = &self.ejector_direction_l;
-            for (foot, _) in self.feet.iter().zip(on).filter(|(_, on)| *on) {
-                let s_i = c.m[2][0].mul_add(foot.x_m, rz);
-                let force_n = foot.fac * curve.force_n(s_i.clamp(0.0, self.stroke_m));
-                let f_l = [force_n * d.x, force_n * d.y, force_n * d.z];
-                ax += f_l[0];
-                ay += f_l[1];
-                az += f_l[2];
-                let [_, by, bz] = c.to_body(f_l);
-                // (x, 0, 0) x (bx, by, bz) = (0, -x bz, x by)
-                my = (-foot.x_m).mul_add(bz, my);
-                mz = foot.x_m.mul_add(by, mz);
-            }
-        }
-
-        // Section 2: dv/dt = g_L + (C_LB F_aero_B + F_ej_L) / m.
-        let g = &self.gravity_l_m_s2;
-        let inv_m = self.inv_mass_per_kg;
-        // Section 2: dq/dt = 0.5 q (x) (0, omega).
-        let [dq0, dq1, dq2, dq3] = quaternion_rate([q0, q1, q2, q3], p, q, r);
-        // Section 2: domega/dt = I^-1 (M_B - omega x (I omega)).
-        let [dp, dq, dr] = self.angular_acceleration([mx, my, mz], [p, q, r]);
-        [
-            vx,
-            vy,
-            vz,
-            ax.mul_add(inv_m, g.x),
-            ay.mul_add(inv_m, g.y),
-            az.mul_add(inv_m, g.z),
-            dq0,
-            dq1,
-            dq2,
-            dq3,
-            dp,
-            dq,
-            dr,
-        ]
+        EquationsOfMotion::new(self, curve).derivative(x, on)
     }
 
     /// Adds the catalogue's coefficient terms (section 7). Out of line, so that the flow and
     /// the coefficients go through memory only when there are terms.
     #[inline(never)]
-    fn add_coefficient_terms(&self, flow: &Flow, k: &mut Coefficients) {
+    fn add_coefficient_terms(&self, flow: Flow, mut k: Coefficients) -> Coefficients {
         for (term, params) in &self.coefficient_terms[..self.coefficient_term_count] {
-            term(params, flow, k);
+            term(params, &flow, &mut k);
         }
+        k
     }
 
     /// I^-1 (M - omega x (I omega)) (MODEL.md section 2), with a short path for the diagonal
@@ -476,6 +386,132 @@ impl RunSetup {
     }
 }
 
+/// The equations of motion of one run (MODEL.md sections 2 and 3), with the products of the
+/// run's constants that the force evaluation needs formed once, when a propagation starts.
+#[derive(Clone, Copy)]
+pub struct EquationsOfMotion<'a> {
+    run: &'a RunSetup,
+    curve: &'a EjectorCurve,
+    /// 0.5 rho S / m [1/m]: times V^2 and a force coefficient, an acceleration.
+    accel_per_speed2: f64,
+    /// 0.5 rho S d [kg]: times V^2 and a moment coefficient, a moment.
+    moment_per_speed2: f64,
+    /// x_ref / d: moving the moments to the CG is Cm -= CZ x_ref / d, Cn += CY x_ref / d.
+    reference_arm: f64,
+}
+
+impl<'a> EquationsOfMotion<'a> {
+    /// The equations of `run` with the ejector force curve `curve`.
+    pub fn new(run: &'a RunSetup, curve: &'a EjectorCurve) -> Self {
+        EquationsOfMotion {
+            run,
+            curve,
+            accel_per_speed2: run.half_rho_area * run.inv_mass_per_kg,
+            moment_per_speed2: run.half_rho_area * run.diameter_m,
+            reference_arm: run.aero_reference_x_m / run.diameter_m,
+        }
+    }
+
+    /// The state derivative with the ejector feet in the given modes (`on[i]`: foot i
+    /// pushes).
+    ///
+    /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
+    /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
+    /// allocation. Each block cites the MODEL.md line it implements.
+    ///
+    /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
+    /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
+    #[inline(always)]
+    pub fn derivative(&self, x: &StateVector, on: [bool; 2]) -> StateVector {
+        let run = self.run;
+        let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
+        // Section 1: interference decay with s = |r|. First: its input is ready long before
+        // the stage's velocity and attitude, so the exponential overlaps the rest.
+        let f_s = run.decay.factor(dot([rx, ry, rz], [rx, ry, rz]).sqrt());
+        // Section 2: C_LB of the stage's quaternion scaled to unit length, kept as
+        // |q|^2 C_LB and 1 / |q|^2 (the scale is applied where it is needed, off the chain
+        // from the stage's state to the flow angles).
+        let c = Dcm::from_quaternion(q0, q1, q2, q3);
+
+        // Section 2: v_air = v + V_inf (cos a cos b, sin b, sin a cos b) in L;
+        // (u, v, w) = C_BL v_air, here |q|^2 (u, v, w).
+        let va = &run.v_aircraft_air_l_m_s;
+        let air = [vx + va.x, vy + va.y, vz + va.z];
+        let [u_s, v_s, w_s] = c.to_body_scaled(air);
+        // Section 3: V = |v_air| (rotation-invariant, so taken in L), qbar = 0.5 rho V^2,
+        // alpha = atan2(w, u) (the scale |q|^2 cancels), beta = asin(v / V) with
+        // (v / V)^2 = (|q|^2 v)^2 / (|q|^4 V^2), p^ = p d / 2V (likewise q^, r^).
+        let speed2 = dot(air, air);
+        let inv_speed = 1.0 / speed2.sqrt();
+        let (alpha, beta) = atan2_asin(
+            w_s,
+            u_s,
+            v_s * (c.inv_n2 * inv_speed),
+            v_s * v_s,
+            speed2 * (c.n2 * c.n2),
+        );
+        let rate_scale = run.half_diameter_m * inv_speed;
+        let flow = Flow {
+            alpha_rad: alpha,
+            beta_rad: beta,
+            p_hat: p * rate_scale,
+            q_hat: q * rate_scale,
+            r_hat: r * rate_scale,
+            speed_m_s: speed2 * inv_speed,
+            interference_factor: f_s,
+        };
+        // Section 3: the six coefficients, then the catalogue's extra terms (section 7).
+        let mut k = run.aero.coefficients(&flow, &run.interference_increments);
+        if run.coefficient_term_count > 0 {
+            k = run.add_coefficient_terms(flow, k);
+        }
+        // Section 3: M_aero_B = qbar S d (Cl, Cm, Cn), moved from the moment reference point
+        // (x_ref, 0, 0) to the CG: M += (x_ref, 0, 0) x F_aero_B.
+        let moment_scale = self.moment_per_speed2 * speed2;
+        let arm = self.reference_arm;
+        let mx = moment_scale * k.cl;
+        let mut my = moment_scale * (-arm).mul_add(k.cz, k.cm);
+        let mut mz = moment_scale * arm.mul_add(k.cy, k.cn);
+        // Sections 2 and 3: dv/dt = g_L + (C_LB F_aero_B + F_ej_L) / m, F_aero_B = qbar S
+        // (CX, CY, CZ), with 1 / (m |q|^2) folded into the body force.
+        let body_scale = (self.accel_per_speed2 * speed2) * c.inv_n2;
+        let g = &run.gravity_l_m_s2;
+        let [mut ax, mut ay, mut az] = c.to_launch_scaled(
+            [body_scale * k.cx, body_scale * k.cy, body_scale * k.cz],
+            [g.x, g.y, g.z],
+        );
+
+        // Section 3: each foot pushes along its L direction d with
+        // F_i = fac_i F_ej(clamp(s_i, 0, stroke)), s_i = (r + C_LB (x_i, 0, 0))_z; its moment
+        // about the CG is (x_i, 0, 0) x (C_BL F_i d) = F_i x_i (0, -(C_BL d)_z, (C_BL d)_y).
+        if on[0] || on[1] {
+            let c20 = c.m[2][0] * c.inv_n2;
+            let (mut force_n, mut arm_force_n_m) = (0.0, 0.0);
+            for (foot, _) in run.feet.iter().zip(on).filter(|(_, on)| *on) {
+                let s_i = c20.mul_add(foot.x_m, rz);
+                let f_i = foot.fac * self.curve.force_n(s_i.clamp(0.0, run.stroke_m));
+                force_n += f_i;
+                arm_force_n_m = foot.x_m.mul_add(f_i, arm_force_n_m);
+            }
+            let d = &run.ejector_direction_l;
+            let accel = force_n * run.inv_mass_per_kg;
+            ax = accel.mul_add(d.x, ax);
+            ay = accel.mul_add(d.y, ay);
+            az = accel.mul_add(d.z, az);
+            let [_, by, bz] = c.to_body_scaled([d.x, d.y, d.z]);
+            let arm_force = arm_force_n_m * c.inv_n2;
+            my = (-arm_force).mul_add(bz, my);
+            mz = arm_force.mul_add(by, mz);
+        }
+
+        // Section 2: dq/dt = 0.5 q (x) (0, omega).
+        let [dq0, dq1, dq2, dq3] = quaternion_rate([q0, q1, q2, q3], p, q, r);
+        // Section 2: domega/dt = I^-1 (M_B - omega x (I omega)).
+        let [dp, dq, dr] = run.angular_acceleration([mx, my, mz], [p, q, r]);
+        [vx, vy, vz, ax, ay, az, dq0, dq1, dq2, dq3, dp, dq, dr]
+    }
+}
+
 /// a . b with fused multiply-adds.
 #[inline(always)]
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -497,48 +533,45 @@ fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {
     ]
 }
 
-/// The direction-cosine matrix C_LB of one stage, row-major (`m[i][j]` = C_LB(i, j)).
+/// The direction-cosine matrix C_LB of one stage's quaternion q scaled to unit length (see
+/// [`crate::frames`]), kept as `m` = |q|^2 C_LB (row-major, `m[i][j]` = |q|^2 C_LB(i, j)),
+/// the products of q without a division, and the scale 1 / |q|^2.
 #[derive(Debug, Clone, Copy)]
 pub struct Dcm {
-    /// The matrix.
+    /// |q|^2 C_LB.
     pub m: [[f64; 3]; 3],
+    /// |q|^2.
+    pub n2: f64,
+    /// 1 / |q|^2.
+    pub inv_n2: f64,
 }
 
 impl Dcm {
-    /// C_LB of the quaternion (q0, q1, q2, q3) scaled to unit length (see [`crate::frames`]):
-    /// the diagonal as 1 - 2 (qj^2 + qk^2) / |q|^2, the rest as 2 (qi qj -+ q0 qk) / |q|^2.
+    /// |q|^2 C_LB of the quaternion (q0, q1, q2, q3): the diagonal as q0^2 + qi^2 - qj^2 - qk^2,
+    /// the rest as 2 (qi qj -+ q0 qk).
     #[inline(always)]
     pub fn from_quaternion(q0: f64, q1: f64, q2: f64, q3: f64) -> Dcm {
-        let (s11, s22, s33) = (q1 * q1, q2 * q2, q3 * q3);
-        let inv_n2 = 1.0 / q0.mul_add(q0, (s11 + s22) + s33);
-        let two = 2.0 * inv_n2;
-        let m_two = -two;
-        // 2 (a b + c d) / |q|^2 with one rounding inside.
-        let off = |a: f64, b: f64, c: f64, d: f64| two * a.mul_add(b, c * d);
+        let (s00, s11, s22, s33) = (q0 * q0, q1 * q1, q2 * q2, q3 * q3);
+        let (a, b) = (s00 + s11, s22 + s33);
+        let (c, d) = (s00 - s11, s22 - s33);
+        let n2 = a + b;
+        // 2 qi qj -+ 2 q0 qk with one rounding after the shared product (doubling is exact).
+        let (p12, p13, p23) = ((q1 + q1) * q2, (q1 + q1) * q3, (q2 + q2) * q3);
+        let (t01, t02, t03) = (q0 + q0, q0 + q0, q0 + q0);
         Dcm {
             m: [
-                [
-                    m_two.mul_add(s22 + s33, 1.0),
-                    off(q1, q2, -q0, q3),
-                    off(q1, q3, q0, q2),
-                ],
-                [
-                    off(q1, q2, q0, q3),
-                    m_two.mul_add(s11 + s33, 1.0),
-                    off(q2, q3, -q0, q1),
-                ],
-                [
-                    off(q1, q3, -q0, q2),
-                    off(q2, q3, q0, q1),
-                    m_two.mul_add(s11 + s22, 1.0),
-                ],
+                [a - b, (-t03).mul_add(q3, p12), t02.mul_add(q2, p13)],
+                [t03.mul_add(q3, p12), c + d, (-t01).mul_add(q1, p23)],
+                [(-t02).mul_add(q2, p13), t01.mul_add(q1, p23), c - d],
             ],
+            n2,
+            inv_n2: 1.0 / n2,
         }
     }
 
-    /// C_BL a: a launch-frame vector in body axes.
+    /// |q|^2 C_BL a: a launch-frame vector in body axes, times |q|^2.
     #[inline(always)]
-    pub fn to_body(&self, a: [f64; 3]) -> [f64; 3] {
+    pub fn to_body_scaled(&self, a: [f64; 3]) -> [f64; 3] {
         let m = &self.m;
         [
             dot([m[0][0], m[1][0], m[2][0]], a),
@@ -547,11 +580,13 @@ impl Dcm {
         ]
     }
 
-    /// C_LB b: a body vector in launch-frame axes.
+    /// base + |q|^2 C_LB b: a body vector in launch-frame axes, times |q|^2, added to base.
     #[inline(always)]
-    pub fn to_launch(&self, b: [f64; 3]) -> [f64; 3] {
+    pub fn to_launch_scaled(&self, b: [f64; 3], base: [f64; 3]) -> [f64; 3] {
         let m = &self.m;
-        [dot(m[0], b), dot(m[1], b), dot(m[2], b)]
+        let row =
+            |i: usize| m[i][0].mul_add(b[0], m[i][1].mul_add(b[1], m[i][2].mul_add(b[2], base[i])));
+        [row(0), row(1), row(2)]
     }
 }
 
