@@ -195,6 +195,13 @@ fn propagate_inline<S: SampleSink>(
             (t / engine.dt_s).floor().max(0.0) as u64
         };
         while k < target_k {
+            if cursor.modes == [FootMode::Off; 2] {
+                // After the stroke ends no switch is due: plain steps, as `advance` takes them
+                // then, with the state kept in registers between steps.
+                let (x, t) = engine.coast(cursor.x, cursor.t_s, k, target_k)?;
+                (cursor.x, cursor.t_s, k) = (x, t, target_k);
+                break;
+            }
             let t_next = (k + 1) as f64 * engine.dt_s;
             cursor = engine.advance(cursor, t_next, true)?;
             k += 1;
@@ -260,6 +267,27 @@ impl Engine<'_> {
             *v *= inv_norm;
         }
         y
+    }
+
+    /// Grid steps from `t_s` = t_k to t_end (k < end), with both feet off: what
+    /// [`Engine::advance`] does then (no switch is due, a full step to each grid point, the
+    /// divergence test after it). Returns the state and time at t_end.
+    #[inline(always)]
+    fn coast(
+        &mut self,
+        mut x: StateVector,
+        mut t_s: f64,
+        k: u64,
+        end: u64,
+    ) -> Result<(StateVector, f64), Diverged> {
+        for j in k + 1..=end {
+            let t_next = j as f64 * self.dt_s;
+            x = self.rk4(&x, t_next - t_s, [FootMode::Off; 2]);
+            t_s = t_next;
+            check_divergence(&x, t_s)?;
+        }
+        self.log.steps += end - k;
+        Ok((x, t_s))
     }
 
     /// s_i - stroke of foot `i` at state `x`.
