@@ -581,11 +581,13 @@ impl Dcm {
     }
 
     /// base + |q|^2 C_LB b: a body vector in launch-frame axes, times |q|^2, added to base.
+    /// The sum runs from b[0] to b[2], so that b[2] (in the force evaluation the normal force,
+    /// the last to be known) waits for one multiply-add only.
     #[inline(always)]
     pub fn to_launch_scaled(&self, b: [f64; 3], base: [f64; 3]) -> [f64; 3] {
         let m = &self.m;
         let row =
-            |i: usize| m[i][0].mul_add(b[0], m[i][1].mul_add(b[1], m[i][2].mul_add(b[2], base[i])));
+            |i: usize| m[i][2].mul_add(b[2], m[i][1].mul_add(b[1], m[i][0].mul_add(b[0], base[i])));
         [row(0), row(1), row(2)]
     }
 }
