@@ -127,9 +127,11 @@ pub fn service_name(name: &str) -> Result<ServiceName, IpcError> {
 }
 
 /// Run ids that have iceoryx2 resources on this host (shared memory or files under the
-/// iceoryx2 root), found by their `sepval_<run id>_` prefix.
-pub fn runs_with_resources() -> Vec<String> {
-    let mut ids = std::collections::BTreeSet::new();
+/// iceoryx2 root), found by their `sepval_<run id>_` prefix, with the age of each run's newest
+/// resource.
+pub fn runs_with_resources() -> Vec<(String, std::time::Duration)> {
+    let mut ids: std::collections::BTreeMap<String, std::time::Duration> =
+        std::collections::BTreeMap::new();
     let root = Config::global_config().global.root_path().to_string();
     let mut dirs = vec![std::path::PathBuf::from("/dev/shm")];
     let root = std::path::PathBuf::from(root);
@@ -146,7 +148,14 @@ pub fn runs_with_resources() -> Vec<String> {
             if let Some(rest) = name.strip_prefix("sepval_") {
                 if let Some((id, _)) = rest.split_once('_') {
                     if validate_run_id(id).is_ok() {
-                        ids.insert(id.to_string());
+                        let age = e
+                            .metadata()
+                            .and_then(|m| m.modified())
+                            .ok()
+                            .and_then(|t| t.elapsed().ok())
+                            .unwrap_or_default();
+                        let entry = ids.entry(id.to_string()).or_insert(age);
+                        *entry = (*entry).min(age);
                     }
                 }
             }
@@ -154,6 +163,9 @@ pub fn runs_with_resources() -> Vec<String> {
     }
     ids.into_iter().collect()
 }
+
+/// Runs younger than this are never cleaned by another run: their processes may be starting.
+pub const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(30);
 
 /// Removes the iceoryx2 resources of run `run_id` if none of its nodes is alive: the dead
 /// nodes' resources (through iceoryx2's own cleanup) and the run's management segment.
@@ -178,11 +190,13 @@ pub fn clean_run_if_stale(run_id: &str) -> Result<bool, IpcError> {
     Ok(true)
 }
 
-/// Cleans every stale sepval run on this host except `except` (returns the runs cleaned).
-pub fn clean_stale_runs(except: &str) -> Vec<String> {
+/// Cleans every stale sepval run on this host except `except`: runs whose newest resource is
+/// older than `min_age` and none of whose nodes is alive (returns the runs cleaned).
+pub fn clean_stale_runs(except: &str, min_age: std::time::Duration) -> Vec<String> {
     runs_with_resources()
         .into_iter()
-        .filter(|id| id != except)
+        .filter(|(id, age)| id != except && *age >= min_age)
+        .map(|(id, _)| id)
         .filter(|id| clean_run_if_stale(id).unwrap_or(false))
         .collect()
 }

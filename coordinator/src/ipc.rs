@@ -165,6 +165,33 @@ impl Connection {
             )));
         }
         let svc = |n: &str| sipc::service_name(n).map_err(transport);
+        let hello = node
+            .service_builder(&svc(names::HELLO)?)
+            .publish_subscribe::<Hello>()
+            .max_publishers(MAX_WORKERS + 8)
+            .max_subscribers(1)
+            .subscriber_max_buffer_size(MAX_WORKERS + 8)
+            .history_size(0)
+            .create()
+            .map_err(iox("creating the hello service"))
+            .map_err(transport)?
+            .subscriber_builder()
+            .create()
+            .map_err(iox("subscribing to hellos"))
+            .map_err(transport)?;
+        let wake = node
+            .service_builder(&svc(names::COORDINATOR_WAKE)?)
+            .event()
+            .max_notifiers(MAX_WORKERS + 8)
+            .max_listeners(1)
+            .create()
+            .map_err(iox("creating the coordinator's wake-up service"))
+            .map_err(transport)?
+            .listener_builder()
+            .create()
+            .map_err(iox("listening for wake-ups"))
+            .map_err(transport)?;
+        // The setup service last: a worker that finds it finds every run service.
         let (mut header, bytes) = encode_setup(&job);
         if let Some(v) = options.announce_protocol {
             header.protocol = v;
@@ -194,32 +221,6 @@ impl Connection {
             .write_from_slice(&bytes)
             .send()
             .map_err(iox("sending the setup"))
-            .map_err(transport)?;
-        let hello = node
-            .service_builder(&svc(names::HELLO)?)
-            .publish_subscribe::<Hello>()
-            .max_publishers(MAX_WORKERS + 8)
-            .max_subscribers(1)
-            .subscriber_max_buffer_size(MAX_WORKERS + 8)
-            .history_size(0)
-            .create()
-            .map_err(iox("creating the hello service"))
-            .map_err(transport)?
-            .subscriber_builder()
-            .create()
-            .map_err(iox("subscribing to hellos"))
-            .map_err(transport)?;
-        let wake = node
-            .service_builder(&svc(names::COORDINATOR_WAKE)?)
-            .event()
-            .max_notifiers(MAX_WORKERS + 8)
-            .max_listeners(1)
-            .create()
-            .map_err(iox("creating the coordinator's wake-up service"))
-            .map_err(transport)?
-            .listener_builder()
-            .create()
-            .map_err(iox("listening for wake-ups"))
             .map_err(transport)?;
         let mut me = Connection {
             job,
@@ -768,7 +769,7 @@ impl IpcEvaluator {
     /// workers. Stale resources of earlier runs whose processes were killed are cleaned first.
     pub fn start(job: Arc<Job>, options: IpcOptions) -> Result<Self, EvalError> {
         sipc::validate_run_id(&options.run_id).map_err(transport)?;
-        for id in sipc::clean_stale_runs(&options.run_id) {
+        for id in sipc::clean_stale_runs(&options.run_id, sipc::STALE_AFTER) {
             eprintln!("sepval: cleaned the stale iceoryx2 resources of run {id}");
         }
         let run_id = options.run_id.clone();

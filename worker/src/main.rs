@@ -170,14 +170,17 @@ fn serve(cli: &Cli, run: &str) -> Result<Option<String>> {
         .history_request(1)
         .create()
         .map_err(sipc::iox("subscribing to the setup"))?;
-    let coordinator_wake = node
-        .service_builder(&svc(names::COORDINATOR_WAKE)?)
-        .event()
-        .open()
-        .map_err(sipc::iox("opening the coordinator's wake-up service"))?
-        .notifier_builder()
-        .create()
-        .map_err(sipc::iox("notifying the coordinator"))?;
+    let coordinator_wake = retry_until(open_deadline, || {
+        node.service_builder(&svc(names::COORDINATOR_WAKE)?)
+            .event()
+            .open()
+            .map_err(|e| {
+                anyhow::Error::from(sipc::iox("opening the coordinator's wake-up service")(e))
+            })
+    })?
+    .notifier_builder()
+    .create()
+    .map_err(sipc::iox("notifying the coordinator"))?;
     // The job setup (delivered from the service's history). A setup we refuse ends the
     // worker at once; we announce ourselves only once we have accepted it.
     let job = loop {
@@ -205,14 +208,15 @@ fn serve(cli: &Cli, run: &str) -> Result<Option<String>> {
         }
         std::thread::sleep(Duration::from_millis(10));
     };
-    let hello_pub = node
-        .service_builder(&svc(names::HELLO)?)
-        .publish_subscribe::<Hello>()
-        .open()
-        .map_err(sipc::iox("opening the hello service"))?
-        .publisher_builder()
-        .create()
-        .map_err(sipc::iox("publishing hello"))?;
+    let hello_pub = retry_until(open_deadline, || {
+        node.service_builder(&svc(names::HELLO)?)
+            .publish_subscribe::<Hello>()
+            .open()
+            .map_err(|e| anyhow::Error::from(sipc::iox("opening the hello service")(e)))
+    })?
+    .publisher_builder()
+    .create()
+    .map_err(sipc::iox("publishing hello"))?;
     hello_pub
         .send_copy(Hello {
             magic: MAGIC,
