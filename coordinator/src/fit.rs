@@ -138,6 +138,7 @@ impl Sigma {
 }
 
 /// Everything a fit needs besides the evaluator.
+#[derive(Clone)]
 pub struct FitOptions {
     /// Searches to run.
     pub method: Method,
@@ -172,6 +173,8 @@ pub struct FitOutput {
     pub result: FitResult,
     /// Per method, the simulated samples of its best member (per event).
     pub best_samples: BTreeMap<String, Vec<Vec<Observation>>>,
+    /// The best refined fit (`+lm` methods), with its residuals and Jacobian.
+    pub refined: Option<LmResult>,
 }
 
 /// Runs the fit and writes DIR/result.json (and a checkpoint per GA generation).
@@ -452,6 +455,7 @@ pub fn run_fit(options: &FitOptions, evaluator: &mut dyn Evaluator) -> Result<Fi
     Ok(FitOutput {
         result,
         best_samples,
+        refined: best_refined,
     })
 }
 

@@ -3,11 +3,14 @@
 //! position and attitude error divided by its noise sigma.
 //!
 //! Sources: K. Levenberg (1944) and D. W. Marquardt (1963) with Marquardt's diagonal scaling
-//! (J^T J + mu diag(J^T J)) delta = -J^T r; bounds by projection onto the box after each step
+//! (J^T J + mu diag(J^T J)) delta = -J^T r, converged after three consecutive accepted steps that
+//! lower the cost by less than the tolerance; bounds by projection onto the box after each step
 //! (as in bounded variants such as Kanzow, Yamashita and Fukushima, 2004). The Jacobian is a
 //! forward difference, one batch of simulations per iteration through the [`Evaluator`]; each
-//! iteration also tries three damping values in one batch (mu/10, mu, 10 mu) and keeps the
-//! best, so the workers stay busy.
+//! iteration also tries four damping values in one batch (mu/100, mu/10, mu, 10 mu) and keeps
+//! the best as the next mu, so the workers stay busy and the damping adapts in one iteration.
+//! Each step carries Transtrum and Sethna's geodesic acceleration (one probe per step), which
+//! follows the narrow curved valleys of strongly compensating parameters.
 
 use anyhow::{Context, Result, bail};
 use nalgebra::{DMatrix, DVector};
@@ -195,16 +198,54 @@ fn fd_steps(space: &ParamSpace, x: &[f64], fd_step: f64) -> Vec<f64> {
         .collect()
 }
 
+/// Probe distance of the geodesic acceleration, as a fraction of the step.
+const CURVATURE_H: f64 = 0.1;
+
+/// Solves (J^T J + mu diag(J^T J)) d = rhs for the free parameters (zero for the others).
+fn solve_damped(jtj: &DMatrix<f64>, free: &[usize], mu: f64, rhs: &[f64]) -> Vec<f64> {
+    let nf = free.len();
+    let mut a = DMatrix::zeros(nf, nf);
+    let mut b = DVector::zeros(nf);
+    for (p, &i) in free.iter().enumerate() {
+        b[p] = rhs[i];
+        for (q, &j) in free.iter().enumerate() {
+            a[(p, q)] = jtj[(i, j)];
+        }
+        a[(p, p)] += mu * jtj[(i, i)].max(1e-12);
+    }
+    let d = a
+        .clone()
+        .cholesky()
+        .map(|c| c.solve(&b))
+        .unwrap_or_else(|| {
+            a.svd(true, true)
+                .solve(&b, 1e-14)
+                .unwrap_or_else(|_| DVector::zeros(nf))
+        });
+    let mut full = vec![0.0; jtj.nrows()];
+    for (p, &i) in free.iter().enumerate() {
+        full[i] = d[p];
+    }
+    full
+}
+
 /// What a refinement waits for.
 enum Stage {
     /// The start point.
     Start,
     /// Derivative probes (then the final Jacobian is complete when `last`).
     Jacobian { steps: Vec<f64>, last: bool },
-    /// Damped Gauss-Newton trials at three damping values.
+    /// Probes along each damped step for its curvature.
+    Curvature {
+        deltas: Vec<Vec<f64>>,
+        probes: Vec<Vec<f64>>,
+        mus: [f64; 4],
+        free: Vec<usize>,
+    },
+    /// Damped (and accelerated) Gauss-Newton trials at four damping values.
     Trials {
         points: Vec<Vec<f64>>,
-        mus: [f64; 3],
+        mus: [f64; 4],
     },
     /// Finished.
     Done,
@@ -229,6 +270,8 @@ pub struct LmRun {
     history: Vec<(u64, Goals)>,
     stage: Stage,
     stop: String,
+    /// Consecutive accepted steps that lowered the cost by less than the tolerance.
+    small_gains: usize,
 }
 
 impl LmRun {
@@ -257,6 +300,7 @@ impl LmRun {
             history: Vec::new(),
             stage: Stage::Start,
             stop: String::new(),
+            small_gains: 0,
         }
     }
 
@@ -276,6 +320,7 @@ impl LmRun {
                     p
                 })
                 .collect(),
+            Stage::Curvature { probes, .. } => probes.clone(),
             Stage::Trials { points, .. } => points.clone(),
             Stage::Done => return Ok(None),
         };
@@ -323,6 +368,9 @@ impl LmRun {
                     self.plan_trials();
                 }
             }
+            Stage::Curvature {
+                deltas, mus, free, ..
+            } => self.plan_accelerated(deltas, out, mus, free),
             Stage::Trials { points, mus } => {
                 let mut best: Option<(usize, f64, Vec<f64>)> = None;
                 let mut kept: Vec<Option<Vec<Vec<Observation>>>> = out;
@@ -342,10 +390,15 @@ impl LmRun {
                         self.cost = ck;
                         self.r = rk;
                         self.samples = kept[k].take().expect("finished trial");
-                        self.mu = (mus[k] / 3.0).max(1e-12);
+                        self.mu = mus[k].max(1e-12);
                         self.history
                             .push((self.evaluations, goals_of(&self.r, self.noise)));
-                        if gain < self.settings.rel_tolerance {
+                        self.small_gains = if gain < self.settings.rel_tolerance {
+                            self.small_gains + 1
+                        } else {
+                            0
+                        };
+                        if self.small_gains >= 3 {
                             self.stop = "converged (relative decrease below tolerance)".into();
                             self.begin_jacobian(true);
                         } else {
@@ -382,7 +435,7 @@ impl LmRun {
             self.stop = "iteration limit".into();
             return;
         }
-        if self.evaluations + 3 + n as u64 > self.settings.budget {
+        if self.evaluations + 8 + n as u64 > self.settings.budget {
             self.stop = "simulation budget".into();
             return;
         }
@@ -399,36 +452,71 @@ impl LmRun {
                 !(at_lo || at_hi)
             })
             .collect();
-        let nf = free.len();
-        let mus = [mu / 10.0, mu, mu * 10.0];
-        let points: Vec<Vec<f64>> = mus
+        let mus = [mu / 100.0, mu / 10.0, mu, mu * 10.0];
+        let minus_g: Vec<f64> = g.iter().map(|v| -v).collect();
+        let deltas: Vec<Vec<f64>> = mus
             .iter()
-            .map(|&m| {
-                let mut a = DMatrix::zeros(nf, nf);
-                let mut b = DVector::zeros(nf);
-                for (p, &i) in free.iter().enumerate() {
-                    b[p] = -g[i];
-                    for (q, &j) in free.iter().enumerate() {
-                        a[(p, q)] = jtj[(i, j)];
-                    }
-                    a[(p, p)] += m * jtj[(i, i)].max(1e-12);
-                }
-                let delta = a
-                    .clone()
-                    .cholesky()
-                    .map(|c| c.solve(&b))
-                    .unwrap_or_else(|| {
-                        a.svd(true, true)
-                            .solve(&b, 1e-14)
-                            .unwrap_or_else(|_| DVector::zeros(nf))
-                    });
-                let mut xt = x.clone();
-                for (p, &i) in free.iter().enumerate() {
-                    xt[i] += delta[p];
-                }
-                space.clamp(&xt)
-            })
+            .map(|&m| solve_damped(&jtj, &free, m, &minus_g))
             .collect();
+        let probes: Vec<Vec<f64>> = deltas
+            .iter()
+            .map(|d| (0..n).map(|i| x[i] + CURVATURE_H * d[i]).collect())
+            .collect();
+        self.stage = Stage::Curvature {
+            deltas,
+            probes,
+            mus,
+            free,
+        };
+    }
+
+    /// Geodesic acceleration (M. K. Transtrum and J. P. Sethna, "Improvements to the
+    /// Levenberg-Marquardt algorithm for nonlinear least-squares minimization", 2012): the
+    /// second directional derivative of the residuals along each step, from one probe at
+    /// h = 0.1 of the step, gives a curvature correction a; the trial is x + delta + a / 2 when
+    /// 2 |a| <= 0.75 |delta| (range-scaled norms), else x + delta.
+    fn plan_accelerated(
+        &mut self,
+        deltas: Vec<Vec<f64>>,
+        probes: Vec<Option<Vec<Vec<Observation>>>>,
+        mus: [f64; 4],
+        free: Vec<usize>,
+    ) {
+        let n = self.space.len();
+        let jtj = self.jac.tr_mul(&self.jac);
+        let scaled = |v: &[f64]| -> f64 {
+            (0..n)
+                .map(|i| (v[i] / self.space.range(i)).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let mut points = Vec::with_capacity(4);
+        for (k, delta) in deltas.iter().enumerate() {
+            let mut step = delta.clone();
+            if let Some(s) = &probes[k] {
+                let rh = residual_vector(&self.job, s, self.noise);
+                let jd = &self.jac * DVector::from_column_slice(delta);
+                let rpp: Vec<f64> = (0..rh.len())
+                    .map(|j| 2.0 / CURVATURE_H * ((rh[j] - self.r[j]) / CURVATURE_H - jd[j]))
+                    .collect();
+                let rhs: Vec<f64> = self
+                    .jac
+                    .tr_mul(&DVector::from_column_slice(&rpp))
+                    .iter()
+                    .map(|v| -v)
+                    .collect();
+                let acc = solve_damped(&jtj, &free, mus[k], &rhs);
+                if 2.0 * scaled(&acc) <= 0.75 * scaled(delta) {
+                    for i in 0..n {
+                        step[i] += 0.5 * acc[i];
+                    }
+                }
+            }
+            points.push(
+                self.space
+                    .clamp(&(0..n).map(|i| self.x[i] + step[i]).collect::<Vec<_>>()),
+            );
+        }
         self.stage = Stage::Trials { points, mus };
     }
 

@@ -259,7 +259,7 @@ fn bad_fit_settings_are_refused() {
         ),
         (
             vec!["--method", "anneal"],
-            "--method anneal: expected ga, hill or both",
+            "--method anneal: expected ga, hill, both, ga+lm or hill+lm",
         ),
         (
             vec!["--evaluator", "carrier-pigeon"],
