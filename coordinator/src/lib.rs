@@ -8,6 +8,7 @@
 
 pub mod bench;
 pub mod checkpoint;
+pub mod diagnose;
 pub mod figures;
 pub mod fit;
 pub mod identifiability;
@@ -20,4 +21,5 @@ pub mod results;
 pub mod rng;
 pub mod search;
 pub mod selftest;
+pub mod stats;
 pub mod uds;

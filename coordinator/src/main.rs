@@ -54,6 +54,9 @@ enum Command {
     Fit(Box<FitArgs>),
     /// Re-evaluate a saved generation and check every goal bit for bit.
     Rerun(RerunArgs),
+    /// Show what the simulation still gets wrong after a fit, name the cause from the effect
+    /// catalogue, extend the model and measure the gain.
+    Diagnose(Box<DiagnoseArgs>),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
     /// Check the Pareto machinery on problems with known fronts.
@@ -118,6 +121,40 @@ struct FitArgs {
     #[arg(long)]
     no_figures: bool,
     /// Run directory (result.json, generations/, figures/).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct DiagnoseArgs {
+    /// Measured trajectory (CSV; repeatable). Default: the embedded synthetic flight test.
+    #[arg(long, value_name = "FILE.csv")]
+    data: Vec<PathBuf>,
+    /// Scenario file (TOML); the embedded default when absent.
+    #[arg(long, value_name = "FILE")]
+    scenario: Option<PathBuf>,
+    /// Seed of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Generations of the baseline fit's genetic search (it stops earlier when its refinement
+    /// reaches the noise floor).
+    #[arg(long, default_value_t = 60)]
+    generations: usize,
+    /// Population of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 100)]
+    population: usize,
+    /// Simulation budget of each refinement.
+    #[arg(long, default_value_t = 3000)]
+    lm_budget: u64,
+    #[command(flatten)]
+    eval: EvalArgs,
+    /// Position noise [m] (default: estimated from the data).
+    #[arg(long)]
+    sigma_pos_m: Option<f64>,
+    /// Attitude noise [deg] (default: estimated from the data).
+    #[arg(long)]
+    sigma_att_deg: Option<f64>,
+    /// Output directory (diagnosis.json, report.html, figures/, baseline/).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
 }
@@ -262,6 +299,7 @@ fn main() -> ExitCode {
         Command::Scenario(args) => scenario(args),
         Command::Fit(args) => fit(*args),
         Command::Rerun(args) => rerun(args),
+        Command::Diagnose(args) => diagnose(*args),
         Command::Bench(args) => bench(args),
         Command::Selftest(SelftestCommand::Zdt {
             problem,
@@ -282,7 +320,8 @@ fn main() -> ExitCode {
             Ok(())
         })(),
         Command::CleanIpc => {
-            let cleaned = sepval_common::ipc::clean_stale_runs("");
+            // Explicitly asked for: any run without a live process, whatever its age.
+            let cleaned = sepval_common::ipc::clean_stale_runs("", std::time::Duration::ZERO);
             println!(
                 "cleaned {} stale run(s) {}",
                 cleaned.len(),
@@ -630,6 +669,64 @@ fn bench(args: BenchArgs) -> Result<()> {
         "wrote {} and {}",
         args.out.join("bench.csv").display(),
         args.out.join("bench.png").display()
+    );
+    Ok(())
+}
+
+fn diagnose(args: DiagnoseArgs) -> Result<()> {
+    use sepval_coordinator::diagnose::{DiagnoseOptions, diagnose};
+    let (job, inputs) = inputs::job(&args.data, args.scenario.as_deref())?;
+    let sigma = Sigma::resolve(&job, args.sigma_pos_m, args.sigma_att_deg)?;
+    let ga = GaSettings {
+        population: args.population,
+        generations: args.generations,
+        seed: args.seed,
+        ..GaSettings::default()
+    };
+    ga.validate()?;
+    let lm = LmSettings {
+        budget: args.lm_budget,
+        ..LmSettings::default()
+    };
+    let fit = FitOptions {
+        method: Method::GaLm,
+        ga,
+        hill: HillSettings::default(),
+        sigma,
+        truth: None,
+        out: args.out.join("baseline"),
+        resume: None,
+        inputs,
+        progress: true,
+        lm: lm.clone(),
+        lm_probe: LmSettings {
+            budget: args.lm_budget.min(800),
+            ..LmSettings::default()
+        },
+    };
+    let mut evaluator = evaluator(&args.eval, job)?;
+    let options = DiagnoseOptions {
+        fit,
+        out: args.out.clone(),
+        candidate_lm: LmSettings {
+            max_iterations: 400,
+            budget: 10_000,
+            ..lm
+        },
+    };
+    let d = diagnose(&options, evaluator.as_mut())?;
+    println!("{}", d.verdict);
+    println!(
+        "causes: [{}]  explained: {}  ({} simulations, {:.1} s)",
+        d.causes.join(", "),
+        d.explained,
+        d.evaluations,
+        d.wall_s
+    );
+    println!(
+        "report: {}  data: {}",
+        args.out.join("report.html").display(),
+        args.out.join("diagnosis.json").display()
     );
     Ok(())
 }
