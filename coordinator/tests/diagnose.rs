@@ -234,3 +234,52 @@ fn sepval_scenario() -> String {
     assert!(s.contains("cm_q_per_rad = -80.0"), "{s}");
     s
 }
+
+/// The public CFD trajectory of the benchmark store (../shared/data/eglin-cfd, not ours to
+/// ship, so read in place and skipped when absent). Its ejectors push 2400 lbf forward and
+/// 9600 lbf aft, 0.2 and 0.8 of the 12 000 lbf curve: the baseline fit must find fwdfac near
+/// 0.2, improve on the nominal model, and the diagnosis must not claim to explain a different
+/// simulator with the catalogue (docs/eglin-cfd.md).
+#[test]
+fn the_eglin_cfd_trajectory_is_diagnosed_honestly() {
+    let data =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/eglin-cfd/M095_AOA0.csv");
+    if !data.exists() {
+        eprintln!(
+            "skipped: {} not present (a fresh clone has no ../shared)",
+            data.display()
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let data = data.to_str().unwrap();
+    ok(&sepval(
+        &[
+            "diagnose",
+            "--data",
+            data,
+            "--generations",
+            "30",
+            "--workers",
+            "2",
+            "--out",
+            "out",
+        ],
+        dir.path(),
+    ));
+    let d: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("out/diagnosis.json")).unwrap())
+            .unwrap();
+    assert_eq!(d["explained"], Value::Bool(false), "{d}");
+    let base = &d["baseline"];
+    assert!(base["j_att_deg"].as_f64().unwrap() < 1.5, "{base}");
+    assert!(base["j_pos_m"].as_f64().unwrap() < 0.02, "{base}");
+    let r: Value = serde_json::from_slice(
+        &std::fs::read(dir.path().join("out/baseline/result.json")).unwrap(),
+    )
+    .unwrap();
+    let fwdfac = r["methods"]["ga+lm"]["best"]["factors"]["fwdfac"]
+        .as_f64()
+        .unwrap();
+    assert!((fwdfac - 0.2).abs() < 0.05, "fwdfac {fwdfac}");
+}
