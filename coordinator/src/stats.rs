@@ -60,16 +60,7 @@ pub fn gamma_q(a: f64, x: f64) -> f64 {
         for i in 1..1000 {
             let an = -(i as f64) * (i as f64 - a);
             b += 2.0;
-            d = an * d + b;
-            if d.abs() < tiny {
-                d = tiny;
-            }
-            c = b + an / c;
-            if c.abs() < tiny {
-                c = tiny;
-            }
-            d = 1.0 / d;
-            let del = d * c;
+            let del = lentz_step(an, b, &mut c, &mut d);
             h *= del;
             if (del - 1.0).abs() < 1e-16 {
                 break;
@@ -82,6 +73,23 @@ pub fn gamma_q(a: f64, x: f64) -> f64 {
 /// Survival function of the chi-square distribution with `dof` degrees of freedom.
 pub fn chi2_sf(x: f64, dof: f64) -> f64 {
     gamma_q(0.5 * dof, 0.5 * x)
+}
+
+/// One step of the modified Lentz algorithm for a continued fraction with partial numerator
+/// `a_n` and partial denominator `b_n` (Press et al., Numerical Recipes, 3rd ed., section 5.2):
+/// updates `c` and `d` and returns the factor `c d` the approximant is multiplied by.
+fn lentz_step(a_n: f64, b_n: f64, c: &mut f64, d: &mut f64) -> f64 {
+    const TINY: f64 = 1e-300;
+    *d = a_n * *d + b_n;
+    if d.abs() < TINY {
+        *d = TINY;
+    }
+    *c = b_n + a_n / *c;
+    if c.abs() < TINY {
+        *c = TINY;
+    }
+    *d = 1.0 / *d;
+    *d * *c
 }
 
 fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
@@ -98,27 +106,9 @@ fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
         let m = m as f64;
         let m2 = 2.0 * m;
         let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-        d = 1.0 + aa * d;
-        if d.abs() < tiny {
-            d = tiny;
-        }
-        c = 1.0 + aa / c;
-        if c.abs() < tiny {
-            c = tiny;
-        }
-        d = 1.0 / d;
-        h *= d * c;
+        h *= lentz_step(aa, 1.0, &mut c, &mut d);
         let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-        d = 1.0 + aa * d;
-        if d.abs() < tiny {
-            d = tiny;
-        }
-        c = 1.0 + aa / c;
-        if c.abs() < tiny {
-            c = tiny;
-        }
-        d = 1.0 / d;
-        let del = d * c;
+        let del = lentz_step(aa, 1.0, &mut c, &mut d);
         h *= del;
         if (del - 1.0).abs() < 1e-15 {
             break;
