@@ -1,26 +1,11 @@
 //! The `sepval` command line, run as a user runs it.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod support;
+use support::{ok, sepval};
+
+use std::process::Output;
 
 use sepval_common::telemetry::Trajectory;
-
-fn sepval(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sepval"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run sepval")
-}
-
-fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "sepval failed: {}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
 
 fn refused(out: &Output, expected: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -2,8 +2,10 @@
 //! visible magnitude on a base that is not the default truth, null cases, an effect outside
 //! the catalogue, and two effects hidden together. Reduced search budgets; release build.
 
+mod support;
+use support::{ok, sepval};
+
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
@@ -12,23 +14,6 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
  "zinerfac": 0.97, "caoff": -0.02, "cyoff": 0.04, "czoff": -0.06, "cmoff": 0.1, "cnoff": -0.08,
  "cloff": -0.05, "caintfac": 1.1, "cyintfac": 1.4, "czintfac": 0.9, "cmintfac": 1.3,
  "cnintfac": 0.8, "clintfac": 1.6}"#;
-
-fn sepval(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sepval"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run sepval")
-}
-
-fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "sepval failed: {}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
 
 /// Simulates flight data on the base with `effects` and `seed`, diagnoses it, returns the
 /// diagnosis.

@@ -1,27 +1,11 @@
 //! `sepval fit` and `sepval rerun` end to end, with reduced budgets.
 
+mod support;
+use support::{ok, sepval};
+
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
-
-fn sepval(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sepval"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run sepval")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "sepval failed: {}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
 
 /// result.json without what may differ between runs of the same fit (timings, evaluator).
 fn deterministic_part(path: &Path) -> Value {

@@ -1,27 +1,12 @@
 //! Refinement to the noise floor, identifiability, pooled events and resolution advice, end
 //! to end on noisy synthetic data (reduced genetic searches).
 
+mod support;
+use support::{ok, sepval};
+
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
-
-fn sepval(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sepval"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run sepval")
-}
-
-fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "sepval failed: {}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
 
 fn result(dir: &Path, run: &str) -> Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join(run).join("result.json")).unwrap())
