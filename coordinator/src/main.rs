@@ -105,12 +105,8 @@ struct FitArgs {
     lm_budget: u64,
     #[command(flatten)]
     eval: EvalArgs,
-    /// Position noise [m] weighting J_pos (default: estimated from the data).
-    #[arg(long)]
-    sigma_pos_m: Option<f64>,
-    /// Attitude noise [deg] weighting J_att (default: estimated from the data).
-    #[arg(long)]
-    sigma_att_deg: Option<f64>,
+    #[command(flatten)]
+    noise: NoiseArgs,
     /// The true factors (JSON), for Figure 7; the embedded truth is used with the default data.
     #[arg(long, value_name = "FILE.json")]
     truth_factors: Option<PathBuf>,
@@ -148,12 +144,8 @@ struct DiagnoseArgs {
     lm_budget: u64,
     #[command(flatten)]
     eval: EvalArgs,
-    /// Position noise [m] (default: estimated from the data).
-    #[arg(long)]
-    sigma_pos_m: Option<f64>,
-    /// Attitude noise [deg] (default: estimated from the data).
-    #[arg(long)]
-    sigma_att_deg: Option<f64>,
+    #[command(flatten)]
+    noise: NoiseArgs,
     /// Output directory (diagnosis.json, report.html, figures/, baseline/).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
@@ -208,6 +200,17 @@ struct RerunArgs {
     scenario: Option<PathBuf>,
     #[command(flatten)]
     eval: EvalArgs,
+}
+
+/// The measurement noise that weights the goals (shared by every search command).
+#[derive(clap::Args)]
+struct NoiseArgs {
+    /// Position noise [m] weighting J_pos (default: estimated from the data).
+    #[arg(long)]
+    sigma_pos_m: Option<f64>,
+    /// Attitude noise [deg] weighting J_att (default: estimated from the data).
+    #[arg(long)]
+    sigma_att_deg: Option<f64>,
 }
 
 /// How simulations are run (shared by every search command).
@@ -523,7 +526,7 @@ fn fit(args: FitArgs) -> Result<()> {
             (
                 ga,
                 hill,
-                Sigma::resolve(&job, args.sigma_pos_m, args.sigma_att_deg)?,
+                Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)?,
             )
         }
     };
@@ -676,7 +679,7 @@ fn bench(args: BenchArgs) -> Result<()> {
 fn diagnose(args: DiagnoseArgs) -> Result<()> {
     use sepval_coordinator::diagnose::{DiagnoseOptions, diagnose};
     let (job, inputs) = inputs::job(&args.data, args.scenario.as_deref())?;
-    let sigma = Sigma::resolve(&job, args.sigma_pos_m, args.sigma_att_deg)?;
+    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)?;
     let ga = GaSettings {
         population: args.population,
         generations: args.generations,
