@@ -43,6 +43,19 @@ use sepval_common::propagator::Observation;
 
 /// Chunks kept in flight per worker.
 pub const IN_FLIGHT_PER_WORKER: usize = 2;
+
+/// Splits a batch of `n` candidates into chunks of consecutive indices for `workers` workers:
+/// about four chunks per worker, so the last chunks balance the load, and at most 16 candidates
+/// per chunk, so a lost worker costs little. Shared by every multi-process evaluator, so that
+/// `sepval bench` compares transports, not chunkings.
+pub(crate) fn chunk_plan(n: usize, workers: usize) -> VecDeque<Vec<usize>> {
+    let chunk = n.div_ceil(workers.max(1) * 4).clamp(1, 16);
+    (0..n)
+        .collect::<Vec<_>>()
+        .chunks(chunk)
+        .map(<[usize]>::to_vec)
+        .collect()
+}
 /// Most workers one run accepts.
 pub const MAX_WORKERS: usize = 64;
 /// How often the coordinator checks worker liveness and deadlines while it waits.
@@ -652,12 +665,7 @@ impl Connection {
             return Ok(Vec::new());
         }
         let per_candidate = self.job.sample_count();
-        let chunk = n.div_ceil(self.workers.len().max(1) * 4).clamp(1, 16);
-        let mut pending: VecDeque<Vec<usize>> = (0..n)
-            .collect::<Vec<_>>()
-            .chunks(chunk)
-            .map(<[usize]>::to_vec)
-            .collect();
+        let mut pending = chunk_plan(n, self.workers.len());
         let mut done = 0usize;
         let waitset = WaitSetBuilder::new()
             .create::<ipc::Service>()

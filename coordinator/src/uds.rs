@@ -14,7 +14,7 @@ use sepval_common::evaluation::{Candidate, EvalError, Evaluation, Evaluator, Job
 use sepval_common::messages::encode_setup;
 use sepval_common::uds::{self, FromWorker, ToWorker, read_frame, write_frame};
 
-use crate::ipc::IN_FLIGHT_PER_WORKER;
+use crate::ipc::{IN_FLIGHT_PER_WORKER, chunk_plan};
 
 fn transport(e: impl std::fmt::Display) -> EvalError {
     EvalError::Transport(e.to_string())
@@ -116,12 +116,7 @@ impl Evaluator for UdsEvaluator {
     ) -> Result<Vec<Evaluation>, EvalError> {
         let n = batch.len();
         let workers = self.streams.len();
-        let chunk = n.div_ceil(workers * 4).clamp(1, 16);
-        let mut pending: std::collections::VecDeque<Vec<usize>> = (0..n)
-            .collect::<Vec<_>>()
-            .chunks(chunk)
-            .map(<[usize]>::to_vec)
-            .collect();
+        let mut pending = chunk_plan(n, workers);
         let mut in_flight: Vec<Vec<(u64, Vec<usize>)>> = vec![Vec::new(); workers];
         let mut results: Vec<Option<Evaluation>> = vec![None; n];
         let mut done = 0;
