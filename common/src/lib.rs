@@ -30,6 +30,8 @@ pub mod messages;
 pub mod model;
 pub mod noise;
 pub mod propagator;
+#[cfg(feature = "zenoh")]
+pub mod remote;
 pub mod scenario;
 pub mod simulation;
 pub mod synthetic;

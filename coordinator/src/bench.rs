@@ -1,8 +1,9 @@
 //! `sepval bench`: simulations per second against worker count, per transport.
 //!
 //! Transports: `single` (one thread, in-process), `pool` (in-process thread pool), `ipc`
-//! (iceoryx2 worker processes) and `uds` (the same requests as postcard frames over Unix domain
-//! sockets). Each measurement is one batch of `evals` distinct candidates after a warm-up batch;
+//! (iceoryx2 worker processes), `uds` (the same requests as postcard frames over Unix domain
+//! sockets) and, when built with the `zenoh` feature, `zenoh` (workers joining over TCP on the
+//! loopback interface). Each measurement is one batch of `evals` distinct candidates after a warm-up batch;
 //! starting the workers is not timed. The transport overhead per evaluation is the wall time
 //! beyond ideal scaling of the single-thread rate: (wall x workers - evals x t_single) / evals.
 
@@ -129,7 +130,18 @@ pub fn run_bench(
                     &options.worker_executable,
                     Duration::from_secs(120),
                 )?),
-                other => bail!("transport {other}: expected single, pool, ipc or uds"),
+                #[cfg(feature = "zenoh")]
+                "zenoh" => Box::new(LoopbackZenoh::start(
+                    Arc::clone(&job),
+                    w,
+                    &options.worker_executable,
+                )?),
+                #[cfg(not(feature = "zenoh"))]
+                "zenoh" => bail!(
+                    "transport zenoh: this sepval was built without the zenoh feature \
+                     (cargo build --release --features zenoh)"
+                ),
+                other => bail!("transport {other}: expected single, pool, ipc, uds or zenoh"),
             };
             let wall = time(evaluator.as_mut(), &batch, &warm)
                 .with_context(|| format!("benchmarking {t} with {w} worker(s)"))?;
@@ -239,4 +251,92 @@ pub fn write_outputs(dir: &Path, rows: &[BenchRow]) -> Result<()> {
         .collect();
     crate::figures::throughput_figure(&dir.join("bench.png"), &series)?;
     Ok(())
+}
+
+/// The zenoh transport on one host: a coordinator listening on a free loopback port and `w`
+/// `sepval-worker --connect` processes (killed when dropped).
+#[cfg(feature = "zenoh")]
+struct LoopbackZenoh {
+    evaluator: Option<crate::remote::RemoteEvaluator>,
+    children: Vec<std::process::Child>,
+}
+
+#[cfg(feature = "zenoh")]
+impl LoopbackZenoh {
+    fn start(job: Arc<Job>, workers: usize, executable: &Path) -> Result<Self> {
+        let port = std::net::TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .context("finding a free loopback port")?
+            .port();
+        let endpoint = format!("tcp/127.0.0.1:{port}");
+        let run_id = sepval_common::ipc::new_run_id();
+        let mut me = LoopbackZenoh {
+            evaluator: None,
+            children: Vec::new(),
+        };
+        for _ in 0..workers {
+            me.children.push(
+                std::process::Command::new(executable)
+                    .args(["--connect", &endpoint, "--run", &run_id])
+                    .stdin(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::null())
+                    .spawn()
+                    .with_context(|| format!("cannot start {}", executable.display()))?,
+            );
+        }
+        me.evaluator = Some(crate::remote::RemoteEvaluator::start(
+            job,
+            crate::remote::RemoteOptions {
+                run_id,
+                listen: endpoint,
+                min_workers: workers,
+                join_timeout: Duration::from_secs(60),
+                chunk_deadline: Duration::from_secs(120),
+                zenoh_config: None,
+                announce_protocol: None,
+            },
+        )?);
+        Ok(me)
+    }
+}
+
+#[cfg(feature = "zenoh")]
+impl Evaluator for LoopbackZenoh {
+    fn evaluate(
+        &mut self,
+        batch: &[Candidate],
+        with_samples: bool,
+    ) -> Result<Vec<sepval_common::evaluation::Evaluation>, sepval_common::evaluation::EvalError>
+    {
+        self.evaluator
+            .as_mut()
+            .expect("started")
+            .evaluate(batch, with_samples)
+    }
+
+    fn job(&self) -> &Job {
+        self.evaluator.as_ref().expect("started").job()
+    }
+
+    fn describe(&self) -> String {
+        self.evaluator.as_ref().expect("started").describe()
+    }
+}
+
+#[cfg(feature = "zenoh")]
+impl Drop for LoopbackZenoh {
+    fn drop(&mut self) {
+        // The coordinator tells its workers to quit; reap them, killing any that linger.
+        self.evaluator = None;
+        let until = Instant::now() + Duration::from_secs(5);
+        for c in self.children.iter_mut() {
+            while matches!(c.try_wait(), Ok(None)) && Instant::now() < until {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            if matches!(c.try_wait(), Ok(None)) {
+                let _ = c.kill();
+            }
+            let _ = c.wait();
+        }
+    }
 }

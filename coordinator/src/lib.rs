@@ -16,6 +16,8 @@ pub mod inputs;
 pub mod ipc;
 pub mod problem;
 pub mod refine;
+#[cfg(feature = "zenoh")]
+pub mod remote;
 pub mod rerun;
 pub mod results;
 pub mod rng;

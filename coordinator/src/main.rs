@@ -64,6 +64,31 @@ enum Command {
     Selftest(SelftestCommand),
     /// Remove the shared-memory resources of sepval runs whose processes are all gone.
     CleanIpc,
+    /// Join a zenoh run as one host's gateway: serve its chunks with local iceoryx2 workers
+    /// (built with the `zenoh` feature).
+    Gateway(GatewayArgs),
+}
+
+#[derive(clap::Args)]
+struct GatewayArgs {
+    /// The coordinator's endpoint, e.g. tcp/192.0.2.7:7447.
+    #[arg(long, value_name = "ENDPOINT")]
+    connect: String,
+    /// The run to join (the coordinator prints it).
+    #[arg(long, value_name = "RUN_ID")]
+    run: String,
+    /// Local iceoryx2 worker processes [default: the number of cores].
+    #[arg(long)]
+    workers: Option<usize>,
+    /// A local worker holding a chunk longer than this [s] is killed and replaced.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    worker_timeout: f64,
+    /// How long to wait for the coordinator's job setup [s].
+    #[arg(long, default_value_t = 30.0, value_name = "S")]
+    setup_timeout: f64,
+    /// A zenoh JSON5 configuration to start from (TLS certificates, authentication).
+    #[arg(long, value_name = "FILE")]
+    zenoh_config: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -171,6 +196,13 @@ enum SelftestCommand {
     },
 }
 
+/// Transports `sepval bench` measures by default.
+#[cfg(feature = "zenoh")]
+const DEFAULT_TRANSPORTS: &str = "single,pool,ipc,uds,zenoh";
+/// Transports `sepval bench` measures by default.
+#[cfg(not(feature = "zenoh"))]
+const DEFAULT_TRANSPORTS: &str = "single,pool,ipc,uds";
+
 #[derive(clap::Args)]
 struct BenchArgs {
     /// Worker counts, comma-separated.
@@ -179,8 +211,8 @@ struct BenchArgs {
     /// Simulations per measurement.
     #[arg(long, default_value_t = 2000)]
     evals: usize,
-    /// Transports, comma-separated (single, pool, ipc, uds).
-    #[arg(long, default_value = "single,pool,ipc,uds", value_delimiter = ',')]
+    /// Transports, comma-separated (single, pool, ipc, uds; zenoh when built with it).
+    #[arg(long, default_value = DEFAULT_TRANSPORTS, value_delimiter = ',')]
     transports: Vec<String>,
     /// Output directory (bench.csv, bench.png).
     #[arg(long, value_name = "DIR")]
@@ -216,12 +248,21 @@ struct NoiseArgs {
 /// How simulations are run (shared by every search command).
 #[derive(clap::Args)]
 struct EvalArgs {
-    /// `ipc`: worker processes over iceoryx2 shared memory; `inproc`: threads of this process.
-    #[arg(long, default_value = "ipc", value_name = "ipc|inproc")]
+    /// `ipc`: worker processes over iceoryx2 shared memory; `inproc`: threads of this process;
+    /// `zenoh`: workers on any host that joins --listen (built with the `zenoh` feature).
+    #[arg(long, default_value = "ipc", value_name = "ipc|inproc|zenoh")]
     evaluator: String,
-    /// Worker processes (ipc) [default: the number of cores].
+    /// Worker processes (ipc) [default: the number of cores]; with zenoh, the workers to wait
+    /// for before the search starts [default: 1] (more may join at any time).
     #[arg(long)]
     workers: Option<usize>,
+    /// zenoh: the endpoint to listen on for workers, e.g. tcp/0.0.0.0:7447 (explicit port).
+    #[arg(long, value_name = "ENDPOINT")]
+    listen: Option<String>,
+    /// zenoh: a zenoh JSON5 configuration to start from (TLS certificates, authentication);
+    /// sepval still sets peer mode, the endpoint and switches scouting off.
+    #[arg(long, value_name = "FILE")]
+    zenoh_config: Option<PathBuf>,
     /// Threads (inproc) [default: the number of cores].
     #[arg(long)]
     threads: Option<usize>,
@@ -304,6 +345,7 @@ fn main() -> ExitCode {
         Command::Rerun(args) => rerun(args),
         Command::Diagnose(args) => diagnose(*args),
         Command::Bench(args) => bench(args),
+        Command::Gateway(args) => gateway(args),
         Command::Selftest(SelftestCommand::Zdt {
             problem,
             evaluations,
@@ -421,6 +463,9 @@ fn count(flag: &str, requested: Option<usize>) -> Result<usize> {
 
 fn evaluator(args: &EvalArgs, job: Job) -> Result<Box<dyn Evaluator>> {
     let job = Arc::new(job);
+    if args.evaluator != "zenoh" && (args.listen.is_some() || args.zenoh_config.is_some()) {
+        anyhow::bail!("--listen and --zenoh-config are for --evaluator zenoh");
+    }
     match args.evaluator.as_str() {
         "inproc" => Ok(Box::new(InProcess::new(
             job,
@@ -458,8 +503,49 @@ fn evaluator(args: &EvalArgs, job: Job) -> Result<Box<dyn Evaluator>> {
             );
             Ok(Box::new(evaluator))
         }
-        other => anyhow::bail!("--evaluator {other}: expected ipc or inproc"),
+        "zenoh" => remote_evaluator(args, job),
+        other => anyhow::bail!("--evaluator {other}: expected ipc, inproc or zenoh"),
     }
+}
+
+#[cfg(feature = "zenoh")]
+fn remote_evaluator(args: &EvalArgs, job: Arc<Job>) -> Result<Box<dyn Evaluator>> {
+    use sepval_coordinator::remote::{RemoteEvaluator, RemoteOptions};
+    let listen = args
+        .listen
+        .clone()
+        .context("--evaluator zenoh needs --listen ENDPOINT (e.g. tcp/0.0.0.0:7447)")?;
+    if args.attach.is_some() {
+        anyhow::bail!("--attach is for --evaluator ipc; zenoh workers always join by themselves");
+    }
+    let secs = |flag: &str, v: f64| -> Result<Duration> {
+        inputs::positive(flag, v).map(Duration::from_secs_f64)
+    };
+    let options = RemoteOptions {
+        run_id: args
+            .run_id
+            .clone()
+            .unwrap_or_else(sepval_common::ipc::new_run_id),
+        listen,
+        min_workers: match args.workers {
+            Some(0) => anyhow::bail!("--workers 0: expected at least 1"),
+            Some(n) => n,
+            None => 1,
+        },
+        join_timeout: secs("--join-timeout", args.join_timeout)?,
+        chunk_deadline: secs("--worker-timeout", args.worker_timeout)?,
+        zenoh_config: args.zenoh_config.clone(),
+        announce_protocol: args.announce_protocol,
+    };
+    Ok(Box::new(RemoteEvaluator::start(job, options)?))
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn remote_evaluator(_: &EvalArgs, _: Arc<Job>) -> Result<Box<dyn Evaluator>> {
+    anyhow::bail!(
+        "--evaluator zenoh: this sepval was built without the zenoh transport; \
+         rebuild with `cargo build --release --features zenoh`"
+    )
 }
 
 /// The worker executable: $SEPVAL_WORKER, or `sepval-worker` beside this executable.
@@ -638,6 +724,59 @@ fn rerun(args: RerunArgs) -> Result<()> {
         "generation {}: {} of {n} members do not reproduce their goals bit for bit",
         checkpoint.state.generation,
         mismatches.len()
+    )
+}
+
+#[cfg(feature = "zenoh")]
+fn gateway(args: GatewayArgs) -> Result<()> {
+    use sepval_common::remote::{JoinOptions, join};
+    use sepval_coordinator::remote::Gateway;
+    let workers = count("--workers", args.workers)?;
+    let joined = join(JoinOptions {
+        endpoint: args.connect.clone(),
+        run_id: args.run.clone(),
+        setup_timeout: Duration::from_secs_f64(inputs::positive(
+            "--setup-timeout",
+            args.setup_timeout,
+        )?),
+        zenoh_config: args.zenoh_config.clone(),
+        announce_protocol: None,
+    })?;
+    let local_run = sepval_common::ipc::new_run_id();
+    let mut gateway = Gateway::start(
+        Arc::new(joined.job().clone()),
+        IpcOptions {
+            run_id: local_run.clone(),
+            workers,
+            launch: Launch::Spawn {
+                executable: worker_executable()?,
+            },
+            chunk_deadline: Duration::from_secs_f64(inputs::positive(
+                "--worker-timeout",
+                args.worker_timeout,
+            )?),
+            join_timeout: Duration::from_secs(60),
+            max_respawns: 2 * workers + 2,
+            announce_protocol: None,
+        },
+    )?;
+    eprintln!(
+        "sepval gateway: joined run {} at {} as {}, serving with {workers} local worker(s) \
+         (iceoryx2 run {local_run})",
+        args.run,
+        args.connect,
+        joined.worker_id()
+    );
+    let stopped = joined.serve(&mut gateway)?;
+    eprintln!("sepval gateway: {stopped}");
+    Ok(())
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn gateway(_: GatewayArgs) -> Result<()> {
+    anyhow::bail!(
+        "gateway: this sepval was built without the zenoh transport; rebuild with \
+         `cargo build --release --features zenoh`"
     )
 }
 

@@ -43,6 +43,13 @@ struct Cli {
     /// Serve over this Unix domain socket instead (the throughput benchmark's comparison).
     #[arg(long, value_name = "PATH")]
     uds: Option<std::path::PathBuf>,
+    /// Join the run over zenoh at the coordinator's endpoint (e.g. tcp/192.0.2.7:7447) instead
+    /// of shared memory: for workers on other hosts (built with the `zenoh` feature).
+    #[arg(long, value_name = "ENDPOINT", requires = "run")]
+    connect: Option<String>,
+    /// zenoh: a zenoh JSON5 configuration to start from (TLS certificates, authentication).
+    #[arg(long, value_name = "FILE", requires = "connect")]
+    zenoh_config: Option<std::path::PathBuf>,
     /// How long to wait for the coordinator's job setup [s].
     #[arg(long, default_value_t = 30.0, value_name = "S")]
     setup_timeout: f64,
@@ -58,6 +65,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     iceoryx2::prelude::set_log_level(LogLevel::Error);
     let result = match (&cli.run, &cli.uds) {
+        (Some(run), _) if cli.connect.is_some() => serve_remote(&cli, run),
         (Some(run), _) => {
             let r = serve(&cli, run);
             // The last process of a run leaves nothing behind on the host.
@@ -277,6 +285,35 @@ fn serve(cli: &Cli, run: &str) -> Result<Option<String>> {
             )));
         }
     }
+}
+
+/// Joins a run over zenoh and serves it (see `sepval_common::remote`).
+#[cfg(feature = "zenoh")]
+fn serve_remote(cli: &Cli, run: &str) -> Result<Option<String>> {
+    use sepval_common::remote::{JoinOptions, Local, join};
+    let endpoint = cli.connect.clone().expect("checked by the caller");
+    let joined = join(JoinOptions {
+        endpoint: endpoint.clone(),
+        run_id: run.to_string(),
+        setup_timeout: Duration::from_secs_f64(cli.setup_timeout.max(0.1)),
+        zenoh_config: cli.zenoh_config.clone(),
+        announce_protocol: cli.announce_protocol,
+    })?;
+    eprintln!(
+        "sepval-worker: joined run {run} at {endpoint} as {}",
+        joined.worker_id()
+    );
+    let mut server = Local(std::sync::Arc::new(joined.job().clone()));
+    let stopped = joined.serve(&mut server)?;
+    Ok(Some(stopped.to_string()))
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn serve_remote(_: &Cli, _: &str) -> Result<Option<String>> {
+    bail!(
+        "--connect: this sepval-worker was built without the zenoh transport; rebuild with \
+         `cargo build --release --features zenoh`"
+    )
 }
 
 /// Evaluates one request; a malformed one becomes a typed failure.
