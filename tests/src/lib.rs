@@ -14,7 +14,7 @@ pub fn binary(name: &str) -> PathBuf {
     let path = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
     assert!(
         path.exists(),
-        "{} is missing: run the tests with `cargo test --release --workspace`",
+        "{} is missing: run the tests with `cargo test --release --workspace --features zenoh`",
         path.display()
     );
     path

@@ -104,7 +104,7 @@ fn kill_one_of_two(coordinator_ns: &[String], worker_ns: &[String], endpoint: &s
     let expected = reference(dir.path(), 30, &[]);
     let run = run_id("zkill");
     let args = fit_args("zenoh", 30, &["--workers", "2"]);
-    let mut workers = vec![
+    let mut workers = [
         start_worker(worker_ns, endpoint, &run, &[]),
         start_worker(worker_ns, endpoint, &run, &[]),
     ];
@@ -174,6 +174,42 @@ fn loopback_workers_give_the_in_process_answer_with_samples_too() {
 fn sigkill_of_a_loopback_worker_changes_nothing() {
     let endpoint = format!("tcp/127.0.0.1:{}", free_port());
     kill_one_of_two(&[], &[], &endpoint);
+}
+
+#[test]
+fn a_hung_remote_worker_is_dropped_at_its_deadline_and_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let expected = reference(dir.path(), 30, &[]);
+    let run = run_id("zhung");
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let args = fit_args("zenoh", 30, &["--workers", "2", "--worker-timeout", "2"]);
+    let mut workers = [
+        start_worker(&[], &endpoint, &run, &[]),
+        start_worker(&[], &endpoint, &run, &[]),
+    ];
+    let mut fit = start_coordinator(dir.path(), &[], &endpoint, &run, &args);
+    let ckpt = dir.path().join("zenoh/generations/gen-0003.json");
+    wait_for("generation 3 over zenoh", Duration::from_secs(90), || {
+        ckpt.exists()
+    });
+    // Stopped, the worker keeps its connection and its liveliness token (until zenoh's lease
+    // expires): only the chunk deadline can tell.
+    signal(workers[0].id() as i32, libc::SIGSTOP);
+    let out = wait_exit(&mut fit, "the zenoh fit", Duration::from_secs(180));
+    signal(workers[0].id() as i32, libc::SIGCONT);
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("it held a chunk longer than 2 s"),
+        "{stderr}"
+    );
+    assert_eq!(
+        deterministic_part(&dir.path().join("zenoh/result.json")),
+        expected
+    );
+    for w in workers.iter_mut() {
+        let _ = wait_exit(w, "a worker", Duration::from_secs(30));
+    }
 }
 
 /// Two network namespaces joined by a veth pair, deleted when dropped.
