@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Throughput per worker count for each transport (single, pool, ipc, uds), and the criterion
+# Throughput per worker count for each transport (single, pool, ipc, uds, zenoh), and the criterion
 # benchmark of one simulation. Writes bench-out/bench.csv and bench-out/bench.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --workspace
+cargo build --release --workspace --features zenoh
 cargo bench -p sepval-common --bench simulate -- --output-format bencher
-./target/release/sepval bench --workers "${WORKERS:-1,2,4}" --evals "${EVALS:-4000}" --out "${OUT:-bench-out}"
+./target/release/sepval bench --workers "${WORKERS:-1,2,4}" --evals "${EVALS:-4000}" --repeat "${REPEAT:-3}" --out "${OUT:-bench-out}"

@@ -4,8 +4,11 @@
 //! (iceoryx2 worker processes), `uds` (the same requests as postcard frames over Unix domain
 //! sockets) and, when built with the `zenoh` feature, `zenoh` (workers joining over TCP on the
 //! loopback interface). Each measurement is one batch of `evals` distinct candidates after a warm-up batch;
-//! starting the workers is not timed. The transport overhead per evaluation is the wall time
-//! beyond ideal scaling of the single-thread rate: (wall x workers - evals x t_single) / evals.
+//! starting the workers is not timed. Measurements are repeated in interleaved rounds and the
+//! median is reported, so that a slow spell of a shared machine hits every transport alike. The
+//! transport overhead per evaluation is measured directly: the same number of requests that the
+//! job refuses before simulating (a factor out of bounds) cross the transport in full, and the
+//! worker time they take beyond the same refusals in one thread is the transport's cost.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -29,8 +32,11 @@ pub struct BenchRow {
     pub workers: usize,
     /// Evaluations timed.
     pub evals: usize,
-    /// Wall time [s].
+    /// Wall time [s] (the median of the repeats).
     pub wall_s: f64,
+    /// Wall time [s] of as many requests refused without simulating (the median of the
+    /// repeats): what the transport alone costs.
+    pub probe_wall_s: f64,
 }
 
 impl BenchRow {
@@ -50,6 +56,8 @@ pub struct BenchOptions {
     pub transports: Vec<String>,
     /// The worker executable.
     pub worker_executable: std::path::PathBuf,
+    /// Measurements per (transport, worker count), interleaved; the median is reported.
+    pub repeat: usize,
 }
 
 /// `n` distinct candidates around the truth (seeded, within bounds).
@@ -68,8 +76,17 @@ pub fn candidates(job: &Job, n: usize) -> Vec<Candidate> {
         .collect()
 }
 
-fn time(evaluator: &mut dyn Evaluator, batch: &[Candidate], warm: &[Candidate]) -> Result<f64> {
-    evaluator.evaluate(warm, false)?;
+/// `n` requests that every transport carries in full but that the job refuses before
+/// simulating (the first factor just above its upper bound): timing them measures the
+/// transport, not the model.
+pub fn probes(job: &Job, n: usize) -> Vec<Candidate> {
+    let bound = job.factor_table().0[0];
+    let mut f = Factors::TRUTH;
+    f.0[0] = bound.max + bound.range().max(1.0);
+    vec![Candidate::baseline(f); n]
+}
+
+fn time(evaluator: &mut dyn Evaluator, batch: &[Candidate]) -> Result<f64> {
     let t0 = Instant::now();
     let out = evaluator.evaluate(batch, false)?;
     let wall = t0.elapsed().as_secs_f64();
@@ -84,7 +101,65 @@ fn time(evaluator: &mut dyn Evaluator, batch: &[Candidate], warm: &[Candidate]) 
     Ok(wall)
 }
 
-/// Runs the benchmark; `progress` hears each finished row.
+fn start(
+    job: &Arc<Job>,
+    transport: &str,
+    workers: usize,
+    options: &BenchOptions,
+) -> Result<Box<dyn Evaluator>> {
+    Ok(match transport {
+        "single" => Box::new(InProcess::new(Arc::clone(job), 1)),
+        "pool" => Box::new(InProcess::new(Arc::clone(job), workers)),
+        "ipc" => Box::new(IpcEvaluator::start(
+            Arc::clone(job),
+            IpcOptions {
+                run_id: sepval_common::ipc::new_run_id(),
+                workers,
+                launch: Launch::Spawn {
+                    executable: options.worker_executable.clone(),
+                },
+                chunk_deadline: Duration::from_secs(120),
+                join_timeout: Duration::from_secs(60),
+                max_respawns: 0,
+                announce_protocol: None,
+            },
+        )?),
+        "uds" => Box::new(UdsEvaluator::start(
+            Arc::clone(job),
+            workers,
+            &options.worker_executable,
+            Duration::from_secs(120),
+        )?),
+        #[cfg(feature = "zenoh")]
+        "zenoh" => Box::new(LoopbackZenoh::start(
+            Arc::clone(job),
+            workers,
+            &options.worker_executable,
+        )?),
+        #[cfg(not(feature = "zenoh"))]
+        "zenoh" => bail!(
+            "transport zenoh: this sepval was built without the zenoh feature \
+             (cargo build --release --features zenoh)"
+        ),
+        other => bail!("transport {other}: expected single, pool, ipc, uds or zenoh"),
+    })
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Runs the benchmark: `repeat` rounds, each measuring every (transport, worker count) once in
+/// turn (so a slow spell of the machine hits every transport alike), each measurement with
+/// freshly started workers, a warm-up batch, the timed batch and the timed probes; rows report
+/// medians. `progress` hears each finished row.
 pub fn run_bench(
     job: Arc<Job>,
     options: &BenchOptions,
@@ -93,67 +168,44 @@ pub fn run_bench(
     if options.evals == 0 {
         bail!("--evals 0: expected at least 1");
     }
+    if options.repeat == 0 {
+        bail!("--repeat 0: expected at least 1");
+    }
     let batch = candidates(&job, options.evals);
     let warm = candidates(&job, 8.min(options.evals));
-    let mut rows = Vec::new();
-    let mut push = |row: BenchRow, rows: &mut Vec<BenchRow>| {
-        progress(&row);
-        rows.push(row);
-    };
-    for t in &options.transports {
-        let counts: Vec<usize> = if t == "single" {
-            vec![1]
-        } else {
-            options.workers.clone()
-        };
-        for &w in &counts {
-            let mut evaluator: Box<dyn Evaluator> = match t.as_str() {
-                "single" => Box::new(InProcess::new(Arc::clone(&job), 1)),
-                "pool" => Box::new(InProcess::new(Arc::clone(&job), w)),
-                "ipc" => Box::new(IpcEvaluator::start(
-                    Arc::clone(&job),
-                    IpcOptions {
-                        run_id: sepval_common::ipc::new_run_id(),
-                        workers: w,
-                        launch: Launch::Spawn {
-                            executable: options.worker_executable.clone(),
-                        },
-                        chunk_deadline: Duration::from_secs(120),
-                        join_timeout: Duration::from_secs(60),
-                        max_respawns: 0,
-                        announce_protocol: None,
-                    },
-                )?),
-                "uds" => Box::new(UdsEvaluator::start(
-                    Arc::clone(&job),
-                    w,
-                    &options.worker_executable,
-                    Duration::from_secs(120),
-                )?),
-                #[cfg(feature = "zenoh")]
-                "zenoh" => Box::new(LoopbackZenoh::start(
-                    Arc::clone(&job),
-                    w,
-                    &options.worker_executable,
-                )?),
-                #[cfg(not(feature = "zenoh"))]
-                "zenoh" => bail!(
-                    "transport zenoh: this sepval was built without the zenoh feature \
-                     (cargo build --release --features zenoh)"
-                ),
-                other => bail!("transport {other}: expected single, pool, ipc, uds or zenoh"),
+    let probe = probes(&job, options.evals);
+    let cells: Vec<(String, usize)> = options
+        .transports
+        .iter()
+        .flat_map(|t| {
+            let counts = if t == "single" {
+                vec![1]
+            } else {
+                options.workers.clone()
             };
-            let wall = time(evaluator.as_mut(), &batch, &warm)
-                .with_context(|| format!("benchmarking {t} with {w} worker(s)"))?;
-            push(
-                BenchRow {
+            counts.into_iter().map(move |w| (t.clone(), w))
+        })
+        .collect();
+    let mut walls: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); cells.len()];
+    let mut rows = Vec::new();
+    for round in 0..options.repeat {
+        for ((t, w), (wall, probe_wall)) in cells.iter().zip(walls.iter_mut()) {
+            let mut evaluator = start(&job, t, *w, options)?;
+            let what = || format!("benchmarking {t} with {w} worker(s)");
+            evaluator.evaluate(&warm, false).with_context(what)?;
+            wall.push(time(evaluator.as_mut(), &batch).with_context(what)?);
+            probe_wall.push(time(evaluator.as_mut(), &probe).with_context(what)?);
+            if round + 1 == options.repeat {
+                let row = BenchRow {
                     transport: t.clone(),
-                    workers: w,
+                    workers: *w,
                     evals: options.evals,
-                    wall_s: wall,
-                },
-                &mut rows,
-            );
+                    wall_s: median(wall),
+                    probe_wall_s: median(probe_wall),
+                };
+                progress(&row);
+                rows.push(row);
+            }
         }
     }
     Ok(rows)
@@ -166,16 +218,20 @@ pub fn single_seconds(rows: &[BenchRow]) -> Option<f64> {
         .map(|r| r.wall_s / r.evals as f64)
 }
 
-/// Transport overhead per evaluation [us] of a row, against ideal scaling of `single`.
-pub fn overhead_us(row: &BenchRow, t_single: f64) -> f64 {
-    (row.wall_s * row.workers as f64 - row.evals as f64 * t_single) / row.evals as f64 * 1e6
+/// Transport overhead per evaluation [us]: the worker time a refused request costs through
+/// this transport (probe wall x workers / evals) beyond what it costs in one thread (the
+/// `single` row's probes).
+pub fn overhead_us(row: &BenchRow, rows: &[BenchRow]) -> Option<f64> {
+    let single = rows.iter().find(|r| r.transport == "single")?;
+    let per = |r: &BenchRow| r.probe_wall_s * r.workers as f64 / r.evals as f64;
+    Some((per(row) - per(single)) * 1e6)
 }
 
 /// The table printed by `sepval bench`.
 pub fn table(rows: &[BenchRow]) -> String {
     let t1 = single_seconds(rows);
     let mut s = format!(
-        "{:<7} {:>7} {:>6} {:>9} {:>10} {:>8} {:>10} {:>12}\n",
+        "{:<7} {:>7} {:>6} {:>9} {:>10} {:>8} {:>10} {:>14}\n",
         "transp.",
         "workers",
         "evals",
@@ -186,19 +242,19 @@ pub fn table(rows: &[BenchRow]) -> String {
         "overhead [us]"
     );
     for r in rows {
-        let (speedup, eff, over) = match t1 {
+        let (speedup, eff) = match t1 {
             Some(t) => {
                 let sp = r.evals as f64 * t / r.wall_s;
                 (
                     format!("{sp:.2}"),
                     format!("{:.0} %", 100.0 * sp / r.workers as f64),
-                    format!("{:.1}", overhead_us(r, t)),
                 )
             }
-            None => ("-".into(), "-".into(), "-".into()),
+            None => ("-".into(), "-".into()),
         };
+        let over = overhead_us(r, rows).map_or("-".into(), |o| format!("{o:.2}"));
         s.push_str(&format!(
-            "{:<7} {:>7} {:>6} {:>9.3} {:>10.0} {:>8} {:>10} {:>12}\n",
+            "{:<7} {:>7} {:>6} {:>9.3} {:>10.0} {:>8} {:>10} {:>14}\n",
             r.transport,
             r.workers,
             r.evals,

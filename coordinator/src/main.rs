@@ -214,6 +214,10 @@ struct BenchArgs {
     /// Transports, comma-separated (single, pool, ipc, uds; zenoh when built with it).
     #[arg(long, default_value = DEFAULT_TRANSPORTS, value_delimiter = ',')]
     transports: Vec<String>,
+    /// Measurements per transport and worker count, taken in interleaved rounds; the table
+    /// reports the median.
+    #[arg(long, default_value_t = 3)]
+    repeat: usize,
     /// Output directory (bench.csv, bench.png).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
@@ -791,18 +795,22 @@ fn bench(args: BenchArgs) -> Result<()> {
         evals: args.evals,
         transports: args.transports.clone(),
         worker_executable: worker_executable()?,
+        repeat: args.repeat,
     };
     eprintln!(
-        "benchmarking {} simulations of the default event per measurement on {} core(s)",
+        "benchmarking {} simulations of the default event per measurement, median of {} \
+         interleaved rounds, on {} core(s)",
         args.evals,
+        args.repeat,
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
     let rows = run_bench(Arc::new(job), &options, &mut |r| {
         eprintln!(
-            "  {:<6} {} worker(s): {:.0} simulations/s",
+            "  {:<6} {} worker(s): {:.0} simulations/s, {:.0} refused requests/s",
             r.transport,
             r.workers,
-            r.evals_per_s()
+            r.evals_per_s(),
+            r.evals as f64 / r.probe_wall_s
         );
     })?;
     print!("{}", table(&rows));

@@ -334,11 +334,28 @@ fn a_worker_outlives_its_coordinator_by_at_most_a_few_seconds() {
 fn bench_writes_its_table_csv_and_figure() {
     let dir = tempfile::tempdir().unwrap();
     let out = ok(&sepval(
-        &["bench", "--workers", "1,2", "--evals", "16", "--out", "b"],
+        &[
+            "bench",
+            "--workers",
+            "1,2",
+            "--evals",
+            "16",
+            "--transports",
+            "single,pool,ipc,uds",
+            "--repeat",
+            "2",
+            "--out",
+            "b",
+        ],
         dir.path(),
     ));
     for t in ["single", "pool", "ipc", "uds"] {
         assert!(out.contains(t), "{out}");
+    }
+    // Every row has a measured overhead (a number; single's is 0 by definition).
+    for line in out.lines().skip(1).filter(|l| !l.starts_with("wrote")) {
+        let over = line.split_whitespace().last().unwrap();
+        assert!(over.parse::<f64>().is_ok(), "{line}");
     }
     let csv = std::fs::read_to_string(dir.path().join("b/bench.csv")).unwrap();
     let mut lines = csv.lines();
@@ -353,4 +370,8 @@ fn bench_writes_its_table_csv_and_figure() {
     let bad = sepval(&["bench", "--workers", "0", "--out", "c"], dir.path());
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--workers 0: expected 1 to 64"));
+    let bad = sepval(&["bench", "--repeat", "0", "--out", "c"], dir.path());
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--repeat 0: expected at least 1"));
+    assert!(!dir.path().join("c").exists());
 }

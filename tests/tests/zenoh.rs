@@ -447,6 +447,8 @@ fn bench_has_a_zenoh_row() {
             "2",
             "--evals",
             "200",
+            "--repeat",
+            "1",
             "--out",
             "b",
         ],
