@@ -26,6 +26,7 @@
 //! each other's bytes. Chunk items and answers are the socket transport's frames
 //! ([`crate::uds`]): the same candidates and outcomes, bit for bit.
 
+use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -325,6 +326,11 @@ pub fn accept_setup(run: &str, bytes: &[u8]) -> Result<(SetupFrame, Job), Remote
 pub trait ChunkServer {
     /// Chunks this server can hold at once (its credits).
     fn credits(&self) -> u32;
+    /// Chunks evaluated together as one batch; the rest of what it holds waits its turn, so
+    /// every answered chunk frees a credit, and a new chunk arrives, while the others run.
+    fn parallelism(&self) -> usize {
+        1
+    }
     /// Evaluates candidates; `out[i]` answers `candidates[i]`. A malformed candidate becomes a
     /// failed outcome; `Err` is for a server that can no longer serve at all.
     fn evaluate(
@@ -522,15 +528,19 @@ impl Joined {
             .put(encode_as(protocol, &ready))
             .wait()
             .map_err(zerr("announcing ourselves"))?;
+        let mut queue: VecDeque<(u64, bool, Vec<ItemFrame>)> = VecDeque::new();
         loop {
-            // Everything waiting is served as one batch (a gateway spreads it over its workers).
-            let first = match self.inbox.recv_timeout(Duration::from_millis(500)) {
-                Ok(m) => m,
-                Err(RecvTimeoutError::Timeout) => continue,
-                Err(RecvTimeoutError::Disconnected) => return Ok(Stopped::CoordinatorGone),
-            };
-            let mut chunks = Vec::new();
-            for message in std::iter::once(first).chain(self.inbox.try_iter()) {
+            // Block only when nothing is queued; control messages act at once.
+            let mut inbox: Vec<Inbox> = Vec::new();
+            if queue.is_empty() {
+                match self.inbox.recv_timeout(Duration::from_millis(500)) {
+                    Ok(m) => inbox.push(m),
+                    Err(RecvTimeoutError::Timeout) => continue,
+                    Err(RecvTimeoutError::Disconnected) => return Ok(Stopped::CoordinatorGone),
+                }
+            }
+            inbox.extend(self.inbox.try_iter());
+            for message in inbox {
                 match message {
                     Inbox::CoordinatorAlive(true) => {}
                     Inbox::CoordinatorAlive(false) => return Ok(Stopped::CoordinatorGone),
@@ -542,50 +552,54 @@ impl Joined {
                                 chunk_id,
                                 with_samples,
                                 items,
-                            } => chunks.push((chunk_id, with_samples, items)),
+                            } => queue.push_back((chunk_id, with_samples, items)),
                         }
                     }
                 }
             }
-            for with_samples in [false, true] {
-                let group: Vec<&(u64, bool, Vec<ItemFrame>)> =
-                    chunks.iter().filter(|c| c.1 == with_samples).collect();
-                if group.is_empty() {
-                    continue;
-                }
-                let items: Vec<&ItemFrame> = group.iter().flat_map(|c| c.2.iter()).collect();
-                let evaluations = server
-                    .evaluate(&items, with_samples)
-                    .map_err(RemoteError::Serve)?;
-                if evaluations.len() != items.len() {
-                    return Err(RemoteError::Serve(format!(
-                        "{} evaluations for {} candidates",
-                        evaluations.len(),
-                        items.len()
-                    )));
-                }
-                let mut evaluations = evaluations.into_iter();
-                for (chunk_id, _, chunk_items) in group {
-                    let answers: Vec<AnswerFrame> = chunk_items
-                        .iter()
-                        .zip(evaluations.by_ref())
-                        .map(|((index, _, _), e)| {
-                            (
-                                *index,
-                                uds::OutcomeFrame::from(&e.outcome),
-                                e.samples.as_deref().map(uds::samples_out),
-                            )
-                        })
-                        .collect();
-                    let answer = Up::Answer(FromWorker {
-                        chunk_id: *chunk_id,
-                        items: answers,
-                    });
-                    publisher
-                        .put(encode_as(protocol, &answer))
-                        .wait()
-                        .map_err(zerr("answering a chunk"))?;
-                }
+            // The next chunks of one kind, up to the server's parallelism (a gateway spreads
+            // them over its workers), in the order they came.
+            let Some(with_samples) = queue.front().map(|c| c.1) else {
+                continue;
+            };
+            let mut group = Vec::new();
+            while group.len() < server.parallelism().max(1)
+                && queue.front().is_some_and(|c| c.1 == with_samples)
+            {
+                group.extend(queue.pop_front());
+            }
+            let items: Vec<&ItemFrame> = group.iter().flat_map(|c| c.2.iter()).collect();
+            let evaluations = server
+                .evaluate(&items, with_samples)
+                .map_err(RemoteError::Serve)?;
+            if evaluations.len() != items.len() {
+                return Err(RemoteError::Serve(format!(
+                    "{} evaluations for {} candidates",
+                    evaluations.len(),
+                    items.len()
+                )));
+            }
+            let mut evaluations = evaluations.into_iter();
+            for (chunk_id, _, chunk_items) in &group {
+                let answers: Vec<AnswerFrame> = chunk_items
+                    .iter()
+                    .zip(evaluations.by_ref())
+                    .map(|((index, _, _), e)| {
+                        (
+                            *index,
+                            uds::OutcomeFrame::from(&e.outcome),
+                            e.samples.as_deref().map(uds::samples_out),
+                        )
+                    })
+                    .collect();
+                let answer = Up::Answer(FromWorker {
+                    chunk_id: *chunk_id,
+                    items: answers,
+                });
+                publisher
+                    .put(encode_as(protocol, &answer))
+                    .wait()
+                    .map_err(zerr("answering a chunk"))?;
             }
         }
     }

@@ -160,7 +160,7 @@ impl RemoteEvaluator {
         while evaluator.workers.len() < evaluator.options.min_workers {
             let left = until.saturating_duration_since(Instant::now());
             match evaluator.events.recv_timeout(left) {
-                Ok(e) => evaluator.handle(e, &mut VecDeque::new(), &mut [], &[])?,
+                Ok(e) => evaluator.handle(e, &mut VecDeque::new(), &mut [])?,
                 Err(_) => {
                     return Err(transport(format!(
                         "{} of {} worker(s) joined run {run} at {} within {} s",
@@ -192,13 +192,10 @@ impl RemoteEvaluator {
         event: Event,
         pending: &mut VecDeque<Vec<usize>>,
         results: &mut [Option<Evaluation>],
-        batch: &[Candidate],
     ) -> Result<(), EvalError> {
-        let _ = batch;
         match event {
-            Event::Alive(id, true) => {
-                let _ = id; // A worker registers with its Ready message.
-            }
+            // A worker registers with its Ready message; its token only tells us it left.
+            Event::Alive(_, true) => {}
             Event::Alive(id, false) => {
                 if let Some(w) = self.workers.remove(&id) {
                     self.requeue(&w, pending, "its liveliness token is gone");
@@ -430,9 +427,9 @@ impl Evaluator for RemoteEvaluator {
             }
             match self.events.recv_timeout(TICK) {
                 Ok(event) => {
-                    self.handle(event, &mut pending, &mut results, batch)?;
+                    self.handle(event, &mut pending, &mut results)?;
                     for event in self.events.try_iter().collect::<Vec<_>>() {
-                        self.handle(event, &mut pending, &mut results, batch)?;
+                        self.handle(event, &mut pending, &mut results)?;
                     }
                 }
                 Err(RecvTimeoutError::Timeout) => {}
@@ -477,8 +474,9 @@ impl Drop for RemoteEvaluator {
 
 /// The gateway of a host: one zenoh worker that serves its chunks with the host's iceoryx2
 /// workers, so the zero-copy path is kept within the host and the zenoh traffic is one session
-/// per host. It asks for two chunks per local worker and evaluates everything it holds as one
-/// batch (spread over its workers by the shared-memory evaluator).
+/// per host. It holds two chunks per local worker and evaluates one chunk per local worker at a
+/// time as one batch (spread over its workers by the shared-memory evaluator), so the next
+/// chunks are already here when a batch ends.
 pub struct Gateway {
     ipc: crate::ipc::IpcEvaluator,
     workers: usize,
@@ -498,6 +496,10 @@ impl Gateway {
 impl remote::ChunkServer for Gateway {
     fn credits(&self) -> u32 {
         (2 * self.workers).clamp(1, 64) as u32
+    }
+
+    fn parallelism(&self) -> usize {
+        self.workers
     }
 
     fn evaluate(
