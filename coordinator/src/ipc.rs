@@ -8,8 +8,9 @@
 //! coordinator and a fast worker gets more chunks than a slow one. Waits block on a WaitSet
 //! (responses wake the coordinator through an event), never spin.
 //!
-//! Faults: a worker whose process exits or whose node is dead (SIGKILL), or that holds a chunk
-//! past the deadline (hung; it is then killed), is dropped; its chunks in flight go back to the
+//! Faults: a worker whose process exits (checked every tick for spawned workers) or whose node
+//! is dead (attached workers, listed every [`LISTING_PERIOD`]), or that holds a chunk past the
+//! deadline (hung; it is then killed), is dropped; its chunks in flight go back to the
 //! queue and are sent to the remaining workers, so a batch completes with exactly one result per
 //! candidate. Spawned workers are replaced (up to a limit); with no worker left the batch fails
 //! with an error instead of hanging. Dead nodes' resources are cleaned at start and after every
