@@ -5,11 +5,11 @@
 //! `a = sqrt(1.4 * 287.053 * T)`. Valid in the troposphere (h < 11 000 m); a scenario above it
 //! is refused by the scenario validation rather than extrapolated silently.
 
-/// Sea-level standard temperature [K].
+/// Sea-level standard temperature \[K\].
 pub const T0_K: f64 = 288.15;
 /// Troposphere lapse rate [K/m].
 pub const LAPSE_K_PER_M: f64 = 0.0065;
-/// Sea-level standard pressure [Pa].
+/// Sea-level standard pressure \[Pa\].
 pub const P0_PA: f64 = 101_325.0;
 /// Pressure exponent of the troposphere (g / (R L)), as printed in MODEL.md.
 pub const PRESSURE_EXPONENT: f64 = 5.25588;
@@ -17,15 +17,15 @@ pub const PRESSURE_EXPONENT: f64 = 5.25588;
 pub const R_AIR_J_PER_KG_K: f64 = 287.053;
 /// Ratio of specific heats of air.
 pub const GAMMA_AIR: f64 = 1.4;
-/// Top of the troposphere [m]: the formulas above stop being valid here.
+/// Top of the troposphere \[m\]: the formulas above stop being valid here.
 pub const TROPOPAUSE_M: f64 = 11_000.0;
 
 /// Air properties at one altitude.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AirState {
-    /// Static temperature [K].
+    /// Static temperature \[K\].
     pub temperature_k: f64,
-    /// Static pressure [Pa].
+    /// Static pressure \[Pa\].
     pub pressure_pa: f64,
     /// Density [kg/m^3].
     pub density_kg_m3: f64,

@@ -211,14 +211,14 @@ impl Candidate {
 pub enum Outcome {
     /// The run finished: its goals (MODEL.md section 5), pooled over all events.
     Goals {
-        /// RMS position error [m].
+        /// RMS position error \[m\].
         j_pos_m: f64,
-        /// RMS attitude error [deg].
+        /// RMS attitude error \[deg\].
         j_att_deg: f64,
     },
     /// The run diverged (MODEL.md section 3) in event `event` at `t_s`.
     Diverged {
-        /// Time of divergence [s].
+        /// Time of divergence \[s\].
         t_s: f64,
         /// Index of the event that diverged.
         event: usize,

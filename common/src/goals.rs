@@ -19,9 +19,9 @@ use crate::telemetry::Trajectory;
 /// The goals of one evaluation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Goals {
-    /// RMS position error [m].
+    /// RMS position error \[m\].
     pub j_pos_m: f64,
-    /// RMS attitude error [deg].
+    /// RMS attitude error \[deg\].
     pub j_att_deg: f64,
 }
 
@@ -75,7 +75,7 @@ impl GoalSums {
     }
 }
 
-/// Differences simulated minus measured of one sample: position [m], and attitude [deg] with
+/// Differences simulated minus measured of one sample: position \[m\], and attitude \[deg\] with
 /// each angle difference wrapped to (-180, 180].
 #[inline]
 pub fn residual(sim: &Observation, pos_m: &[f64; 3], att_deg: &[f64; 3]) -> ([f64; 3], [f64; 3]) {

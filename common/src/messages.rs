@@ -120,11 +120,11 @@ pub struct WireResponse {
     pub status: u32,
     /// Event index (diverged runs).
     pub event: u32,
-    /// RMS position error [m].
+    /// RMS position error \[m\].
     pub j_pos_m: f64,
-    /// RMS attitude error [deg].
+    /// RMS attitude error \[deg\].
     pub j_att_deg: f64,
-    /// Divergence time [s].
+    /// Divergence time \[s\].
     pub t_s: f64,
     /// Length of `reason`.
     pub reason_len: u32,
@@ -137,9 +137,9 @@ pub struct WireResponse {
 #[type_name("sepval.WireObservation")]
 #[repr(C)]
 pub struct WireObservation {
-    /// Position [m].
+    /// Position \[m\].
     pub pos_m: [f64; 3],
-    /// Euler angles [deg].
+    /// Euler angles \[deg\].
     pub att_deg: [f64; 3],
 }
 

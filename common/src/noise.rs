@@ -14,9 +14,9 @@ use rand_distr::{Distribution, StandardNormal};
 use crate::frames::wrap_deg;
 use crate::telemetry::Trajectory;
 
-/// Position noise of the default synthetic flight test [m].
+/// Position noise of the default synthetic flight test \[m\].
 pub const SIGMA_POS_M: f64 = 0.003;
-/// Attitude noise of the default synthetic flight test [deg].
+/// Attitude noise of the default synthetic flight test \[deg\].
 pub const SIGMA_ATT_DEG: f64 = 0.1;
 
 /// Adds Gaussian noise with the given sigmas, from a generator seeded with `seed`.
@@ -35,7 +35,7 @@ pub fn add_noise(traj: &mut Trajectory, sigma_pos_m: f64, sigma_att_deg: f64, se
     }
 }
 
-/// Estimates the noise sigmas (position [m], attitude [deg]) of a trajectory from its second
+/// Estimates the noise sigmas (position \[m\], attitude \[deg\]) of a trajectory from its second
 /// differences: for a smooth signal sampled densely, x_{k+1} - 2 x_k + x_{k-1} is dominated by
 /// noise, whose variance it multiplies by 6. Each channel's estimate uses the median absolute
 /// second difference (robust to the few samples where the motion itself is not smooth, such as

@@ -31,9 +31,9 @@ use nalgebra::Vector3;
 use crate::frames::{dcm_from_quaternion, euler_321_deg, wrap_deg};
 use crate::model::{EquationsOfMotion, Model, RunSetup, StateVector};
 
-/// Tolerance to which switch times are located [s] (MODEL.md section 3a).
+/// Tolerance to which switch times are located \[s\] (MODEL.md section 3a).
 pub const SWITCH_TOLERANCE_S: f64 = 1e-12;
-/// A sample time this close to a grid time takes the grid state [s] (MODEL.md section 3a).
+/// A sample time this close to a grid time takes the grid state \[s\] (MODEL.md section 3a).
 pub const GRID_MATCH_TOLERANCE_S: f64 = 1e-9;
 /// Divergence threshold on |omega| [rad/s] (MODEL.md section 3).
 pub const MAX_RATE_RAD_S: f64 = 100.0;
@@ -42,16 +42,16 @@ pub const MAX_RATE_RAD_S: f64 = 100.0;
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error("diverged at t = {t_s} s (non-finite state or |omega| > 100 rad/s)")]
 pub struct Diverged {
-    /// Time of the step after which the state failed the test [s].
+    /// Time of the step after which the state failed the test \[s\].
     pub t_s: f64,
 }
 
 /// One simulated telemetry sample, as measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Observation {
-    /// Launch-frame position (x downrange, y crossrange, z down) [m].
+    /// Launch-frame position (x downrange, y crossrange, z down) \[m\].
     pub pos_m: [f64; 3],
-    /// Euler angles (roll, pitch, yaw) [deg].
+    /// Euler angles (roll, pitch, yaw) \[deg\].
     pub att_deg: [f64; 3],
 }
 
@@ -88,9 +88,9 @@ pub enum FootMode {
 /// What happened during a run, for tests and reports.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RunLog {
-    /// Time each foot (forward, aft) turned on [s].
+    /// Time each foot (forward, aft) turned on \[s\].
     pub foot_on_s: [Option<f64>; 2],
-    /// Time each foot (forward, aft) turned off [s].
+    /// Time each foot (forward, aft) turned off \[s\].
     pub foot_off_s: [Option<f64>; 2],
     /// Full and part RK4 steps taken on the main trajectory.
     pub steps: u64,

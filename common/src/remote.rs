@@ -81,7 +81,7 @@ pub enum RemoteError {
         run: String,
         /// The endpoint.
         endpoint: String,
-        /// The wait [s].
+        /// The wait \[s\].
         seconds: f64,
     },
     /// The chunk server failed.
@@ -375,7 +375,7 @@ pub struct JoinOptions {
     pub endpoint: String,
     /// The run to join.
     pub run_id: String,
-    /// How long to wait for the setup [s].
+    /// How long to wait for the setup \[s\].
     pub setup_timeout: Duration,
     /// A zenoh configuration file to start from (TLS, authentication).
     pub zenoh_config: Option<std::path::PathBuf>,

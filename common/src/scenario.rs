@@ -30,7 +30,7 @@ pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../scenarios/eglin_default
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Store {
-    /// Mass [kg].
+    /// Mass \[kg\].
     pub mass_kg: f64,
     /// Roll inertia about the CG [kg m^2].
     pub ixx_kg_m2: f64,
@@ -38,13 +38,13 @@ pub struct Store {
     pub iyy_kg_m2: f64,
     /// Yaw inertia about the CG [kg m^2].
     pub izz_kg_m2: f64,
-    /// Reference diameter d [m]; the reference area is pi d^2 / 4.
+    /// Reference diameter d \[m\]; the reference area is pi d^2 / 4.
     pub diameter_m: f64,
-    /// Body x of the forward ejector foot [m], positive ahead of the CG.
+    /// Body x of the forward ejector foot \[m\], positive ahead of the CG.
     pub fwd_foot_x_m: f64,
-    /// Body x of the aft ejector foot [m], negative aft of the CG.
+    /// Body x of the aft ejector foot \[m\], negative aft of the CG.
     pub aft_foot_x_m: f64,
-    /// Ejector stroke [m].
+    /// Ejector stroke \[m\].
     pub stroke_m: f64,
 }
 
@@ -52,7 +52,7 @@ pub struct Store {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Ejector {
-    /// (stroke displacement [m], force [N]) points, displacement strictly increasing, linear
+    /// (stroke displacement \[m\], force \[N\]) points, displacement strictly increasing, linear
     /// between points, covering [0, stroke].
     pub curve: Vec<[f64; 2]>,
 }
@@ -86,9 +86,9 @@ pub struct Interference {
     pub dcl0: f64,
     pub dcm0: f64,
     pub dcn0: f64,
-    /// Decay length lambda [m].
+    /// Decay length lambda \[m\].
     pub lambda_m: f64,
-    /// Distance beyond which the interference is zero [m].
+    /// Distance beyond which the interference is zero \[m\].
     pub s_end_m: f64,
 }
 
@@ -98,15 +98,15 @@ pub struct Interference {
 pub struct Flight {
     /// Free-stream Mach number.
     pub mach: f64,
-    /// Altitude [m] (ISA troposphere).
+    /// Altitude \[m\] (ISA troposphere).
     pub altitude_m: f64,
-    /// Aircraft angle of attack [deg].
+    /// Aircraft angle of attack \[deg\].
     #[serde(default)]
     pub alpha_deg: f64,
-    /// Aircraft sideslip [deg].
+    /// Aircraft sideslip \[deg\].
     #[serde(default)]
     pub beta_deg: f64,
-    /// Flight-path angle [deg].
+    /// Flight-path angle \[deg\].
     #[serde(default)]
     pub gamma_deg: f64,
 }
@@ -115,11 +115,11 @@ pub struct Flight {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Integrator {
-    /// Fixed RK4 step [s].
+    /// Fixed RK4 step \[s\].
     pub dt_s: f64,
-    /// Event length [s].
+    /// Event length \[s\].
     pub t_end_s: f64,
-    /// Telemetry rate of simulated trajectories [Hz].
+    /// Telemetry rate of simulated trajectories \[Hz\].
     pub rate_hz: f64,
 }
 

@@ -24,11 +24,11 @@ use crate::units::M_PER_FT;
 /// A trajectory: samples of position and attitude against time.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Trajectory {
-    /// Sample times [s], strictly increasing.
+    /// Sample times \[s\], strictly increasing.
     pub times_s: Vec<f64>,
-    /// Launch-frame positions (x, y, z; z down) [m].
+    /// Launch-frame positions (x, y, z; z down) \[m\].
     pub pos_m: Vec<[f64; 3]>,
-    /// Euler angles (roll, pitch, yaw) [deg].
+    /// Euler angles (roll, pitch, yaw) \[deg\].
     pub att_deg: Vec<[f64; 3]>,
     /// `# key = value` comments, in file order.
     pub metadata: Vec<(String, String)>,

@@ -13,7 +13,7 @@ use crate::factors::Factors;
 use crate::messages::{PROTOCOL_VERSION, SetupHeader};
 use crate::propagator::Observation;
 
-/// Largest frame accepted [bytes] (a corrupt length must not allocate gigabytes).
+/// Largest frame accepted \[bytes\] (a corrupt length must not allocate gigabytes).
 pub const MAX_FRAME: usize = 256 << 20;
 
 /// One candidate in a frame: (index, factors, effects as (catalogue index, values)).
@@ -60,9 +60,9 @@ pub struct FromWorker {
 /// An outcome as a frame carries it (postcard needs an externally tagged enum).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum OutcomeFrame {
-    /// Goals (J_pos [m], J_att [deg]).
+    /// Goals (J_pos \[m\], J_att \[deg\]).
     Goals(f64, f64),
-    /// Diverged at t [s] in an event.
+    /// Diverged at t \[s\] in an event.
     Diverged(f64, u64),
     /// Failed, with the reason.
     Failed(String),

@@ -32,9 +32,9 @@ pub struct BenchRow {
     pub workers: usize,
     /// Evaluations timed.
     pub evals: usize,
-    /// Wall time [s] (the median of the repeats).
+    /// Wall time \[s\] (the median of the repeats).
     pub wall_s: f64,
-    /// Wall time [s] of as many requests refused without simulating (the median of the
+    /// Wall time \[s\] of as many requests refused without simulating (the median of the
     /// repeats): what the transport alone costs.
     pub probe_wall_s: f64,
 }
@@ -218,7 +218,7 @@ pub fn single_seconds(rows: &[BenchRow]) -> Option<f64> {
         .map(|r| r.wall_s / r.evals as f64)
 }
 
-/// Transport overhead per evaluation [us]: the worker time a refused request costs through
+/// Transport overhead per evaluation \[us\]: the worker time a refused request costs through
 /// this transport (probe wall x workers / evals) beyond what it costs in one thread (the
 /// `single` row's probes).
 pub fn overhead_us(row: &BenchRow, rows: &[BenchRow]) -> Option<f64> {

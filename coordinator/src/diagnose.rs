@@ -86,9 +86,9 @@ pub struct ModelSummary {
     pub effects: Vec<String>,
     /// Free parameters.
     pub parameters: usize,
-    /// RMS position error [m].
+    /// RMS position error \[m\].
     pub j_pos_m: f64,
-    /// RMS attitude error [deg].
+    /// RMS attitude error \[deg\].
     pub j_att_deg: f64,
     /// Sum of squared normalised residuals.
     pub chi2: f64,
@@ -121,7 +121,7 @@ pub struct CandidateReport {
     pub delta_bic: f64,
     /// Whether the extension is significant.
     pub significant: bool,
-    /// Goals after the extension: J_pos [m], J_att [deg].
+    /// Goals after the extension: J_pos \[m\], J_att \[deg\].
     pub goals: [f64; 2],
     /// RMS residual per channel after the extension.
     pub channel_rms: ChannelRms,
@@ -136,9 +136,9 @@ pub struct CandidateReport {
 pub struct SegmentRms {
     /// Segment name.
     pub name: String,
-    /// Start [s] (first event).
+    /// Start \[s\] (first event).
     pub t_start_s: f64,
-    /// End [s] (first event).
+    /// End \[s\] (first event).
     pub t_end_s: f64,
     /// RMS residual in the segment, pooled over events (channel unit).
     pub rms: f64,
@@ -192,9 +192,9 @@ pub struct Diagnosis {
     pub explained: bool,
     /// The verdict in one sentence.
     pub verdict: String,
-    /// Position noise [m].
+    /// Position noise \[m\].
     pub sigma_pos_m: f64,
-    /// Attitude noise [deg].
+    /// Attitude noise \[deg\].
     pub sigma_att_deg: f64,
     /// Where the sigmas came from.
     pub sigma_source: String,
@@ -210,7 +210,7 @@ pub struct Diagnosis {
     pub residuals: BTreeMap<String, ResidualReport>,
     /// Simulations run (baseline fit included).
     pub evaluations: u64,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_s: f64,
 }
 
@@ -227,7 +227,7 @@ fn noise_of(options: &FitOptions) -> Noise {
     }
 }
 
-/// Residuals in physical units per event, per sample: (x, y, z [m], roll, pitch, yaw [deg]).
+/// Residuals in physical units per event, per sample: (x, y, z \[m\], roll, pitch, yaw \[deg\]).
 fn physical_residuals(r: &[f64], noise: Noise, events: &[usize]) -> Vec<Vec<[f64; 6]>> {
     let mut out = Vec::new();
     let mut pos = 0;

@@ -506,7 +506,7 @@ struct Channel {
     file: &'static str,
     title: &'static str,
     y_desc: &'static str,
-    /// The plotted value from a position [m] and attitude [deg].
+    /// The plotted value from a position \[m\] and attitude \[deg\].
     value: fn(&[f64; 3], &[f64; 3]) -> f64,
 }
 
@@ -549,7 +549,7 @@ const CHANNELS: [Channel; 6] = [
     },
 ];
 
-/// The (time [s], value) samples of one channel of a trajectory, paired up to the shortest of
+/// The (time \[s\], value) samples of one channel of a trajectory, paired up to the shortest of
 /// its vectors.
 fn channel_samples(traj: &Trajectory, channel: &Channel) -> Vec<(f64, f64)> {
     traj.times_s
@@ -816,7 +816,7 @@ fn estimate_width(s: &str, size: f64) -> u32 {
 // ---------------------------------------------------------------------------------------------
 // Pareto fronts and convergence.
 
-/// Pareto fronts (J_pos [m] on x, J_att [deg] on y), one colour per method, each front as
+/// Pareto fronts (J_pos \[m\] on x, J_att \[deg\] on y), one colour per method, each front as
 /// points joined in order of J_pos, with the noise floor `(sigma_pos_m, sigma_att_deg)` drawn
 /// as grey dashed lines when given (a front below it fits the noise). 1000 × 700 px.
 pub fn pareto_figure(
@@ -1007,7 +1007,7 @@ fn draw_legend_strip(area: &Root<'_>, entries: &[(String, Mark)]) -> DrawResult 
 const BAND: RGBColor = RGBColor(222, 222, 222);
 
 /// Residuals (simulated minus measured) against time for six channels in a 2 × 3 grid (x, y,
-/// z [m]; roll, pitch, yaw [deg]), one line per labelled residual set (e.g. "baseline",
+/// z \[m\]; roll, pitch, yaw \[deg\]), one line per labelled residual set (e.g. "baseline",
 /// "extended"), with grey ±σ bands: `sigma` is (sigma_pos_m, sigma_att_deg), a band left out
 /// when its σ is not positive. Each set gives one `[x, y, z, roll, pitch, yaw]` per time in
 /// `times_s`. 1600 × 1000 px, `title` on top and one legend below it.

@@ -81,9 +81,9 @@ impl Method {
 /// Noise levels that weight the goals.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Sigma {
-    /// Position [m].
+    /// Position \[m\].
     pub pos_m: f64,
-    /// Attitude [deg].
+    /// Attitude \[deg\].
     pub att_deg: f64,
     /// Where they came from.
     pub source: String,

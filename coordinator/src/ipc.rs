@@ -9,7 +9,7 @@
 //! (responses wake the coordinator through an event), never spin.
 //!
 //! Faults: a worker whose process exits (checked every tick for spawned workers) or whose node
-//! is dead (attached workers, listed every [`LISTING_PERIOD`]), or that holds a chunk past the
+//! is dead (attached workers, listed every 500 ms), or that holds a chunk past the
 //! deadline (hung; it is then killed), is dropped; its chunks in flight go back to the
 //! queue and are sent to the remaining workers, so a batch completes with exactly one result per
 //! candidate. Spawned workers are replaced (up to a limit); with no worker left the batch fails

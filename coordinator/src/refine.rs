@@ -104,9 +104,9 @@ impl ParamSpace {
 /// Noise levels normalising the residuals.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Noise {
-    /// Position [m].
+    /// Position \[m\].
     pub pos_m: f64,
-    /// Attitude [deg].
+    /// Attitude \[deg\].
     pub att_deg: f64,
 }
 

@@ -1,7 +1,7 @@
 //! The zenoh evaluator (cargo feature `zenoh`): workers on other hosts.
 //!
 //! The coordinator listens on one endpoint, serves the job setup from a queryable, and hands
-//! chunks (the same [`chunk_plan`] as every other transport) to workers that asked for them
+//! chunks (the same chunk plan as every other transport) to workers that asked for them
 //! (credits, see [`sepval_common::remote`]). It watches the workers' liveliness tokens: a worker
 //! whose token goes (killed, host down, link cut) has its in-flight chunks re-dispatched; a
 //! worker that holds a chunk past the deadline is told to quit and treated the same way. Workers

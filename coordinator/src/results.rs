@@ -23,9 +23,9 @@ pub struct FitResult {
     pub data_sha256: String,
     /// SHA-256 of the scenario(s).
     pub scenario_sha256: String,
-    /// Position noise used to weight J_pos [m].
+    /// Position noise used to weight J_pos \[m\].
     pub sigma_pos_m: f64,
-    /// Attitude noise used to weight J_att [deg].
+    /// Attitude noise used to weight J_att \[deg\].
     pub sigma_att_deg: f64,
     /// Where the sigmas came from.
     pub sigma_source: String,
@@ -46,9 +46,9 @@ pub struct FitResult {
 /// The noise floor.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FloorInfo {
-    /// 1.1 sigma_pos [m].
+    /// 1.1 sigma_pos \[m\].
     pub j_pos_m: f64,
-    /// 1.1 sigma_att [deg].
+    /// 1.1 sigma_att \[deg\].
     pub j_att_deg: f64,
 }
 
@@ -59,13 +59,13 @@ pub struct ResolutionRow {
     pub factor: String,
     /// Its grid step ((max - min) / (2^bits - 1)).
     pub step: f64,
-    /// Change of J_pos [m].
+    /// Change of J_pos \[m\].
     pub d_j_pos_m: f64,
-    /// Change of J_att [deg].
+    /// Change of J_att \[deg\].
     pub d_j_att_deg: f64,
-    /// RMS change of the simulated positions [m].
+    /// RMS change of the simulated positions \[m\].
     pub traj_rms_pos_m: f64,
-    /// RMS change of the simulated angles [deg].
+    /// RMS change of the simulated angles \[deg\].
     pub traj_rms_att_deg: f64,
     /// Whether one step moves the trajectory by more than the noise.
     pub coarse: bool,
@@ -80,7 +80,7 @@ pub struct Probe {
     pub evaluations_before: u64,
     /// Its simulations.
     pub evaluations: u64,
-    /// Goals it reached: J_pos [m], J_att [deg].
+    /// Goals it reached: J_pos \[m\], J_att \[deg\].
     pub goals: [f64; 2],
     /// Whether it reached the floor.
     pub reached_floor: bool,
@@ -89,7 +89,7 @@ pub struct Probe {
 /// The refinement stage of a method.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Refinement {
-    /// Goals before it: J_pos [m], J_att [deg].
+    /// Goals before it: J_pos \[m\], J_att \[deg\].
     pub start_goals: [f64; 2],
     /// Its simulations (final refinement only).
     pub evaluations: u64,
@@ -115,7 +115,7 @@ pub struct EventInfo {
 pub struct RunInfo {
     /// The evaluator ("inproc, 2 thread(s)").
     pub evaluator: String,
-    /// Wall time of the whole fit [s].
+    /// Wall time of the whole fit \[s\].
     pub wall_s: f64,
     /// sepval version.
     pub version: String,
@@ -144,15 +144,15 @@ pub struct MethodResult {
 pub struct Best {
     /// The 17 factors by name.
     pub factors: Factors,
-    /// RMS position error [m].
+    /// RMS position error \[m\].
     pub j_pos_m: f64,
-    /// RMS attitude error [deg].
+    /// RMS attitude error \[deg\].
     pub j_att_deg: f64,
     /// J_pos/sigma_pos + J_att/sigma_att.
     pub weighted: f64,
     /// Simulations the method ran.
     pub evaluations: u64,
-    /// Wall time of the method [s].
+    /// Wall time of the method \[s\].
     pub wall_s: f64,
     /// RMS residual per channel.
     pub channel_rms: ChannelRms,
@@ -163,9 +163,9 @@ pub struct Best {
 pub struct FrontPoint {
     /// The factors.
     pub factors: Factors,
-    /// RMS position error [m].
+    /// RMS position error \[m\].
     pub j_pos_m: f64,
-    /// RMS attitude error [deg].
+    /// RMS attitude error \[deg\].
     pub j_att_deg: f64,
 }
 
@@ -176,9 +176,9 @@ pub struct HistoryPoint {
     pub step: usize,
     /// Simulations so far.
     pub evaluations: u64,
-    /// Smallest J_pos in the population (the point itself for the hill climber) [m].
+    /// Smallest J_pos in the population (the point itself for the hill climber) \[m\].
     pub best_j_pos_m: f64,
-    /// Smallest J_att [deg].
+    /// Smallest J_att \[deg\].
     pub best_j_att_deg: f64,
     /// Smallest weighted sum.
     pub best_weighted: f64,
@@ -187,17 +187,17 @@ pub struct HistoryPoint {
 /// RMS residual (simulated minus measured) per channel, pooled over events.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ChannelRms {
-    /// Downrange [m].
+    /// Downrange \[m\].
     pub x_m: f64,
-    /// Crossrange [m].
+    /// Crossrange \[m\].
     pub y_m: f64,
-    /// Down [m].
+    /// Down \[m\].
     pub z_m: f64,
-    /// Roll [deg].
+    /// Roll \[deg\].
     pub roll_deg: f64,
-    /// Pitch [deg].
+    /// Pitch \[deg\].
     pub pitch_deg: f64,
-    /// Yaw [deg].
+    /// Yaw \[deg\].
     pub yaw_deg: f64,
 }
 
@@ -216,7 +216,7 @@ impl ChannelRms {
 }
 
 /// Residuals of simulated samples against the job's data, per event, per sample:
-/// (dx, dy, dz [m], droll, dpitch, dyaw [deg]), angle differences wrapped.
+/// (dx, dy, dz \[m\], droll, dpitch, dyaw \[deg\]), angle differences wrapped.
 pub fn residuals(job: &Job, samples: &[Vec<Observation>]) -> Vec<Vec<[f64; 6]>> {
     job.events()
         .iter()

@@ -50,7 +50,7 @@ struct Cli {
     /// zenoh: a zenoh JSON5 configuration to start from (TLS certificates, authentication).
     #[arg(long, value_name = "FILE", requires = "connect")]
     zenoh_config: Option<std::path::PathBuf>,
-    /// How long to wait for the coordinator's job setup [s].
+    /// How long to wait for the coordinator's job setup \[s\].
     #[arg(long, default_value_t = 30.0, value_name = "S")]
     setup_timeout: f64,
     /// Announce this protocol version instead of our own (compatibility testing only).

@@ -3,7 +3,7 @@
 //! Source: `../shared/MODEL.md` section 7. Each effect is one small type in its own file
 //! implementing [`Effect`], registered once in [`CATALOGUE`]; adding an effect means adding one
 //! file and one line there. An effect changes a run through the knobs of
-//! [`RunSetup`](crate::model::RunSetup) (inertia tensor, ejector direction and start time, moment
+//! [`RunSetup`] (inertia tensor, ejector direction and start time, moment
 //! reference point, initial rates, measurement offsets) or by adding a coefficient term that is
 //! evaluated at every force evaluation. Every effect at its neutral parameters leaves the run
 //! bit-for-bit equal to the baseline.

@@ -17,9 +17,9 @@ use crate::scenario::Aero;
 /// The flow seen by the store at one force evaluation; effects' coefficient terms read it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Flow {
-    /// Angle of attack atan2(w, u) [rad].
+    /// Angle of attack atan2(w, u) \[rad\].
     pub alpha_rad: f64,
-    /// Sideslip asin(v / V) [rad].
+    /// Sideslip asin(v / V) \[rad\].
     pub beta_rad: f64,
     /// Non-dimensional roll rate p d / 2V.
     pub p_hat: f64,

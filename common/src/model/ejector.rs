@@ -21,7 +21,7 @@ impl EjectorCurve {
         }
     }
 
-    /// Force at displacement `s_m` [N], linear between points, constant beyond the ends.
+    /// Force at displacement `s_m` \[N\], linear between points, constant beyond the ends.
     #[inline(always)]
     pub fn force_n(&self, s_m: f64) -> f64 {
         let n = self.s_m.len();

@@ -10,9 +10,9 @@
 /// Precomputed constants of f(s) for one lambda and s_end.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InterferenceDecay {
-    /// Decay length lambda [m].
+    /// Decay length lambda \[m\].
     pub lambda_m: f64,
-    /// Cut-off distance [m].
+    /// Cut-off distance \[m\].
     pub s_end_m: f64,
     inv_lambda_per_m: f64,
     exp_end: f64,

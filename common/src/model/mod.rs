@@ -68,17 +68,17 @@ pub enum ModelError {
 #[derive(Debug, Clone)]
 pub struct Model {
     scenario: Scenario,
-    /// Mass [kg].
+    /// Mass \[kg\].
     pub mass_kg: f64,
     /// Nominal principal inertias (Ixx, Iyy, Izz) [kg m^2].
     pub inertia_kg_m2: [f64; 3],
-    /// Reference diameter [m].
+    /// Reference diameter \[m\].
     pub diameter_m: f64,
     /// Reference area pi d^2 / 4 [m^2].
     pub area_m2: f64,
-    /// Body x of the (forward, aft) ejector feet relative to the nominal CG [m].
+    /// Body x of the (forward, aft) ejector feet relative to the nominal CG \[m\].
     pub feet_x_m: [f64; 2],
-    /// Ejector stroke [m].
+    /// Ejector stroke \[m\].
     pub stroke_m: f64,
     /// Nominal ejector force curve.
     pub curve: EjectorCurve,
@@ -91,7 +91,7 @@ pub struct Model {
     pub v_aircraft_air_l_m_s: Vector3<f64>,
     /// Gravity in L: g (-sin theta_a, 0, cos theta_a), theta_a = alpha + gamma.
     pub gravity_l_m_s2: Vector3<f64>,
-    /// Fixed RK4 step [s].
+    /// Fixed RK4 step \[s\].
     pub dt_s: f64,
     /// Initial velocity relative to L [m/s].
     pub initial_velocity_m_s: Vector3<f64>,
@@ -147,7 +147,7 @@ pub const MAX_COEFFICIENT_TERMS: usize = 8;
 /// One ejector foot of a run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Foot {
-    /// Body x of the foot relative to the (true) CG [m].
+    /// Body x of the foot relative to the (true) CG \[m\].
     pub x_m: f64,
     /// Force multiplier (fwdfac or aftfac).
     pub fac: f64,
@@ -173,9 +173,9 @@ pub struct RunSetup {
     pub inertia_principal_differences: [f64; 3],
     /// 0.5 rho S [kg/m]: multiplied by V^2 gives qbar S.
     pub half_rho_area: f64,
-    /// Reference diameter d [m].
+    /// Reference diameter d \[m\].
     pub diameter_m: f64,
-    /// d / 2 [m], for the non-dimensional rates.
+    /// d / 2 \[m\], for the non-dimensional rates.
     pub half_diameter_m: f64,
     /// Aircraft velocity relative to the air in L [m/s].
     pub v_aircraft_air_l_m_s: Vector3<f64>,
@@ -189,13 +189,13 @@ pub struct RunSetup {
     pub decay: InterferenceDecay,
     /// Forward and aft feet.
     pub feet: [Foot; 2],
-    /// Ejector stroke [m].
+    /// Ejector stroke \[m\].
     pub stroke_m: f64,
     /// Unit direction of each foot's force in L (MODEL.md: +z of L).
     pub ejector_direction_l: Vector3<f64>,
-    /// Time at which the feet start pushing [s] (0: at release).
+    /// Time at which the feet start pushing \[s\] (0: at release).
     pub ejector_start_s: f64,
-    /// Body x of the aerodynamic moment reference point relative to the CG [m] (0: the CG);
+    /// Body x of the aerodynamic moment reference point relative to the CG \[m\] (0: the CG);
     /// moments about the CG are M_ref + (x_ref, 0, 0) x F_aero.
     pub aero_reference_x_m: f64,
     /// Initial velocity relative to L [m/s].
@@ -206,11 +206,11 @@ pub struct RunSetup {
     pub coefficient_terms: [(CoefficientFn, [f64; MAX_EFFECT_PARAMS]); MAX_COEFFICIENT_TERMS],
     /// Number of entries of `coefficient_terms` in use.
     pub coefficient_term_count: usize,
-    /// Measurement: the sample labelled t shows the store at t + offset [s].
+    /// Measurement: the sample labelled t shows the store at t + offset \[s\].
     pub time_offset_s: f64,
-    /// Measurement: constant Euler angle biases (roll, pitch, yaw) [rad].
+    /// Measurement: constant Euler angle biases (roll, pitch, yaw) \[rad\].
     pub attitude_bias_rad: [f64; 3],
-    /// Measurement: the tracked body point relative to the CG, body axes [m].
+    /// Measurement: the tracked body point relative to the CG, body axes \[m\].
     pub tracked_point_b_m: Vector3<f64>,
 }
 
@@ -394,7 +394,7 @@ pub struct EquationsOfMotion<'a> {
     curve: &'a EjectorCurve,
     /// 0.5 rho S / m [1/m]: times V^2 and a force coefficient, an acceleration.
     accel_per_speed2: f64,
-    /// 0.5 rho S d [kg]: times V^2 and a moment coefficient, a moment.
+    /// 0.5 rho S d \[kg\]: times V^2 and a moment coefficient, a moment.
     moment_per_speed2: f64,
     /// x_ref / d: moving the moments to the CG is Cm -= CZ x_ref / d, Cn += CY x_ref / d.
     reference_arm: f64,
@@ -581,7 +581,7 @@ impl Dcm {
     }
 
     /// base + |q|^2 C_LB b: a body vector in launch-frame axes, times |q|^2, added to base.
-    /// The sum runs from b[0] to b[2], so that b[2] (in the force evaluation the normal force,
+    /// The sum runs from b\[0\] to b\[2\], so that b\[2\] (in the force evaluation the normal force,
     /// the last to be known) waits for one multiply-add only.
     #[inline(always)]
     pub fn to_launch_scaled(&self, b: [f64; 3], base: [f64; 3]) -> [f64; 3] {
