@@ -3,6 +3,10 @@
 //! Only the command line lives here; see the `sepval_coordinator` and `sepval_common`
 //! libraries for the logic.
 
+// The doc comments here are clap's --help text, where units read `[s]`, `[m]`; rustdoc would
+// take those for links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -46,7 +50,7 @@ enum Command {
     Simulate(SimulateArgs),
     /// List the effect catalogue: the physics the baseline model leaves out.
     Effects,
-    /// Print the goals J_pos \[m\] and J_att \[deg\] of a simulated trajectory against data.
+    /// Print the goals J_pos [m] and J_att [deg] of a simulated trajectory against data.
     Goals(GoalsArgs),
     /// Write a scenario file (the embedded default unless --scenario is given) as TOML.
     Scenario(ScenarioArgs),
@@ -80,10 +84,10 @@ struct GatewayArgs {
     /// Local iceoryx2 worker processes [default: the number of cores].
     #[arg(long)]
     workers: Option<usize>,
-    /// A local worker holding a chunk longer than this \[s\] is killed and replaced.
+    /// A local worker holding a chunk longer than this [s] is killed and replaced.
     #[arg(long, default_value_t = 60.0, value_name = "S")]
     worker_timeout: f64,
-    /// How long to wait for the coordinator's job setup \[s\].
+    /// How long to wait for the coordinator's job setup [s].
     #[arg(long, default_value_t = 30.0, value_name = "S")]
     setup_timeout: f64,
     /// A zenoh JSON5 configuration to start from (TLS certificates, authentication).
@@ -241,10 +245,10 @@ struct RerunArgs {
 /// The measurement noise that weights the goals (shared by every search command).
 #[derive(clap::Args)]
 struct NoiseArgs {
-    /// Position noise \[m\] weighting J_pos (default: estimated from the data).
+    /// Position noise [m] weighting J_pos (default: estimated from the data).
     #[arg(long)]
     sigma_pos_m: Option<f64>,
-    /// Attitude noise \[deg\] weighting J_att (default: estimated from the data).
+    /// Attitude noise [deg] weighting J_att (default: estimated from the data).
     #[arg(long)]
     sigma_att_deg: Option<f64>,
 }
@@ -277,10 +281,10 @@ struct EvalArgs {
     /// Run id of spawned workers [default: a fresh one].
     #[arg(long, value_name = "RUN_ID")]
     run_id: Option<String>,
-    /// A worker that holds a chunk longer than this \[s\] is killed and replaced.
+    /// A worker that holds a chunk longer than this [s] is killed and replaced.
     #[arg(long, default_value_t = 60.0, value_name = "S")]
     worker_timeout: f64,
-    /// How long to wait for workers to join \[s\].
+    /// How long to wait for workers to join [s].
     #[arg(long, default_value_t = 60.0, value_name = "S")]
     join_timeout: f64,
     /// Announce this protocol version in the job setup (compatibility testing only).
@@ -303,10 +307,10 @@ struct SimulateArgs {
     /// Add Gaussian measurement noise (0.003 m, 0.1 deg) from this seed.
     #[arg(long, value_name = "N")]
     noise_seed: Option<u64>,
-    /// Event length \[s\] (default: the scenario's).
+    /// Event length [s] (default: the scenario's).
     #[arg(long, value_name = "S")]
     t_end: Option<f64>,
-    /// Telemetry rate \[Hz\] (default: the scenario's).
+    /// Telemetry rate [Hz] (default: the scenario's).
     #[arg(long, value_name = "HZ")]
     rate: Option<f64>,
     /// Output CSV file (written atomically).

@@ -281,3 +281,18 @@ fn selftest_zdt_prints_a_hypervolume() {
         "--problem zdt9: expected zdt1, zdt2 or zdt3",
     );
 }
+
+#[test]
+fn help_shows_units_as_written() {
+    // Doc comments are the help text; markdown escapes meant for rustdoc must not leak into it.
+    let dir = tempfile::tempdir().unwrap();
+    for command in [&["fit", "--help"][..], &["simulate", "--help"], &["--help"]] {
+        let help = ok(&sepval(command, dir.path()));
+        assert!(!help.contains('\\'), "{command:?}:\n{help}");
+    }
+    let fit = ok(&sepval(&["fit", "--help"], dir.path()));
+    assert!(
+        fit.contains("How long to wait for workers to join [s]"),
+        "{fit}"
+    );
+}

@@ -11,6 +11,10 @@
 //! typed failure instead of crashing. Run `iox2 service list` with the run's configuration to
 //! see its services (see the README).
 
+// The doc comments here are clap's --help text, where units read `[s]`, `[m]`; rustdoc would
+// take those for links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
@@ -50,7 +54,7 @@ struct Cli {
     /// zenoh: a zenoh JSON5 configuration to start from (TLS certificates, authentication).
     #[arg(long, value_name = "FILE", requires = "connect")]
     zenoh_config: Option<std::path::PathBuf>,
-    /// How long to wait for the coordinator's job setup \[s\].
+    /// How long to wait for the coordinator's job setup [s].
     #[arg(long, default_value_t = 30.0, value_name = "S")]
     setup_timeout: f64,
     /// Announce this protocol version instead of our own (compatibility testing only).
