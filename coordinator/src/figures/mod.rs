@@ -119,7 +119,7 @@ impl FigureError {
 // Shared machinery: font, rendering, ranges, ticks, colours.
 
 /// DejaVu Sans, embedded so that text renders without system fonts.
-static FONT_BYTES: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+static FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// The font family every text of the figures uses (plotters' default family too).
 const FONT: &str = "sans-serif";
