@@ -1,0 +1,153 @@
+//! Figures: PNG plots of fitted trajectories, found factors, Pareto fronts, convergence,
+//! residuals, factor correlations and worker throughput.
+//!
+//! The trajectory and factor figures follow M. B. Anderson's store-separation GA study,
+//! Figures 1-7:
+//! - [`trajectory_figures`] draws Figures 1-6: pitch, yaw, roll, downrange, crossrange and
+//!   altitude against time, the flight data as points and each fitted simulation as a line.
+//! - [`factor_figure`] draws Figure 7: the factors each method found beside the true ones, every
+//!   factor normalised to its search range so that factors of different units share one axis.
+//!
+//! The others show how a fit went and what is left of it:
+//! - [`pareto_figure`]: the Pareto fronts of the two goals (position and attitude error), with
+//!   the measurement noise floor below which no fit can honestly go.
+//! - [`convergence_figure`]: the best weighted goal against the number of simulations run.
+//! - [`residual_figure`]: simulated minus measured for the six channels, with the noise bands.
+//! - [`correlation_figure`]: a heat map of a correlation matrix (for example of the fitted
+//!   factors over the final population).
+//! - [`throughput_figure`]: simulations per second against worker count, per transport.
+//!
+//! Choices made here:
+//! - Rendering needs no system library and no installed font: `plotters` draws into an in-memory
+//!   RGB buffer, its text drawn with `ab_glyph` from DejaVu Sans, which is embedded in the binary
+//!   (`assets/fonts/DejaVuSans.ttf`, licence beside it), and the PNG is encoded by the pure-Rust
+//!   `png` crate. Files are written atomically (a temporary file in the target directory, then
+//!   renamed), so a failed figure never leaves a partial file.
+//! - Odd data never panics: values that are not finite (or beyond ±1e100, which no axis can
+//!   show) are skipped, a line is broken where they were; empty series draw empty axes;
+//!   degenerate axis ranges (one value, or none) are widened. Inputs whose lengths must agree
+//!   (factor names and ranges, residual sets and times, a square correlation matrix) are
+//!   checked and refused with [`FigureError::Input`]. Within a [`Trajectory`] the samples are
+//!   paired up to the shortest of its vectors.
+//! - Colours follow label order: the i-th fit, method, residual set or transport always gets
+//!   the i-th colour of one ten-colour palette (Tableau 10); measured data and the truth are
+//!   black, noise floors grey.
+//!
+//! Layout: the plotting kit every figure is drawn with (font, rendering and PNG encoding,
+//! ranges, ticks, palette, legends, lines and marks) is the private submodule `kit`; each
+//! figure family has a submodule of its own (`trajectory`, `factors`, `pareto`,
+//! `convergence`, `residuals`, `correlation`, `throughput`) whose function is re-exported here.
+
+use std::path::{Path, PathBuf};
+
+use sepval_common::telemetry::Trajectory;
+
+mod convergence;
+mod correlation;
+mod factors;
+mod kit;
+mod pareto;
+mod residuals;
+#[cfg(test)]
+mod testing;
+mod throughput;
+mod trajectory;
+
+pub use convergence::convergence_figure;
+pub use correlation::correlation_figure;
+pub use factors::factor_figure;
+pub use pareto::pareto_figure;
+pub use residuals::residual_figure;
+pub use throughput::throughput_figure;
+pub use trajectory::trajectory_figures;
+
+/// A labelled trajectory to draw beside the measured data.
+#[derive(Debug, Clone, Copy)]
+pub struct Series<'a> {
+    /// The legend label (for example the method that found the fit).
+    pub label: &'a str,
+    /// The trajectory (for example the simulation with the fitted factors).
+    pub traj: &'a Trajectory,
+}
+
+/// Failure to draw or write a figure. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FigureError {
+    /// The inputs do not fit together (for example fewer names than factors).
+    #[error("{}: {message}", path.display())]
+    Input {
+        /// The figure file.
+        path: PathBuf,
+        /// What does not fit.
+        message: String,
+    },
+    /// The embedded font could not be loaded.
+    #[error("{}: cannot load the embedded font DejaVuSans.ttf", path.display())]
+    Font {
+        /// The figure file.
+        path: PathBuf,
+    },
+    /// The plotting library failed to draw the figure.
+    #[error("{}: cannot draw the figure: {message}", path.display())]
+    Draw {
+        /// The figure file.
+        path: PathBuf,
+        /// The cause.
+        message: String,
+    },
+    /// The image could not be encoded as PNG.
+    #[error("{}: cannot encode the PNG: {message}", path.display())]
+    Encode {
+        /// The figure file.
+        path: PathBuf,
+        /// The cause.
+        message: String,
+    },
+    /// The file could not be written (for example because its directory does not exist).
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        /// The figure file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl FigureError {
+    /// The figure file the error is about.
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::Input { path, .. }
+            | Self::Font { path }
+            | Self::Draw { path, .. }
+            | Self::Encode { path, .. }
+            | Self::Write { path, .. } => path,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::testing::trajectory;
+    use super::*;
+
+    #[test]
+    fn missing_directory_is_an_error_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("no-such-dir");
+        let err = trajectory_figures(&missing, &trajectory(1.0), &[]).unwrap_err();
+        assert!(matches!(err, FigureError::Write { .. }), "{err:?}");
+        assert_eq!(err.path(), missing.join("fig1_pitch.png"));
+        assert!(err.to_string().contains("no-such-dir"), "{err}");
+
+        let path = missing.join("pareto.png");
+        let err = pareto_figure(&path, &[("GA", &[[1.0, 2.0]][..])], None).unwrap_err();
+        assert!(
+            err.to_string().contains(&path.display().to_string()),
+            "{err}"
+        );
+        assert!(!missing.exists());
+    }
+}
