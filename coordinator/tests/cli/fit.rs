@@ -1,10 +1,8 @@
 //! `sepval fit` and `sepval rerun` end to end, with reduced budgets.
 
-mod support;
-use support::{ok, sepval};
-
 use std::path::Path;
 
+use sepval_tests::{ok, sepval};
 use serde_json::Value;
 
 /// result.json without what may differ between runs of the same fit (timings, evaluator).
