@@ -1,5 +1,8 @@
-//! Shared fixtures of the end-to-end tests: the binaries under test, unique run ids, process
-//! lookup by run id, and waits that always have a deadline.
+//! Shared fixtures of every test that runs a built binary (the end-to-end tests of this crate,
+//! the `sepval` command-line tests of sepval-coordinator and the `sepval-worker` test): the
+//! binaries under test, unique run ids, process lookup by run id, and waits that always have a
+//! deadline. This library depends on no sepval crate, so any of them can use it as a
+//! dev-dependency without a cycle.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -7,7 +10,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 /// Path of a binary built beside the tests (`sepval`, `sepval-worker`). `cargo test
-/// --workspace` builds them (their packages have integration tests).
+/// --workspace` builds them because their packages have integration tests (keep one in each).
 pub fn binary(name: &str) -> PathBuf {
     let exe = std::env::current_exe().expect("test executable");
     let dir = exe.parent().and_then(Path::parent).expect("target dir");
@@ -30,7 +33,7 @@ pub fn run_id(tag: &str) -> String {
     )
 }
 
-/// Runs `sepval` to completion.
+/// Runs `sepval` with `args` in `dir` to completion.
 pub fn sepval(args: &[&str], dir: &Path) -> Output {
     Command::new(binary("sepval"))
         .args(args)
@@ -61,7 +64,7 @@ pub fn spawn_worker(run: &str, extra: &[&str]) -> Child {
         .expect("start sepval-worker")
 }
 
-/// Asserts success and returns stdout.
+/// Fails the test with sepval's stderr unless it exited successfully; returns its stdout.
 pub fn ok(out: &Output) -> String {
     assert!(
         out.status.success(),

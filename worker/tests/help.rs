@@ -1,9 +1,11 @@
 //! The worker binary describes itself (and this test makes `cargo test` build it for the
-//! end-to-end tests of the `tests` crate).
+//! end-to-end tests of the `tests` crate: the package must keep an integration test).
+
+use sepval_tests::binary;
 
 #[test]
 fn help_describes_the_worker() {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sepval-worker"))
+    let out = std::process::Command::new(binary("sepval-worker"))
         .arg("--help")
         .output()
         .unwrap();

@@ -1,11 +1,9 @@
 //! The `sepval` command line, run as a user runs it.
 
-mod support;
-use support::{ok, sepval};
-
 use std::process::Output;
 
 use sepval_common::telemetry::Trajectory;
+use sepval_tests::{ok, sepval};
 
 fn refused(out: &Output, expected: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -1,11 +1,9 @@
 //! Refinement to the noise floor, identifiability, pooled events and resolution advice, end
 //! to end on noisy synthetic data (reduced genetic searches).
 
-mod support;
-use support::{ok, sepval};
-
 use std::path::Path;
 
+use sepval_tests::{ok, sepval};
 use serde_json::Value;
 
 fn result(dir: &Path, run: &str) -> Value {

@@ -2,11 +2,9 @@
 //! visible magnitude on a base that is not the default truth, null cases, an effect outside
 //! the catalogue, and two effects hidden together. Reduced search budgets; release build.
 
-mod support;
-use support::{ok, sepval};
-
 use std::path::Path;
 
+use sepval_tests::{ok, sepval};
 use serde_json::Value;
 
 /// Factors of the base model of these tests (not the default truth).

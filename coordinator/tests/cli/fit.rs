@@ -1,21 +1,7 @@
 //! `sepval fit` and `sepval rerun` end to end, with reduced budgets.
 
-mod support;
-use support::{ok, sepval};
-
-use std::path::Path;
-
+use sepval_tests::{deterministic_part, ok, sepval};
 use serde_json::Value;
-
-/// result.json without what may differ between runs of the same fit (timings, evaluator).
-fn deterministic_part(path: &Path) -> Value {
-    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    v.as_object_mut().unwrap().remove("run");
-    for m in v["methods"].as_object_mut().unwrap().values_mut() {
-        m["best"].as_object_mut().unwrap().remove("wall_s");
-    }
-    v
-}
 
 const SMALL: [&str; 8] = [
     "--generations",

@@ -3,8 +3,6 @@
 //! namespaces (two "hosts" joined by a virtual Ethernet pair) created by the test itself where
 //! the machine allows it. Every fit is checked against the in-process evaluator bit for bit.
 
-#![cfg(feature = "zenoh")]
-
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
