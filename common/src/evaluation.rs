@@ -144,11 +144,7 @@ impl Job {
         for (k, event) in self.events.iter().enumerate() {
             let run = match event.simulator.run_setup(&c.factors, &c.effects) {
                 Ok(run) => run,
-                Err(e) => {
-                    return Evaluation::from(Outcome::Failed {
-                        reason: e.to_string(),
-                    });
-                }
+                Err(e) => return Evaluation::from(Outcome::failed(e.to_string())),
             };
             let model = event.simulator.model();
             let result = if keep {
@@ -230,7 +226,25 @@ pub enum Outcome {
     },
 }
 
+/// Longest failure reason an [`Outcome::Failed`] carries \[bytes of UTF-8\]. Reasons are cut
+/// (at a character boundary) where the outcome is made, so that every evaluator, in this process
+/// or across any transport, gives the same outcome to the last byte.
+pub const MAX_REASON_BYTES: usize = 240;
+
 impl Outcome {
+    /// A failed outcome whose reason is cut to [`MAX_REASON_BYTES`] at a character boundary.
+    pub fn failed(reason: impl Into<String>) -> Outcome {
+        let mut reason = reason.into();
+        if reason.len() > MAX_REASON_BYTES {
+            let mut end = MAX_REASON_BYTES;
+            while !reason.is_char_boundary(end) {
+                end -= 1;
+            }
+            reason.truncate(end);
+        }
+        Outcome::Failed { reason }
+    }
+
     /// The goals, if the run finished.
     pub fn goals(&self) -> Option<Goals> {
         match *self {
@@ -270,8 +284,18 @@ impl From<Outcome> for Evaluation {
 #[non_exhaustive]
 pub enum EvalError {
     /// The evaluator cannot go on (for example every worker is gone).
-    #[error("evaluator failed: {0}")]
-    Transport(String),
+    #[error("evaluator failed")]
+    Transport(#[source] Box<dyn std::error::Error + Send + Sync>),
+    /// A signal (SIGINT, SIGTERM) asked the process to stop.
+    #[error("interrupted by a signal")]
+    Interrupted,
+}
+
+impl EvalError {
+    /// A transport failure with its cause.
+    pub fn transport(e: impl Into<Box<dyn std::error::Error + Send + Sync>>) -> Self {
+        EvalError::Transport(e.into())
+    }
 }
 
 /// Evaluates batches of candidates for one job.

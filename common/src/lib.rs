@@ -1,8 +1,9 @@
-//! sepval common library: the store-separation 6DOF model of `../shared/MODEL.md`, the 17
-//! factors and their binary encoding, telemetry files, goals, and the evaluation interface
-//! shared by the coordinator and the workers.
+//! sepval's model library: the store-separation 6DOF model specified in the repository's
+//! `docs/model.md`, the 17 factors and their binary encoding, telemetry files, goals, and the
+//! batch evaluation interface shared by the searches, the coordinator and the workers. It
+//! builds without any transport (those live in `sepval-transport`).
 //!
-//! Module map (mirrors MODEL.md):
+//! Module map (mirrors `docs/model.md`):
 //! - [`scenario`]: section 1, the scenario file and the embedded default;
 //! - [`frames`]: section 2, quaternions, direction cosines, Euler angles;
 //! - [`model`]: sections 2 and 3, forces, moments and equations of motion;
@@ -18,6 +19,7 @@
 
 pub mod atmosphere;
 pub mod atomic_file;
+pub mod cancel;
 pub mod effects;
 pub mod elementary;
 pub mod encoding;
@@ -25,18 +27,13 @@ pub mod evaluation;
 pub mod factors;
 pub mod frames;
 pub mod goals;
-pub mod ipc;
-pub mod messages;
 pub mod model;
 pub mod noise;
 pub mod propagator;
-#[cfg(feature = "zenoh")]
-pub mod remote;
 pub mod scenario;
 pub mod simulation;
 pub mod synthetic;
 pub mod telemetry;
-pub mod uds;
 pub mod units;
 
 pub use effects::EffectSet;

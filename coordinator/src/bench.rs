@@ -14,14 +14,91 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
 use rand::RngExt;
-use sepval_common::atomic_file::write_atomically;
-use sepval_common::evaluation::{Candidate, Evaluator, InProcess, Job};
+use sepval_common::atomic_file::{WriteError, write_atomically};
+use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
 use sepval_common::factors::Factors;
+use sepval_transport::dispatch::DispatchOptions;
+use sepval_transport::ipc::{IpcOptions, Launch};
+use sepval_transport::link::quiet;
+use sepval_transport::spec::EvaluatorSpec;
+use sepval_transport::{RunId, TransportError};
 
-use crate::ipc::{IpcEvaluator, IpcOptions, Launch};
-use crate::uds::UdsEvaluator;
+use crate::figures::FigureError;
+
+/// A transport `sepval bench` can measure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Transport {
+    /// One thread of this process.
+    Single,
+    /// A thread pool in this process.
+    Pool,
+    /// iceoryx2 worker processes.
+    Ipc,
+    /// Unix-socket worker processes.
+    Uds,
+    /// zenoh worker processes over loopback TCP (feature `zenoh`).
+    Zenoh,
+}
+
+impl Transport {
+    /// Its name in tables and files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Transport::Single => "single",
+            Transport::Pool => "pool",
+            Transport::Ipc => "ipc",
+            Transport::Uds => "uds",
+            Transport::Zenoh => "zenoh",
+        }
+    }
+}
+
+/// Errors of a benchmark.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BenchError {
+    /// A setting out of range.
+    #[error("{0}")]
+    Setting(String),
+    /// A transport that could not be started.
+    #[error("starting {transport} with {workers} worker(s)")]
+    Start {
+        /// The transport.
+        transport: &'static str,
+        /// Workers.
+        workers: usize,
+        /// Why.
+        #[source]
+        source: TransportError,
+    },
+    /// A measurement that failed.
+    #[error("benchmarking {transport} with {workers} worker(s)")]
+    Measure {
+        /// The transport.
+        transport: &'static str,
+        /// Workers.
+        workers: usize,
+        /// Why.
+        #[source]
+        source: EvalError,
+    },
+    /// An output that cannot be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    /// The figure.
+    #[error(transparent)]
+    Figure(#[from] FigureError),
+    /// The output directory.
+    #[error("cannot create {path}")]
+    Dir {
+        /// The directory.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+}
 
 /// One measurement.
 #[derive(Debug, Clone, PartialEq)]
@@ -53,7 +130,7 @@ pub struct BenchOptions {
     /// Evaluations per measurement.
     pub evals: usize,
     /// Transports to measure.
-    pub transports: Vec<String>,
+    pub transports: Vec<Transport>,
     /// The worker executable.
     pub worker_executable: std::path::PathBuf,
     /// Measurements per (transport, worker count), interleaved; the median is reported.
@@ -86,63 +163,71 @@ pub fn probes(job: &Job, n: usize) -> Vec<Candidate> {
     vec![Candidate::baseline(f); n]
 }
 
-fn time(evaluator: &mut dyn Evaluator, batch: &[Candidate]) -> Result<f64> {
+fn time(evaluator: &mut dyn Evaluator, batch: &[Candidate]) -> Result<f64, EvalError> {
     let t0 = Instant::now();
     let out = evaluator.evaluate(batch, false)?;
     let wall = t0.elapsed().as_secs_f64();
-    if out.len() != batch.len() {
-        bail!(
-            "{} returned {} of {} results",
-            evaluator.describe(),
-            out.len(),
-            batch.len()
-        );
-    }
+    assert_eq!(
+        out.len(),
+        batch.len(),
+        "an evaluator returns one result per candidate"
+    );
     Ok(wall)
+}
+
+fn dispatch(workers: usize) -> DispatchOptions {
+    DispatchOptions {
+        min_workers: workers,
+        join_timeout: Duration::from_secs(60),
+        chunk_deadline: Duration::from_secs(120),
+    }
 }
 
 fn start(
     job: &Arc<Job>,
-    transport: &str,
+    transport: Transport,
     workers: usize,
     options: &BenchOptions,
-) -> Result<Box<dyn Evaluator>> {
-    Ok(match transport {
-        "single" => Box::new(InProcess::new(Arc::clone(job), 1)),
-        "pool" => Box::new(InProcess::new(Arc::clone(job), workers)),
-        "ipc" => Box::new(IpcEvaluator::start(
-            Arc::clone(job),
-            IpcOptions {
-                run_id: sepval_common::ipc::new_run_id(),
+) -> Result<Box<dyn Evaluator>, TransportError> {
+    let spec = match transport {
+        Transport::Single => EvaluatorSpec::InProcess { threads: 1 },
+        Transport::Pool => EvaluatorSpec::InProcess { threads: workers },
+        Transport::Ipc => EvaluatorSpec::Ipc {
+            link: IpcOptions {
+                run_id: RunId::fresh(),
                 workers,
                 launch: Launch::Spawn {
                     executable: options.worker_executable.clone(),
                 },
-                chunk_deadline: Duration::from_secs(120),
-                join_timeout: Duration::from_secs(60),
                 max_respawns: 0,
+                join_timeout: Duration::from_secs(60),
                 announce_protocol: None,
             },
-        )?),
-        "uds" => Box::new(UdsEvaluator::start(
-            Arc::clone(job),
+            dispatch: dispatch(workers),
+        },
+        Transport::Uds => EvaluatorSpec::Uds {
             workers,
-            &options.worker_executable,
-            Duration::from_secs(120),
-        )?),
+            executable: options.worker_executable.clone(),
+            dispatch: dispatch(workers),
+        },
         #[cfg(feature = "zenoh")]
-        "zenoh" => Box::new(LoopbackZenoh::start(
-            Arc::clone(job),
-            workers,
-            &options.worker_executable,
-        )?),
+        Transport::Zenoh => {
+            return Ok(Box::new(LoopbackZenoh::start(
+                Arc::clone(job),
+                workers,
+                &options.worker_executable,
+            )?));
+        }
         #[cfg(not(feature = "zenoh"))]
-        "zenoh" => bail!(
-            "transport zenoh: this sepval was built without the zenoh feature \
-             (cargo build --release --features zenoh)"
-        ),
-        other => bail!("transport {other}: expected single, pool, ipc, uds or zenoh"),
-    })
+        Transport::Zenoh => {
+            return Err(TransportError::NotBuilt(
+                "transport zenoh: this sepval was built without the zenoh feature \
+                 (cargo build --release --features zenoh)"
+                    .into(),
+            ));
+        }
+    };
+    spec.start(Arc::clone(job), quiet())
 }
 
 fn median(v: &[f64]) -> f64 {
@@ -164,40 +249,52 @@ pub fn run_bench(
     job: Arc<Job>,
     options: &BenchOptions,
     progress: &mut dyn FnMut(&BenchRow),
-) -> Result<Vec<BenchRow>> {
+) -> Result<Vec<BenchRow>, BenchError> {
     if options.evals == 0 {
-        bail!("--evals 0: expected at least 1");
+        return Err(BenchError::Setting(
+            "evaluations 0: expected at least 1".into(),
+        ));
     }
     if options.repeat == 0 {
-        bail!("--repeat 0: expected at least 1");
+        return Err(BenchError::Setting("repeat 0: expected at least 1".into()));
     }
     let batch = candidates(&job, options.evals);
     let warm = candidates(&job, 8.min(options.evals));
     let probe = probes(&job, options.evals);
-    let cells: Vec<(String, usize)> = options
+    let cells: Vec<(Transport, usize)> = options
         .transports
         .iter()
-        .flat_map(|t| {
-            let counts = if t == "single" {
+        .flat_map(|&t| {
+            let counts = if t == Transport::Single {
                 vec![1]
             } else {
                 options.workers.clone()
             };
-            counts.into_iter().map(move |w| (t.clone(), w))
+            counts.into_iter().map(move |w| (t, w))
         })
         .collect();
     let mut walls: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); cells.len()];
     let mut rows = Vec::new();
     for round in 0..options.repeat {
         for ((t, w), (wall, probe_wall)) in cells.iter().zip(walls.iter_mut()) {
-            let mut evaluator = start(&job, t, *w, options)?;
-            let what = || format!("benchmarking {t} with {w} worker(s)");
-            evaluator.evaluate(&warm, false).with_context(what)?;
-            wall.push(time(evaluator.as_mut(), &batch).with_context(what)?);
-            probe_wall.push(time(evaluator.as_mut(), &probe).with_context(what)?);
+            let (transport, workers) = (t.name(), *w);
+            let mut evaluator =
+                start(&job, *t, workers, options).map_err(|source| BenchError::Start {
+                    transport,
+                    workers,
+                    source,
+                })?;
+            let measure = |source| BenchError::Measure {
+                transport,
+                workers,
+                source,
+            };
+            evaluator.evaluate(&warm, false).map_err(measure)?;
+            wall.push(time(evaluator.as_mut(), &batch).map_err(measure)?);
+            probe_wall.push(time(evaluator.as_mut(), &probe).map_err(measure)?);
             if round + 1 == options.repeat {
                 let row = BenchRow {
-                    transport: t.clone(),
+                    transport: transport.to_string(),
                     workers: *w,
                     evals: options.evals,
                     wall_s: median(wall),
@@ -269,8 +366,11 @@ pub fn table(rows: &[BenchRow]) -> String {
 }
 
 /// Writes DIR/bench.csv and DIR/bench.png.
-pub fn write_outputs(dir: &Path, rows: &[BenchRow]) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+pub fn write_outputs(dir: &Path, rows: &[BenchRow]) -> Result<(), BenchError> {
+    std::fs::create_dir_all(dir).map_err(|source| BenchError::Dir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let mut csv = String::from("transport,workers,evals,wall_s,evals_per_s\n");
     for r in rows {
         csv.push_str(&format!(
@@ -313,19 +413,19 @@ pub fn write_outputs(dir: &Path, rows: &[BenchRow]) -> Result<()> {
 /// `sepval-worker --connect` processes (killed when dropped).
 #[cfg(feature = "zenoh")]
 struct LoopbackZenoh {
-    evaluator: Option<crate::remote::RemoteEvaluator>,
+    evaluator: Option<Box<dyn Evaluator>>,
     children: Vec<std::process::Child>,
 }
 
 #[cfg(feature = "zenoh")]
 impl LoopbackZenoh {
-    fn start(job: Arc<Job>, workers: usize, executable: &Path) -> Result<Self> {
+    fn start(job: Arc<Job>, workers: usize, executable: &Path) -> Result<Self, TransportError> {
         let port = std::net::TcpListener::bind("127.0.0.1:0")
             .and_then(|l| l.local_addr())
-            .context("finding a free loopback port")?
+            .map_err(sepval_transport::io("finding a free loopback port"))?
             .port();
         let endpoint = format!("tcp/127.0.0.1:{port}");
-        let run_id = sepval_common::ipc::new_run_id();
+        let run_id = RunId::fresh();
         let mut me = LoopbackZenoh {
             evaluator: None,
             children: Vec::new(),
@@ -333,25 +433,28 @@ impl LoopbackZenoh {
         for _ in 0..workers {
             me.children.push(
                 std::process::Command::new(executable)
-                    .args(["--connect", &endpoint, "--run", &run_id])
+                    .args(["--connect", &endpoint, "--run", run_id.as_str()])
                     .stdin(std::process::Stdio::null())
                     .stderr(std::process::Stdio::null())
                     .spawn()
-                    .with_context(|| format!("cannot start {}", executable.display()))?,
+                    .map_err(sepval_transport::io(format!(
+                        "cannot start {}",
+                        executable.display()
+                    )))?,
             );
         }
-        me.evaluator = Some(crate::remote::RemoteEvaluator::start(
-            job,
-            crate::remote::RemoteOptions {
+        let spec = EvaluatorSpec::Zenoh {
+            link: sepval_transport::zenoh::ZenohOptions {
                 run_id,
                 listen: endpoint,
-                min_workers: workers,
+                workers,
                 join_timeout: Duration::from_secs(60),
-                chunk_deadline: Duration::from_secs(120),
                 zenoh_config: None,
                 announce_protocol: None,
             },
-        )?);
+            dispatch: dispatch(workers),
+        };
+        me.evaluator = Some(spec.start(job, quiet())?);
         Ok(me)
     }
 }
@@ -362,8 +465,7 @@ impl Evaluator for LoopbackZenoh {
         &mut self,
         batch: &[Candidate],
         with_samples: bool,
-    ) -> Result<Vec<sepval_common::evaluation::Evaluation>, sepval_common::evaluation::EvalError>
-    {
+    ) -> Result<Vec<sepval_common::evaluation::Evaluation>, EvalError> {
         self.evaluator
             .as_mut()
             .expect("started")

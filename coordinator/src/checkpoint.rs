@@ -5,13 +5,64 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
-use sepval_common::atomic_file::write_atomically;
+use sepval_common::atomic_file::{WriteError, write_atomically};
 use sepval_common::evaluation::Job;
 use serde::{Deserialize, Serialize};
 
 use crate::search::ga::{GaSettings, GaState};
 use crate::search::hill::HillSettings;
+use crate::sigma::Sigma;
+
+/// Errors reading, writing or using a checkpoint.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CheckpointError {
+    /// The file cannot be read.
+    #[error("cannot read checkpoint {path}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not a checkpoint.
+    #[error("checkpoint {path} is not a sepval checkpoint")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: serde_json::Error,
+    },
+    /// The file does not fit this sepval or its job.
+    #[error("checkpoint {path}: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A job other than the checkpoint's.
+    #[error(
+        "checkpoint {path} was made with {what} (sha256 {saved}, given {given}): give the same {inputs}"
+    )]
+    OtherJob {
+        /// The file.
+        path: PathBuf,
+        /// "other data", "another scenario".
+        what: &'static str,
+        /// The checkpoint's hash (shortened).
+        saved: String,
+        /// The given job's hash (shortened).
+        given: String,
+        /// What to give.
+        inputs: &'static str,
+    },
+    /// The checkpoint cannot be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+}
 
 /// Format tag of checkpoint files.
 pub const CHECKPOINT_FORMAT: &str = "sepval-ga-checkpoint/1";
@@ -37,7 +88,7 @@ pub struct Checkpoint {
     /// Hill-climber settings (for `both`).
     pub hill: HillSettings,
     /// Noise levels used to weight the goals.
-    pub sigma: crate::fit::Sigma,
+    pub sigma: Sigma,
     /// SHA-256 of the measured data.
     pub data_sha256: String,
     /// SHA-256 of the scenario(s).
@@ -59,56 +110,68 @@ impl Checkpoint {
     }
 
     /// Writes the checkpoint atomically.
-    pub fn save(&self, path: &Path) -> Result<()> {
-        let json = serde_json::to_vec(self).context("serialising a checkpoint")?;
+    pub fn save(&self, path: &Path) -> Result<(), CheckpointError> {
+        let json = serde_json::to_vec(self).expect("a checkpoint serialises");
         write_atomically(path, &json)?;
         Ok(())
     }
 
     /// Reads and checks a checkpoint file.
-    pub fn load(path: &Path) -> Result<Checkpoint> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
-        let c: Checkpoint = serde_json::from_str(&text)
-            .with_context(|| format!("checkpoint {} is not a sepval checkpoint", path.display()))?;
+    pub fn load(path: &Path) -> Result<Checkpoint, CheckpointError> {
+        let text = std::fs::read_to_string(path).map_err(|source| CheckpointError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let c: Checkpoint =
+            serde_json::from_str(&text).map_err(|source| CheckpointError::Parse {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        let invalid = |message: String| CheckpointError::Invalid {
+            path: path.to_path_buf(),
+            message,
+        };
         if c.format != CHECKPOINT_FORMAT {
-            bail!(
-                "checkpoint {}: format `{}`, this sepval reads `{CHECKPOINT_FORMAT}`",
-                path.display(),
+            return Err(invalid(format!(
+                "format `{}`, this sepval reads `{CHECKPOINT_FORMAT}`",
                 c.format
-            );
+            )));
         }
-        c.settings
-            .validate()
-            .with_context(|| format!("checkpoint {}", path.display()))?;
+        c.settings.validate().map_err(|e| invalid(e.to_string()))?;
         if c.state.population.len() != c.settings.population {
-            bail!(
-                "checkpoint {}: population of {} members, settings say {}",
-                path.display(),
+            return Err(invalid(format!(
+                "population of {} members, settings say {}",
                 c.state.population.len(),
                 c.settings.population
-            );
+            )));
         }
         Ok(c)
     }
 
     /// Refuses a job whose data or scenario differ from the checkpoint's.
-    pub fn check_job(&self, job: &Job, path: &Path) -> Result<()> {
+    pub fn check_job(&self, job: &Job, path: &Path) -> Result<(), CheckpointError> {
+        let other = |what, saved: &str, given: &str, inputs| CheckpointError::OtherJob {
+            path: path.to_path_buf(),
+            what,
+            saved: short(saved).to_string(),
+            given: short(given).to_string(),
+            inputs,
+        };
         if job.data_sha256() != self.data_sha256 {
-            bail!(
-                "checkpoint {} was made with other data (sha256 {}, given {}): give the same --data files",
-                path.display(),
-                short(&self.data_sha256),
-                short(job.data_sha256())
-            );
+            return Err(other(
+                "other data",
+                &self.data_sha256,
+                job.data_sha256(),
+                "data files",
+            ));
         }
         if job.scenario_sha256() != self.scenario_sha256 {
-            bail!(
-                "checkpoint {} was made with another scenario (sha256 {}, given {}): give the same --scenario",
-                path.display(),
-                short(&self.scenario_sha256),
-                short(job.scenario_sha256())
-            );
+            return Err(other(
+                "another scenario",
+                &self.scenario_sha256,
+                job.scenario_sha256(),
+                "scenario",
+            ));
         }
         Ok(())
     }

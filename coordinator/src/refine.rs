@@ -12,13 +12,20 @@
 //! Each step carries Transtrum and Sethna's geodesic acceleration (one probe per step), which
 //! follows the narrow curved valleys of strongly compensating parameters.
 
-use anyhow::{Context, Result, bail};
 use nalgebra::{DMatrix, DVector};
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Candidate, Evaluation, Evaluator, Job};
 use sepval_common::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
 use sepval_common::goals::{Goals, residual};
 use sepval_common::propagator::Observation;
+
+use crate::run::{Ask, Evaluate, Progress, RunError, Solver, run};
+
+type Result<T> = std::result::Result<T, RunError>;
+
+fn search_error(what: impl std::fmt::Display) -> RunError {
+    RunError::Search(what.to_string())
+}
 
 /// The continuous parameters of a fit: the 17 factors, then the effects' parameters.
 #[derive(Debug, Clone)]
@@ -96,7 +103,10 @@ impl ParamSpace {
         f.copy_from_slice(&x[..FACTOR_COUNT]);
         Ok(Candidate {
             factors: Factors(f),
-            effects: self.effects.with_values(&x[FACTOR_COUNT..])?,
+            effects: self
+                .effects
+                .with_values(&x[FACTOR_COUNT..])
+                .map_err(search_error)?,
         })
     }
 }
@@ -337,10 +347,9 @@ impl LmRun {
         self.evaluations += out.len() as u64;
         match std::mem::replace(&mut self.stage, Stage::Done) {
             Stage::Start => {
-                let s =
-                    out.into_iter().next().flatten().context(
-                        "the refinement's start does not simulate (diverged or invalid)",
-                    )?;
+                let s = out.into_iter().next().flatten().ok_or_else(|| {
+                    search_error("the refinement's start does not simulate (diverged or invalid)")
+                })?;
                 self.r = residual_vector(&self.job, &s, self.noise);
                 self.cost = self.r.iter().map(|v| v * v).sum();
                 self.samples = s;
@@ -352,11 +361,11 @@ impl LmRun {
                 let n = self.space.len();
                 let mut jac = DMatrix::zeros(self.r.len(), n);
                 for (i, s) in out.into_iter().enumerate() {
-                    let s = s.with_context(|| {
-                        format!(
+                    let s = s.ok_or_else(|| {
+                        search_error(format!(
                             "the derivative probe of {} did not simulate",
                             self.space.names[i]
-                        )
+                        ))
                     })?;
                     let ri = residual_vector(&self.job, &s, self.noise);
                     for (k, v) in ri.iter().enumerate() {
@@ -415,7 +424,7 @@ impl LmRun {
                     }
                 }
             }
-            Stage::Done => bail!("a finished refinement received samples"),
+            Stage::Done => return Err(search_error("a finished refinement received samples")),
         }
         Ok(())
     }
@@ -537,31 +546,72 @@ impl LmRun {
     }
 }
 
+impl Solver for LmRun {
+    type Point = Candidate;
+
+    fn ask(&mut self) -> Result<Option<Ask<Candidate>>> {
+        Ok(self.request()?.map(|points| Ask {
+            points,
+            with_samples: true,
+        }))
+    }
+
+    fn tell(&mut self, evaluations: Vec<Evaluation>) -> Result<Option<Progress>> {
+        let accepted = self.history.len();
+        self.absorb(evaluations.into_iter().map(|e| e.samples).collect())?;
+        Ok((self.history.len() > accepted).then(|| Progress {
+            step: self.iterations,
+            steps: Some(self.settings.max_iterations),
+            evaluations: self.evaluations,
+            best: goals_of(&self.r, self.noise).as_array(),
+        }))
+    }
+}
+
+/// Several refinements driven together: each ask joins the requests of every unfinished run
+/// into one batch, so that the workers stay busy.
+pub struct Together<'a> {
+    runs: &'a mut [LmRun],
+    owners: Vec<(usize, usize)>,
+}
+
+impl Solver for Together<'_> {
+    type Point = Candidate;
+
+    fn ask(&mut self) -> Result<Option<Ask<Candidate>>> {
+        let mut points = Vec::new();
+        self.owners.clear();
+        for (k, run) in self.runs.iter().enumerate() {
+            if let Some(c) = run.request()? {
+                self.owners.push((k, c.len()));
+                points.extend(c);
+            }
+        }
+        Ok((!points.is_empty()).then_some(Ask {
+            points,
+            with_samples: true,
+        }))
+    }
+
+    fn tell(&mut self, evaluations: Vec<Evaluation>) -> Result<Option<Progress>> {
+        let mut out = evaluations.into_iter();
+        for &(k, len) in &self.owners {
+            let part: Vec<Option<Vec<Vec<Observation>>>> =
+                out.by_ref().take(len).map(|e| e.samples).collect();
+            self.runs[k].absorb(part)?;
+        }
+        Ok(None)
+    }
+}
+
 /// Drives several refinements together: each round, the requests of all unfinished runs go to
 /// the evaluator as one batch.
 pub fn refine_together(evaluator: &mut dyn Evaluator, runs: &mut [LmRun]) -> Result<()> {
-    loop {
-        let mut batch: Vec<Candidate> = Vec::new();
-        let mut owners: Vec<(usize, usize)> = Vec::new();
-        for (k, run) in runs.iter().enumerate() {
-            if let Some(c) = run.request()? {
-                owners.push((k, c.len()));
-                batch.extend(c);
-            }
-        }
-        if batch.is_empty() {
-            return Ok(());
-        }
-        let mut out = evaluator.evaluate(&batch, true)?.into_iter();
-        for (k, len) in owners {
-            let part: Vec<Option<Vec<Vec<Observation>>>> = out
-                .by_ref()
-                .take(len)
-                .map(|e: Evaluation| e.samples)
-                .collect();
-            runs[k].absorb(part)?;
-        }
-    }
+    let mut together = Together {
+        runs,
+        owners: Vec::new(),
+    };
+    run(&mut together, &mut Evaluate(evaluator), &mut [])
 }
 
 /// Refines `x0` (projected onto the bounds).
@@ -573,8 +623,7 @@ pub fn levenberg_marquardt(
     settings: &LmSettings,
 ) -> Result<LmResult> {
     let job = std::sync::Arc::new(evaluator.job().clone());
-    let mut runs = [LmRun::new(space.clone(), job, x0, noise, settings.clone())];
-    refine_together(evaluator, &mut runs)?;
-    let [run] = runs;
-    Ok(run.finish())
+    let mut lm = LmRun::new(space.clone(), job, x0, noise, settings.clone());
+    run(&mut lm, &mut Evaluate(evaluator), &mut [])?;
+    Ok(lm.finish())
 }

@@ -3,10 +3,9 @@
 
 use std::path::Path;
 
-use anyhow::Result;
-use sepval_common::evaluation::{Candidate, Evaluator, Outcome};
+use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Outcome};
 
-use crate::checkpoint::Checkpoint;
+use crate::checkpoint::{Checkpoint, CheckpointError};
 use crate::problem::factors_of;
 
 /// A member whose re-evaluation differs from the checkpoint.
@@ -20,13 +19,25 @@ pub struct Mismatch {
     pub rerun: Outcome,
 }
 
+/// Errors of a rerun.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RerunError {
+    /// The checkpoint does not fit the job.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    /// The evaluator failed.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+}
+
 /// Re-evaluates the checkpoint's population with `evaluator` (whose job must be the
 /// checkpoint's: checked) and returns the members that do not match bit for bit.
 pub fn rerun(
     checkpoint: &Checkpoint,
     path: &Path,
     evaluator: &mut dyn Evaluator,
-) -> Result<Vec<Mismatch>> {
+) -> Result<Vec<Mismatch>, RerunError> {
     checkpoint.check_job(evaluator.job(), path)?;
     let batch: Vec<Candidate> = checkpoint
         .state

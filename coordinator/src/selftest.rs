@@ -13,11 +13,11 @@
 //! rates); the final population's non-dominated set is scored by its hypervolume with reference
 //! point (1.1, 1.1).
 
-use anyhow::{Result, bail};
-use sepval_common::evaluation::{EvalError, Outcome};
+use sepval_common::evaluation::{EvalError, Evaluation, Outcome};
 use sepval_common::factors::FactorSpec;
 
-use crate::search::ga::{GaSettings, GeneticAlgorithm, Member, ParetoProblem};
+use crate::run::{Problem, RunError, run};
+use crate::search::ga::{GaError, GaSearch, GaSettings, Member};
 use crate::search::pareto::{hypervolume, non_dominated_fronts};
 
 /// Reference point of the hypervolume.
@@ -34,17 +34,22 @@ pub enum Zdt {
     Zdt3,
 }
 
-impl Zdt {
-    /// Parses `zdt1`, `zdt2` or `zdt3`.
-    pub fn parse(text: &str) -> Result<Zdt> {
-        Ok(match text {
-            "zdt1" => Zdt::Zdt1,
-            "zdt2" => Zdt::Zdt2,
-            "zdt3" => Zdt::Zdt3,
-            other => bail!("--problem {other}: expected zdt1, zdt2 or zdt3"),
-        })
-    }
+/// Errors of a self-test.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SelftestError {
+    /// Bits per variable out of range.
+    #[error("{0} bits per variable: expected 1 to 52")]
+    Bits(u32),
+    /// Invalid GA settings.
+    #[error(transparent)]
+    Ga(#[from] GaError),
+    /// The search failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+}
 
+impl Zdt {
     /// The two objectives of `x`.
     pub fn objectives(self, x: &[f64]) -> [f64; 2] {
         let n = x.len();
@@ -84,21 +89,17 @@ impl ZdtProblem {
     }
 }
 
-impl ParetoProblem for ZdtProblem {
-    fn genes(&self) -> &[FactorSpec] {
-        &self.genes
-    }
-
-    fn evaluate(&mut self, batch: &[Vec<f64>]) -> Result<Vec<Outcome>, EvalError> {
+impl Problem<Vec<f64>> for ZdtProblem {
+    fn evaluate(&mut self, batch: &[Vec<f64>], _: bool) -> Result<Vec<Evaluation>, EvalError> {
         Ok(batch
             .iter()
             .map(|x| {
                 let [f1, f2] = self.problem.objectives(x);
                 // The pair travels as the typed "goals" outcome: first and second objective.
-                Outcome::Goals {
+                Evaluation::from(Outcome::Goals {
                     j_pos_m: f1,
                     j_att_deg: f2,
-                }
+                })
             })
             .collect())
     }
@@ -111,17 +112,19 @@ pub fn run_zdt(
     evaluations: usize,
     seed: u64,
     bits: u32,
-) -> Result<(f64, Vec<[f64; 2]>)> {
+) -> Result<(f64, Vec<[f64; 2]>), SelftestError> {
+    if !(1..=52).contains(&bits) {
+        return Err(SelftestError::Bits(bits));
+    }
     let settings = GaSettings {
         generations: (evaluations / 100).max(1),
         seed,
         ..GaSettings::default()
     };
-    let ga = GeneticAlgorithm::new(settings, [1.0, 1.0])?;
     let mut p = ZdtProblem::new(problem, 30, bits);
-    let state = ga.run(&mut p, None, &mut |_| {
-        Ok(crate::search::ga::Control::Continue)
-    })?;
+    let mut ga = GaSearch::new(settings, [1.0, 1.0], p.genes.clone())?;
+    run(&mut ga, &mut p, &mut [])?;
+    let state = ga.state().expect("a finished search has a state").clone();
     let points: Vec<[f64; 2]> = state.population.iter().map(Member::objectives).collect();
     let front: Vec<[f64; 2]> = non_dominated_fronts(&points)
         .first()

@@ -24,43 +24,69 @@
 //! `report` submodule.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
-use sepval_common::atomic_file::write_atomically;
+use sepval_common::atomic_file::{WriteError, write_atomically};
 use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS};
 use sepval_common::evaluation::{Evaluator, Job};
 use sepval_common::factors::FACTOR_COUNT;
 use serde::{Deserialize, Serialize};
 
-use crate::fit::{FitOptions, Method, run_fit};
+use crate::figures::FigureError;
+use crate::fit::{FitError, FitOptions, Method, run_fit};
 use crate::identifiability::identifiability;
 use crate::refine::{LmResult, LmRun, LmSettings, Noise, ParamSpace, refine_together};
 use crate::results::ChannelRms;
-use crate::stats::{autocorrelation, f_test, ljung_box};
+use crate::run::{ProgressObserver, RunError};
+use crate::stats::f_test;
+
+/// Errors of a diagnosis.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DiagnoseError {
+    /// The output directory cannot be created.
+    #[error("cannot create {path}")]
+    Dir {
+        /// The directory.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The baseline fit failed.
+    #[error("the baseline fit failed")]
+    Baseline(#[source] FitError),
+    /// A refinement failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A file that cannot be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    /// A figure that cannot be drawn.
+    #[error(transparent)]
+    Figure(#[from] FigureError),
+    /// A model extension that cannot be made.
+    #[error("{0}")]
+    Model(String),
+}
+
+type Result<T> = std::result::Result<T, DiagnoseError>;
 
 mod report;
+mod residuals;
+
+pub use residuals::{
+    CHANNELS, ChannelReport, LAGS, ResidualReport, SegmentRms, WHITENESS_P, physical_residuals,
+    residual_report,
+};
+use residuals::{residual_figures, rms_channels};
 
 /// Format tag of diagnosis files.
 pub const DIAGNOSIS_FORMAT: &str = "sepval-diagnosis/1";
 /// Family-wise significance level of the candidate tests.
 pub const ALPHA: f64 = 0.01;
-/// Per-channel Ljung-Box p-value below which residuals are not white.
-pub const WHITENESS_P: f64 = 0.001;
-/// Lags of the whiteness tests.
-pub const LAGS: usize = 20;
-/// Channel names and units.
-pub const CHANNELS: [(&str, &str); 6] = [
-    ("x", "m"),
-    ("y", "m"),
-    ("z", "m"),
-    ("roll", "deg"),
-    ("pitch", "deg"),
-    ("yaw", "deg"),
-];
-
 /// Settings of a diagnosis.
 pub struct DiagnoseOptions {
     /// The baseline fit (its method is forced to `ga+lm`; its output goes to DIR/baseline).
@@ -136,55 +162,6 @@ pub struct CandidateReport {
     pub refinement: String,
 }
 
-/// Residual time segment.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SegmentRms {
-    /// Segment name.
-    pub name: String,
-    /// Start \[s\] (first event).
-    pub t_start_s: f64,
-    /// End \[s\] (first event).
-    pub t_end_s: f64,
-    /// RMS residual in the segment, pooled over events (channel unit).
-    pub rms: f64,
-}
-
-/// Residual analysis of one channel.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ChannelReport {
-    /// Channel.
-    pub channel: String,
-    /// Unit.
-    pub unit: String,
-    /// RMS residual.
-    pub rms: f64,
-    /// Noise sigma.
-    pub sigma: f64,
-    /// RMS / sigma.
-    pub rms_over_sigma: f64,
-    /// RMS per time segment.
-    pub segments: Vec<SegmentRms>,
-    /// Fraction of autocorrelations at lags 1..20 outside the 95 % band +-1.96/sqrt(N).
-    pub autocorr_outside_band: f64,
-    /// Ljung-Box statistic (summed over events).
-    pub ljung_box_q: f64,
-    /// Its p-value.
-    pub ljung_box_p: f64,
-    /// Whether the residuals are white (p >= 0.001).
-    pub white: bool,
-}
-
-/// Residual analysis of one model.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ResidualReport {
-    /// Per channel.
-    pub channels: Vec<ChannelReport>,
-    /// Whether every channel is white.
-    pub white: bool,
-    /// Whether both goals are within 1.1 sigma.
-    pub at_noise_floor: bool,
-}
-
 /// DIR/diagnosis.json.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
@@ -232,35 +209,6 @@ fn noise_of(options: &FitOptions) -> Noise {
     }
 }
 
-/// Residuals in physical units per event, per sample: (x, y, z \[m\], roll, pitch, yaw \[deg\]).
-fn physical_residuals(r: &[f64], noise: Noise, events: &[usize]) -> Vec<Vec<[f64; 6]>> {
-    let mut out = Vec::new();
-    let mut pos = 0;
-    for &n in events {
-        out.push(
-            (0..n)
-                .map(|i| {
-                    let s = &r[pos + 6 * i..pos + 6 * i + 6];
-                    [
-                        s[0] * noise.pos_m,
-                        s[1] * noise.pos_m,
-                        s[2] * noise.pos_m,
-                        s[3] * noise.att_deg,
-                        s[4] * noise.att_deg,
-                        s[5] * noise.att_deg,
-                    ]
-                })
-                .collect(),
-        );
-        pos += 6 * n;
-    }
-    out
-}
-
-fn rms_channels(res: &[Vec<[f64; 6]>]) -> ChannelRms {
-    crate::results::channel_rms(res)
-}
-
 fn summary(fitted: &Fitted, noise: Noise, events: &[usize]) -> ModelSummary {
     ModelSummary {
         effects: fitted
@@ -273,117 +221,6 @@ fn summary(fitted: &Fitted, noise: Noise, events: &[usize]) -> ModelSummary {
         j_att_deg: fitted.lm.goals.j_att_deg,
         chi2: fitted.lm.cost,
         channel_rms: rms_channels(&physical_residuals(&fitted.lm.residuals, noise, events)),
-    }
-}
-
-/// Time segments of the first event: ejector stroke, interference zone (until the decay factor
-/// falls below 0.1), free flight.
-fn segments(job: &Job, lm: &LmResult) -> Vec<(String, f64, f64)> {
-    let e = &job.events()[0];
-    let times = &e.data.times_s;
-    let t_end = *times.last().unwrap_or(&0.0);
-    let scenario = e.simulator.scenario();
-    let decay = sepval_common::model::InterferenceDecay::new(
-        scenario.interference.lambda_m,
-        scenario.interference.s_end_m,
-    );
-    // Stroke end: the later foot of the baseline fit's own run.
-    let factors = sepval_common::factors::Factors(std::array::from_fn(|i| lm.x[i]));
-    let stroke = e
-        .simulator
-        .simulate_logged(&factors, &EffectSet::NONE, &[times[0].max(0.0)])
-        .ok()
-        .and_then(|(_, log)| {
-            log.foot_off_s
-                .iter()
-                .flatten()
-                .cloned()
-                .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t))))
-        })
-        .unwrap_or(0.06);
-    let zone_end = lm.samples[0]
-        .iter()
-        .zip(times)
-        .find(|(o, t)| {
-            **t > stroke
-                && decay
-                    .factor((o.pos_m[0].powi(2) + o.pos_m[1].powi(2) + o.pos_m[2].powi(2)).sqrt())
-                    < 0.1
-        })
-        .map_or(t_end, |(_, t)| *t);
-    vec![
-        ("ejector stroke".into(), times[0], stroke.min(t_end)),
-        ("interference zone".into(), stroke.min(t_end), zone_end),
-        ("free flight".into(), zone_end, t_end),
-    ]
-}
-
-fn residual_report(job: &Job, lm: &LmResult, noise: Noise, floor: [f64; 2]) -> ResidualReport {
-    let events: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
-    let res = physical_residuals(&lm.residuals, noise, &events);
-    let segs = segments(job, lm);
-    let mut channels = Vec::new();
-    for (c, (name, unit)) in CHANNELS.iter().enumerate() {
-        let sigma = if c < 3 { noise.pos_m } else { noise.att_deg };
-        let all: Vec<f64> = res.iter().flatten().map(|s| s[c]).collect();
-        let rms = (all.iter().map(|v| v * v).sum::<f64>() / all.len().max(1) as f64).sqrt();
-        let segments = segs
-            .iter()
-            .map(|(n, t0, t1)| {
-                let mut acc = (0.0, 0usize);
-                for (ev, r) in job.events().iter().zip(&res) {
-                    for (t, s) in ev.data.times_s.iter().zip(r) {
-                        if *t >= *t0
-                            && (*t < *t1 || (*t1 >= *ev.data.times_s.last().unwrap() && *t <= *t1))
-                        {
-                            acc.0 += s[c] * s[c];
-                            acc.1 += 1;
-                        }
-                    }
-                }
-                SegmentRms {
-                    name: n.clone(),
-                    t_start_s: *t0,
-                    t_end_s: *t1,
-                    rms: if acc.1 > 0 {
-                        (acc.0 / acc.1 as f64).sqrt()
-                    } else {
-                        0.0
-                    },
-                }
-            })
-            .collect();
-        let (mut q, mut dof, mut outside, mut lags) = (0.0, 0usize, 0usize, 0usize);
-        for r in &res {
-            let x: Vec<f64> = r.iter().map(|s| s[c]).collect();
-            let h = LAGS.min(x.len().saturating_sub(2)).max(1);
-            let (qk, _) = ljung_box(&x, h);
-            q += qk;
-            dof += h;
-            let band = 1.96 / (x.len() as f64).sqrt();
-            let rho = autocorrelation(&x, h);
-            outside += rho.iter().filter(|r| r.abs() > band).count();
-            lags += h;
-        }
-        let p = crate::stats::chi2_sf(q, dof as f64);
-        channels.push(ChannelReport {
-            channel: name.to_string(),
-            unit: unit.to_string(),
-            rms,
-            sigma,
-            rms_over_sigma: rms / sigma,
-            segments,
-            autocorr_outside_band: outside as f64 / lags.max(1) as f64,
-            ljung_box_q: q,
-            ljung_box_p: p,
-            white: p >= WHITENESS_P,
-        });
-    }
-    let white = channels.iter().all(|c| c.white);
-    ResidualReport {
-        channels,
-        white,
-        at_noise_floor: lm.goals.j_pos_m <= floor[0] && lm.goals.j_att_deg <= floor[1],
     }
 }
 
@@ -438,7 +275,8 @@ fn try_extensions(
             .iter()
             .map(|p| p.neutral)
             .collect();
-        set.push(index, &neutral)?;
+        set.push(index, &neutral)
+            .map_err(|e| DiagnoseError::Model(e.to_string()))?;
         let space = ParamSpace::new(&table, &set);
         let mut x0 = base.lm.x.clone();
         x0.extend(neutral);
@@ -492,10 +330,16 @@ fn param_values(
 }
 
 /// Runs the diagnosis and writes DIR/diagnosis.json, DIR/report.html and the figures.
-pub fn diagnose(options: &DiagnoseOptions, evaluator: &mut dyn Evaluator) -> Result<Diagnosis> {
+pub fn diagnose(
+    options: &DiagnoseOptions,
+    evaluator: &mut dyn Evaluator,
+    progress: &mut dyn ProgressObserver,
+) -> Result<Diagnosis> {
     let t0 = Instant::now();
-    std::fs::create_dir_all(options.out.join("figures"))
-        .with_context(|| format!("cannot create {}", options.out.display()))?;
+    std::fs::create_dir_all(options.out.join("figures")).map_err(|source| DiagnoseError::Dir {
+        path: options.out.join("figures"),
+        source,
+    })?;
     let noise = noise_of(&options.fit);
     let floor = [1.1 * noise.pos_m, 1.1 * noise.att_deg];
     let job = Arc::new(evaluator.job().clone());
@@ -509,10 +353,13 @@ pub fn diagnose(options: &DiagnoseOptions, evaluator: &mut dyn Evaluator) -> Res
         resume: None,
         ..options.fit.clone()
     };
-    let baseline_out = run_fit(&fit, evaluator).context("the baseline fit failed")?;
-    let baseline_lm = baseline_out
-        .refined
-        .context("the baseline fit produced no refined optimum")?;
+    let baseline_out = run_fit(&fit, evaluator, progress).map_err(|e| match e {
+        FitError::Run(RunError::Interrupted) => DiagnoseError::Run(RunError::Interrupted),
+        other => DiagnoseError::Baseline(other),
+    })?;
+    let baseline_lm = baseline_out.refined.ok_or_else(|| {
+        DiagnoseError::Model("the baseline fit produced no refined optimum".into())
+    })?;
     let mut evaluations: u64 = baseline_out
         .result
         .methods
@@ -690,7 +537,7 @@ pub fn diagnose(options: &DiagnoseOptions, evaluator: &mut dyn Evaluator) -> Res
         noise,
         &events,
     )?;
-    let json = serde_json::to_vec_pretty(&diagnosis).context("serialising the diagnosis")?;
+    let json = serde_json::to_vec_pretty(&diagnosis).expect("a diagnosis serialises");
     write_atomically(&options.out.join("diagnosis.json"), &json)?;
     write_atomically(
         &options.out.join("report.html"),
@@ -774,29 +621,4 @@ fn verdict(
             named.join(" with ")
         )
     }
-}
-
-fn residual_figures(
-    dir: &Path,
-    job: &Job,
-    base: &LmResult,
-    ext: &LmResult,
-    noise: Noise,
-    events: &[usize],
-) -> Result<Vec<String>> {
-    let b = physical_residuals(&base.residuals, noise, events);
-    let e = physical_residuals(&ext.residuals, noise, events);
-    let mut names = Vec::new();
-    for (k, event) in job.events().iter().enumerate() {
-        let name = format!("figures/residuals_event{}.png", k + 1);
-        crate::figures::residual_figure(
-            &dir.join(&name),
-            &event.data.times_s,
-            &[("baseline", &b[k]), ("extended", &e[k])],
-            (noise.pos_m, noise.att_deg),
-            &format!("Residuals (simulated - measured), {}", event.name),
-        )?;
-        names.push(name);
-    }
-    Ok(names)
 }

@@ -9,28 +9,20 @@
 //!
 //! The state after each generation ([`GaState`]) holds everything the next generation needs,
 //! the generator included, so a search resumed from it continues exactly as the uninterrupted
-//! one.
+//! one. [`GaSearch`] is the algorithm as a [`Solver`]: it asks for a population (the initial
+//! one, then each generation's children) and is told their outcomes.
 
 use sepval_common::encoding::Chromosome;
-use sepval_common::evaluation::{EvalError, Outcome};
+use sepval_common::evaluation::{EvalError, Evaluation, Outcome};
 use sepval_common::factors::FactorSpec;
 use serde::{Deserialize, Serialize};
 
 use crate::rng::{RngState, RngStateError, SearchRng, seeded};
+use crate::run::{Ask, Progress, RunError, Solver};
 use crate::search::operators::{
     creep_mutation, crossover, jump_mutation, random_chromosome, tournament,
 };
 use crate::search::pareto::{dominates, non_dominated_fronts, rank_and_crowding, select_best};
-
-/// A problem the genetic algorithm can search: a gene layout and a batch evaluation of decoded
-/// values into two minimised objectives (as [`Outcome`]s: a run that does not finish is
-/// dominated by every finished one).
-pub trait ParetoProblem {
-    /// Bounds and bits of each gene.
-    fn genes(&self) -> &[FactorSpec];
-    /// Evaluates decoded parameter vectors, one outcome per vector, in order.
-    fn evaluate(&mut self, batch: &[Vec<f64>]) -> Result<Vec<Outcome>, EvalError>;
-}
 
 /// Settings of the genetic algorithm; the defaults are the study's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -191,27 +183,60 @@ fn weighted(m: &Member, w: [f64; 2]) -> f64 {
     w[0] * o[0] + w[1] * o[1]
 }
 
-/// What an observer wants after a generation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Control {
-    /// Go on.
-    Continue,
-    /// Stop the search now (the state is complete and valid).
-    Stop,
+/// A population drawn and not yet evaluated.
+struct Pending {
+    chromosomes: Vec<Chromosome>,
+    values: Vec<Vec<f64>>,
+    /// The generator after drawing them.
+    rng: RngState,
 }
 
-/// The genetic algorithm with its settings.
-pub struct GeneticAlgorithm {
+/// The genetic algorithm as ask-and-tell: the initial population, then one generation's
+/// children per ask, until the settings' count of generations.
+pub struct GaSearch {
     settings: GaSettings,
     weights: [f64; 2],
+    genes: Vec<FactorSpec>,
+    state: Option<GaState>,
+    pending: Option<Pending>,
 }
 
-impl GeneticAlgorithm {
-    /// A genetic algorithm; `weights` scalarise the objectives for reporting the best member
-    /// (the search itself is Pareto-based and does not use them).
-    pub fn new(settings: GaSettings, weights: [f64; 2]) -> Result<Self, GaError> {
+impl GaSearch {
+    /// A new search over `genes`; `weights` scalarise the objectives for reporting the best
+    /// member (the search itself is Pareto-based and does not use them).
+    pub fn new(
+        settings: GaSettings,
+        weights: [f64; 2],
+        genes: Vec<FactorSpec>,
+    ) -> Result<Self, GaError> {
         settings.validate()?;
-        Ok(GeneticAlgorithm { settings, weights })
+        Ok(GaSearch {
+            settings,
+            weights,
+            genes,
+            state: None,
+            pending: None,
+        })
+    }
+
+    /// A search continuing from `state` (a checkpoint's).
+    pub fn resume(
+        settings: GaSettings,
+        weights: [f64; 2],
+        genes: Vec<FactorSpec>,
+        state: GaState,
+    ) -> Result<Self, GaError> {
+        let mut s = GaSearch::new(settings, weights, genes)?;
+        if state.population.len() != s.settings.population {
+            return Err(GaError::State(format!(
+                "population of {} members, settings say {}",
+                state.population.len(),
+                s.settings.population
+            )));
+        }
+        state.rng.restore()?;
+        s.state = Some(state);
+        Ok(s)
     }
 
     /// The settings.
@@ -219,105 +244,64 @@ impl GeneticAlgorithm {
         &self.settings
     }
 
-    /// Draws and evaluates the initial population (generation 1).
-    pub fn initialize(&self, problem: &mut dyn ParetoProblem) -> Result<GaState, GaError> {
-        let mut rng = seeded(self.settings.seed);
-        let len: usize = problem.genes().iter().map(|g| g.bits as usize).sum();
-        let chromosomes: Vec<Chromosome> = (0..self.settings.population)
-            .map(|_| random_chromosome(&mut rng, len))
-            .collect();
-        let population = evaluate(problem, chromosomes)?;
-        let mut state = GaState {
-            generation: 1,
-            evaluations: population.len() as u64,
-            archive: Vec::new(),
-            population,
-            rng: RngState::of(&rng),
-            history: Vec::new(),
-        };
-        state.archive = update_archive(&[], &state.population);
-        state.history.push(self.stats(&state));
-        Ok(state)
+    /// The state after the last completed generation.
+    pub fn state(&self) -> Option<&GaState> {
+        self.state.as_ref()
     }
 
-    /// Breeds, evaluates and selects one generation.
-    pub fn step(
-        &self,
-        problem: &mut dyn ParetoProblem,
-        state: &GaState,
-    ) -> Result<GaState, GaError> {
+    /// Whether the settings' generations are done.
+    pub fn finished(&self) -> bool {
+        self.state
+            .as_ref()
+            .is_some_and(|s| s.generation >= self.settings.generations)
+    }
+
+    /// Draws the next population: the initial one, or the children of the current state.
+    fn draw(&self) -> Result<Pending, GaError> {
         let s = &self.settings;
-        if state.population.len() != s.population {
-            return Err(GaError::State(format!(
-                "population of {} members, settings say {}",
-                state.population.len(),
-                s.population
-            )));
-        }
-        let mut rng: SearchRng = state.rng.restore()?;
-        let genes = problem.genes().to_vec();
-        let objectives: Vec<[f64; 2]> = state.population.iter().map(Member::objectives).collect();
-        let (rank, crowd) = rank_and_crowding(&objectives);
-        let mut children = Vec::with_capacity(s.population);
-        while children.len() < s.population {
-            let a = tournament(&mut rng, &rank, &crowd);
-            let b = tournament(&mut rng, &rank, &crowd);
-            let (mut c, mut d, _) = crossover(
-                &mut rng,
-                &state.population[a].chromosome,
-                &state.population[b].chromosome,
-                s.p_crossover,
-            );
-            for child in [&mut c, &mut d] {
-                jump_mutation(&mut rng, child, s.p_jump);
-                creep_mutation(&mut rng, child, &genes, s.p_creep);
-            }
-            children.push(c);
-            children.push(d);
-        }
-        let children = evaluate(problem, children)?;
-        let mut pool: Vec<Member> = state.population.clone();
-        pool.extend(children.iter().cloned());
-        let pool_objectives: Vec<[f64; 2]> = pool.iter().map(Member::objectives).collect();
-        let chosen = select_best(&pool_objectives, s.population);
-        let population: Vec<Member> = chosen.iter().map(|&i| pool[i].clone()).collect();
-        let mut next = GaState {
-            generation: state.generation + 1,
-            evaluations: state.evaluations + children.len() as u64,
-            archive: update_archive(&state.archive, &children),
-            population,
-            rng: RngState::of(&rng),
-            history: state.history.clone(),
-        };
-        next.history.push(self.stats(&next));
-        Ok(next)
-    }
-
-    /// Runs generations from `state` until the settings' count or until `observer` stops it;
-    /// the observer sees every state, the initial one included when `state` is `None`.
-    pub fn run(
-        &self,
-        problem: &mut dyn ParetoProblem,
-        state: Option<GaState>,
-        observer: &mut dyn FnMut(&GaState) -> Result<Control, anyhow::Error>,
-    ) -> Result<GaState, anyhow::Error> {
-        let mut state = match state {
-            Some(s) => s,
+        let (chromosomes, rng) = match &self.state {
             None => {
-                let s = self.initialize(problem)?;
-                if observer(&s)? == Control::Stop {
-                    return Ok(s);
+                let mut rng = seeded(s.seed);
+                let len: usize = self.genes.iter().map(|g| g.bits as usize).sum();
+                let c: Vec<Chromosome> = (0..s.population)
+                    .map(|_| random_chromosome(&mut rng, len))
+                    .collect();
+                (c, rng)
+            }
+            Some(state) => {
+                let mut rng: SearchRng = state.rng.restore()?;
+                let objectives: Vec<[f64; 2]> =
+                    state.population.iter().map(Member::objectives).collect();
+                let (rank, crowd) = rank_and_crowding(&objectives);
+                let mut children = Vec::with_capacity(s.population);
+                while children.len() < s.population {
+                    let a = tournament(&mut rng, &rank, &crowd);
+                    let b = tournament(&mut rng, &rank, &crowd);
+                    let (mut c, mut d, _) = crossover(
+                        &mut rng,
+                        &state.population[a].chromosome,
+                        &state.population[b].chromosome,
+                        s.p_crossover,
+                    );
+                    for child in [&mut c, &mut d] {
+                        jump_mutation(&mut rng, child, s.p_jump);
+                        creep_mutation(&mut rng, child, &self.genes, s.p_creep);
+                    }
+                    children.push(c);
+                    children.push(d);
                 }
-                s
+                (children, rng)
             }
         };
-        while state.generation < self.settings.generations {
-            state = self.step(problem, &state)?;
-            if observer(&state)? == Control::Stop {
-                break;
-            }
-        }
-        Ok(state)
+        let values = chromosomes
+            .iter()
+            .map(|c| c.decode_values(&self.genes))
+            .collect();
+        Ok(Pending {
+            chromosomes,
+            values,
+            rng: RngState::of(&rng),
+        })
     }
 
     fn stats(&self, state: &GaState) -> GenerationStats {
@@ -340,26 +324,78 @@ impl GeneticAlgorithm {
     }
 }
 
-fn evaluate(
-    problem: &mut dyn ParetoProblem,
-    chromosomes: Vec<Chromosome>,
-) -> Result<Vec<Member>, EvalError> {
-    let genes = problem.genes().to_vec();
-    let values: Vec<Vec<f64>> = chromosomes
-        .iter()
-        .map(|c| c.decode_values(&genes))
-        .collect();
-    let outcomes = problem.evaluate(&values)?;
-    Ok(chromosomes
-        .into_iter()
-        .zip(values)
-        .zip(outcomes)
-        .map(|((chromosome, values), outcome)| Member {
-            chromosome,
+impl Solver for GaSearch {
+    type Point = Vec<f64>;
+
+    fn ask(&mut self) -> Result<Option<Ask<Vec<f64>>>, RunError> {
+        if self.finished() {
+            return Ok(None);
+        }
+        let pending = self.draw().map_err(|e| RunError::Search(e.to_string()))?;
+        let points = pending.values.clone();
+        self.pending = Some(pending);
+        Ok(Some(Ask {
+            points,
+            with_samples: false,
+        }))
+    }
+
+    fn tell(&mut self, evaluations: Vec<Evaluation>) -> Result<Option<Progress>, RunError> {
+        let Pending {
+            chromosomes,
             values,
-            outcome,
-        })
-        .collect())
+            rng,
+        } = self
+            .pending
+            .take()
+            .ok_or_else(|| RunError::Search("the GA was told without being asked".into()))?;
+        let members: Vec<Member> = chromosomes
+            .into_iter()
+            .zip(values)
+            .zip(evaluations)
+            .map(|((chromosome, values), e)| Member {
+                chromosome,
+                values,
+                outcome: e.outcome,
+            })
+            .collect();
+        let mut next = match self.state.take() {
+            None => GaState {
+                generation: 1,
+                evaluations: members.len() as u64,
+                archive: update_archive(&[], &members),
+                population: members,
+                rng,
+                history: Vec::new(),
+            },
+            Some(state) => {
+                let mut pool: Vec<Member> = state.population;
+                let evaluations = state.evaluations + members.len() as u64;
+                let archive = update_archive(&state.archive, &members);
+                pool.extend(members);
+                let objectives: Vec<[f64; 2]> = pool.iter().map(Member::objectives).collect();
+                let chosen = select_best(&objectives, self.settings.population);
+                GaState {
+                    generation: state.generation + 1,
+                    evaluations,
+                    archive,
+                    population: chosen.iter().map(|&i| pool[i].clone()).collect(),
+                    rng,
+                    history: state.history,
+                }
+            }
+        };
+        let stats = self.stats(&next);
+        let progress = Progress {
+            step: next.generation,
+            steps: Some(self.settings.generations),
+            evaluations: next.evaluations,
+            best: [stats.best_j_pos_m, stats.best_j_att_deg],
+        };
+        next.history.push(stats);
+        self.state = Some(next);
+        Ok(Some(progress))
+    }
 }
 
 /// The non-dominated set of `archive` and the finished runs of `new`, without duplicate

@@ -9,10 +9,13 @@
 //! When no trial step improves F, the step shrinks; below `min_step` the climber has reached a
 //! point it cannot leave (a local optimum at its resolution) and stops.
 
-use sepval_common::evaluation::{EvalError, Outcome};
+use sepval_common::encoding::Chromosome;
+use sepval_common::evaluation::{Evaluation, Outcome};
+use sepval_common::factors::FactorSpec;
 use serde::{Deserialize, Serialize};
 
-use crate::search::ga::{Member, ParetoProblem};
+use crate::run::{Ask, Progress, RunError, Solver};
+use crate::search::ga::Member;
 
 /// Settings of the hill climber.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -71,148 +74,250 @@ pub struct HillResult {
     pub stop: HillStop,
 }
 
-/// Climbs from `start` (values within the problem's bounds).
-pub fn climb(
-    problem: &mut dyn ParetoProblem,
-    start: &[f64],
+/// What the climber waits for.
+enum Stage {
+    /// The start point.
+    Start,
+    /// The forward-difference probes around the current point.
+    Gradient { probes: Vec<Vec<f64>> },
+    /// The line-search trials along the steepest descent.
+    Line {
+        trials: Vec<Vec<f64>>,
+        steps: Vec<f64>,
+    },
+    /// Finished.
+    Done(HillStop),
+}
+
+/// The hill climber as ask-and-tell, in coordinates normalised to the unit box.
+pub struct HillSearch {
+    settings: HillSettings,
     weights: [f64; 2],
-    settings: &HillSettings,
-) -> Result<HillResult, EvalError> {
-    let genes = problem.genes().to_vec();
-    let n = genes.len();
-    let lo: Vec<f64> = genes.iter().map(|g| g.min).collect();
-    let span: Vec<f64> = genes.iter().map(|g| g.max - g.min).collect();
-    let to_values = |u: &[f64]| -> Vec<f64> {
-        (0..n)
-            .map(|i| (lo[i] + u[i].clamp(0.0, 1.0) * span[i]).clamp(genes[i].min, genes[i].max))
+    genes: Vec<FactorSpec>,
+    u: Vec<f64>,
+    f: f64,
+    best_outcome: Outcome,
+    step: f64,
+    evaluations: u64,
+    history: Vec<(u64, f64, [f64; 2])>,
+    visited: Vec<Member>,
+    stage: Stage,
+}
+
+impl HillSearch {
+    /// A climb over `genes` from `start` (values within their bounds) on the weighted sum.
+    pub fn new(
+        genes: Vec<FactorSpec>,
+        start: &[f64],
+        weights: [f64; 2],
+        settings: HillSettings,
+    ) -> Self {
+        let u = genes
+            .iter()
+            .zip(start)
+            .map(|(g, v)| ((v - g.min) / (g.max - g.min)).clamp(0.0, 1.0))
+            .collect();
+        HillSearch {
+            step: settings.initial_step,
+            settings,
+            weights,
+            genes,
+            u,
+            f: f64::INFINITY,
+            best_outcome: Outcome::failed("not evaluated"),
+            evaluations: 0,
+            history: Vec::new(),
+            visited: Vec::new(),
+            stage: Stage::Start,
+        }
+    }
+
+    fn to_values(&self, u: &[f64]) -> Vec<f64> {
+        self.genes
+            .iter()
+            .zip(u)
+            .map(|(g, u)| (g.min + u.clamp(0.0, 1.0) * (g.max - g.min)).clamp(g.min, g.max))
             .collect()
-    };
-    let f_of = |o: &Outcome| {
+    }
+
+    fn weighted(&self, o: &Outcome) -> f64 {
         let [a, b] = o.objectives();
-        weights[0] * a + weights[1] * b
-    };
-    let mut visited: Vec<Member> = Vec::new();
-    let mut evaluations = 0u64;
-    let mut eval_batch = |points: &[Vec<f64>],
-                          visited: &mut Vec<Member>,
-                          evaluations: &mut u64|
-     -> Result<Vec<Outcome>, EvalError> {
-        let values: Vec<Vec<f64>> = points.iter().map(|u| to_values(u)).collect();
-        let outcomes = problem.evaluate(&values)?;
-        *evaluations += values.len() as u64;
-        for (v, o) in values.into_iter().zip(&outcomes) {
-            visited.push(Member {
-                chromosome: sepval_common::encoding::Chromosome::encode_values(&genes, &v),
-                values: v,
+        self.weights[0] * a + self.weights[1] * b
+    }
+
+    /// Plans the next gradient, or stops.
+    fn next_iteration(&mut self) {
+        let n = self.genes.len();
+        self.stage = if !self.f.is_finite() {
+            Stage::Done(HillStop::StartFailed)
+        } else if self.evaluations as usize + n + self.settings.line_points > self.settings.budget {
+            Stage::Done(HillStop::Budget)
+        } else {
+            // Forward differences, inward at a bound.
+            let h = self.settings.fd_step;
+            let u = &self.u;
+            Stage::Gradient {
+                probes: (0..n)
+                    .map(|i| {
+                        let mut p = u.clone();
+                        p[i] = if u[i] + h <= 1.0 { u[i] + h } else { u[i] - h };
+                        p
+                    })
+                    .collect(),
+            }
+        };
+    }
+
+    /// The result (after [`Solver::ask`] returned `None`).
+    pub fn finish(self) -> HillResult {
+        let values = self.to_values(&self.u);
+        let stop = match self.stage {
+            Stage::Done(s) => s,
+            _ => HillStop::Budget,
+        };
+        HillResult {
+            best: Member {
+                chromosome: Chromosome::encode_values(&self.genes, &values),
+                values,
+                outcome: self.best_outcome,
+            },
+            best_weighted: self.f,
+            evaluations: self.evaluations,
+            history: self.history,
+            visited: self.visited,
+            stop,
+        }
+    }
+}
+
+impl Solver for HillSearch {
+    type Point = Vec<f64>;
+
+    fn ask(&mut self) -> Result<Option<Ask<Vec<f64>>>, RunError> {
+        let points = match &self.stage {
+            Stage::Start => vec![self.u.clone()],
+            Stage::Gradient { probes } => probes.clone(),
+            Stage::Line { trials, .. } => trials.clone(),
+            Stage::Done(_) => return Ok(None),
+        };
+        Ok(Some(Ask {
+            points: points.iter().map(|u| self.to_values(u)).collect(),
+            with_samples: false,
+        }))
+    }
+
+    fn tell(&mut self, evaluations: Vec<Evaluation>) -> Result<Option<Progress>, RunError> {
+        let outcomes: Vec<Outcome> = evaluations.into_iter().map(|e| e.outcome).collect();
+        let points = match &self.stage {
+            Stage::Start => vec![self.u.clone()],
+            Stage::Gradient { probes } => probes.clone(),
+            Stage::Line { trials, .. } => trials.clone(),
+            Stage::Done(_) => return Err(RunError::Search("a finished climb was told".into())),
+        };
+        self.evaluations += outcomes.len() as u64;
+        for (u, o) in points.iter().zip(&outcomes) {
+            let values = self.to_values(u);
+            self.visited.push(Member {
+                chromosome: Chromosome::encode_values(&self.genes, &values),
+                values,
                 outcome: o.clone(),
             });
         }
-        Ok(outcomes)
-    };
-
-    let mut u: Vec<f64> = (0..n)
-        .map(|i| ((start[i] - lo[i]) / span[i]).clamp(0.0, 1.0))
-        .collect();
-    let first = eval_batch(std::slice::from_ref(&u), &mut visited, &mut evaluations)?;
-    let mut f = f_of(&first[0]);
-    let mut best_outcome = first[0].clone();
-    let mut history = vec![(evaluations, f, best_outcome.objectives())];
-    let mut step = settings.initial_step;
-    let stop = loop {
-        if !f.is_finite() {
-            break HillStop::StartFailed;
+        let n = self.genes.len();
+        match std::mem::replace(&mut self.stage, Stage::Done(HillStop::Budget)) {
+            Stage::Start => {
+                self.f = self.weighted(&outcomes[0]);
+                self.best_outcome = outcomes[0].clone();
+                self.history
+                    .push((self.evaluations, self.f, self.best_outcome.objectives()));
+                self.next_iteration();
+                Ok(None)
+            }
+            Stage::Gradient { probes } => {
+                let grad: Vec<f64> = (0..n)
+                    .map(|i| {
+                        let fi = self.weighted(&outcomes[i]);
+                        let dh = probes[i][i] - self.u[i];
+                        if fi.is_finite() {
+                            (fi - self.f) / dh
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                let norm = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
+                if norm == 0.0 || !norm.is_finite() {
+                    self.stage = Stage::Done(HillStop::LocalOptimum);
+                    return Ok(None);
+                }
+                let dir: Vec<f64> = grad.iter().map(|g| -g / norm).collect();
+                let steps: Vec<f64> = (0..self.settings.line_points)
+                    .map(|j| 2.0 * self.step / 2f64.powi(j as i32))
+                    .collect();
+                let trials = steps
+                    .iter()
+                    .map(|s| {
+                        (0..n)
+                            .map(|i| (self.u[i] + s * dir[i]).clamp(0.0, 1.0))
+                            .collect()
+                    })
+                    .collect();
+                self.stage = Stage::Line { trials, steps };
+                Ok(None)
+            }
+            Stage::Line { trials, steps } => {
+                let (k, fk) = outcomes
+                    .iter()
+                    .map(|o| self.weighted(o))
+                    .enumerate()
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .ok_or_else(|| RunError::Search("an empty line search".into()))?;
+                if fk < self.f {
+                    self.u = trials[k].clone();
+                    self.f = fk;
+                    self.best_outcome = outcomes[k].clone();
+                    self.step = steps[k];
+                } else {
+                    self.step = steps[self.settings.line_points - 1] / 2.0;
+                }
+                self.history
+                    .push((self.evaluations, self.f, self.best_outcome.objectives()));
+                if self.step < self.settings.min_step {
+                    self.stage = Stage::Done(HillStop::LocalOptimum);
+                } else {
+                    self.next_iteration();
+                }
+                Ok(Some(Progress {
+                    step: self.history.len() - 1,
+                    steps: None,
+                    evaluations: self.evaluations,
+                    best: self.best_outcome.objectives(),
+                }))
+            }
+            Stage::Done(_) => unreachable!("checked above"),
         }
-        if evaluations as usize + n + settings.line_points > settings.budget {
-            break HillStop::Budget;
-        }
-        // Forward differences, inward at a bound.
-        let h = settings.fd_step;
-        let probes: Vec<Vec<f64>> = (0..n)
-            .map(|i| {
-                let mut p = u.clone();
-                p[i] = if u[i] + h <= 1.0 { u[i] + h } else { u[i] - h };
-                p
-            })
-            .collect();
-        let fd = eval_batch(&probes, &mut visited, &mut evaluations)?;
-        let grad: Vec<f64> = (0..n)
-            .map(|i| {
-                let fi = f_of(&fd[i]);
-                let dh = probes[i][i] - u[i];
-                if fi.is_finite() { (fi - f) / dh } else { 0.0 }
-            })
-            .collect();
-        let norm = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
-        if norm == 0.0 || !norm.is_finite() {
-            break HillStop::LocalOptimum;
-        }
-        let dir: Vec<f64> = grad.iter().map(|g| -g / norm).collect();
-        let steps: Vec<f64> = (0..settings.line_points)
-            .map(|j| 2.0 * step / 2f64.powi(j as i32))
-            .collect();
-        let trials: Vec<Vec<f64>> = steps
-            .iter()
-            .map(|s| {
-                (0..n)
-                    .map(|i| (u[i] + s * dir[i]).clamp(0.0, 1.0))
-                    .collect()
-            })
-            .collect();
-        let outcomes = eval_batch(&trials, &mut visited, &mut evaluations)?;
-        let (k, fk) = outcomes
-            .iter()
-            .map(f_of)
-            .enumerate()
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .expect("at least one trial");
-        if fk < f {
-            u = trials[k].clone();
-            f = fk;
-            best_outcome = outcomes[k].clone();
-            step = steps[k];
-        } else {
-            step = steps[settings.line_points - 1] / 2.0;
-        }
-        history.push((evaluations, f, best_outcome.objectives()));
-        if step < settings.min_step {
-            break HillStop::LocalOptimum;
-        }
-    };
-    let values = to_values(&u);
-    Ok(HillResult {
-        best: Member {
-            chromosome: sepval_common::encoding::Chromosome::encode_values(&genes, &values),
-            values,
-            outcome: best_outcome,
-        },
-        best_weighted: f,
-        evaluations,
-        history,
-        visited,
-        stop,
-    })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sepval_common::factors::FactorSpec;
+
+    use crate::run::{Problem, run};
+    use sepval_common::evaluation::EvalError;
 
     /// A smooth bowl with its minimum at (0.3, 0.7) of the unit square.
-    struct Bowl {
-        genes: Vec<FactorSpec>,
-    }
+    struct Bowl;
 
-    impl ParetoProblem for Bowl {
-        fn genes(&self) -> &[FactorSpec] {
-            &self.genes
-        }
-        fn evaluate(&mut self, batch: &[Vec<f64>]) -> Result<Vec<Outcome>, EvalError> {
+    impl Problem<Vec<f64>> for Bowl {
+        fn evaluate(&mut self, batch: &[Vec<f64>], _: bool) -> Result<Vec<Evaluation>, EvalError> {
             Ok(batch
                 .iter()
-                .map(|v| Outcome::Goals {
-                    j_pos_m: (v[0] - 0.3).powi(2) + 0.01,
-                    j_att_deg: (v[1] - 0.7).powi(2) + 0.01,
+                .map(|v| {
+                    Evaluation::from(Outcome::Goals {
+                        j_pos_m: (v[0] - 0.3).powi(2) + 0.01,
+                        j_att_deg: (v[1] - 0.7).powi(2) + 0.01,
+                    })
                 })
                 .collect())
         }
@@ -225,14 +330,13 @@ mod tests {
             max: 1.0,
             bits: 8,
         };
-        let mut p = Bowl {
-            genes: vec![spec; 2],
-        };
         let settings = HillSettings {
             budget: 200,
             ..HillSettings::default()
         };
-        let r = climb(&mut p, &[0.9, 0.1], [1.0, 1.0], &settings).unwrap();
+        let mut climb = HillSearch::new(vec![spec; 2], &[0.9, 0.1], [1.0, 1.0], settings);
+        run(&mut climb, &mut Bowl, &mut []).unwrap();
+        let r = climb.finish();
         assert!(r.evaluations <= 200);
         assert!((r.best.values[0] - 0.3).abs() < 0.01, "{:?}", r.best.values);
         assert!((r.best.values[1] - 0.7).abs() < 0.01, "{:?}", r.best.values);

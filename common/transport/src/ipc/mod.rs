@@ -1,6 +1,7 @@
-//! What the coordinator and the workers share about the iceoryx2 transport: the per-run
-//! configuration (one prefix per run id, so that two runs on one host never see each other),
-//! the service and node names, and liveness queries.
+//! The iceoryx2 transport (shared memory, one host): the coordinator's [`IpcLink`] and the
+//! worker's [`IpcWorker`], and what both ends share: the per-run configuration (one prefix per
+//! run id, so that two runs on one host never see each other), the service names, and liveness
+//! queries and cleanup.
 //!
 //! Service names say what they carry. Within a run's prefix:
 //!
@@ -8,19 +9,33 @@
 //! |---|---|---|
 //! | `sepval/run/setup` | publish-subscribe `[u8]` + [`SetupHeader`] (history 1) | the job setup |
 //! | `sepval/run/hello` | publish-subscribe [`Hello`] | workers announcing themselves |
-//! | `sepval/run/coordinator-wake` | event | "responses are waiting" (workers to coordinator) |
+//! | `sepval/run/coordinator-wake` | event | "answers are waiting" (workers to coordinator) |
 //! | `sepval/worker/<node id>/requests` | publish-subscribe `[WireRequest]` + [`ChunkHeader`] | chunks of candidates |
 //! | `sepval/worker/<node id>/responses` | publish-subscribe `[WireResponse]` + [`ChunkHeader`] | their outcomes |
 //! | `sepval/worker/<node id>/samples` | publish-subscribe `[WireObservation]` + [`ChunkHeader`] | simulated samples (residual fits) |
 //! | `sepval/worker/<node id>/wake` | event | "requests are waiting" (coordinator to worker) |
 //!
-//! [`SetupHeader`]: crate::messages::SetupHeader
-//! [`Hello`]: crate::messages::Hello
-//! [`ChunkHeader`]: crate::messages::ChunkHeader
+//! Every node is built with iceoryx2's own signal handling off: SIGINT and SIGTERM set sepval's
+//! cancellation flag ([`sepval_common::cancel`]), which both ends check at every wake-up.
+//!
+//! [`SetupHeader`]: crate::wire::SetupHeader
+//! [`Hello`]: crate::wire::Hello
+//! [`ChunkHeader`]: crate::wire::ChunkHeader
+//! [`WireRequest`]: crate::wire::WireRequest
+//! [`WireResponse`]: crate::wire::WireResponse
+//! [`WireObservation`]: crate::wire::WireObservation
+
+mod coordinator;
+mod worker;
+
+pub use coordinator::{IpcLink, IpcOptions, Launch};
+pub use worker::IpcWorker;
 
 use iceoryx2::config::Config;
 use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
+
+use crate::{RunId, TransportError, iox};
 
 /// Node name of a coordinator.
 pub const COORDINATOR_NODE: &str = "sepval-coordinator";
@@ -28,67 +43,50 @@ pub const COORDINATOR_NODE: &str = "sepval-coordinator";
 pub const WORKER_NODE: &str = "sepval-worker";
 /// Chunks a worker's request buffer holds (the coordinator never has more in flight).
 pub const REQUEST_BUFFER: usize = 8;
+/// Chunks kept in flight per worker.
+pub const IN_FLIGHT_PER_WORKER: usize = 2;
+/// Most workers one run accepts.
+pub const MAX_WORKERS: usize = 64;
 
-/// Errors of the shared transport helpers.
-#[derive(Debug, thiserror::Error, PartialEq)]
-#[non_exhaustive]
-pub enum IpcError {
-    /// A run id with characters a file name cannot hold.
-    #[error("run id `{0}`: expected 1 to 48 characters from A-Z, a-z, 0-9 and '-'")]
-    RunId(String),
-    /// An iceoryx2 operation failed.
-    #[error("{what}: {detail}")]
-    Iceoryx {
-        /// What was attempted.
-        what: String,
-        /// iceoryx2's error.
-        detail: String,
-    },
-}
+/// Removes a run's iceoryx2 resources when dropped, if no process of the run is left: the last
+/// field of whatever owns a run's node, so that it drops after the node.
+pub(crate) struct RunCleanup(pub(crate) RunId);
 
-/// Wraps an iceoryx2 error with what was attempted.
-pub fn iox<E: std::fmt::Debug>(what: impl Into<String>) -> impl FnOnce(E) -> IpcError {
-    let what = what.into();
-    move |e| IpcError::Iceoryx {
-        what,
-        detail: format!("{e:?}"),
-    }
-}
-
-/// Checks a run id.
-pub fn validate_run_id(run_id: &str) -> Result<(), IpcError> {
-    let ok = !run_id.is_empty()
-        && run_id.len() <= 48
-        && run_id
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '-');
-    if ok {
-        Ok(())
-    } else {
-        Err(IpcError::RunId(run_id.to_string()))
+impl Drop for RunCleanup {
+    fn drop(&mut self) {
+        let _ = clean_run_if_stale(&self.0);
     }
 }
 
 /// The file-name prefix of a run's iceoryx2 resources.
-pub fn run_prefix(run_id: &str) -> String {
+pub fn run_prefix(run_id: &RunId) -> String {
     format!("sepval_{run_id}_")
 }
 
 /// The iceoryx2 configuration of a run: the global configuration with the run's own prefix.
-pub fn run_config(run_id: &str) -> Result<Config, IpcError> {
-    validate_run_id(run_id)?;
+pub fn run_config(run_id: &RunId) -> Result<Config, TransportError> {
+    quiet_logs();
     let mut cfg = Config::global_config().clone();
     cfg.global.prefix = FileName::new(run_prefix(run_id).as_bytes())
         .map_err(iox(format!("run id {run_id} as a file-name prefix")))?;
     Ok(cfg)
 }
 
-/// A fresh run id: the process id and the time, in hex (unique on a host; not random).
-pub fn new_run_id() -> String {
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    format!("r{:x}{:x}", std::process::id(), nanos & 0xffff_ffff_ffff)
+/// iceoryx2 reports only errors (its warnings about a missing configuration file are noise
+/// for sepval's users). Called by every process before its first node.
+pub fn quiet_logs() {
+    iceoryx2::prelude::set_log_level(LogLevel::Error);
+}
+
+/// A node of a run, with iceoryx2's signal handling off (see the module docs).
+pub fn node(cfg: &Config, name: &str) -> Result<Node<ipc::Service>, TransportError> {
+    quiet_logs();
+    NodeBuilder::new()
+        .config(cfg)
+        .name(&NodeName::new(name).map_err(iox("node name"))?)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(iox(format!("creating the {name} node")))
 }
 
 /// Service names of a run.
@@ -122,7 +120,7 @@ pub mod names {
 }
 
 /// A service name from text.
-pub fn service_name(name: &str) -> Result<ServiceName, IpcError> {
+pub fn service_name(name: &str) -> Result<ServiceName, TransportError> {
     ServiceName::new(name).map_err(iox(format!("service name {name}")))
 }
 
@@ -147,7 +145,7 @@ pub fn runs_with_resources() -> Vec<(String, std::time::Duration)> {
             let name = e.file_name().to_string_lossy().into_owned();
             if let Some(rest) = name.strip_prefix("sepval_") {
                 if let Some((id, _)) = rest.split_once('_') {
-                    if validate_run_id(id).is_ok() {
+                    if RunId::new(id).is_ok() {
                         let age = e
                             .metadata()
                             .and_then(|m| m.modified())
@@ -170,20 +168,13 @@ pub const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(30);
 /// Removes the iceoryx2 resources of run `run_id` if none of its nodes is alive: the dead
 /// nodes' resources (through iceoryx2's own cleanup) and the run's management segment.
 /// Returns whether the run was stale (and cleaned).
-pub fn clean_run_if_stale(run_id: &str) -> Result<bool, IpcError> {
+pub fn clean_run_if_stale(run_id: &RunId) -> Result<bool, TransportError> {
     let cfg = run_config(run_id)?;
     let (alive, _) = node_states(&cfg)?;
     if !alive.is_empty() {
         return Ok(false);
     }
-    {
-        let janitor = NodeBuilder::new()
-            .config(&cfg)
-            .name(&NodeName::new("sepval-janitor").map_err(iox("node name"))?)
-            .create::<ipc::Service>()
-            .map_err(iox(format!("joining stale run {run_id} to clean it")))?;
-        janitor.try_cleanup_dead_nodes();
-    }
+    node(&cfg, "sepval-janitor")?.try_cleanup_dead_nodes();
     // SAFETY: no node of this run is alive (checked above); the management segment only
     // counts node creations and is recreated by the next node of the run.
     let _ = unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&cfg) };
@@ -192,11 +183,11 @@ pub fn clean_run_if_stale(run_id: &str) -> Result<bool, IpcError> {
 
 /// Cleans every stale sepval run on this host except `except`: runs whose newest resource is
 /// older than `min_age` and none of whose nodes is alive (returns the runs cleaned).
-pub fn clean_stale_runs(except: &str, min_age: std::time::Duration) -> Vec<String> {
+pub fn clean_stale_runs(except: Option<&RunId>, min_age: std::time::Duration) -> Vec<RunId> {
     runs_with_resources()
         .into_iter()
-        .filter(|(id, age)| id != except && *age >= min_age)
-        .map(|(id, _)| id)
+        .filter(|(id, age)| except.is_none_or(|e| e.as_str() != id) && *age >= min_age)
+        .filter_map(|(id, _)| RunId::new(&id).ok())
         .filter(|id| clean_run_if_stale(id).unwrap_or(false))
         .collect()
 }
@@ -211,7 +202,7 @@ pub struct Presence {
 }
 
 /// How many nodes named `name` are alive or dead in the run of `cfg`.
-pub fn presence(cfg: &Config, name: &str) -> Result<Presence, IpcError> {
+pub fn presence(cfg: &Config, name: &str) -> Result<Presence, TransportError> {
     let mut p = Presence::default();
     Node::<ipc::Service>::list(cfg, |state| {
         let named = |details: &Option<iceoryx2::node::NodeDetails>| {
@@ -229,7 +220,7 @@ pub fn presence(cfg: &Config, name: &str) -> Result<Presence, IpcError> {
 }
 
 /// Node ids of the alive and the dead nodes of a run.
-pub fn node_states(cfg: &Config) -> Result<(Vec<u128>, Vec<u128>), IpcError> {
+pub fn node_states(cfg: &Config) -> Result<(Vec<u128>, Vec<u128>), TransportError> {
     let (mut alive, mut dead) = (Vec::new(), Vec::new());
     Node::<ipc::Service>::list(cfg, |state| {
         match &state {
@@ -241,23 +232,4 @@ pub fn node_states(cfg: &Config) -> Result<(Vec<u128>, Vec<u128>), IpcError> {
     })
     .map_err(iox("listing the run's nodes"))?;
     Ok((alive, dead))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn run_ids_are_checked() {
-        validate_run_id("run-1-A").unwrap();
-        assert!(validate_run_id("run_1").is_err());
-        assert!(validate_run_id("").is_err());
-        assert!(validate_run_id("a/b").is_err());
-        assert!(validate_run_id(&"x".repeat(49)).is_err());
-        assert_eq!(
-            validate_run_id("a b").unwrap_err().to_string(),
-            "run id `a b`: expected 1 to 48 characters from A-Z, a-z, 0-9 and '-'"
-        );
-        assert!(run_config(&new_run_id()).is_ok());
-    }
 }

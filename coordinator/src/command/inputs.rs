@@ -1,9 +1,9 @@
-//! Turning command-line inputs (scenario, factors, effects, data files) into validated values,
-//! with errors that name the file and the problem.
+//! Reading the inputs the flags name (scenario, factors, effects, data files) into validated
+//! values, with errors that name the file and the problem.
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use sepval_common::effects::EffectSet;
 use sepval_common::factors::{FactorTable, Factors};
 use sepval_common::scenario::Scenario;
@@ -58,14 +58,6 @@ pub fn data(paths: &[std::path::PathBuf]) -> Result<Vec<Trajectory>> {
         .collect()
 }
 
-/// A strictly positive, finite number given on the command line.
-pub fn positive(name: &str, value: f64) -> Result<f64> {
-    if !(value.is_finite() && value > 0.0) {
-        bail!("{name} = {value}: expected a finite number > 0");
-    }
-    Ok(value)
-}
-
 /// The job of a fit: each data file (or the embedded default flight test) with the scenario,
 /// and the record of where they came from.
 pub fn job(
@@ -73,7 +65,7 @@ pub fn job(
     scenario_path: Option<&Path>,
 ) -> Result<(
     sepval_common::evaluation::Job,
-    crate::checkpoint::InputsRecord,
+    sepval_coordinator::checkpoint::InputsRecord,
 )> {
     use sepval_common::evaluation::{Event, Job};
     use sepval_common::simulation::Simulator;
@@ -94,7 +86,7 @@ pub fn job(
         });
     }
     let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
-    let record = crate::checkpoint::InputsRecord {
+    let record = sepval_coordinator::checkpoint::InputsRecord {
         data: data_paths.iter().map(|p| absolute(p)).collect(),
         scenario: scenario_path.map(absolute),
     };

@@ -1,0 +1,211 @@
+//! The job setup: what every worker needs once (the events: scenario and measured data of
+//! each release), sent by the coordinator when a worker joins.
+//!
+//! The setup is the scenario TOML and data CSV texts of every event, which round-trip exactly
+//! (sepval writes every number in the shortest form that reads back as the same double), in the
+//! byte form of [`crate::codec`]: the event count, then each event's name, scenario and data as
+//! length-prefixed UTF-8. A [`SetupHeader`] carries the protocol version, the bytes' SHA-256 and
+//! the effect catalogue's fingerprint; a worker checks all three before it decodes anything.
+
+use sepval_common::effects::catalogue_fingerprint;
+use sepval_common::evaluation::{Event, Job, JobError};
+use sepval_common::scenario::Scenario;
+use sepval_common::simulation::Simulator;
+use sepval_common::telemetry::Trajectory;
+
+use crate::codec::{CodecError, MAX_SETUP, Reader, Writer};
+use crate::wire::{MAGIC, PROTOCOL_VERSION, SetupHeader};
+
+/// Most events in one job.
+pub const MAX_EVENTS: usize = 4096;
+
+/// Errors decoding a job setup.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SetupError {
+    /// Not a sepval setup.
+    #[error("setup header has magic {found:#x}, expected {MAGIC:#x}: not a sepval setup")]
+    Magic {
+        /// The magic found.
+        found: u64,
+    },
+    /// Another protocol version.
+    #[error("setup has protocol version {theirs}, this process speaks version {ours}")]
+    Protocol {
+        /// The sender's version.
+        theirs: u32,
+        /// Ours.
+        ours: u32,
+    },
+    /// Another effect catalogue.
+    #[error(
+        "setup was made with another effect catalogue (fingerprints differ): build both executables from the same sources"
+    )]
+    Catalogue,
+    /// Corrupted bytes.
+    #[error("setup bytes do not match their SHA-256 ({len} bytes)")]
+    Hash {
+        /// Bytes received.
+        len: usize,
+    },
+    /// Bytes that do not decode.
+    #[error("setup bytes do not decode: {0}")]
+    Decode(#[from] CodecError),
+    /// A scenario or data text that does not parse.
+    #[error("setup event `{event}`: {message}")]
+    Content {
+        /// The event.
+        event: String,
+        /// What failed.
+        message: String,
+    },
+    /// An invalid job.
+    #[error(transparent)]
+    Job(#[from] JobError),
+}
+
+/// SHA-256 of `bytes`.
+pub fn sha256(bytes: &[u8]) -> [u8; 32] {
+    use sha2::{Digest, Sha256};
+    Sha256::digest(bytes).into()
+}
+
+/// The catalogue fingerprint as 32 bytes.
+pub fn catalogue_bytes() -> [u8; 32] {
+    sha256(catalogue_fingerprint().as_bytes())
+}
+
+/// Hex form of a digest, for messages.
+pub fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// A job's setup: its header (announcing `protocol`) and bytes.
+pub fn encode_setup_as(job: &Job, protocol: u32) -> (SetupHeader, Vec<u8>) {
+    let mut w = Writer(Vec::new());
+    w.u64(job.events().len() as u64);
+    for e in job.events() {
+        w.bytes(e.name.as_bytes());
+        w.bytes(e.simulator.scenario().to_toml_string().as_bytes());
+        w.bytes(e.data.to_csv_string().as_bytes());
+    }
+    let bytes = w.0;
+    let header = SetupHeader {
+        magic: MAGIC,
+        protocol,
+        reserved: 0,
+        len: bytes.len() as u64,
+        sha256: sha256(&bytes),
+        catalogue: catalogue_bytes(),
+    };
+    (header, bytes)
+}
+
+/// A job's setup: its header and bytes.
+pub fn encode_setup(job: &Job) -> (SetupHeader, Vec<u8>) {
+    encode_setup_as(job, PROTOCOL_VERSION)
+}
+
+/// Checks a setup header against this process (magic, protocol, catalogue).
+pub fn check_setup_header(header: &SetupHeader) -> Result<(), SetupError> {
+    if header.magic != MAGIC {
+        return Err(SetupError::Magic {
+            found: header.magic,
+        });
+    }
+    if header.protocol != PROTOCOL_VERSION {
+        return Err(SetupError::Protocol {
+            theirs: header.protocol,
+            ours: PROTOCOL_VERSION,
+        });
+    }
+    if header.catalogue != catalogue_bytes() {
+        return Err(SetupError::Catalogue);
+    }
+    Ok(())
+}
+
+/// Decodes a job setup after checking its header and hash.
+pub fn decode_setup(header: &SetupHeader, bytes: &[u8]) -> Result<Job, SetupError> {
+    check_setup_header(header)?;
+    if header.len != bytes.len() as u64 || sha256(bytes) != header.sha256 {
+        return Err(SetupError::Hash { len: bytes.len() });
+    }
+    let mut r = Reader { bytes, at: 0 };
+    let n = r.count("events", MAX_EVENTS, 24)?;
+    let mut events = Vec::with_capacity(n);
+    for _ in 0..n {
+        let name = r.text("event name")?;
+        let scenario_toml = r.text_up_to("scenario", MAX_SETUP)?;
+        let data_csv = r.text_up_to("data", MAX_SETUP)?;
+        let content = |message: String| SetupError::Content {
+            event: name.clone(),
+            message,
+        };
+        let scenario =
+            Scenario::from_toml_str(&scenario_toml, &name).map_err(|x| content(x.to_string()))?;
+        let data = Trajectory::parse(&data_csv, &name).map_err(|x| content(x.to_string()))?;
+        events.push(Event {
+            name,
+            simulator: Simulator::new(&scenario),
+            data,
+        });
+    }
+    r.end()?;
+    Ok(Job::new(events)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sepval_common::synthetic::default_flight_test;
+
+    fn job() -> Job {
+        Job::single(
+            "default",
+            &Scenario::embedded_default(),
+            default_flight_test(),
+        )
+    }
+
+    #[test]
+    fn setup_round_trips_with_the_same_hashes() {
+        let j = job();
+        let (h, bytes) = encode_setup(&j);
+        let back = decode_setup(&h, &bytes).unwrap();
+        assert_eq!(back.data_sha256(), j.data_sha256());
+        assert_eq!(back.scenario_sha256(), j.scenario_sha256());
+    }
+
+    #[test]
+    fn bad_setups_are_refused_with_their_reason() {
+        let (h, bytes) = encode_setup(&job());
+        let mut other = h;
+        other.protocol = PROTOCOL_VERSION + 1;
+        assert_eq!(
+            decode_setup(&other, &bytes).unwrap_err().to_string(),
+            format!(
+                "setup has protocol version {}, this process speaks version {PROTOCOL_VERSION}",
+                PROTOCOL_VERSION + 1
+            )
+        );
+        let mut corrupt = bytes.clone();
+        corrupt[10] ^= 1;
+        assert!(matches!(
+            decode_setup(&h, &corrupt),
+            Err(SetupError::Hash { .. })
+        ));
+        let mut magic = h;
+        magic.magic = 7;
+        assert!(matches!(
+            decode_setup(&magic, &bytes),
+            Err(SetupError::Magic { found: 7 })
+        ));
+        let mut catalogue = h;
+        catalogue.catalogue[0] ^= 1;
+        assert!(matches!(
+            decode_setup(&catalogue, &bytes),
+            Err(SetupError::Catalogue)
+        ));
+    }
+}

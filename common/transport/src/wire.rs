@@ -1,0 +1,589 @@
+//! The wire protocol between a coordinator and its workers, defined once for every transport.
+//!
+//! Evaluation traffic is chunks: a [`ChunkHeader`] and a slice of fixed-layout, `#[repr(C)]`
+//! [`WireRequest`]s one way; the same header, a slice of [`WireResponse`]s and (for residual
+//! fits) of [`WireObservation`]s the other way. Over iceoryx2 these slices are the shared-memory
+//! samples themselves (zero copy, no serialisation); over byte streams (Unix sockets, zenoh) the
+//! same types are written field by field, little-endian ([`crate::codec`]). Either way the
+//! values are the same bits, and this module is the one place where a request becomes a
+//! candidate ([`WireRequest::candidate`], one validation with one set of messages), where a
+//! chunk is evaluated ([`serve_chunks`], used by every worker loop and by the gateway), and where
+//! an answer becomes evaluations again ([`Answer::evaluations`]).
+//!
+//! The layouts of [`Hello`] and [`SetupHeader`] never change, so that a worker and a
+//! coordinator of different protocol versions can still read each other's version and refuse
+//! with a clear message; every other type may change with [`PROTOCOL_VERSION`]. No type has
+//! implicit padding (explicit `reserved` fields instead).
+
+use iceoryx2::prelude::ZeroCopySend;
+use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
+use sepval_common::evaluation::{Candidate, Evaluation, Job, MAX_REASON_BYTES, Outcome};
+use sepval_common::factors::{FACTOR_COUNT, Factors};
+use sepval_common::propagator::Observation;
+
+/// Version of the coordinator-worker protocol. A coordinator and a worker refuse each other
+/// unless they agree on it. Version 2: one wire format for every transport (failure reasons of
+/// up to 240 bytes, explicit padding).
+pub const PROTOCOL_VERSION: u32 = 2;
+
+/// "SEPVAL01" as a little-endian integer: the first field of [`Hello`], [`SetupHeader`] and
+/// every byte-stream frame.
+pub const MAGIC: u64 = u64::from_le_bytes(*b"SEPVAL01");
+
+/// Longest failure reason carried by a [`WireResponse`] \[bytes of UTF-8\]: the same bound as
+/// every outcome has where it is made, so no transport ever cuts one.
+pub const REASON_CAPACITY: usize = MAX_REASON_BYTES;
+
+/// Most candidates in one chunk (a chunk plan never makes more than 16; a decoder refuses more).
+pub const MAX_CHUNK: usize = 1024;
+
+/// A worker announcing itself to an iceoryx2 coordinator (layout fixed across versions).
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[type_name("sepval.Hello")]
+#[repr(C)]
+pub struct Hello {
+    /// [`MAGIC`].
+    pub magic: u64,
+    /// The worker's [`PROTOCOL_VERSION`].
+    pub protocol: u32,
+    /// The worker's process id.
+    pub pid: u32,
+    /// The worker's iceoryx2 node id (which also names its services).
+    pub node_id: u128,
+}
+
+/// Header of the job setup (layout fixed across protocol versions).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
+#[type_name("sepval.SetupHeader")]
+#[repr(C)]
+pub struct SetupHeader {
+    /// [`MAGIC`].
+    pub magic: u64,
+    /// The coordinator's [`PROTOCOL_VERSION`].
+    pub protocol: u32,
+    /// Reserved (zero).
+    pub reserved: u32,
+    /// Length of the setup bytes.
+    pub len: u64,
+    /// SHA-256 of the setup bytes.
+    pub sha256: [u8; 32],
+    /// SHA-256 of the effect catalogue's fingerprint text.
+    pub catalogue: [u8; 32],
+}
+
+/// Header of a chunk of requests or of its answer.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
+#[type_name("sepval.ChunkHeader")]
+#[repr(C)]
+pub struct ChunkHeader {
+    /// The coordinator's id of the chunk (echoed in the answer).
+    pub chunk_id: u64,
+    /// Number of items.
+    pub count: u32,
+    /// 1 when the simulated samples are wanted back.
+    pub with_samples: u32,
+}
+
+/// One candidate to evaluate.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[type_name("sepval.WireRequest")]
+#[repr(C)]
+pub struct WireRequest {
+    /// The candidate's index in its batch (echoed in the response).
+    pub index: u64,
+    /// The 17 factors in table order.
+    pub factors: [f64; FACTOR_COUNT],
+    /// Number of active effects.
+    pub effect_count: u32,
+    /// Catalogue index of each active effect.
+    pub effect_index: [u32; MAX_ACTIVE_EFFECTS],
+    /// Reserved (zero): keeps the parameters 8-byte aligned without implicit padding.
+    pub reserved: u32,
+    /// Parameters of each active effect (unused entries zero).
+    pub effect_params: [[f64; MAX_EFFECT_PARAMS]; MAX_ACTIVE_EFFECTS],
+}
+
+/// Status codes of [`WireResponse`].
+pub mod status {
+    /// The run finished: `j_pos_m`, `j_att_deg` hold the goals.
+    pub const GOALS: u32 = 0;
+    /// The run diverged at `t_s` in event `event`.
+    pub const DIVERGED: u32 = 1;
+    /// The candidate could not be run: `reason`.
+    pub const FAILED: u32 = 2;
+}
+
+/// One evaluation's outcome.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[type_name("sepval.WireResponse")]
+#[repr(C)]
+pub struct WireResponse {
+    /// The candidate's index in its batch.
+    pub index: u64,
+    /// One of [`status`].
+    pub status: u32,
+    /// Event index (diverged runs).
+    pub event: u32,
+    /// RMS position error \[m\].
+    pub j_pos_m: f64,
+    /// RMS attitude error \[deg\].
+    pub j_att_deg: f64,
+    /// Divergence time \[s\].
+    pub t_s: f64,
+    /// Length of `reason` \[bytes\].
+    pub reason_len: u32,
+    /// Reserved (zero).
+    pub reserved: u32,
+    /// Failure reason, UTF-8.
+    pub reason: [u8; REASON_CAPACITY],
+}
+
+/// One simulated sample (residual fits).
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[type_name("sepval.WireObservation")]
+#[repr(C)]
+pub struct WireObservation {
+    /// Position \[m\].
+    pub pos_m: [f64; 3],
+    /// Euler angles \[deg\].
+    pub att_deg: [f64; 3],
+}
+
+impl WireObservation {
+    /// The sample of a run that did not finish.
+    pub const MISSING: WireObservation = WireObservation {
+        pos_m: [f64::NAN; 3],
+        att_deg: [f64::NAN; 3],
+    };
+}
+
+impl From<&Observation> for WireObservation {
+    fn from(o: &Observation) -> Self {
+        WireObservation {
+            pos_m: o.pos_m,
+            att_deg: o.att_deg,
+        }
+    }
+}
+
+impl From<&WireObservation> for Observation {
+    fn from(o: &WireObservation) -> Self {
+        Observation {
+            pos_m: o.pos_m,
+            att_deg: o.att_deg,
+        }
+    }
+}
+
+/// What a message from another process can get wrong. One set of messages for every transport.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum WireError {
+    /// More effects than a request holds.
+    #[error("effect count {0} exceeds the maximum of {MAX_ACTIVE_EFFECTS}")]
+    EffectCount(u32),
+    /// An effect index outside the catalogue.
+    #[error("effect index {0} is not in the catalogue")]
+    EffectIndex(u32),
+    /// Effect parameters the catalogue refuses.
+    #[error("{0}")]
+    Effect(String),
+    /// An unknown response status.
+    #[error("unknown response status {0}")]
+    Status(u32),
+    /// A failure reason longer than its buffer or not UTF-8.
+    #[error("failure reason of {0} bytes is not valid UTF-8 within {REASON_CAPACITY} bytes")]
+    Reason(u32),
+}
+
+impl WireRequest {
+    /// The wire form of candidate `index`.
+    pub fn new(index: u64, c: &Candidate) -> Self {
+        let mut r = WireRequest {
+            index,
+            factors: c.factors.0,
+            effect_count: c.effects.len() as u32,
+            effect_index: [0; MAX_ACTIVE_EFFECTS],
+            reserved: 0,
+            effect_params: [[0.0; MAX_EFFECT_PARAMS]; MAX_ACTIVE_EFFECTS],
+        };
+        for (k, a) in c.effects.iter().enumerate() {
+            r.effect_index[k] = a.index as u32;
+            r.effect_params[k][..a.values().len()].copy_from_slice(a.values());
+        }
+        r
+    }
+
+    /// The candidate, after checking everything that a [`Candidate`] cannot hold (effect
+    /// counts, catalogue indices, parameters the catalogue refuses). The factors are checked
+    /// when the candidate runs, by the model itself, as in-process candidates are: a factor
+    /// that is not finite, or out of its bounds, fails with the same message over every
+    /// transport.
+    pub fn candidate(&self) -> Result<Candidate, WireError> {
+        let n = self.effect_count as usize;
+        if n > MAX_ACTIVE_EFFECTS {
+            return Err(WireError::EffectCount(self.effect_count));
+        }
+        let mut effects = EffectSet::NONE;
+        for k in 0..n {
+            let index = self.effect_index[k];
+            let effect = CATALOGUE
+                .get(index as usize)
+                .ok_or(WireError::EffectIndex(index))?;
+            let params = &self.effect_params[k][..effect.params().len()];
+            effects
+                .push(index as usize, params)
+                .map_err(|e| WireError::Effect(e.to_string()))?;
+        }
+        Ok(Candidate {
+            factors: Factors(self.factors),
+            effects,
+        })
+    }
+}
+
+impl WireResponse {
+    /// The wire form of `outcome` for candidate `index`.
+    pub fn new(index: u64, outcome: &Outcome) -> Self {
+        let mut r = WireResponse {
+            index,
+            status: status::GOALS,
+            event: 0,
+            j_pos_m: 0.0,
+            j_att_deg: 0.0,
+            t_s: 0.0,
+            reason_len: 0,
+            reserved: 0,
+            reason: [0; REASON_CAPACITY],
+        };
+        match outcome {
+            Outcome::Goals { j_pos_m, j_att_deg } => {
+                r.j_pos_m = *j_pos_m;
+                r.j_att_deg = *j_att_deg;
+            }
+            Outcome::Diverged { t_s, event } => {
+                r.status = status::DIVERGED;
+                r.t_s = *t_s;
+                r.event = *event as u32;
+            }
+            Outcome::Failed { reason } => {
+                r.status = status::FAILED;
+                // Outcomes are made with reasons of at most REASON_CAPACITY bytes
+                // (`Outcome::failed`); cut at a character boundary all the same.
+                let mut end = reason.len().min(REASON_CAPACITY);
+                while !reason.is_char_boundary(end) {
+                    end -= 1;
+                }
+                r.reason[..end].copy_from_slice(&reason.as_bytes()[..end]);
+                r.reason_len = end as u32;
+            }
+        }
+        r
+    }
+
+    /// The outcome, refusing a malformed message.
+    pub fn outcome(&self) -> Result<Outcome, WireError> {
+        match self.status {
+            status::GOALS => Ok(Outcome::Goals {
+                j_pos_m: self.j_pos_m,
+                j_att_deg: self.j_att_deg,
+            }),
+            status::DIVERGED => Ok(Outcome::Diverged {
+                t_s: self.t_s,
+                event: self.event as usize,
+            }),
+            status::FAILED => {
+                let len = self.reason_len as usize;
+                let text = self
+                    .reason
+                    .get(..len)
+                    .and_then(|b| std::str::from_utf8(b).ok())
+                    .ok_or(WireError::Reason(self.reason_len))?;
+                Ok(Outcome::Failed {
+                    reason: text.to_string(),
+                })
+            }
+            other => Err(WireError::Status(other)),
+        }
+    }
+}
+
+/// A chunk of requests, as a worker holds it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chunk {
+    /// Its header (`count` = `requests.len()`).
+    pub header: ChunkHeader,
+    /// The candidates.
+    pub requests: Vec<WireRequest>,
+}
+
+impl Chunk {
+    /// The chunk `chunk_id` of `batch[indices]`.
+    pub fn new(chunk_id: u64, indices: &[usize], batch: &[Candidate], with_samples: bool) -> Self {
+        Chunk {
+            header: ChunkHeader {
+                chunk_id,
+                count: indices.len() as u32,
+                with_samples: u32::from(with_samples),
+            },
+            requests: indices
+                .iter()
+                .map(|&i| WireRequest::new(i as u64, &batch[i]))
+                .collect(),
+        }
+    }
+
+    /// Whether samples are wanted back.
+    pub fn with_samples(&self) -> bool {
+        self.header.with_samples != 0
+    }
+}
+
+/// The answer to a chunk.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Answer {
+    /// The chunk's header, echoed.
+    pub header: ChunkHeader,
+    /// One response per request, in order.
+    pub responses: Vec<WireResponse>,
+    /// With samples: the job's samples of every candidate in turn ([`WireObservation::MISSING`]
+    /// for runs that did not finish); otherwise empty.
+    pub samples: Vec<WireObservation>,
+}
+
+/// Evaluates chunks: their requests become candidates (a malformed one a `Failed` outcome),
+/// `evaluate` runs every valid one as one batch (the job's own evaluation in a worker, a host's
+/// workers behind a gateway), and the evaluations become one answer per chunk. The one serve
+/// function of every worker loop. The chunks must be of one kind (all with samples, or none).
+pub fn serve_chunks<E>(
+    job: &Job,
+    chunks: &[Chunk],
+    evaluate: impl FnOnce(&[Candidate], bool) -> Result<Vec<Evaluation>, E>,
+) -> Result<Vec<Answer>, E> {
+    let with_samples = chunks.first().is_some_and(Chunk::with_samples);
+    let requests: Vec<&WireRequest> = chunks.iter().flat_map(|c| &c.requests).collect();
+    let mut outcomes: Vec<Option<Evaluation>> = vec![None; requests.len()];
+    let mut batch = Vec::with_capacity(requests.len());
+    let mut at = Vec::with_capacity(requests.len());
+    for (k, r) in requests.iter().enumerate() {
+        match r.candidate() {
+            Ok(c) => {
+                batch.push(c);
+                at.push(k);
+            }
+            Err(e) => {
+                outcomes[k] = Some(Evaluation::from(Outcome::failed(format!(
+                    "malformed request: {e}"
+                ))));
+            }
+        }
+    }
+    if !batch.is_empty() {
+        for (e, k) in evaluate(&batch, with_samples)?.into_iter().zip(at) {
+            outcomes[k] = Some(e);
+        }
+    }
+    let per = job.sample_count();
+    let mut outcomes = outcomes.into_iter();
+    Ok(chunks
+        .iter()
+        .map(|chunk| {
+            let mut samples = Vec::new();
+            let mut responses = Vec::with_capacity(chunk.requests.len());
+            for (r, e) in chunk.requests.iter().zip(outcomes.by_ref()) {
+                let e = e.unwrap_or_else(|| Evaluation::from(Outcome::failed("not evaluated")));
+                if with_samples {
+                    match &e.samples {
+                        Some(events) => {
+                            samples.extend(events.iter().flatten().map(WireObservation::from))
+                        }
+                        None => samples.extend(std::iter::repeat_n(WireObservation::MISSING, per)),
+                    }
+                }
+                responses.push(WireResponse::new(r.index, &e.outcome));
+            }
+            Answer {
+                header: ChunkHeader {
+                    count: responses.len() as u32,
+                    ..chunk.header
+                },
+                responses,
+                samples,
+            }
+        })
+        .collect())
+}
+
+/// Evaluates a chunk in this process, one candidate after the other.
+pub fn serve_locally(job: &Job, chunk: &Chunk) -> Answer {
+    let result: Result<Vec<Answer>, std::convert::Infallible> =
+        serve_chunks(job, std::slice::from_ref(chunk), |batch, s| {
+            Ok(batch
+                .iter()
+                .map(|c| {
+                    if s {
+                        job.evaluate_with_samples(c)
+                    } else {
+                        job.evaluate(c)
+                    }
+                })
+                .collect())
+        });
+    match result {
+        Ok(mut a) => a.remove(0),
+        Err(never) => match never {},
+    }
+}
+
+impl Answer {
+    /// The evaluations of the candidates at `indices` (the chunk as sent), refusing an answer
+    /// that does not fit it: another count, another candidate, a malformed outcome, samples of
+    /// the wrong length.
+    pub fn evaluations(
+        &self,
+        indices: &[usize],
+        job: &Job,
+    ) -> Result<Vec<(usize, Evaluation)>, String> {
+        if self.responses.len() != indices.len() {
+            return Err(format!(
+                "it answered {} of {} candidates",
+                self.responses.len(),
+                indices.len()
+            ));
+        }
+        let per = job.sample_count();
+        let with_samples = self.header.with_samples != 0;
+        if with_samples && self.samples.len() != per * indices.len() {
+            return Err(format!(
+                "it sent {} samples for {} candidates of {per}",
+                self.samples.len(),
+                indices.len()
+            ));
+        }
+        let mut out = Vec::with_capacity(indices.len());
+        for (k, (r, &index)) in self.responses.iter().zip(indices).enumerate() {
+            if r.index as usize != index {
+                return Err(format!(
+                    "it answered candidate {} in place of {index}",
+                    r.index
+                ));
+            }
+            let outcome = r.outcome().map_err(|e| format!("malformed answer: {e}"))?;
+            let samples = (with_samples && outcome.goals().is_some())
+                .then(|| split_events(job, &self.samples[k * per..(k + 1) * per]));
+            out.push((index, Evaluation { outcome, samples }));
+        }
+        Ok(out)
+    }
+}
+
+/// Flat samples of one candidate, split per event.
+fn split_events(job: &Job, flat: &[WireObservation]) -> Vec<Vec<Observation>> {
+    let mut out = Vec::with_capacity(job.events().len());
+    let mut pos = 0;
+    for e in job.events() {
+        out.push(
+            flat[pos..pos + e.data.len()]
+                .iter()
+                .map(Observation::from)
+                .collect(),
+        );
+        pos += e.data.len();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sepval_common::scenario::Scenario;
+    use sepval_common::synthetic::default_flight_test;
+
+    fn job() -> Job {
+        Job::single(
+            "default",
+            &Scenario::embedded_default(),
+            default_flight_test(),
+        )
+    }
+
+    #[test]
+    fn requests_and_responses_round_trip_and_bad_ones_are_refused() {
+        let mut effects = EffectSet::NONE;
+        effects.push_spec("release_rates=0.1,0.2,0.3").unwrap();
+        let c = Candidate {
+            factors: Factors::TRUTH,
+            effects,
+        };
+        let w = WireRequest::new(5, &c);
+        assert_eq!(w.candidate().unwrap(), c);
+        // Non-finite factors travel as they are: the model refuses them, as it does in process.
+        let mut nan = w;
+        nan.factors[3] = f64::NAN;
+        assert!(nan.candidate().unwrap().factors.0[3].is_nan());
+        let mut bad = w;
+        bad.effect_count = 9;
+        assert_eq!(
+            bad.candidate().unwrap_err().to_string(),
+            "effect count 9 exceeds the maximum of 4"
+        );
+        let mut bad = w;
+        bad.effect_index[0] = 99;
+        assert_eq!(
+            bad.candidate().unwrap_err().to_string(),
+            "effect index 99 is not in the catalogue"
+        );
+        let mut bad = w;
+        bad.effect_params[0][1] = f64::INFINITY;
+        assert!(
+            bad.candidate()
+                .unwrap_err()
+                .to_string()
+                .contains("not a finite number")
+        );
+
+        for o in [
+            Outcome::Goals {
+                j_pos_m: 0.1,
+                j_att_deg: 2.0,
+            },
+            Outcome::Diverged { t_s: 0.5, event: 1 },
+            Outcome::failed("é".repeat(200)),
+        ] {
+            assert_eq!(WireResponse::new(3, &o).outcome().unwrap(), o);
+        }
+        let mut r = WireResponse::new(0, &Outcome::Diverged { t_s: 0.0, event: 0 });
+        r.status = 42;
+        assert_eq!(
+            r.outcome().unwrap_err().to_string(),
+            "unknown response status 42"
+        );
+        let mut r = WireResponse::new(0, &Outcome::failed("x"));
+        r.reason_len = 9999;
+        assert!(r.outcome().is_err());
+    }
+
+    #[test]
+    fn a_served_chunk_is_the_local_evaluation_and_malformed_requests_fail() {
+        let job = job();
+        let mut far = Factors::TRUTH;
+        far.0[0] = 7.0;
+        let batch = [
+            Candidate::baseline(Factors::TRUTH),
+            Candidate::baseline(far),
+            Candidate::baseline(Factors::NOMINAL),
+        ];
+        let mut chunk = Chunk::new(9, &[0, 1, 2], &batch, true);
+        chunk.requests[2].effect_count = 77;
+        let answer = serve_locally(&job, &chunk);
+        let back = answer.evaluations(&[0, 1, 2], &job).unwrap();
+        assert_eq!(back[0].1, job.evaluate_with_samples(&batch[0]));
+        assert_eq!(back[1].1.outcome, job.evaluate(&batch[1]).outcome);
+        assert_eq!(
+            back[2].1.outcome,
+            Outcome::failed("malformed request: effect count 77 exceeds the maximum of 4")
+        );
+        assert!(answer.evaluations(&[0, 1], &job).is_err());
+        assert!(answer.evaluations(&[0, 2, 1], &job).is_err());
+    }
+}

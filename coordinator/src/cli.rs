@@ -1,0 +1,368 @@
+//! The command line: clap types only, one `ValueEnum` per closed set of values. Raw flags
+//! become a validated configuration in `command/` before anything runs.
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use sepval_transport::RunId;
+
+#[derive(Parser)]
+#[command(
+    name = "sepval",
+    version,
+    about = "Post-flight validation of store-separation simulations",
+    long_about = "sepval compares a 6DOF store-separation simulation with measured trajectories, \
+                  fits the model factors that make it match, and diagnoses what it still gets wrong."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Simulate a release and write its trajectory (CSV, MODEL.md section 6).
+    Simulate(SimulateArgs),
+    /// List the effect catalogue: the physics the baseline model leaves out.
+    Effects,
+    /// Print the goals J_pos [m] and J_att [deg] of a simulated trajectory against data.
+    Goals(GoalsArgs),
+    /// Write a scenario file (the embedded default unless --scenario is given) as TOML.
+    Scenario(ScenarioArgs),
+    /// Fit the 17 factors to measured data: Anderson's genetic algorithm and hill climber.
+    Fit(Box<FitArgs>),
+    /// Re-evaluate a saved generation and check every goal bit for bit.
+    Rerun(RerunArgs),
+    /// Show what the simulation still gets wrong after a fit, name the cause from the effect
+    /// catalogue, extend the model and measure the gain.
+    Diagnose(Box<DiagnoseArgs>),
+    /// Measure simulations per second against worker count for each transport.
+    Bench(BenchArgs),
+    /// Check the Pareto machinery on problems with known fronts.
+    #[command(subcommand)]
+    Selftest(SelftestCommand),
+    /// Remove the shared-memory resources of sepval runs whose processes are all gone.
+    CleanIpc,
+    /// Join a zenoh run as one host's gateway: serve its chunks with local iceoryx2 workers
+    /// (built with the `zenoh` feature).
+    Gateway(GatewayArgs),
+}
+
+#[derive(clap::Args)]
+pub struct GatewayArgs {
+    /// The coordinator's endpoint, e.g. tcp/192.0.2.7:7447.
+    #[arg(long, value_name = "ENDPOINT")]
+    pub connect: String,
+    /// The run to join (the coordinator prints it).
+    #[arg(long, value_name = "RUN_ID")]
+    pub run: RunId,
+    /// Local iceoryx2 worker processes [default: the number of cores].
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// A local worker holding a chunk longer than this [s] is killed and replaced.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    pub worker_timeout: f64,
+    /// How long to wait for the coordinator's job setup [s].
+    #[arg(long, default_value_t = 30.0, value_name = "S")]
+    pub setup_timeout: f64,
+    /// A zenoh JSON5 configuration to start from (TLS certificates, authentication).
+    #[arg(long, value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+pub struct FitArgs {
+    /// Measured trajectory (CSV; repeatable for several releases). Default: the embedded
+    /// synthetic flight test (truth factors plus noise).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: Vec<PathBuf>,
+    /// Scenario file (TOML); the embedded default when absent.
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    /// Searches to run [default: both; when resuming: the checkpoint's].
+    #[arg(long, value_enum)]
+    pub method: Option<MethodArg>,
+    /// Seed of the genetic algorithm's generator.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Generations (evaluated populations, the initial one included) [default: 500; when
+    /// resuming: the checkpoint's].
+    #[arg(long)]
+    pub generations: Option<usize>,
+    /// Population size (even).
+    #[arg(long, default_value_t = 100)]
+    pub population: usize,
+    /// Probability of single-point crossover.
+    #[arg(long, default_value_t = 0.9)]
+    pub p_crossover: f64,
+    /// Probability of a jump mutation per bit.
+    #[arg(long, default_value_t = 0.005)]
+    pub p_jump: f64,
+    /// Probability of a creep mutation per parameter.
+    #[arg(long, default_value_t = 0.05)]
+    pub p_creep: f64,
+    /// Simulation budget of the hill climber.
+    #[arg(long, default_value_t = 500)]
+    pub hill_budget: usize,
+    /// Simulation budget of the Levenberg-Marquardt refinement (`+lm` methods).
+    #[arg(long, default_value_t = 5000)]
+    pub lm_budget: u64,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    /// The true factors (JSON), for Figure 7; the embedded truth is used with the default data.
+    #[arg(long, value_name = "FILE.json")]
+    pub truth_factors: Option<PathBuf>,
+    /// Continue from a checkpoint (DIR/generations/gen-NNNN.json).
+    #[arg(long, value_name = "CHECKPOINT")]
+    pub resume: Option<PathBuf>,
+    /// Skip the figures.
+    #[arg(long)]
+    pub no_figures: bool,
+    /// Run directory (result.json, generations/, figures/).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct DiagnoseArgs {
+    /// Measured trajectory (CSV; repeatable). Default: the embedded synthetic flight test.
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: Vec<PathBuf>,
+    /// Scenario file (TOML); the embedded default when absent.
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    /// Seed of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Generations of the baseline fit's genetic search (it stops earlier when its refinement
+    /// reaches the noise floor).
+    #[arg(long, default_value_t = 60)]
+    pub generations: usize,
+    /// Population of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 100)]
+    pub population: usize,
+    /// Simulation budget of each refinement.
+    #[arg(long, default_value_t = 3000)]
+    pub lm_budget: u64,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    /// Output directory (diagnosis.json, report.html, figures/, baseline/).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+#[derive(Subcommand)]
+pub enum SelftestCommand {
+    /// The genetic algorithm on ZDT1, ZDT2 or ZDT3 (30 variables): prints the hypervolume of
+    /// the final front with reference point (1.1, 1.1).
+    Zdt {
+        /// The test problem.
+        #[arg(long, value_enum)]
+        problem: ZdtArg,
+        /// Evaluations (whole generations of 100).
+        #[arg(long, default_value_t = 25_000)]
+        evaluations: usize,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Bits per variable.
+        #[arg(long, default_value_t = 20)]
+        bits: u32,
+    },
+}
+
+/// Transports `sepval bench` measures by default.
+#[cfg(feature = "zenoh")]
+pub const DEFAULT_TRANSPORTS: &str = "single,pool,ipc,uds,zenoh";
+/// Transports `sepval bench` measures by default.
+#[cfg(not(feature = "zenoh"))]
+pub const DEFAULT_TRANSPORTS: &str = "single,pool,ipc,uds";
+
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// Worker counts, comma-separated.
+    #[arg(long, default_value = "1,2,4", value_delimiter = ',')]
+    pub workers: Vec<usize>,
+    /// Simulations per measurement.
+    #[arg(long, default_value_t = 2000)]
+    pub evals: usize,
+    /// Transports, comma-separated (zenoh when built with it).
+    #[arg(long, value_enum, default_value = DEFAULT_TRANSPORTS, value_delimiter = ',')]
+    pub transports: Vec<TransportArg>,
+    /// Measurements per transport and worker count, taken in interleaved rounds; the table
+    /// reports the median.
+    #[arg(long, default_value_t = 3)]
+    pub repeat: usize,
+    /// Output directory (bench.csv, bench.png).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct RerunArgs {
+    /// Checkpoint of the generation to re-evaluate.
+    #[arg(value_name = "CHECKPOINT")]
+    pub checkpoint: PathBuf,
+    /// Data files (default: those recorded in the checkpoint).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: Vec<PathBuf>,
+    /// Scenario file (default: the one recorded in the checkpoint).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+}
+
+/// The measurement noise that weights the goals (shared by every search command).
+#[derive(clap::Args)]
+pub struct NoiseArgs {
+    /// Position noise [m] weighting J_pos (default: estimated from the data).
+    #[arg(long)]
+    pub sigma_pos_m: Option<f64>,
+    /// Attitude noise [deg] weighting J_att (default: estimated from the data).
+    #[arg(long)]
+    pub sigma_att_deg: Option<f64>,
+}
+
+/// How simulations are run (shared by every search command).
+#[derive(clap::Args)]
+pub struct EvalArgs {
+    /// `ipc`: worker processes over iceoryx2 shared memory; `inproc`: threads of this process;
+    /// `zenoh`: workers on any host that joins --listen (built with the `zenoh` feature).
+    #[arg(long, value_enum, default_value_t = EvaluatorKind::Ipc)]
+    pub evaluator: EvaluatorKind,
+    /// Worker processes (ipc) [default: the number of cores]; with zenoh, the workers to wait
+    /// for before the search starts [default: 1] (more may join at any time).
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// zenoh: the endpoint to listen on for workers, e.g. tcp/0.0.0.0:7447 (explicit port).
+    #[arg(long, value_name = "ENDPOINT")]
+    pub listen: Option<String>,
+    /// zenoh: a zenoh JSON5 configuration to start from (TLS certificates, authentication);
+    /// sepval still sets peer mode, the endpoint and switches scouting off.
+    #[arg(long, value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
+    /// Threads (inproc) [default: the number of cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Do not start workers: create run RUN_ID and wait for --workers externally started
+    /// `sepval-worker --run RUN_ID`.
+    #[arg(long, value_name = "RUN_ID")]
+    pub attach: Option<RunId>,
+    /// Run id of spawned workers [default: a fresh one].
+    #[arg(long, value_name = "RUN_ID")]
+    pub run_id: Option<RunId>,
+    /// A worker that holds a chunk longer than this [s] is killed and replaced.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    pub worker_timeout: f64,
+    /// How long to wait for workers to join [s].
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    pub join_timeout: f64,
+    /// Announce this protocol version in the job setup (compatibility testing only).
+    #[arg(long, hide = true)]
+    pub announce_protocol: Option<u32>,
+}
+
+#[derive(clap::Args)]
+pub struct SimulateArgs {
+    /// Scenario file (TOML); the embedded default (Eglin benchmark store) when absent.
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    /// Factors: `truth`, `nominal`, or a JSON file mapping the 17 factor names to values.
+    #[arg(long, default_value = "truth", value_name = "truth|nominal|FILE.json")]
+    pub factors: String,
+    /// Switch on a catalogue effect with its parameters in MODEL.md units and order
+    /// (repeatable), e.g. `--effect roll_due_to_sideslip=-0.3`.
+    #[arg(long = "effect", value_name = "ID=V1,V2,...")]
+    pub effects: Vec<String>,
+    /// Add Gaussian measurement noise (0.003 m, 0.1 deg) from this seed.
+    #[arg(long, value_name = "N")]
+    pub noise_seed: Option<u64>,
+    /// Event length [s] (default: the scenario's).
+    #[arg(long, value_name = "S")]
+    pub t_end: Option<f64>,
+    /// Telemetry rate [Hz] (default: the scenario's).
+    #[arg(long, value_name = "HZ")]
+    pub rate: Option<f64>,
+    /// Output CSV file (written atomically).
+    #[arg(long, value_name = "FILE.csv")]
+    pub out: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct GoalsArgs {
+    /// Measured trajectory (CSV).
+    #[arg(long, value_name = "A.csv")]
+    pub data: PathBuf,
+    /// Simulated trajectory (CSV) at the same sample times.
+    #[arg(long, value_name = "B.csv")]
+    pub sim: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct ScenarioArgs {
+    /// Scenario to rewrite (validated); the embedded default when absent.
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    /// Output TOML file (written atomically).
+    #[arg(long, value_name = "FILE.toml")]
+    pub out: PathBuf,
+}
+
+/// `--method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// The study's genetic algorithm.
+    Ga,
+    /// The study's hill climber.
+    Hill,
+    /// Both, as in the study's comparison.
+    Both,
+    /// The genetic algorithm, then refinement to the noise floor.
+    #[value(name = "ga+lm")]
+    GaLm,
+    /// The hill climber, then refinement to the noise floor.
+    #[value(name = "hill+lm")]
+    HillLm,
+}
+
+/// `--evaluator`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum EvaluatorKind {
+    /// Worker processes over iceoryx2 shared memory.
+    Ipc,
+    /// Threads of this process.
+    Inproc,
+    /// Workers on any host that joins --listen (built with the `zenoh` feature).
+    Zenoh,
+}
+
+/// `--transports`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TransportArg {
+    /// One thread of this process.
+    Single,
+    /// A thread pool of this process.
+    Pool,
+    /// iceoryx2 worker processes.
+    Ipc,
+    /// Unix-socket worker processes.
+    Uds,
+    /// zenoh worker processes over loopback TCP.
+    Zenoh,
+}
+
+/// `selftest zdt --problem`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ZdtArg {
+    /// Convex front.
+    Zdt1,
+    /// Non-convex front.
+    Zdt2,
+    /// Disconnected front.
+    Zdt3,
+}

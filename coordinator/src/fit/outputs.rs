@@ -1,0 +1,317 @@
+//! What a fit reports: each method's result (best member, Pareto front, history, per-channel
+//! residuals), what one grid step of each factor does at the best fit, the results file and the
+//! figures.
+
+use std::path::{Path, PathBuf};
+
+use sepval_common::atomic_file::write_atomically;
+use sepval_common::evaluation::{Candidate, Evaluator, Job, Outcome};
+use sepval_common::factors::{FACTOR_COUNT, Factors};
+use sepval_common::goals::residual;
+use sepval_common::propagator::Observation;
+
+use super::{FitError, FitOutput};
+use crate::problem::factors_of;
+use crate::refine::{LmResult, Noise};
+use crate::results::{
+    Best, ChannelRms, FitResult, FrontPoint, HistoryPoint, MethodResult, Probe, Refinement,
+    ResolutionRow, channel_rms, residuals,
+};
+use crate::search::ga::Member;
+
+/// Simulations at which the history first has both goals at the floor.
+pub(super) fn first_at_floor(
+    history: &[HistoryPoint],
+    at_floor: &dyn Fn([f64; 2]) -> bool,
+) -> Option<u64> {
+    history
+        .iter()
+        .find(|h| at_floor([h.best_j_pos_m, h.best_j_att_deg]))
+        .map(|h| h.evaluations)
+}
+
+pub(super) fn lm_first_at_floor(
+    lm: &LmResult,
+    before: u64,
+    at_floor: &dyn Fn([f64; 2]) -> bool,
+) -> Option<u64> {
+    lm.history
+        .iter()
+        .find(|(_, g)| at_floor(g.as_array()))
+        .map(|(n, _)| before + n)
+}
+
+/// The refined member, its channel summary and samples, and the refinement record.
+pub(super) fn refined_member(
+    evaluator: &mut dyn Evaluator,
+    lm: &LmResult,
+    start: &Member,
+    probes: Vec<Probe>,
+) -> (Member, ChannelRms, Vec<Vec<Observation>>, Refinement) {
+    let values = lm.x[..FACTOR_COUNT].to_vec();
+    let member = Member {
+        chromosome: sepval_common::encoding::Chromosome::encode_values(
+            &evaluator.job().factor_table().0,
+            &values,
+        ),
+        values,
+        outcome: Outcome::Goals {
+            j_pos_m: lm.goals.j_pos_m,
+            j_att_deg: lm.goals.j_att_deg,
+        },
+    };
+    let rms = channel_rms(&residuals(evaluator.job(), &lm.samples));
+    let refinement = Refinement {
+        start_goals: start.objectives(),
+        evaluations: lm.evaluations,
+        iterations: lm.iterations,
+        stop: lm.stop.clone(),
+        probes,
+    };
+    (member, rms, lm.samples.clone(), refinement)
+}
+
+/// One grid step of each factor at `factors` (inward at a bound): the change of the goals and
+/// of the simulated trajectory, coarse when the trajectory moves by more than the noise.
+pub fn resolution_advice(
+    evaluator: &mut dyn Evaluator,
+    table: &sepval_common::factors::FactorTable,
+    factors: &Factors,
+    noise: Noise,
+) -> Result<Vec<ResolutionRow>, FitError> {
+    use sepval_common::factors::Factor;
+    let mut batch = vec![Candidate::baseline(*factors)];
+    for (i, spec) in table.0.iter().enumerate() {
+        let mut f = *factors;
+        let step = spec.step();
+        f.0[i] = if f.0[i] + step <= spec.max {
+            f.0[i] + step
+        } else {
+            f.0[i] - step
+        };
+        batch.push(Candidate::baseline(f));
+    }
+    let out = evaluator.evaluate(&batch, true)?;
+    let base = out[0]
+        .samples
+        .clone()
+        .ok_or_else(|| FitError::Failed("the best fit did not simulate".into()))?;
+    let g0 = out[0].outcome.objectives();
+    let mut rows = Vec::new();
+    for (i, e) in out.iter().enumerate().skip(1) {
+        let name = Factor::NAMES[i - 1].to_string();
+        let step = table.0[i - 1].step();
+        let Some(s) = &e.samples else {
+            rows.push(ResolutionRow {
+                factor: name,
+                step,
+                d_j_pos_m: f64::INFINITY,
+                d_j_att_deg: f64::INFINITY,
+                traj_rms_pos_m: f64::INFINITY,
+                traj_rms_att_deg: f64::INFINITY,
+                coarse: true,
+            });
+            continue;
+        };
+        let (mut dp, mut da, mut n) = (0.0, 0.0, 0usize);
+        for (ev_a, ev_b) in s.iter().zip(&base) {
+            for (a, b) in ev_a.iter().zip(ev_b) {
+                let (p, q) = residual(a, &b.pos_m, &b.att_deg);
+                dp += p.iter().map(|v| v * v).sum::<f64>();
+                da += q.iter().map(|v| v * v).sum::<f64>();
+                n += 1;
+            }
+        }
+        let n3 = 3.0 * n.max(1) as f64;
+        let (rp, ra) = ((dp / n3).sqrt(), (da / n3).sqrt());
+        let g = e.outcome.objectives();
+        rows.push(ResolutionRow {
+            factor: name,
+            step,
+            d_j_pos_m: g[0] - g0[0],
+            d_j_att_deg: g[1] - g0[1],
+            traj_rms_pos_m: rp,
+            traj_rms_att_deg: ra,
+            coarse: rp > noise.pos_m || ra > noise.att_deg,
+        });
+    }
+    Ok(rows)
+}
+
+/// Re-evaluates a best member with its samples: its per-channel residual RMS and trajectory.
+pub(super) fn best_samples_of(
+    evaluator: &mut dyn Evaluator,
+    best: &Member,
+) -> Result<(ChannelRms, Vec<Vec<Observation>>), FitError> {
+    let batch = [Candidate::baseline(factors_of(&best.values))];
+    let e = evaluator.evaluate(&batch, true)?.remove(0);
+    let samples = e.samples.ok_or_else(|| {
+        FitError::Failed("the best member did not finish when re-evaluated".into())
+    })?;
+    Ok((channel_rms(&residuals(evaluator.job(), &samples)), samples))
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn method_result(
+    best: &Member,
+    front: &[Member],
+    history: Vec<HistoryPoint>,
+    evaluations: u64,
+    wall_s: f64,
+    weights: [f64; 2],
+    channel_rms: ChannelRms,
+    stop: String,
+) -> MethodResult {
+    let [j_pos_m, j_att_deg] = best.objectives();
+    MethodResult {
+        best: Best {
+            factors: factors_of(&best.values),
+            j_pos_m,
+            j_att_deg,
+            weighted: weights[0] * j_pos_m + weights[1] * j_att_deg,
+            evaluations,
+            wall_s,
+            channel_rms,
+        },
+        pareto_front: front
+            .iter()
+            .map(|m| {
+                let [p, a] = m.objectives();
+                FrontPoint {
+                    factors: factors_of(&m.values),
+                    j_pos_m: p,
+                    j_att_deg: a,
+                }
+            })
+            .collect(),
+        history,
+        stop,
+        evaluations_to_floor: None,
+        refinement: None,
+    }
+}
+
+/// Writes DIR/result.json atomically.
+pub fn write_result(dir: &Path, result: &FitResult) -> Result<(), FitError> {
+    let json = serde_json::to_vec_pretty(result).expect("a result serialises");
+    write_atomically(&dir.join("result.json"), &json)?;
+    Ok(())
+}
+
+/// Writes the fit's figures into DIR/figures: the study's Figures 1-6 (trajectories of the
+/// first event against each method's best), Figure 7 (factors beside the truth, when known),
+/// the Pareto fronts and the convergence histories. Returns the files written.
+pub fn write_fit_figures(
+    dir: &Path,
+    job: &Job,
+    output: &FitOutput,
+) -> Result<Vec<PathBuf>, FitError> {
+    use crate::figures::{
+        Series, convergence_figure, factor_figure, pareto_figure, trajectory_figures,
+    };
+    use sepval_common::factors::Factor;
+    let fig_dir = dir.join("figures");
+    std::fs::create_dir_all(&fig_dir).map_err(|source| FitError::Dir {
+        path: fig_dir.clone(),
+        source,
+    })?;
+    let r = &output.result;
+    fn label(m: &str) -> String {
+        match m {
+            "ga" => "genetic algorithm".to_string(),
+            "hill" => "hill climber".to_string(),
+            other => other.to_string(),
+        }
+    }
+    let first = &job.events()[0];
+    let fits: Vec<(String, sepval_common::telemetry::Trajectory)> = output
+        .best_samples
+        .iter()
+        .map(|(m, samples)| {
+            let obs = &samples[0];
+            let traj = sepval_common::telemetry::Trajectory {
+                times_s: first.data.times_s.clone(),
+                pos_m: obs.iter().map(|o| o.pos_m).collect(),
+                att_deg: obs.iter().map(|o| o.att_deg).collect(),
+                ..Default::default()
+            };
+            (label(m), traj)
+        })
+        .collect();
+    let series: Vec<Series> = fits
+        .iter()
+        .map(|(l, t)| Series { label: l, traj: t })
+        .collect();
+    let mut written = trajectory_figures(&fig_dir, &first.data, &series)?;
+
+    let table = job.factor_table();
+    let ranges: Vec<(f64, f64)> = table.0.iter().map(|s| (s.min, s.max)).collect();
+    let method_values: Vec<(String, Vec<f64>)> = r
+        .methods
+        .iter()
+        .map(|(m, v)| (label(m), v.best.factors.0.to_vec()))
+        .collect();
+    let methods: Vec<(&str, &[f64])> = method_values
+        .iter()
+        .map(|(l, v)| (l.as_str(), v.as_slice()))
+        .collect();
+    let truth = r.truth.map(|t| t.0.to_vec());
+    let path = fig_dir.join("fig7_factors.png");
+    factor_figure(&path, &Factor::NAMES, &ranges, &methods, truth.as_deref())?;
+    written.push(path);
+
+    let fronts_data: Vec<(String, Vec<[f64; 2]>)> = r
+        .methods
+        .iter()
+        .map(|(m, v)| {
+            (
+                label(m),
+                v.pareto_front
+                    .iter()
+                    .map(|p| [p.j_pos_m, p.j_att_deg])
+                    .collect(),
+            )
+        })
+        .collect();
+    let fronts: Vec<(&str, &[[f64; 2]])> = fronts_data
+        .iter()
+        .map(|(l, v)| (l.as_str(), v.as_slice()))
+        .collect();
+    let path = fig_dir.join("pareto_front.png");
+    pareto_figure(&path, &fronts, Some((r.sigma_pos_m, r.sigma_att_deg)))?;
+    written.push(path);
+
+    let hist_data: Vec<(String, Vec<(u64, f64)>)> = r
+        .methods
+        .iter()
+        .map(|(m, v)| {
+            (
+                label(m),
+                v.history
+                    .iter()
+                    .map(|h| (h.evaluations, h.best_weighted))
+                    .collect(),
+            )
+        })
+        .collect();
+    let hists: Vec<(&str, &[(u64, f64)])> = hist_data
+        .iter()
+        .map(|(l, v)| (l.as_str(), v.as_slice()))
+        .collect();
+    let path = fig_dir.join("convergence.png");
+    convergence_figure(&path, &hists, Some(2.0))?;
+    written.push(path);
+
+    if let Some(id) = &r.identifiability {
+        let names: Vec<&str> = id.names.iter().map(String::as_str).collect();
+        let path = fig_dir.join("correlation.png");
+        crate::figures::correlation_figure(
+            &path,
+            &names,
+            &id.correlation,
+            "Correlation of the refined estimates (|rho| > 0.9: compensating)",
+        )?;
+        written.push(path);
+    }
+    Ok(written)
+}
