@@ -1,6 +1,6 @@
 //! ISA troposphere and the free-stream state of a flight condition.
 //!
-//! Source: `../shared/MODEL.md` section 1, "atmosphere" row:
+//! Source: `docs/model.md` section 1, "atmosphere" row:
 //! `T = 288.15 - 0.0065 h`, `p = 101325 (T/288.15)^5.25588`, `rho = p / (287.053 T)`,
 //! `a = sqrt(1.4 * 287.053 * T)`. Valid in the troposphere (h < 11 000 m); a scenario above it
 //! is refused by the scenario validation rather than extrapolated silently.
@@ -11,9 +11,9 @@ pub const T0_K: f64 = 288.15;
 pub const LAPSE_K_PER_M: f64 = 0.0065;
 /// Sea-level standard pressure \[Pa\].
 pub const P0_PA: f64 = 101_325.0;
-/// Pressure exponent of the troposphere (g / (R L)), as printed in MODEL.md.
+/// Pressure exponent of the troposphere (g / (R L)), as printed in docs/model.md.
 pub const PRESSURE_EXPONENT: f64 = 5.25588;
-/// Specific gas constant of air [J/(kg K)], as printed in MODEL.md.
+/// Specific gas constant of air [J/(kg K)], as printed in docs/model.md.
 pub const R_AIR_J_PER_KG_K: f64 = 287.053;
 /// Ratio of specific heats of air.
 pub const GAMMA_AIR: f64 = 1.4;
@@ -33,7 +33,7 @@ pub struct AirState {
     pub speed_of_sound_m_s: f64,
 }
 
-/// ISA troposphere at geometric altitude `altitude_m` (MODEL.md section 1).
+/// ISA troposphere at geometric altitude `altitude_m` (docs/model.md section 1).
 pub fn isa_troposphere(altitude_m: f64) -> AirState {
     let temperature_k = T0_K - LAPSE_K_PER_M * altitude_m;
     let pressure_pa = P0_PA * (temperature_k / T0_K).powf(PRESSURE_EXPONENT);
@@ -51,7 +51,7 @@ pub fn isa_troposphere(altitude_m: f64) -> AirState {
 mod tests {
     use super::*;
 
-    /// MODEL.md section 1 prints rho = 0.52981 kg/m^3 and V = 292.96 m/s at Mach 0.95,
+    /// docs/model.md section 1 prints rho = 0.52981 kg/m^3 and V = 292.96 m/s at Mach 0.95,
     /// 26 000 ft (for orientation; the values are derived, not given).
     #[test]
     fn default_condition_matches_the_printed_orientation_values() {

@@ -1,6 +1,6 @@
 //! Carroll's binary encoding of the factors.
 //!
-//! Source: `../shared/MODEL.md` section 4 ("Binary encoding as in Carroll's GA driver"): a gene
+//! Source: `docs/model.md` section 4 ("Binary encoding as in Carroll's GA driver"): a gene
 //! of `b` bits, most significant bit first, integer `k` in `[0, 2^b - 1]`,
 //! `value = min + (max - min) k / (2^b - 1)`. Genes are concatenated in table order; with
 //! Table 1 the chromosome has 93 bits.
@@ -11,7 +11,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::factors::{FACTOR_COUNT, FactorSpec, FactorTable, Factors};
 
-/// Value of gene integer `k` (MODEL.md section 4).
+/// Value of gene integer `k` (docs/model.md section 4).
 #[inline]
 pub fn decode_gene(spec: &FactorSpec, k: u64) -> f64 {
     spec.min + (spec.max - spec.min) * k as f64 / spec.levels_minus_one() as f64

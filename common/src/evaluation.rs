@@ -8,7 +8,7 @@
 //! function of the job and the candidate.
 //!
 //! A [`Job`] is what every evaluator needs once: the events (scenario and measured data of each
-//! release of the store). Goals are pooled over all samples of all events (MODEL.md section 5).
+//! release of the store). Goals are pooled over all samples of all events (docs/model.md section 5).
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -205,14 +205,14 @@ impl Candidate {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "status", rename_all = "snake_case")]
 pub enum Outcome {
-    /// The run finished: its goals (MODEL.md section 5), pooled over all events.
+    /// The run finished: its goals (docs/model.md section 5), pooled over all events.
     Goals {
         /// RMS position error \[m\].
         j_pos_m: f64,
         /// RMS attitude error \[deg\].
         j_att_deg: f64,
     },
-    /// The run diverged (MODEL.md section 3) in event `event` at `t_s`.
+    /// The run diverged (docs/model.md section 3) in event `event` at `t_s`.
     Diverged {
         /// Time of divergence \[s\].
         t_s: f64,

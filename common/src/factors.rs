@@ -1,6 +1,6 @@
 //! The 17 model factors of Anderson's study, their bounds and binary resolution.
 //!
-//! Source: `../shared/MODEL.md` section 4 (Anderson, Table 1) for names, bounds and bits; the
+//! Source: `docs/model.md` section 4 (Anderson, Table 1) for names, bounds and bits; the
 //! truth factors of the default synthetic flight test and the nominal factors
 //! (fwdfac 0.5, aftfac 0.5, inertia factors 1, offsets 0, interference multipliers 1) from the
 //! same section and from issue 2.
@@ -17,7 +17,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 /// Number of factors in the study's table.
 pub const FACTOR_COUNT: usize = 17;
 
-/// One of the 17 factors, in the order of MODEL.md section 4.
+/// One of the 17 factors, in the order of docs/model.md section 4.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[repr(u8)]
 pub enum Factor {
@@ -186,12 +186,12 @@ pub struct Factors(pub [f64; FACTOR_COUNT]);
 
 impl Factors {
     /// The nominal model: fwdfac 0.5, aftfac 0.5, inertia factors 1, offsets 0, interference
-    /// multipliers 1 (issue 2; MODEL.md section 8 "nominal factors").
+    /// multipliers 1 (issue 2; docs/model.md section 8 "nominal factors").
     pub const NOMINAL: Factors = Factors([
         0.5, 0.5, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0,
     ]);
 
-    /// The truth factors of the default synthetic flight test (MODEL.md section 4).
+    /// The truth factors of the default synthetic flight test (docs/model.md section 4).
     pub const TRUTH: Factors = Factors([
         0.25, 0.80, 1.04, 0.96, 1.02, 0.03, -0.05, 0.08, -0.14, 0.10, 0.03, 1.30, 0.80, 1.50, 0.70,
         1.20, 0.60,
@@ -313,7 +313,7 @@ pub struct FactorSpec {
 }
 
 impl FactorSpec {
-    /// Grid step of the gene: (max - min) / (2^bits - 1) (MODEL.md section 4).
+    /// Grid step of the gene: (max - min) / (2^bits - 1) (docs/model.md section 4).
     #[inline]
     pub fn step(&self) -> f64 {
         (self.max - self.min) / self.levels_minus_one() as f64
@@ -343,7 +343,7 @@ impl FactorSpec {
 pub struct FactorTable(pub [FactorSpec; FACTOR_COUNT]);
 
 impl Default for FactorTable {
-    /// Anderson's Table 1 (MODEL.md section 4): 93 bits in all.
+    /// Anderson's Table 1 (docs/model.md section 4): 93 bits in all.
     fn default() -> Self {
         const fn s(min: f64, max: f64, bits: u32) -> FactorSpec {
             FactorSpec { min, max, bits }

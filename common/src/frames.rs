@@ -1,13 +1,13 @@
 //! Frames, attitude and angle conventions.
 //!
-//! Source: `../shared/MODEL.md` section 2.
+//! Source: `docs/model.md` section 2.
 //! - Launch frame L: x forward, y right, z down, inertial; body frame B: x along the store axis.
 //! - Attitude: unit quaternion `q = (q0, q1, q2, q3)`, scalar first, rotating vectors from B to
 //!   L (`v_L = q v_B q*`), so `C_LB` below is the Hamilton rotation matrix of `q`.
 //! - Euler angles: 3-2-1 sequence, `C_LB = Rz(psi) Ry(theta) Rx(phi)`; phi and psi wrapped to
 //!   (-180, 180] deg, theta in [-90, 90] deg.
 //!
-//! Choice left open by MODEL.md and made here: inside an RK4 stage the quaternion is not unit
+//! Choice left open by docs/model.md and made here: inside an RK4 stage the quaternion is not unit
 //! (it is renormalised only after a full step, section 2). [`dcm_from_quaternion`] returns the
 //! rotation of the *normalised* stage quaternion (every entry divided by `|q|^2`), so each
 //! stage sees a proper rotation. The difference from the unnormalised formula is O(h^2 |omega|^2)
@@ -39,7 +39,7 @@ pub fn dcm_from_quaternion(q: [f64; 4]) -> Matrix3<f64> {
     )
 }
 
-/// Quaternion kinematics `dq/dt = 0.5 q (x) (0, omega)` (MODEL.md section 2), with
+/// Quaternion kinematics `dq/dt = 0.5 q (x) (0, omega)` (docs/model.md section 2), with
 /// `omega = (p, q, r)` in body axes [rad/s].
 #[inline]
 pub fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {

@@ -1,6 +1,6 @@
 //! The two goals of the fit, both minimised.
 //!
-//! Source: `../shared/MODEL.md` section 5. Over the N telemetry samples:
+//! Source: `docs/model.md` section 5. Over the N telemetry samples:
 //!
 //! ```text
 //! J_pos = sqrt( sum_k (dx^2 + dy^2 + dz^2) / (3N) )        [m]

@@ -1,6 +1,6 @@
 //! Measurement noise for synthetic flight tests.
 //!
-//! Source: `../shared/MODEL.md` section 4: Gaussian, sigma 0.003 m on each position and 0.1 deg
+//! Source: `docs/model.md` section 4: Gaussian, sigma 0.003 m on each position and 0.1 deg
 //! on each Euler angle, "from the project's own seeded generator". The generator is ChaCha8
 //! (`rand_chacha`), seeded with `seed_from_u64`, and the normal deviates come from
 //! `rand_distr::StandardNormal`: both portable across platforms, so a seed gives the same file

@@ -1,6 +1,6 @@
 //! Classic RK4 with located switching events, and sampling at telemetry times.
 //!
-//! Source: `../shared/MODEL.md` sections 1 (integrator), 2 (renormalisation), 3 (divergence)
+//! Source: `docs/model.md` sections 1 (integrator), 2 (renormalisation), 3 (divergence)
 //! and 3a (switching events and sample times):
 //! - the nominal grid is `t_k = k dt`; a step never straddles a switch: when the trial step
 //!   from `t_k` (modes held) carries an "on" foot's `s_i` past the stroke, or crosses the
@@ -14,7 +14,7 @@
 //!   between grid times it is one RK4 step (split at a switch inside it) from the grid state
 //!   before it.
 //!
-//! Choices made here (MODEL.md leaves them open):
+//! Choices made here (docs/model.md leaves them open):
 //! - Stroke-end times are located by the Illinois variant of regula falsi on the length of the
 //!   trial step, safeguarded by bisection, until the bracket is at most 1e-12 s wide; the step
 //!   is taken to the bracket's upper end, where the foot's displacement has just exceeded the
@@ -31,14 +31,14 @@ use nalgebra::Vector3;
 use crate::frames::{dcm_from_quaternion, euler_321_deg, wrap_deg};
 use crate::model::{EquationsOfMotion, Model, RunSetup, StateVector};
 
-/// Tolerance to which switch times are located \[s\] (MODEL.md section 3a).
+/// Tolerance to which switch times are located \[s\] (docs/model.md section 3a).
 pub const SWITCH_TOLERANCE_S: f64 = 1e-12;
-/// A sample time this close to a grid time takes the grid state \[s\] (MODEL.md section 3a).
+/// A sample time this close to a grid time takes the grid state \[s\] (docs/model.md section 3a).
 pub const GRID_MATCH_TOLERANCE_S: f64 = 1e-9;
-/// Divergence threshold on |omega| [rad/s] (MODEL.md section 3).
+/// Divergence threshold on |omega| [rad/s] (docs/model.md section 3).
 pub const MAX_RATE_RAD_S: f64 = 100.0;
 
-/// The run diverged at `t_s` (MODEL.md section 3): reported as such, never as a number.
+/// The run diverged at `t_s` (docs/model.md section 3): reported as such, never as a number.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error("diverged at t = {t_s} s (non-finite state or |omega| > 100 rad/s)")]
 pub struct Diverged {
@@ -74,7 +74,7 @@ impl SampleSink for Vec<(Observation, StateVector)> {
     }
 }
 
-/// Mode of one ejector foot (MODEL.md section 3a).
+/// Mode of one ejector foot (docs/model.md section 3a).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FootMode {
     /// Before the ejector start time: not pushing yet.
@@ -364,7 +364,7 @@ impl Engine<'_> {
         let tau = self.run.ejector_start_s;
         for i in 0..2 {
             if c.modes[i] == FootMode::Waiting && c.t_s >= tau - SWITCH_TOLERANCE_S {
-                // MODEL.md 3a: at t = tau each foot whose s_i <= stroke turns on.
+                // docs/model.md 3a: at t = tau each foot whose s_i <= stroke turns on.
                 c.modes[i] = if self.stroke_excess(&c.x, i) <= 0.0 {
                     if main {
                         self.log.foot_on_s[i] = Some(c.t_s);

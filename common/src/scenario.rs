@@ -1,14 +1,14 @@
 //! Scenarios: the store, its ejector, aerodynamics, interference, flight condition, integrator
 //! settings and factor table, loaded from TOML.
 //!
-//! Source: `../shared/MODEL.md` section 1 (the embedded default, `scenarios/eglin_default.toml`)
+//! Source: `docs/model.md` section 1 (the embedded default, `scenarios/eglin_default.toml`)
 //! and section 4 (the factor table). Files are SI (m, kg, N, s) with angles in degrees, like
 //! every file sepval reads; each field name carries its unit.
 //!
-//! Choices MODEL.md leaves open, made here:
+//! Choices docs/model.md leaves open, made here:
 //! - `[factors]` may list any subset of the 17 factors; the rest keep Anderson's Table 1.
 //! - `[initial]` (optional) sets the store's velocity relative to the launch frame and its body
-//!   rates at t = 0 (MODEL.md section 2: "All zero at t = 0 unless a scenario says otherwise").
+//!   rates at t = 0 (docs/model.md section 2: "All zero at t = 0 unless a scenario says otherwise").
 //!   Position and attitude at t = 0 are the carriage position and attitude by definition of the
 //!   launch frame.
 //! - The atmosphere is the ISA troposphere of section 1; a flight condition above 11 000 m is
@@ -23,10 +23,10 @@ use sha2::{Digest, Sha256};
 use crate::atmosphere::TROPOPAUSE_M;
 use crate::factors::{Factor, FactorSpec, FactorTable};
 
-/// The embedded default scenario text (MODEL.md section 1).
+/// The embedded default scenario text (docs/model.md section 1).
 pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../scenarios/eglin_default.toml");
 
-/// Mass properties and ejector geometry of the store (MODEL.md section 1).
+/// Mass properties and ejector geometry of the store (docs/model.md section 1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Store {
@@ -48,7 +48,7 @@ pub struct Store {
     pub stroke_m: f64,
 }
 
-/// The nominal ejector force curve per foot (MODEL.md section 1).
+/// The nominal ejector force curve per foot (docs/model.md section 1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Ejector {
@@ -57,7 +57,7 @@ pub struct Ejector {
     pub curve: Vec<[f64; 2]>,
 }
 
-/// Freestream aerodynamic database, body axes (MODEL.md section 1).
+/// Freestream aerodynamic database, body axes (docs/model.md section 1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
@@ -75,7 +75,7 @@ pub struct Aero {
     pub cn_r_per_rad: f64,
 }
 
-/// Aircraft interference increments at carriage and their decay (MODEL.md section 1).
+/// Aircraft interference increments at carriage and their decay (docs/model.md section 1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
@@ -92,7 +92,7 @@ pub struct Interference {
     pub s_end_m: f64,
 }
 
-/// Flight condition of the aircraft at release (MODEL.md sections 1 and 2).
+/// Flight condition of the aircraft at release (docs/model.md sections 1 and 2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Flight {
@@ -111,7 +111,7 @@ pub struct Flight {
     pub gamma_deg: f64,
 }
 
-/// Integrator and telemetry settings (MODEL.md sections 1 and 3a).
+/// Integrator and telemetry settings (docs/model.md sections 1 and 3a).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Integrator {
@@ -228,7 +228,7 @@ pub enum ScenarioError {
 }
 
 impl Scenario {
-    /// The embedded default scenario (MODEL.md section 1).
+    /// The embedded default scenario (docs/model.md section 1).
     pub fn embedded_default() -> Scenario {
         Scenario::from_toml_str(DEFAULT_SCENARIO_TOML, "embedded default")
             .expect("the embedded default scenario is valid (checked by tests)")

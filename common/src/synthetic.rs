@@ -1,5 +1,5 @@
 //! Synthetic flight tests: a simulated trajectory plus seeded measurement noise, standing in
-//! for flight data (the "flight test data" of Anderson's study; MODEL.md section 4).
+//! for flight data (the "flight test data" of Anderson's study; docs/model.md section 4).
 
 use crate::effects::EffectSet;
 use crate::factors::Factors;
@@ -11,7 +11,7 @@ use crate::telemetry::Trajectory;
 pub const DEFAULT_NOISE_SEED: u64 = 20_260_101;
 
 /// A synthetic flight test: `factors` and `effects` simulated at `times_s`, with Gaussian noise
-/// of the MODEL.md sigmas from `noise_seed` (none when `None`), and metadata naming how it was
+/// of the docs/model.md sigmas from `noise_seed` (none when `None`), and metadata naming how it was
 /// made and its flight condition.
 pub fn synthetic_flight_test(
     sim: &Simulator,
@@ -42,7 +42,7 @@ pub fn synthetic_flight_test(
     Ok(traj)
 }
 
-/// The embedded default synthetic flight test: the truth factors of MODEL.md section 4 on the
+/// The embedded default synthetic flight test: the truth factors of docs/model.md section 4 on the
 /// default scenario, 201 samples at 200 Hz, noise from [`DEFAULT_NOISE_SEED`].
 pub fn default_flight_test() -> Trajectory {
     let sim = Simulator::embedded_default();

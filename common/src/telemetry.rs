@@ -1,6 +1,6 @@
 //! Telemetry files: measured or simulated trajectories as CSV.
 //!
-//! Source: `../shared/MODEL.md` section 6. One header row naming the columns `t_s, x_m, y_m,
+//! Source: `docs/model.md` section 6. One header row naming the columns `t_s, x_m, y_m,
 //! z_m, roll_deg, pitch_deg, yaw_deg` (any order; positions may be `x_ft, y_ft, z_ft`), then one
 //! row per sample, time strictly increasing. Lines starting with `#` are comments; a comment of
 //! the form `# key = value` or `# key: value` is also kept as metadata (for example the event

@@ -1,6 +1,6 @@
 //! Exact unit conversions.
 //!
-//! Source: `../shared/MODEL.md`, preamble: "Constants are defined in the units in which they
+//! Source: `docs/model.md`, preamble: "Constants are defined in the units in which they
 //! are given and converted exactly, in double precision, never rounded". Every constant below is
 //! the exact definition of the unit (international foot and pound, standard gravity-based
 //! pound-force), so converting with them costs at most the rounding of one multiplication.
@@ -13,7 +13,7 @@ pub const M_PER_IN: f64 = 0.0254;
 pub const KG_PER_LB: f64 = 0.45359237;
 /// Newtons per pound-force (exact: 0.45359237 kg x 9.80665 m/s^2).
 pub const N_PER_LBF: f64 = 4.4482216152605;
-/// kg m^2 per slug ft^2, as given by MODEL.md (slug = lbf s^2 / ft).
+/// kg m^2 per slug ft^2, as given by docs/model.md (slug = lbf s^2 / ft).
 pub const KG_M2_PER_SLUG_FT2: f64 = 1.3558179483314004;
 
 /// Degrees to radians.

@@ -21,7 +21,7 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
-    /// Simulate a release and write its trajectory (CSV, MODEL.md section 6).
+    /// Simulate a release and write its trajectory (CSV, docs/model.md section 6).
     Simulate(SimulateArgs),
     /// List the effect catalogue: the physics the baseline model leaves out.
     Effects,
@@ -275,7 +275,7 @@ pub struct SimulateArgs {
     /// Factors: `truth`, `nominal`, or a JSON file mapping the 17 factor names to values.
     #[arg(long, default_value = "truth", value_name = "truth|nominal|FILE.json")]
     pub factors: String,
-    /// Switch on a catalogue effect with its parameters in MODEL.md units and order
+    /// Switch on a catalogue effect with its parameters in docs/model.md units and order
     /// (repeatable), e.g. `--effect roll_due_to_sideslip=-0.3`.
     #[arg(long = "effect", value_name = "ID=V1,V2,...")]
     pub effects: Vec<String>,

@@ -1,4 +1,4 @@
-//! `attitude_bias` (MODEL.md section 7): measured Euler angles carry constant biases (roll and
+//! `attitude_bias` (docs/model.md section 7): measured Euler angles carry constant biases (roll and
 //! yaw rewrapped to (-180, 180] after adding).
 
 use super::{Effect, EffectError, ParamSpec};

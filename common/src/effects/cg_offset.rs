@@ -1,4 +1,4 @@
-//! `cg_offset` (MODEL.md section 7): the true CG lies dx_cg ahead of the nominal one, which
+//! `cg_offset` (docs/model.md section 7): the true CG lies dx_cg ahead of the nominal one, which
 //! stays the aerodynamic moment reference. Foot arms become x_i - dx_cg; moments move to the
 //! true CG (Cm += CZ dx_cg/d, Cn -= CY dx_cg/d, which is M += r_ref x F with
 //! r_ref = (-dx_cg, 0, 0)); the state, f(s), the reported position and a tracked point refer to

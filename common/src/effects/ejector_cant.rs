@@ -1,4 +1,4 @@
-//! `ejector_cant` (MODEL.md section 7): each foot's force is turned by kappa about the L x
+//! `ejector_cant` (docs/model.md section 7): each foot's force is turned by kappa about the L x
 //! axis: F_i (0, -sin kappa, cos kappa).
 
 use nalgebra::Vector3;

@@ -1,4 +1,4 @@
-//! `ejector_delay` (MODEL.md sections 7 and 3a): hooks open at t = 0 and the store falls
+//! `ejector_delay` (docs/model.md sections 7 and 3a): hooks open at t = 0 and the store falls
 //! freely; the feet push only from t = tau, when each foot whose s_i <= stroke turns on.
 
 use super::{Effect, EffectError, ParamSpec, require};

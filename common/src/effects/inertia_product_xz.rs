@@ -1,4 +1,4 @@
-//! `inertia_product_xz` (MODEL.md section 7): I = [[Ixx, 0, -Ixz], [0, Iyy, 0], [-Ixz, 0, Izz]];
+//! `inertia_product_xz` (docs/model.md section 7): I = [[Ixx, 0, -Ixz], [0, Iyy, 0], [-Ixz, 0, Izz]];
 //! Ixz is not scaled by the inertia factors. A value that makes the tensor indefinite
 //! (Ixz^2 >= Ixx Izz) is refused when the run is built.
 

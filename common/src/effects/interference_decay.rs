@@ -1,4 +1,4 @@
-//! `interference_decay` (MODEL.md section 7): lambda becomes k_lambda * 0.6 m (generally:
+//! `interference_decay` (docs/model.md section 7): lambda becomes k_lambda * 0.6 m (generally:
 //! k_lambda times the scenario's lambda); s_end is unchanged.
 
 use super::{Effect, EffectError, ParamSpec, require};

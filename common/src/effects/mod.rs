@@ -1,6 +1,6 @@
 //! The effect catalogue: physics the baseline model leaves out, as optional extensions.
 //!
-//! Source: `../shared/MODEL.md` section 7. Each effect is one small type in its own file
+//! Source: `docs/model.md` section 7. Each effect is one small type in its own file
 //! implementing [`Effect`], registered once in [`CATALOGUE`]; adding an effect means adding one
 //! file and one line there. An effect changes a run through the knobs of
 //! [`RunSetup`] (inertia tensor, ejector direction and start time, moment
@@ -8,7 +8,7 @@
 //! evaluated at every force evaluation. Every effect at its neutral parameters leaves the run
 //! bit-for-bit equal to the baseline.
 //!
-//! Parameters are in the units of the MODEL.md table (radians, metres, seconds), in its order.
+//! Parameters are in the units of the docs/model.md table (radians, metres, seconds), in its order.
 //! Each parameter also carries a search range and a typical magnitude, used when a fit
 //! estimates it (the ranges are sepval's choice: generous physical limits, documented in
 //! `sepval effects`).
@@ -39,9 +39,9 @@ pub const MAX_ACTIVE_EFFECTS: usize = 4;
 /// One parameter of an effect.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamSpec {
-    /// Name as in MODEL.md section 7.
+    /// Name as in docs/model.md section 7.
     pub name: &'static str,
-    /// Unit, as in MODEL.md section 7.
+    /// Unit, as in docs/model.md section 7.
     pub unit: &'static str,
     /// Value at which the effect is absent.
     pub neutral: f64,
@@ -53,19 +53,19 @@ pub struct ParamSpec {
     pub scale: f64,
 }
 
-/// An extension of the baseline model (MODEL.md section 7).
+/// An extension of the baseline model (docs/model.md section 7).
 pub trait Effect: Send + Sync {
-    /// Identifier, as in MODEL.md section 7.
+    /// Identifier, as in docs/model.md section 7.
     fn id(&self) -> &'static str;
     /// What it adds, in one line.
     fn adds(&self) -> &'static str;
-    /// Its parameters, in MODEL.md order.
+    /// Its parameters, in docs/model.md order.
     fn params(&self) -> &'static [ParamSpec];
     /// Applies the effect with parameters `p` (as many as [`Effect::params`], finite) to a run.
     fn apply(&self, p: &[f64], run: &mut RunSetup) -> Result<(), EffectError>;
 }
 
-/// Every effect, in MODEL.md order: the one place to register an effect.
+/// Every effect, in docs/model.md order: the one place to register an effect.
 pub static CATALOGUE: [&dyn Effect; 11] = [
     &roll_due_to_sideslip::RollDueToSideslip,
     &pitch_stiffness_cubic::PitchStiffnessCubic,
@@ -370,7 +370,7 @@ impl fmt::Display for EffectSet {
 pub struct NamedEffect {
     /// Effect id.
     pub id: String,
-    /// Parameter values in MODEL.md units and order.
+    /// Parameter values in docs/model.md units and order.
     pub values: Vec<f64>,
 }
 

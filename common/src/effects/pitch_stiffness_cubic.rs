@@ -1,4 +1,4 @@
-//! `pitch_stiffness_cubic`: Cm += Cm_alpha3 * alpha^3 (MODEL.md section 7).
+//! `pitch_stiffness_cubic`: Cm += Cm_alpha3 * alpha^3 (docs/model.md section 7).
 
 use super::{Effect, EffectError, MAX_EFFECT_PARAMS, ParamSpec};
 use crate::model::{Coefficients, Flow, RunSetup};

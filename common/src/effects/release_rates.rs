@@ -1,4 +1,4 @@
-//! `release_rates` (MODEL.md section 7): omega(0) = (p0, q0, r0) instead of zero (aircraft
+//! `release_rates` (docs/model.md section 7): omega(0) = (p0, q0, r0) instead of zero (aircraft
 //! manoeuvring at release). With a scenario that sets initial rates, these add to them.
 
 use nalgebra::Vector3;

@@ -1,4 +1,4 @@
-//! `roll_due_to_sideslip`: Cl += Cl_beta * beta (MODEL.md section 7).
+//! `roll_due_to_sideslip`: Cl += Cl_beta * beta (docs/model.md section 7).
 
 use super::{Effect, EffectError, MAX_EFFECT_PARAMS, ParamSpec};
 use crate::model::{Coefficients, Flow, RunSetup};

@@ -1,4 +1,4 @@
-//! `telemetry_time_offset` (MODEL.md section 7): the measured sample labelled t shows the store
+//! `telemetry_time_offset` (docs/model.md section 7): the measured sample labelled t shows the store
 //! at t + dt_tm (the carriage state where t + dt_tm < 0; the simulation runs past the last
 //! sample where needed).
 

@@ -1,4 +1,4 @@
-//! `tracked_point_offset` (MODEL.md section 7): the measured position is of the body point
+//! `tracked_point_offset` (docs/model.md section 7): the measured position is of the body point
 //! (l_x, 0, 0), relative to that point's carriage position: r + C_LB (l_x, 0, 0) - (l_x, 0, 0).
 
 use super::{Effect, EffectError, ParamSpec};

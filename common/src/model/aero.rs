@@ -1,6 +1,6 @@
 //! Aerodynamic coefficients: freestream database, factor offsets and interference.
 //!
-//! Source: `../shared/MODEL.md` section 3:
+//! Source: `docs/model.md` section 3:
 //!
 //! ```text
 //! CX = -(CA0 + caoff)                        + caintfac * dCX0 * f(s)
@@ -96,7 +96,7 @@ impl AeroConstants {
         }
     }
 
-    /// The coefficients of MODEL.md section 3 (without the catalogue's terms).
+    /// The coefficients of docs/model.md section 3 (without the catalogue's terms).
     /// `increments` are the interference increments times their multipliers,
     /// (dCX, dCY, dCZ, dCl, dCm, dCn).
     #[inline(always)]

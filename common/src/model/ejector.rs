@@ -1,6 +1,6 @@
 //! The ejector force-versus-displacement table.
 //!
-//! Source: `../shared/MODEL.md` section 1 ("nominal ejector force curve"): a table of
+//! Source: `docs/model.md` section 1 ("nominal ejector force curve"): a table of
 //! (s_m, force_N) points, linear between them, covering [0, stroke]. The force of foot i is
 //! `fac_i * F_ej(clamp(s_i, 0, stroke))` (section 3); the clamp is the caller's.
 

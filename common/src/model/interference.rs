@@ -1,6 +1,6 @@
 //! Aircraft interference decay with distance from carriage.
 //!
-//! Source: `../shared/MODEL.md` section 1:
+//! Source: `docs/model.md` section 1:
 //!
 //! ```text
 //! f(s) = (exp(-s/lambda) - exp(-s_end/lambda)) / (1 - exp(-s_end/lambda))   for s < s_end

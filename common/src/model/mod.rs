@@ -2,11 +2,11 @@
 //! ([`RunSetup`]: factors and effects applied), and the equations of motion
 //! ([`RunSetup::derivative`]).
 //!
-//! Source: `../shared/MODEL.md` sections 1 to 3. The tree mirrors the physics:
+//! Source: `docs/model.md` sections 1 to 3. The tree mirrors the physics:
 //! [`ejector`] (force-versus-displacement table), [`interference`] (decay with distance),
 //! [`aero`] (coefficients and the flow state the catalogue's terms see).
 //!
-//! Equations of motion (MODEL.md section 2), implemented in [`RunSetup::derivative`]:
+//! Equations of motion (docs/model.md section 2), implemented in [`RunSetup::derivative`]:
 //!
 //! ```text
 //! dr/dt     = v
@@ -22,8 +22,11 @@
 //! (`release_rates`), and the measurement knobs (time offset, attitude bias, tracked point).
 
 pub mod aero;
+mod dcm;
 pub mod ejector;
 pub mod interference;
+
+pub use dcm::Dcm;
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -37,13 +40,13 @@ pub use aero::{Coefficients, Flow};
 pub use ejector::EjectorCurve;
 pub use interference::InterferenceDecay;
 
-/// Standard gravity [m/s^2] (MODEL.md section 1).
+/// Standard gravity [m/s^2] (docs/model.md section 1).
 pub const G_M_S2: f64 = 9.80665;
 
 /// Length of the state vector: r (3), v (3), q (4), omega (3).
 pub const STATE_LEN: usize = 13;
 
-/// The state `[r_L (m), v_L (m/s), q (scalar first), omega_B (rad/s)]` (MODEL.md section 2).
+/// The state `[r_L (m), v_L (m/s), q (scalar first), omega_B (rad/s)]` (docs/model.md section 2).
 pub type StateVector = [f64; STATE_LEN];
 
 /// Errors building a run.
@@ -64,7 +67,7 @@ pub enum ModelError {
     },
 }
 
-/// One scenario, set up once: every constant derived from its file (MODEL.md section 1).
+/// One scenario, set up once: every constant derived from its file (docs/model.md section 1).
 #[derive(Debug, Clone)]
 pub struct Model {
     scenario: Scenario,
@@ -87,7 +90,7 @@ pub struct Model {
     /// Free-stream speed V_inf = Mach a [m/s].
     pub v_inf_m_s: f64,
     /// Aircraft velocity relative to the air in L:
-    /// V_inf (cos a cos b, sin b, sin a cos b) (MODEL.md section 2).
+    /// V_inf (cos a cos b, sin b, sin a cos b) (docs/model.md section 2).
     pub v_aircraft_air_l_m_s: Vector3<f64>,
     /// Gravity in L: g (-sin theta_a, 0, cos theta_a), theta_a = alpha + gamma.
     pub gravity_l_m_s2: Vector3<f64>,
@@ -191,7 +194,7 @@ pub struct RunSetup {
     pub feet: [Foot; 2],
     /// Ejector stroke \[m\].
     pub stroke_m: f64,
-    /// Unit direction of each foot's force in L (MODEL.md: +z of L).
+    /// Unit direction of each foot's force in L (docs/model.md: +z of L).
     pub ejector_direction_l: Vector3<f64>,
     /// Time at which the feet start pushing \[s\] (0: at release).
     pub ejector_start_s: f64,
@@ -331,14 +334,14 @@ impl RunSetup {
         ]
     }
 
-    /// Stroke displacement of foot `i`: the L-frame z of its body point (MODEL.md section 3),
+    /// Stroke displacement of foot `i`: the L-frame z of its body point (docs/model.md section 3),
     /// `s_i = (r + C_LB (x_i, 0, 0))_z`, given `c20 = C_LB[2][0]`.
     #[inline(always)]
     pub fn foot_displacement_m(&self, i: usize, r_z: f64, c20: f64) -> f64 {
         r_z + c20 * self.feet[i].x_m
     }
 
-    /// The state derivative (MODEL.md sections 2 and 3) with the ejector feet in the given
+    /// The state derivative (docs/model.md sections 2 and 3) with the ejector feet in the given
     /// modes (`on[i]`: foot i pushes). See [`EquationsOfMotion::derivative`], which the
     /// propagator calls with the run's constant products formed once.
     #[inline(always)]
@@ -356,7 +359,7 @@ impl RunSetup {
         k
     }
 
-    /// I^-1 (M - omega x (I omega)) (MODEL.md section 2), with a short path for the diagonal
+    /// I^-1 (M - omega x (I omega)) (docs/model.md section 2), with a short path for the diagonal
     /// tensor of the contract.
     #[inline(always)]
     fn angular_acceleration(&self, m: [f64; 3], w: [f64; 3]) -> [f64; 3] {
@@ -386,7 +389,7 @@ impl RunSetup {
     }
 }
 
-/// The equations of motion of one run (MODEL.md sections 2 and 3), with the products of the
+/// The equations of motion of one run (docs/model.md sections 2 and 3), with the products of the
 /// run's constants that the force evaluation needs formed once, when a propagation starts.
 #[derive(Clone, Copy)]
 pub struct EquationsOfMotion<'a> {
@@ -417,7 +420,7 @@ impl<'a> EquationsOfMotion<'a> {
     ///
     /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
     /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
-    /// allocation. Each block cites the MODEL.md line it implements.
+    /// allocation. Each block cites the docs/model.md line it implements.
     ///
     /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
     /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
@@ -514,11 +517,11 @@ impl<'a> EquationsOfMotion<'a> {
 
 /// a . b with fused multiply-adds.
 #[inline(always)]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0].mul_add(b[0], a[1].mul_add(b[1], a[2] * b[2]))
 }
 
-/// Quaternion kinematics `dq/dt = 0.5 q (x) (0, omega)` (MODEL.md section 2), as
+/// Quaternion kinematics `dq/dt = 0.5 q (x) (0, omega)` (docs/model.md section 2), as
 /// [`crate::frames::quaternion_rate`] with fused multiply-adds.
 #[inline(always)]
 fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {
@@ -531,65 +534,6 @@ fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {
         q0.mul_add(hq, q3.mul_add(hp, -q1 * hr)),
         q0.mul_add(hr, q1.mul_add(hq, -q2 * hp)),
     ]
-}
-
-/// The direction-cosine matrix C_LB of one stage's quaternion q scaled to unit length (see
-/// [`crate::frames`]), kept as `m` = |q|^2 C_LB (row-major, `m[i][j]` = |q|^2 C_LB(i, j)),
-/// the products of q without a division, and the scale 1 / |q|^2.
-#[derive(Debug, Clone, Copy)]
-pub struct Dcm {
-    /// |q|^2 C_LB.
-    pub m: [[f64; 3]; 3],
-    /// |q|^2.
-    pub n2: f64,
-    /// 1 / |q|^2.
-    pub inv_n2: f64,
-}
-
-impl Dcm {
-    /// |q|^2 C_LB of the quaternion (q0, q1, q2, q3): the diagonal as q0^2 + qi^2 - qj^2 - qk^2,
-    /// the rest as 2 (qi qj -+ q0 qk).
-    #[inline(always)]
-    pub fn from_quaternion(q0: f64, q1: f64, q2: f64, q3: f64) -> Dcm {
-        let (s00, s11, s22, s33) = (q0 * q0, q1 * q1, q2 * q2, q3 * q3);
-        let (a, b) = (s00 + s11, s22 + s33);
-        let (c, d) = (s00 - s11, s22 - s33);
-        let n2 = a + b;
-        // 2 qi qj -+ 2 q0 qk with one rounding after the shared product (doubling is exact).
-        let (p12, p13, p23) = ((q1 + q1) * q2, (q1 + q1) * q3, (q2 + q2) * q3);
-        let (t01, t02, t03) = (q0 + q0, q0 + q0, q0 + q0);
-        Dcm {
-            m: [
-                [a - b, (-t03).mul_add(q3, p12), t02.mul_add(q2, p13)],
-                [t03.mul_add(q3, p12), c + d, (-t01).mul_add(q1, p23)],
-                [(-t02).mul_add(q2, p13), t01.mul_add(q1, p23), c - d],
-            ],
-            n2,
-            inv_n2: 1.0 / n2,
-        }
-    }
-
-    /// |q|^2 C_BL a: a launch-frame vector in body axes, times |q|^2.
-    #[inline(always)]
-    pub fn to_body_scaled(&self, a: [f64; 3]) -> [f64; 3] {
-        let m = &self.m;
-        [
-            dot([m[0][0], m[1][0], m[2][0]], a),
-            dot([m[0][1], m[1][1], m[2][1]], a),
-            dot([m[0][2], m[1][2], m[2][2]], a),
-        ]
-    }
-
-    /// base + |q|^2 C_LB b: a body vector in launch-frame axes, times |q|^2, added to base.
-    /// The sum runs from b\[0\] to b\[2\], so that b\[2\] (in the force evaluation the normal force,
-    /// the last to be known) waits for one multiply-add only.
-    #[inline(always)]
-    pub fn to_launch_scaled(&self, b: [f64; 3], base: [f64; 3]) -> [f64; 3] {
-        let m = &self.m;
-        let row =
-            |i: usize| m[i][2].mul_add(b[2], m[i][1].mul_add(b[1], m[i][0].mul_add(b[0], base[i])));
-        [row(0), row(1), row(2)]
-    }
 }
 
 /// Inverse of a symmetric inertia tensor, refusing one that is not positive definite.

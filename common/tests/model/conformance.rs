@@ -1,4 +1,4 @@
-//! Conformance with `../shared/MODEL.md` section 8: the trajectories an independent
+//! Conformance with `docs/model.md` section 8: the trajectories an independent
 //! implementation gives, noise-free, at the truth and nominal factors. Agreement to the last
 //! printed digit is expected (1e-9 m and 1e-7 deg as printed; the contract's tolerance is 1e-6).
 
@@ -8,7 +8,7 @@ use sepval_common::{EffectSet, Factors, Simulator};
 
 const TIMES: [f64; 5] = [0.05, 0.10, 0.25, 0.50, 1.00];
 
-/// MODEL.md section 8, truth factors: t, x, y, z [m], roll, pitch, yaw [deg].
+/// docs/model.md section 8, truth factors: t, x, y, z [m], roll, pitch, yaw [deg].
 const TRUTH: [[f64; 7]; 5] = [
     [
         0.05,
@@ -57,7 +57,7 @@ const TRUTH: [[f64; 7]; 5] = [
     ],
 ];
 
-/// MODEL.md section 8, nominal factors.
+/// docs/model.md section 8, nominal factors.
 const NOMINAL: [[f64; 7]; 5] = [
     [
         0.05,

@@ -1,4 +1,4 @@
-//! The effect catalogue (MODEL.md section 7), each effect tested from its definition.
+//! The effect catalogue (docs/model.md section 7), each effect tested from its definition.
 
 #![allow(clippy::needless_range_loop)] // index loops over x, y, z read like the equations
 
@@ -84,7 +84,7 @@ fn derivative_change(sim: &Simulator, spec: &str, x: &StateVector) -> (StateVect
     (base, with)
 }
 
-/// Flow angles, qbar S and C_LB of a state, computed here from MODEL.md section 3.
+/// Flow angles, qbar S and C_LB of a state, computed here from docs/model.md section 3.
 fn flow(sim: &Simulator, x: &StateVector) -> (f64, f64, f64, Matrix3<f64>) {
     let run = run_of(sim, &EffectSet::NONE);
     let c = dcm_from_quaternion([x[6], x[7], x[8], x[9]]);

@@ -1,5 +1,5 @@
 //! The model library's integration tests, in one test binary (one link instead of three):
-//! conformance with MODEL.md section 8, the effect catalogue, and verification against known
+//! conformance with docs/model.md section 8, the effect catalogue, and verification against known
 //! solutions. Run in release: `cargo test --release -p sepval-common`.
 
 mod conformance;

@@ -324,6 +324,21 @@ impl Frame {
         }
     }
 
+    /// What a frame from the coordinator means to a worker: a chunk, or the end of the run;
+    /// `Dropped`, or a frame coordinators do not send, is an error.
+    pub fn into_incoming(self) -> Result<crate::link::Incoming, crate::TransportError> {
+        use crate::link::{Incoming, Stopped};
+        match self {
+            Frame::Chunk(c) => Ok(Incoming::Chunk(c)),
+            Frame::Quit(reason) => Ok(Incoming::Stop(Stopped::Quit(reason))),
+            Frame::Dropped(reason) => Err(crate::TransportError::Dropped(reason)),
+            other => Err(crate::TransportError::Protocol(format!(
+                "the coordinator sent {}, which coordinators do not send",
+                Frame::name_of(Some(&other))
+            ))),
+        }
+    }
+
     /// The frame's bytes, announcing our protocol version.
     pub fn encode(&self) -> Vec<u8> {
         self.encode_as(PROTOCOL_VERSION)
@@ -468,15 +483,11 @@ impl Frame {
 mod tests {
     use super::*;
     use crate::wire::{Chunk, serve_locally};
-    use sepval_common::evaluation::{Candidate, Job};
+    use sepval_common::evaluation::Candidate;
     use sepval_common::factors::Factors;
 
     fn frames() -> Vec<Frame> {
-        let job = Job::single(
-            "default",
-            &sepval_common::scenario::Scenario::embedded_default(),
-            sepval_common::synthetic::default_flight_test(),
-        );
+        let job = crate::default_job();
         let batch = [
             Candidate::baseline(Factors::TRUTH),
             Candidate::baseline(Factors([9.0; 17])),

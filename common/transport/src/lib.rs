@@ -178,6 +178,16 @@ impl From<sepval_common::cancel::Cancelled> for TransportError {
     }
 }
 
+/// The embedded default job (tests).
+#[cfg(test)]
+pub(crate) fn default_job() -> sepval_common::evaluation::Job {
+    sepval_common::evaluation::Job::single(
+        "default",
+        &sepval_common::scenario::Scenario::embedded_default(),
+        sepval_common::synthetic::default_flight_test(),
+    )
+}
+
 /// An error and its causes, joined by ": " (what `{:#}` shows for an `anyhow` error).
 pub fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
     let mut text = e.to_string();

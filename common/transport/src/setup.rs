@@ -158,14 +158,9 @@ pub fn decode_setup(header: &SetupHeader, bytes: &[u8]) -> Result<Job, SetupErro
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sepval_common::synthetic::default_flight_test;
 
     fn job() -> Job {
-        Job::single(
-            "default",
-            &Scenario::embedded_default(),
-            default_flight_test(),
-        )
+        crate::default_job()
     }
 
     #[test]

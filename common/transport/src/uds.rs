@@ -316,15 +316,9 @@ impl WorkerLink for UdsWorker {
             Err(RecvTimeoutError::Disconnected) => Ok(None),
         };
         match r? {
-            Some(Frame::Chunk(c)) => Ok(Incoming::Chunk(c)),
-            Some(Frame::Quit(reason)) => Ok(Incoming::Stop(Stopped::Quit(reason))),
-            Some(Frame::Dropped(reason)) => Err(TransportError::Dropped(reason)),
+            Some(frame) => frame.into_incoming(),
             None => Ok(Incoming::Stop(Stopped::Quit(
                 "the coordinator closed the connection".into(),
-            ))),
-            Some(other) => Err(TransportError::Protocol(format!(
-                "unexpected message from the coordinator: {}",
-                Frame::name_of(Some(&other))
             ))),
         }
     }

@@ -496,15 +496,9 @@ fn split_events(job: &Job, flat: &[WireObservation]) -> Vec<Vec<Observation>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sepval_common::scenario::Scenario;
-    use sepval_common::synthetic::default_flight_test;
 
     fn job() -> Job {
-        Job::single(
-            "default",
-            &Scenario::embedded_default(),
-            default_flight_test(),
-        )
+        crate::default_job()
     }
 
     #[test]

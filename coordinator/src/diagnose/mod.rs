@@ -5,7 +5,7 @@
 //!    the optimum) and its residuals are analysed per channel and over time: RMS against the
 //!    noise, where in time the misfit sits (ejector stroke, interference zone, free flight),
 //!    and whiteness (autocorrelation against its 95 % band, Ljung-Box portmanteau test).
-//! 2. Every effect of the catalogue (MODEL.md section 7) extends the model in turn and is
+//! 2. Every effect of the catalogue (docs/model.md section 7) extends the model in turn and is
 //!    refitted from the baseline optimum; all candidate refits share each batch sent to the
 //!    workers. Each is judged by the statistics of nested least squares: the chi-square drop,
 //!    the F test of the extra parameters (Bonferroni-corrected over the candidates tried), and
@@ -75,6 +75,7 @@ pub enum DiagnoseError {
 type Result<T> = std::result::Result<T, DiagnoseError>;
 
 mod report;
+use report::verdict;
 mod residuals;
 
 pub use residuals::{
@@ -544,81 +545,4 @@ pub fn diagnose(
         report::report_html(&diagnosis, &figures).as_bytes(),
     )?;
     Ok(diagnosis)
-}
-
-fn fmt_value(v: &ParamValue) -> String {
-    match v.std_error {
-        Some(se) => format!(
-            "{} = {:.4} ± {:.2} {}",
-            v.name,
-            v.value,
-            se,
-            per_unit(&v.unit)
-        ),
-        None => format!(
-            "{} = {:.4} {} (undetermined)",
-            v.name,
-            v.value,
-            per_unit(&v.unit)
-        ),
-    }
-}
-
-fn per_unit(unit: &str) -> String {
-    match unit.strip_prefix("1/") {
-        Some(u) => format!("per {u}"),
-        None => unit.to_string(),
-    }
-}
-
-fn verdict(
-    causes: &[String],
-    explained: bool,
-    parameters: &BTreeMap<String, Vec<ParamValue>>,
-    base: &ModelSummary,
-    ext: &ModelSummary,
-    noise: Noise,
-) -> String {
-    let rms = |s: &ModelSummary| (s.j_pos_m, s.j_att_deg);
-    let (bp, ba) = rms(base);
-    let (ep, ea) = rms(ext);
-    if causes.is_empty() {
-        return if explained {
-            format!(
-                "the baseline model explains the data to the noise level (position RMS {bp:.4} m, sigma {:.4} m; attitude RMS {ba:.3} deg, sigma {:.3} deg)",
-                noise.pos_m, noise.att_deg
-            )
-        } else {
-            format!(
-                "not explained: the residuals keep structure beyond the noise (position RMS {bp:.4} m, attitude RMS {ba:.3} deg) and no effect of the catalogue accounts for it: the cause lies outside the catalogue"
-            )
-        };
-    }
-    let named: Vec<String> = causes
-        .iter()
-        .map(|id| {
-            let adds = CATALOGUE
-                .iter()
-                .find(|e| e.id() == id)
-                .map_or(id.as_str(), |e| e.adds());
-            let values = parameters
-                .get(id)
-                .map(|v| v.iter().map(fmt_value).collect::<Vec<_>>().join(", "))
-                .unwrap_or_default();
-            format!(
-                "missing {} ({id}), {values}",
-                adds.split(':').next().unwrap_or(adds)
-            )
-        })
-        .collect();
-    let gains =
-        format!("position RMS {bp:.4} m -> {ep:.4} m, attitude RMS {ba:.3} deg -> {ea:.3} deg");
-    if explained {
-        format!("{}; {gains}", named.join("; and "))
-    } else {
-        format!(
-            "not explained: the closest extension of the catalogue, {}, improves the fit ({gains}) but leaves structure beyond the noise: part of the cause lies outside the catalogue",
-            named.join(" with ")
-        )
-    }
 }

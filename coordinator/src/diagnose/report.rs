@@ -1,6 +1,12 @@
-//! DIR/report.html: the diagnosis as a page for people, beside the figures it links to.
+//! The diagnosis in words: the verdict sentence, and DIR/report.html, a page for people beside
+//! the figures it links to.
 
-use super::{Diagnosis, fmt_value};
+use std::collections::BTreeMap;
+
+use sepval_common::effects::CATALOGUE;
+
+use super::{Diagnosis, ModelSummary, ParamValue};
+use crate::refine::Noise;
 
 /// `s` escaped for HTML text.
 fn esc(s: &str) -> String {
@@ -67,4 +73,81 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> String {
     }
     h.push_str("</body></html>\n");
     h
+}
+
+pub(super) fn fmt_value(v: &ParamValue) -> String {
+    match v.std_error {
+        Some(se) => format!(
+            "{} = {:.4} ± {:.2} {}",
+            v.name,
+            v.value,
+            se,
+            per_unit(&v.unit)
+        ),
+        None => format!(
+            "{} = {:.4} {} (undetermined)",
+            v.name,
+            v.value,
+            per_unit(&v.unit)
+        ),
+    }
+}
+
+fn per_unit(unit: &str) -> String {
+    match unit.strip_prefix("1/") {
+        Some(u) => format!("per {u}"),
+        None => unit.to_string(),
+    }
+}
+
+pub(super) fn verdict(
+    causes: &[String],
+    explained: bool,
+    parameters: &BTreeMap<String, Vec<ParamValue>>,
+    base: &ModelSummary,
+    ext: &ModelSummary,
+    noise: Noise,
+) -> String {
+    let rms = |s: &ModelSummary| (s.j_pos_m, s.j_att_deg);
+    let (bp, ba) = rms(base);
+    let (ep, ea) = rms(ext);
+    if causes.is_empty() {
+        return if explained {
+            format!(
+                "the baseline model explains the data to the noise level (position RMS {bp:.4} m, sigma {:.4} m; attitude RMS {ba:.3} deg, sigma {:.3} deg)",
+                noise.pos_m, noise.att_deg
+            )
+        } else {
+            format!(
+                "not explained: the residuals keep structure beyond the noise (position RMS {bp:.4} m, attitude RMS {ba:.3} deg) and no effect of the catalogue accounts for it: the cause lies outside the catalogue"
+            )
+        };
+    }
+    let named: Vec<String> = causes
+        .iter()
+        .map(|id| {
+            let adds = CATALOGUE
+                .iter()
+                .find(|e| e.id() == id)
+                .map_or(id.as_str(), |e| e.adds());
+            let values = parameters
+                .get(id)
+                .map(|v| v.iter().map(fmt_value).collect::<Vec<_>>().join(", "))
+                .unwrap_or_default();
+            format!(
+                "missing {} ({id}), {values}",
+                adds.split(':').next().unwrap_or(adds)
+            )
+        })
+        .collect();
+    let gains =
+        format!("position RMS {bp:.4} m -> {ep:.4} m, attitude RMS {ba:.3} deg -> {ea:.3} deg");
+    if explained {
+        format!("{}; {gains}", named.join("; and "))
+    } else {
+        format!(
+            "not explained: the closest extension of the catalogue, {}, improves the fit ({gains}) but leaves structure beyond the noise: part of the cause lies outside the catalogue",
+            named.join(" with ")
+        )
+    }
 }

@@ -1,6 +1,6 @@
 //! The elitist Pareto genetic algorithm of Anderson's study.
 //!
-//! Binary chromosomes (MODEL.md section 4), population 100, binary tournament on Pareto rank
+//! Binary chromosomes (docs/model.md section 4), population 100, binary tournament on Pareto rank
 //! then crowding distance, single-point crossover 0.9, jump mutation 0.5 % per bit, creep
 //! mutation 5 % per parameter, elitism by letting parents and children compete on rank and
 //! crowding (NSGA-II's environmental selection), two goals. A generation evaluates one

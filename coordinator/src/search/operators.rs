@@ -1,5 +1,5 @@
 //! The genetic operators of Carroll's GA driver, as used in Anderson's study, on binary
-//! chromosomes (MODEL.md section 4): binary tournament, single-point crossover, jump mutation
+//! chromosomes (docs/model.md section 4): binary tournament, single-point crossover, jump mutation
 //! (independent bit flips) and creep mutation (one grid step of one parameter).
 //!
 //! Source: D. L. Carroll, "FORTRAN genetic algorithm driver" (ga2.f: selectn/crosovr/mutate,

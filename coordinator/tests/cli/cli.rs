@@ -23,7 +23,7 @@ fn simulate_truth_reproduces_the_conformance_table() {
     ));
     let t = Trajectory::read(&dir.path().join("t.csv")).unwrap();
     assert_eq!(t.len(), 201);
-    // MODEL.md section 8 at t = 1.0 s.
+    // docs/model.md section 8 at t = 1.0 s.
     let last = t.len() - 1;
     assert!((t.pos_m[last][2] - 5.780992554).abs() < 1e-9);
     assert!((t.att_deg[last][0] - 26.0943588).abs() < 1e-7);

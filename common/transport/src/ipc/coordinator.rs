@@ -30,7 +30,7 @@ use sepval_common::evaluation::Job;
 
 use super::{
     COORDINATOR_NODE, IN_FLIGHT_PER_WORKER, MAX_WORKERS, REQUEST_BUFFER, names, node, node_states,
-    presence, run_config, service_name,
+    open_chunk_service, presence, run_config, service_name,
 };
 use crate::link::{Link, LinkEvent, Notice, WorkerId};
 use crate::setup::encode_setup_as;
@@ -332,41 +332,25 @@ impl IpcLink {
     }
 
     fn connect(&self, h: &Hello, child: Option<Child>) -> Result<Port, TransportError> {
-        let requests = self
-            .node
-            .service_builder(&service_name(&names::requests(h.node_id))?)
-            .publish_subscribe::<[WireRequest]>()
-            .user_header::<ChunkHeader>()
-            .open()
-            .map_err(iox("opening a worker's requests"))?
+        let requests = open_chunk_service::<WireRequest>(&self.node, &names::requests(h.node_id))?
             .publisher_builder()
             .initial_max_slice_len(16)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .max_loaned_samples(2)
             .create()
             .map_err(iox("publishing requests"))?;
-        let responses = self
-            .node
-            .service_builder(&service_name(&names::responses(h.node_id))?)
-            .publish_subscribe::<[WireResponse]>()
-            .user_header::<ChunkHeader>()
-            .open()
-            .map_err(iox("opening a worker's responses"))?
-            .subscriber_builder()
-            .buffer_size(REQUEST_BUFFER)
-            .create()
-            .map_err(iox("subscribing to responses"))?;
-        let samples = self
-            .node
-            .service_builder(&service_name(&names::samples(h.node_id))?)
-            .publish_subscribe::<[WireObservation]>()
-            .user_header::<ChunkHeader>()
-            .open()
-            .map_err(iox("opening a worker's samples"))?
-            .subscriber_builder()
-            .buffer_size(REQUEST_BUFFER)
-            .create()
-            .map_err(iox("subscribing to samples"))?;
+        let responses =
+            open_chunk_service::<WireResponse>(&self.node, &names::responses(h.node_id))?
+                .subscriber_builder()
+                .buffer_size(REQUEST_BUFFER)
+                .create()
+                .map_err(iox("subscribing to responses"))?;
+        let samples =
+            open_chunk_service::<WireObservation>(&self.node, &names::samples(h.node_id))?
+                .subscriber_builder()
+                .buffer_size(REQUEST_BUFFER)
+                .create()
+                .map_err(iox("subscribing to samples"))?;
         let wake = self
             .node
             .service_builder(&service_name(&names::wake(h.node_id))?)

@@ -58,6 +58,44 @@ impl Drop for RunCleanup {
     }
 }
 
+/// One of a worker's chunk services (requests, responses, samples): slices of `T` behind a
+/// [`ChunkHeader`](crate::wire::ChunkHeader).
+pub(crate) type ChunkService<T> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<
+    ipc::Service,
+    [T],
+    crate::wire::ChunkHeader,
+>;
+
+/// Creates a worker's chunk service `name` (the worker does): one publisher, one subscriber,
+/// [`REQUEST_BUFFER`] chunks, no silent overwriting, no history.
+pub(crate) fn create_chunk_service<T: std::fmt::Debug + ZeroCopySend>(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> Result<ChunkService<T>, TransportError> {
+    node.service_builder(&service_name(name)?)
+        .publish_subscribe::<[T]>()
+        .user_header::<crate::wire::ChunkHeader>()
+        .max_publishers(1)
+        .max_subscribers(1)
+        .subscriber_max_buffer_size(REQUEST_BUFFER)
+        .enable_safe_overflow(false)
+        .history_size(0)
+        .create()
+        .map_err(iox(format!("creating {name}")))
+}
+
+/// Opens a worker's chunk service `name` (the coordinator does).
+pub(crate) fn open_chunk_service<T: std::fmt::Debug + ZeroCopySend>(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> Result<ChunkService<T>, TransportError> {
+    node.service_builder(&service_name(name)?)
+        .publish_subscribe::<[T]>()
+        .user_header::<crate::wire::ChunkHeader>()
+        .open()
+        .map_err(iox(format!("opening {name}")))
+}
+
 /// The file-name prefix of a run's iceoryx2 resources.
 pub fn run_prefix(run_id: &RunId) -> String {
     format!("sepval_{run_id}_")

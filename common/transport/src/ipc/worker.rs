@@ -21,7 +21,10 @@ use iceoryx2::prelude::*;
 use sepval_common::cancel;
 use sepval_common::evaluation::Job;
 
-use super::{COORDINATOR_NODE, REQUEST_BUFFER, WORKER_NODE, names, node, presence, service_name};
+use super::{
+    COORDINATOR_NODE, REQUEST_BUFFER, WORKER_NODE, create_chunk_service, names, node, presence,
+    service_name,
+};
 use crate::link::{Incoming, Stopped, WorkerLink};
 use crate::setup::{check_setup_header, decode_setup, hex};
 use crate::wire::{
@@ -81,48 +84,18 @@ impl IpcWorker {
         let node = node(&cfg, WORKER_NODE)?;
         let id = node.id().value();
         // Our own services, created before we announce ourselves.
-        let requests = node
-            .service_builder(&service_name(&names::requests(id))?)
-            .publish_subscribe::<[WireRequest]>()
-            .user_header::<ChunkHeader>()
-            .max_publishers(1)
-            .max_subscribers(1)
-            .subscriber_max_buffer_size(REQUEST_BUFFER)
-            .enable_safe_overflow(false)
-            .history_size(0)
-            .create()
-            .map_err(iox("creating the request service"))?
+        let requests = create_chunk_service::<WireRequest>(&node, &names::requests(id))?
             .subscriber_builder()
             .buffer_size(REQUEST_BUFFER)
             .create()
             .map_err(iox("subscribing to requests"))?;
-        let responses = node
-            .service_builder(&service_name(&names::responses(id))?)
-            .publish_subscribe::<[WireResponse]>()
-            .user_header::<ChunkHeader>()
-            .max_publishers(1)
-            .max_subscribers(1)
-            .subscriber_max_buffer_size(REQUEST_BUFFER)
-            .enable_safe_overflow(false)
-            .history_size(0)
-            .create()
-            .map_err(iox("creating the response service"))?
+        let responses = create_chunk_service::<WireResponse>(&node, &names::responses(id))?
             .publisher_builder()
             .initial_max_slice_len(64)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .create()
             .map_err(iox("publishing responses"))?;
-        let samples = node
-            .service_builder(&service_name(&names::samples(id))?)
-            .publish_subscribe::<[WireObservation]>()
-            .user_header::<ChunkHeader>()
-            .max_publishers(1)
-            .max_subscribers(1)
-            .subscriber_max_buffer_size(REQUEST_BUFFER)
-            .enable_safe_overflow(false)
-            .history_size(0)
-            .create()
-            .map_err(iox("creating the sample service"))?
+        let samples = create_chunk_service::<WireObservation>(&node, &names::samples(id))?
             .publisher_builder()
             .initial_max_slice_len(1024)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)

@@ -220,19 +220,12 @@ impl WorkerLink for ZenohWorker {
             Inbox::CoordinatorAlive(false) => Ok(Incoming::Stop(Stopped::CoordinatorGone(
                 self.options.run_id.to_string(),
             ))),
-            Inbox::Down(bytes) => match Frame::decode(&bytes) {
-                Ok(Frame::Chunk(c)) => Ok(Incoming::Chunk(c)),
-                Ok(Frame::Quit(reason)) => Ok(Incoming::Stop(Stopped::Quit(reason))),
-                Ok(Frame::Dropped(reason)) => Err(TransportError::Dropped(reason)),
-                Ok(other) => Err(TransportError::Protocol(format!(
-                    "the coordinator sent {}, which coordinators do not send",
-                    Frame::name_of(Some(&other))
-                ))),
-                Err(source) => Err(TransportError::Codec {
+            Inbox::Down(bytes) => Frame::decode(&bytes)
+                .map_err(|source| TransportError::Codec {
                     what: "message from the coordinator".into(),
                     source,
-                }),
-            },
+                })?
+                .into_incoming(),
         }
     }
 
