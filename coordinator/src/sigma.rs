@@ -21,15 +21,17 @@ pub struct Sigma {
 pub enum SigmaError {
     /// Too few samples to estimate the noise.
     #[error(
-        "event {event}: too few samples to estimate the noise; give both --sigma-pos-m and --sigma-att-deg"
+        "event {event}: {samples} samples are too few to estimate the noise (5 at least); give both noise levels"
     )]
     TooFewSamples {
         /// The event.
         event: String,
+        /// Its samples.
+        samples: usize,
     },
     /// A level that is not a finite number > 0.
     #[error(
-        "{name} = {value}: the noise level must be a finite number > 0 (data without noise? give --sigma-pos-m and --sigma-att-deg)"
+        "{name} = {value}: the noise level must be a finite number > 0 (data without noise? give both noise levels)"
     )]
     NotPositive {
         /// Which level.
@@ -83,6 +85,7 @@ fn estimated(job: &Job) -> Result<(f64, f64), SigmaError> {
     for e in job.events() {
         let (p, a) = estimate_noise(&e.data).ok_or_else(|| SigmaError::TooFewSamples {
             event: e.name.clone(),
+            samples: e.data.len(),
         })?;
         let k = e.data.len();
         p2 += p * p * k as f64;

@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use sepval_coordinator::diagnose::{DiagnoseOptions, diagnose};
 use sepval_coordinator::fit::{FitOptions, Method};
 use sepval_coordinator::refine::LmSettings;
@@ -24,7 +24,8 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     };
     ga.validate()?;
     let (job, inputs) = inputs::job(&args.data, args.scenario.as_deref())?;
-    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)?;
+    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
+        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
     let lm = LmSettings {
         budget: args.lm_budget,
         ..LmSettings::default()

@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_coordinator::checkpoint::Checkpoint;
 use sepval_coordinator::fit::{FitOptions, FitOutput, Method, run_fit, write_fit_figures};
@@ -75,7 +75,10 @@ pub fn run(args: FitArgs) -> Result<()> {
                 budget: args.hill_budget,
                 ..HillSettings::default()
             };
-            let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)?;
+            let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
+                .context(
+                    "the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)",
+                )?;
             (ga, hill, sigma)
         }
     };
