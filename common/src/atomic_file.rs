@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 /// Failure to write a file.
 #[derive(Debug, thiserror::Error)]
-#[error("cannot write {path}: {source}")]
+#[error("cannot write {path}")]
 pub struct WriteError {
     /// The target file.
     pub path: PathBuf,

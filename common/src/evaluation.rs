@@ -14,6 +14,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 
 use crate::effects::EffectSet;
 use crate::factors::{FactorTable, Factors};
@@ -41,6 +42,14 @@ pub enum JobError {
     /// No events.
     #[error("a job needs at least one event (measured trajectory)")]
     NoEvents,
+    /// An event beyond the limits of one run (`crate::limits`).
+    #[error("event `{event}`: {error}")]
+    Limit {
+        /// The event.
+        event: String,
+        /// The limit.
+        error: crate::limits::LimitError,
+    },
     /// Events whose scenarios have different factor tables.
     #[error(
         "event `{event}` has a different factor table from event `{first}`: the 17 factors are shared, so their bounds and bits must be too"
@@ -51,6 +60,16 @@ pub enum JobError {
         /// The differing event.
         event: String,
     },
+}
+
+/// Text written straight into a SHA-256.
+struct HashWriter(Sha256);
+
+impl std::fmt::Write for HashWriter {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0.update(s.as_bytes());
+        Ok(())
+    }
 }
 
 /// Everything an evaluator needs once: the events of a fit.
@@ -73,21 +92,40 @@ impl Job {
                 });
             }
         }
-        let mut data = String::new();
+        let mut samples = 0usize;
+        for e in &events {
+            let limit = |error| JobError::Limit {
+                event: e.name.clone(),
+                error,
+            };
+            // The run integrates up to the last sample (the carriage state before release).
+            let span = e.data.times_s.last().copied().unwrap_or(0.0).max(0.0);
+            let dt = e.simulator.scenario().integrator.dt_s;
+            crate::limits::check_steps(span, dt).map_err(limit)?;
+            samples += e.data.len();
+            if samples > crate::limits::MAX_SAMPLES {
+                return Err(limit(crate::limits::LimitError::Samples {
+                    samples: samples as f64,
+                }));
+            }
+        }
+        // SHA-256 of each event's samples as CSV (without comments), events separated by
+        // U+001E, written into the hash line by line (never held whole in memory).
+        let mut data = HashWriter(Sha256::new());
         let mut scen = String::new();
         for e in &events {
-            let numbers = Trajectory {
-                comments: Vec::new(),
-                metadata: Vec::new(),
-                ..e.data.clone()
-            };
-            data.push_str(&numbers.to_csv_string());
-            data.push('\u{1e}');
+            e.data.write_csv_rows(&mut data);
+            data.0.update("\u{1e}".as_bytes());
             scen.push_str(&e.simulator.scenario().content_hash());
             scen.push('\u{1e}');
         }
         Ok(Job {
-            data_sha256: hex_sha256(data.as_bytes()),
+            data_sha256: data
+                .0
+                .finalize()
+                .iter()
+                .map(|b| format!("{b:02x}"))
+                .collect(),
             scenario_sha256: hex_sha256(scen.as_bytes()),
             events,
         })
@@ -171,6 +209,14 @@ impl Job {
             }
         }
         let g = sums.goals();
+        if !(g.j_pos_m.is_finite() && g.j_att_deg.is_finite()) {
+            // Residuals beyond f64 (a run far outside the data): a failed run, never a
+            // number that files would write as null.
+            return Evaluation::from(Outcome::failed(format!(
+                "the goals are not finite numbers (J_pos = {} m, J_att = {} deg)",
+                g.j_pos_m, g.j_att_deg
+            )));
+        }
         Evaluation {
             outcome: Outcome::Goals {
                 j_pos_m: g.j_pos_m,
@@ -308,8 +354,8 @@ pub trait Evaluator {
         with_samples: bool,
     ) -> Result<Vec<Evaluation>, EvalError>;
 
-    /// The job.
-    fn job(&self) -> &Job;
+    /// The job (shared: evaluators and searches hold one copy of the data).
+    fn job(&self) -> &Arc<Job>;
 
     /// A short description for reports ("inproc, 2 threads").
     fn describe(&self) -> String;
@@ -347,7 +393,12 @@ impl Evaluator for InProcess {
         };
         let threads = self.threads.min(batch.len());
         if threads <= 1 {
-            return Ok(batch.iter().map(eval).collect());
+            let mut out = Vec::with_capacity(batch.len());
+            for c in batch {
+                crate::cancel::check().map_err(|_| EvalError::Interrupted)?;
+                out.push(eval(c));
+            }
+            return Ok(out);
         }
         // Threads take the next index until the batch is done; each result goes to its own
         // slot, so the order (and every bit) is independent of the thread count.
@@ -360,7 +411,7 @@ impl Evaluator for InProcess {
                         let mut mine = Vec::new();
                         loop {
                             let i = next.fetch_add(1, Ordering::Relaxed);
-                            if i >= batch.len() {
+                            if i >= batch.len() || crate::cancel::requested() {
                                 break mine;
                             }
                             mine.push((i, eval(&batch[i])));
@@ -373,6 +424,7 @@ impl Evaluator for InProcess {
                 .map(|h| h.join().expect("evaluation threads do not panic"))
                 .collect()
         });
+        crate::cancel::check().map_err(|_| EvalError::Interrupted)?;
         for (i, e) in results.into_iter().flatten() {
             slots[i] = Some(e);
         }
@@ -382,7 +434,7 @@ impl Evaluator for InProcess {
             .collect())
     }
 
-    fn job(&self) -> &Job {
+    fn job(&self) -> &Arc<Job> {
         &self.job
     }
 

@@ -255,7 +255,7 @@ impl Factors {
 #[non_exhaustive]
 pub enum FactorsFileError {
     /// Not a JSON object of names to numbers.
-    #[error("expected a JSON object mapping the 17 factor names to numbers: {0}")]
+    #[error("expected a JSON object mapping the 17 factor names to numbers")]
     Json(#[source] serde_json::Error),
     /// A value that is not a number.
     #[error("factor `{name}`: expected a number, found {found}")]

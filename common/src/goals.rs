@@ -144,6 +144,14 @@ pub enum CompareError {
         /// Time in the second.
         b: f64,
     },
+    /// Goals beyond the range of f64.
+    #[error("the goals are not finite numbers (J_pos = {j_pos_m} m, J_att = {j_att_deg} deg)")]
+    NotFinite {
+        /// J_pos \[m\].
+        j_pos_m: f64,
+        /// J_att \[deg\].
+        j_att_deg: f64,
+    },
 }
 
 /// Goals of `sim` against `data` (same sample times, within 1e-9 s).
@@ -169,7 +177,14 @@ pub fn goals_between(data: &Trajectory, sim: &Trajectory) -> Result<Goals, Compa
         };
         sums.add(&obs, &data.pos_m[k], &data.att_deg[k]);
     }
-    Ok(sums.goals())
+    let g = sums.goals();
+    if !(g.j_pos_m.is_finite() && g.j_att_deg.is_finite()) {
+        return Err(CompareError::NotFinite {
+            j_pos_m: g.j_pos_m,
+            j_att_deg: g.j_att_deg,
+        });
+    }
+    Ok(g)
 }
 
 #[cfg(test)]

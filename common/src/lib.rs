@@ -27,6 +27,7 @@ pub mod evaluation;
 pub mod factors;
 pub mod frames;
 pub mod goals;
+pub mod limits;
 pub mod model;
 pub mod noise;
 pub mod propagator;

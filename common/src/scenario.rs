@@ -200,7 +200,7 @@ mod factor_table_serde {
 #[non_exhaustive]
 pub enum ScenarioError {
     /// The file could not be read.
-    #[error("cannot read scenario {path}: {source}")]
+    #[error("cannot read scenario {path}")]
     Io {
         /// The file.
         path: PathBuf,
@@ -398,15 +398,11 @@ impl Scenario {
                 ),
             ));
         }
-        if n.t_end_s / n.dt_s > 1e8 {
-            return Err(bad(
-                "integrator.dt_s",
-                format!(
-                    "= {}: more than 1e8 steps for t_end_s = {}",
-                    n.dt_s, n.t_end_s
-                ),
-            ));
-        }
+        // The work of one run (crate::limits), refused before anything is allocated.
+        crate::limits::check_steps(n.t_end_s, n.dt_s)
+            .map_err(|e| bad("integrator.dt_s", format!("= {}: {e}", n.dt_s)))?;
+        crate::limits::check_sampling(n.t_end_s, n.rate_hz)
+            .map_err(|e| bad("integrator.rate_hz", format!("= {}: {e}", n.rate_hz)))?;
         for (k, v) in self.initial.velocity_m_s.iter().enumerate() {
             finite(&format!("initial.velocity_m_s[{k}]"), *v)?;
         }

@@ -19,6 +19,9 @@ pub enum SimError {
     /// The run diverged.
     #[error(transparent)]
     Diverged(#[from] Diverged),
+    /// The sample times ask for more work than one run may do.
+    #[error(transparent)]
+    Limit(#[from] crate::limits::LimitError),
 }
 
 /// A scenario set up for simulation.
@@ -72,6 +75,14 @@ impl Simulator {
         effects: &EffectSet,
         times_s: &[f64],
     ) -> Result<(Trajectory, RunLog), SimError> {
+        let span = times_s.last().copied().unwrap_or(0.0).max(0.0);
+        crate::limits::check_steps(span, self.scenario().integrator.dt_s)?;
+        if times_s.len() > crate::limits::MAX_SAMPLES {
+            return Err(crate::limits::LimitError::Samples {
+                samples: times_s.len() as f64,
+            }
+            .into());
+        }
         let run = self.run_setup(factors, effects)?;
         let mut samples: Vec<Observation> = Vec::with_capacity(times_s.len());
         let log = propagate(&self.model, &run, times_s, &mut samples)?;

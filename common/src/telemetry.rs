@@ -10,15 +10,23 @@
 //! - Columns for other quantities (a header whose quantity is not t, x, y, z, roll, pitch or
 //!   yaw) are ignored, so that files with extra channels can be read; a known quantity with an
 //!   unknown unit (`x_km`, `roll_rad`) is refused.
-//! - Blank lines are skipped. Fields may be surrounded by spaces. Quoting is not supported
-//!   (no field of this format needs it).
+//! - Blank lines are skipped. Fields may be surrounded by spaces, and enclosed in double quotes
+//!   as spreadsheets write them (`"t_s","x_m",...`); a quote that does not enclose a whole field
+//!   is refused. A UTF-8 byte-order mark at the start of the file is skipped.
+//! - The limits of [`crate::limits`]: at most [`MAX_SAMPLES`] samples, sample times within
+//!   +-[`MAX_SPAN_S`], positions within +-[`MAX_POSITION_M`] and angles within
+//!   +-[`MAX_ANGLE_DEG`]; a value beyond them is refused with its line and column (it is a
+//!   unit or export mistake, and it would overflow the goals).
+//! - Files are read line by line: the text is never held whole in memory.
 //! - Files sepval writes print every number in the shortest form that reads back as the same
 //!   double, so writing and reading is exact.
 
 use std::fmt::Write as _;
+use std::io::BufRead;
 use std::path::Path;
 
 use crate::atomic_file::{WriteError, write_atomically};
+use crate::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SAMPLES, MAX_SPAN_S};
 use crate::units::M_PER_FT;
 
 /// A trajectory: samples of position and attitude against time.
@@ -151,6 +159,59 @@ pub enum TelemetryError {
         /// The text found.
         value: String,
     },
+    /// A line that is not UTF-8 text.
+    #[error("{file}: line {line}: not valid UTF-8 text")]
+    NotText {
+        /// The file.
+        file: String,
+        /// The line.
+        line: usize,
+    },
+    /// A double quote that does not enclose a whole field.
+    #[error(
+        "{file}: line {line}, column {column}: unbalanced double quote in `{value}` (a quoted field must start and end with a quote)"
+    )]
+    Quote {
+        /// The file.
+        file: String,
+        /// The line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The field.
+        value: String,
+    },
+    /// More samples than an event may have.
+    #[error("{file}: line {line}: more than {limit} samples, the limit per event")]
+    TooManySamples {
+        /// The file.
+        file: String,
+        /// The line of the first sample beyond the limit.
+        line: usize,
+        /// The limit.
+        limit: usize,
+    },
+    /// A value beyond the bounds of plausible telemetry.
+    #[error(
+        "{file}: line {line}, column {column} (`{header}`): {value} is beyond the plausible bound of +-{} {} for {}",
+        kind.bound(),
+        kind.unit(),
+        kind.what()
+    )]
+    Implausible {
+        /// The file.
+        file: String,
+        /// The line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Its header.
+        header: String,
+        /// The value (in the file's unit).
+        value: String,
+        /// Which bound.
+        kind: Bound,
+    },
     /// Time not strictly increasing.
     #[error(
         "{file}: line {line}, column {column} (`t_s`): time {t_s} s is not after the previous sample's {previous_s} s (times must increase strictly)"
@@ -167,6 +228,46 @@ pub enum TelemetryError {
         /// The previous time.
         previous_s: f64,
     },
+}
+
+/// The bounds of plausible telemetry ([`crate::limits`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bound {
+    /// A sample time: +-[`MAX_SPAN_S`].
+    Time,
+    /// A position coordinate: +-[`MAX_POSITION_M`].
+    Position,
+    /// An Euler angle: +-[`MAX_ANGLE_DEG`].
+    Angle,
+}
+
+impl Bound {
+    /// The bound, SI.
+    pub fn bound(self) -> f64 {
+        match self {
+            Bound::Time => MAX_SPAN_S,
+            Bound::Position => MAX_POSITION_M,
+            Bound::Angle => MAX_ANGLE_DEG,
+        }
+    }
+
+    /// Its unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Bound::Time => "s",
+            Bound::Position => "m",
+            Bound::Angle => "deg",
+        }
+    }
+
+    /// What it bounds.
+    pub fn what(self) -> &'static str {
+        match self {
+            Bound::Time => "a sample time",
+            Bound::Position => "a position",
+            Bound::Angle => "an angle",
+        }
+    }
 }
 
 /// One quantity of a telemetry row: its name, accepted headers with their scale to SI, and how
@@ -230,23 +331,49 @@ impl Trajectory {
             .map(|(_, v)| v.as_str())
     }
 
-    /// Reads a telemetry file.
+    /// Reads a telemetry file, line by line.
     pub fn read(path: &Path) -> Result<Trajectory, TelemetryError> {
-        let text = std::fs::read_to_string(path).map_err(|e| TelemetryError::Io {
-            file: path.display().to_string(),
+        let name = path.display().to_string();
+        let file = std::fs::File::open(path).map_err(|e| TelemetryError::Io {
+            file: name.clone(),
             message: e.to_string(),
         })?;
-        Trajectory::parse(&text, &path.display().to_string())
+        let lines = std::io::BufReader::new(file).split(b'\n');
+        Trajectory::parse_lines(lines, &name, MAX_SAMPLES)
     }
 
     /// Parses telemetry text; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Trajectory, TelemetryError> {
+        let lines = text.split('\n').map(|l| Ok(l.as_bytes().to_vec()));
+        Trajectory::parse_lines(lines, file, MAX_SAMPLES)
+    }
+
+    /// Parses telemetry lines (without their `\n`), at most `max_samples` samples; `file`
+    /// names the source in errors.
+    fn parse_lines(
+        lines: impl Iterator<Item = std::io::Result<Vec<u8>>>,
+        file: &str,
+        max_samples: usize,
+    ) -> Result<Trajectory, TelemetryError> {
         let file = file.to_string();
         let mut out = Trajectory::default();
         let mut header: Option<Header> = None;
-        for (i, raw) in text.lines().enumerate() {
+        for (i, raw) in lines.enumerate() {
             let line = i + 1;
-            let trimmed = raw.trim();
+            let raw = raw.map_err(|e| TelemetryError::Io {
+                file: file.clone(),
+                message: format!("line {line}: {e}"),
+            })?;
+            let text = std::str::from_utf8(&raw).map_err(|_| TelemetryError::NotText {
+                file: file.clone(),
+                line,
+            })?;
+            let text = if line == 1 {
+                text.strip_prefix('\u{feff}').unwrap_or(text)
+            } else {
+                text
+            };
+            let trimmed = text.trim();
             if trimmed.is_empty() {
                 continue;
             }
@@ -258,7 +385,7 @@ impl Trajectory {
                 }
                 continue;
             }
-            let fields: Vec<&str> = trimmed.split(',').map(str::trim).collect();
+            let fields = split_fields(trimmed, line, &file)?;
             let Some(Header { names, columns, .. }) = &header else {
                 header = Some(Header {
                     line,
@@ -275,26 +402,56 @@ impl Trajectory {
                     found: fields.len(),
                 });
             }
+            if out.times_s.len() >= max_samples {
+                return Err(TelemetryError::TooManySamples {
+                    file,
+                    line,
+                    limit: max_samples,
+                });
+            }
             let mut values = [0.0; 7];
             for (q, &(col, scale)) in columns.iter().enumerate() {
                 let text = fields[col];
-                let v: f64 = text.parse().map_err(|_| TelemetryError::NotNumeric {
-                    file: file.clone(),
-                    line,
-                    column: col + 1,
-                    header: names[col].clone(),
-                    value: text.to_string(),
+                let field_error =
+                    |value: &str| (file.clone(), col + 1, names[col].clone(), value.to_string());
+                let v: f64 = text.parse().map_err(|_| {
+                    let (file, column, header, value) = field_error(text);
+                    TelemetryError::NotNumeric {
+                        file,
+                        line,
+                        column,
+                        header,
+                        value,
+                    }
                 })?;
                 if !v.is_finite() {
+                    let (file, column, header, value) = field_error(text);
                     return Err(TelemetryError::NotFinite {
                         file,
                         line,
-                        column: col + 1,
-                        header: names[col].clone(),
-                        value: text.to_string(),
+                        column,
+                        header,
+                        value,
                     });
                 }
-                values[q] = v * scale;
+                let si = v * scale;
+                let kind = match q {
+                    0 => Bound::Time,
+                    1..=3 => Bound::Position,
+                    _ => Bound::Angle,
+                };
+                if si.abs() > kind.bound() {
+                    let (file, column, header, value) = field_error(text);
+                    return Err(TelemetryError::Implausible {
+                        file,
+                        line,
+                        column,
+                        header,
+                        value,
+                        kind,
+                    });
+                }
+                values[q] = si;
             }
             if let Some(&previous_s) = out.times_s.last() {
                 if values[0] <= previous_s {
@@ -326,17 +483,23 @@ impl Trajectory {
         for c in &self.comments {
             let _ = writeln!(s, "# {c}");
         }
-        s.push_str("t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n");
+        self.write_csv_rows(&mut s);
+        s
+    }
+
+    /// Writes the header and the rows (no comments) as CSV into `w`, every number in the
+    /// shortest form that reads back as the same double.
+    pub fn write_csv_rows(&self, w: &mut impl std::fmt::Write) {
+        let _ = w.write_str("t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n");
         for k in 0..self.len() {
             let p = self.pos_m[k];
             let a = self.att_deg[k];
             let _ = writeln!(
-                s,
+                w,
                 "{},{},{},{},{},{},{}",
                 self.times_s[k], p[0], p[1], p[2], a[0], a[1], a[2]
             );
         }
-        s
     }
 
     /// Writes the trajectory atomically (no partial file is ever left at `path`).
@@ -349,6 +512,35 @@ impl Trajectory {
         self.comments.push(format!("{key} = {value}"));
         self.metadata.push((key.to_string(), value.to_string()));
     }
+}
+
+/// The comma-separated fields of a line, trimmed, each with one pair of enclosing double
+/// quotes removed.
+fn split_fields<'a>(
+    line_text: &'a str,
+    line: usize,
+    file: &str,
+) -> Result<Vec<&'a str>, TelemetryError> {
+    line_text
+        .split(',')
+        .enumerate()
+        .map(|(k, f)| {
+            let f = f.trim();
+            let inner = f
+                .strip_prefix('"')
+                .and_then(|g| g.strip_suffix('"'))
+                .unwrap_or(f);
+            if inner.contains('"') || (f.len() == 1 && f == "\"") {
+                return Err(TelemetryError::Quote {
+                    file: file.to_string(),
+                    line,
+                    column: k + 1,
+                    value: f.to_string(),
+                });
+            }
+            Ok(inner.trim())
+        })
+        .collect()
 }
 
 fn split_metadata(comment: &str) -> Option<(String, String)> {
@@ -505,5 +697,46 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("/no/such/file.csv: cannot read:"), "{e}");
+    }
+
+    #[test]
+    fn spreadsheet_exports_read_and_implausible_values_are_refused_where_they_stand() {
+        let bom = format!("\u{feff}{GOOD}");
+        assert_eq!(Trajectory::parse(&bom, "f.csv").unwrap().len(), 2);
+        let quoted = "\"t_s\",\"x_m\",\"y_m\",\"z_m\",\"roll_deg\",\"pitch_deg\",\"yaw_deg\"\r\n\"0\",0,0,0,0,0,0\r\n";
+        assert_eq!(Trajectory::parse(quoted, "f.csv").unwrap().len(), 1);
+        assert_eq!(
+            err("t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n0,0,\"0,0,0,0,0\n"),
+            "f.csv: line 2, column 3: unbalanced double quote in `\"0` (a quoted field must start and end with a quote)"
+        );
+        assert_eq!(
+            err("t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n0,1e308,0,0,0,0,0\n"),
+            "f.csv: line 2, column 2 (`x_m`): 1e308 is beyond the plausible bound of +-100000 m for a position"
+        );
+        assert_eq!(
+            err("t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n1e6,0,0,0,0,0,0\n"),
+            "f.csv: line 2, column 1 (`t_s`): 1e6 is beyond the plausible bound of +-3600 s for a sample time"
+        );
+        assert!(
+            err("t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n0,0,0,0,0,0,4000\n")
+                .contains("for an angle")
+        );
+        let lines = GOOD.split('\n').map(|l| Ok(l.as_bytes().to_vec()));
+        assert_eq!(
+            Trajectory::parse_lines(lines, "f.csv", 1)
+                .unwrap_err()
+                .to_string(),
+            "f.csv: line 6: more than 1 samples, the limit per event"
+        );
+        let bad_utf8 = [
+            b"t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg".to_vec(),
+            vec![0xff, 0xfe],
+        ];
+        assert_eq!(
+            Trajectory::parse_lines(bad_utf8.into_iter().map(Ok), "f.csv", 10)
+                .unwrap_err()
+                .to_string(),
+            "f.csv: line 2: not valid UTF-8 text"
+        );
     }
 }

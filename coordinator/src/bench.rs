@@ -472,7 +472,7 @@ impl Evaluator for LoopbackZenoh {
             .evaluate(batch, with_samples)
     }
 
-    fn job(&self) -> &Job {
+    fn job(&self) -> &Arc<Job> {
         self.evaluator.as_ref().expect("started").job()
     }
 

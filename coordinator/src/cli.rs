@@ -120,6 +120,9 @@ pub struct FitArgs {
     /// Skip the figures.
     #[arg(long)]
     pub no_figures: bool,
+    /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).
+    #[arg(long)]
+    pub overwrite: bool,
     /// Run directory (result.json, generations/, figures/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -153,6 +156,9 @@ pub struct DiagnoseArgs {
     /// Output directory (diagnosis.json, report.html, figures/, baseline/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).
+    #[arg(long)]
+    pub overwrite: bool,
 }
 
 #[derive(Subcommand)]

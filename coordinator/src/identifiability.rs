@@ -71,6 +71,40 @@ pub struct Identifiability {
     pub max_lag: usize,
 }
 
+/// Most (sample, lag) pairs of the coloured-residual correction per event.
+const MAX_COLOUR_PAIRS: usize = 4_000_000;
+
+/// The report when the information matrix cannot be decomposed (non-finite entries): every
+/// parameter undetermined.
+fn undetermined_everywhere(
+    space: &ParamSpace,
+    x: &[f64],
+    event_samples: &[usize],
+) -> Identifiability {
+    let n = space.len();
+    Identifiability {
+        parameters: (0..n)
+            .map(|i| ParamEstimate {
+                name: space.names[i].clone(),
+                unit: space.units[i].clone(),
+                value: x[i],
+                std_error: None,
+                std_error_white: None,
+                identifiable: false,
+            })
+            .collect(),
+        names: space.names.clone(),
+        correlation: vec![vec![0.0; n]; n],
+        compensating: Vec::new(),
+        not_identifiable: space.names.clone(),
+        max_lag: event_samples
+            .iter()
+            .map(|&ns| (ns / 5).max(1))
+            .max()
+            .unwrap_or(1),
+    }
+}
+
 /// The identifiability of the parameters `x` of `space`, from the normalised residuals `r`
 /// and their Jacobian `jac` (rows in the order of `r`), with the events' sample counts.
 pub fn identifiability(
@@ -83,7 +117,16 @@ pub fn identifiability(
     let n = space.len();
     let m = jac.tr_mul(jac);
     // Inverse of M on its range; directions with no information are undetermined.
-    let eig = SymmetricEigen::new(m.clone());
+    // A bounded number of sweeps: on a pathological matrix (non-finite entries) the
+    // decomposition gives up and every parameter is reported undetermined.
+    let Some(eig) = m
+        .iter()
+        .all(|v| v.is_finite())
+        .then(|| SymmetricEigen::try_new(m.clone(), f64::EPSILON, 1000))
+        .flatten()
+    else {
+        return undetermined_everywhere(space, x, event_samples);
+    };
     let lmax = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
     let tol = lmax * 1e-13;
     let mut m_inv = DMatrix::zeros(n, n);
@@ -105,7 +148,10 @@ pub fn identifiability(
     let mut max_lag = 0;
     let mut row0 = 0;
     for &ns in event_samples {
-        let lag_max = (ns / 5).max(1);
+        // Lags up to a fifth of the event, at most 50, and at most MAX_COLOUR_PAIRS (sample,
+        // lag) pairs per event, so that the correction stays cheap on long records (there it
+        // uses fewer lags and the standard errors lean low).
+        let lag_max = (ns / 5).min(50).min(MAX_COLOUR_PAIRS / ns.max(1)).max(1);
         max_lag = max_lag.max(lag_max);
         let v = |i: usize, c: usize| r[row0 + 6 * i + c];
         for lag in 0..=lag_max.min(ns.saturating_sub(1)) {

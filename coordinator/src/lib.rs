@@ -16,6 +16,7 @@ pub mod diagnose;
 pub mod figures;
 pub mod fit;
 pub mod identifiability;
+pub mod out_dir;
 pub mod problem;
 pub mod refine;
 pub mod rerun;

@@ -59,14 +59,14 @@ pub struct ResolutionRow {
     pub factor: String,
     /// Its grid step ((max - min) / (2^bits - 1)).
     pub step: f64,
-    /// Change of J_pos \[m\].
-    pub d_j_pos_m: f64,
-    /// Change of J_att \[deg\].
-    pub d_j_att_deg: f64,
-    /// RMS change of the simulated positions \[m\].
-    pub traj_rms_pos_m: f64,
-    /// RMS change of the simulated angles \[deg\].
-    pub traj_rms_att_deg: f64,
+    /// Change of J_pos \[m\] (null when the step did not simulate).
+    pub d_j_pos_m: Option<f64>,
+    /// Change of J_att \[deg\] (null when the step did not simulate).
+    pub d_j_att_deg: Option<f64>,
+    /// RMS change of the simulated positions \[m\] (null when the step did not simulate).
+    pub traj_rms_pos_m: Option<f64>,
+    /// RMS change of the simulated angles \[deg\] (null when the step did not simulate).
+    pub traj_rms_att_deg: Option<f64>,
     /// Whether one step moves the trajectory by more than the noise.
     pub coarse: bool,
 }

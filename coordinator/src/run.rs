@@ -103,7 +103,13 @@ pub trait Problem<P> {
     fn evaluate(&mut self, points: &[P], with_samples: bool) -> Result<Vec<Evaluation>, EvalError>;
 }
 
-/// Model candidates evaluated by an [`Evaluator`] (threads of this process, or workers).
+/// Most simulated samples one batch brings back (about 100 MB as observations): a batch that
+/// asks for more is evaluated in parts, so that long telemetry records do not multiply into
+/// gigabytes (the default event's 201 samples allow 9 950 candidates a batch).
+pub const SAMPLE_BUDGET: usize = 2_000_000;
+
+/// Model candidates evaluated by an [`Evaluator`] (threads of this process, or workers); a
+/// batch whose samples exceed [`SAMPLE_BUDGET`] goes in parts.
 pub struct Evaluate<'a>(pub &'a mut dyn Evaluator);
 
 impl Problem<Candidate> for Evaluate<'_> {
@@ -112,7 +118,16 @@ impl Problem<Candidate> for Evaluate<'_> {
         points: &[Candidate],
         with_samples: bool,
     ) -> Result<Vec<Evaluation>, EvalError> {
-        self.0.evaluate(points, with_samples)
+        let per = self.0.job().sample_count().max(1);
+        let part = (SAMPLE_BUDGET / per).max(1);
+        if !with_samples || points.len() <= part {
+            return self.0.evaluate(points, with_samples);
+        }
+        let mut out = Vec::with_capacity(points.len());
+        for chunk in points.chunks(part) {
+            out.extend(self.0.evaluate(chunk, true)?);
+        }
+        Ok(out)
     }
 }
 

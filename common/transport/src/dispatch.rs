@@ -352,7 +352,7 @@ impl<L: Link> Evaluator for Dispatcher<L> {
         self.run_batch(batch, with_samples).map_err(EvalError::from)
     }
 
-    fn job(&self) -> &Job {
+    fn job(&self) -> &Arc<Job> {
         &self.job
     }
 

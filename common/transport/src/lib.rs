@@ -95,7 +95,7 @@ pub enum TransportError {
         detail: String,
     },
     /// An operating-system operation failed.
-    #[error("{what}: {source}")]
+    #[error("{what}")]
     Io {
         /// What was attempted.
         what: String,
@@ -115,7 +115,7 @@ pub enum TransportError {
         reason: String,
     },
     /// A message that does not decode.
-    #[error("{what}: {source}")]
+    #[error("{what}")]
     Codec {
         /// Which message.
         what: String,

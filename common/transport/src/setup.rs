@@ -1,14 +1,17 @@
 //! The job setup: what every worker needs once (the events: scenario and measured data of
 //! each release), sent by the coordinator when a worker joins.
 //!
-//! The setup is the scenario TOML and data CSV texts of every event, which round-trip exactly
-//! (sepval writes every number in the shortest form that reads back as the same double), in the
-//! byte form of [`crate::codec`]: the event count, then each event's name, scenario and data as
-//! length-prefixed UTF-8. A [`SetupHeader`] carries the protocol version, the bytes' SHA-256 and
+//! The setup is, for every event, its name and scenario TOML (length-prefixed UTF-8; the TOML
+//! round-trips exactly: sepval writes every number in the shortest form that reads back as the
+//! same double) and its samples as little-endian doubles (count, then t, x, y, z, roll, pitch,
+//! yaw per sample: 56 bytes a sample, nothing parsed), in the byte form of [`crate::codec`].
+//! Comments and metadata of the data files do not travel: the coordinator has already applied
+//! what the simulation needs (the flight condition) to each event's scenario. A [`SetupHeader`] carries the protocol version, the bytes' SHA-256 and
 //! the effect catalogue's fingerprint; a worker checks all three before it decodes anything.
 
 use sepval_common::effects::catalogue_fingerprint;
 use sepval_common::evaluation::{Event, Job, JobError};
+use sepval_common::limits::MAX_SAMPLES;
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
@@ -49,7 +52,7 @@ pub enum SetupError {
         len: usize,
     },
     /// Bytes that do not decode.
-    #[error("setup bytes do not decode: {0}")]
+    #[error("setup bytes do not decode")]
     Decode(#[from] CodecError),
     /// A scenario or data text that does not parse.
     #[error("setup event `{event}`: {message}")]
@@ -80,6 +83,33 @@ pub fn hex(digest: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// Checks samples that arrived as numbers as a telemetry file's are checked: finite, within the
+/// plausible bounds, times increasing.
+fn check_samples(d: &Trajectory) -> Result<(), String> {
+    use sepval_common::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
+    for k in 0..d.len() {
+        let t = d.times_s[k];
+        let within = |v: &f64, bound: f64| v.is_finite() && v.abs() <= bound;
+        if !(within(&t, MAX_SPAN_S)
+            && d.pos_m[k].iter().all(|v| within(v, MAX_POSITION_M))
+            && d.att_deg[k].iter().all(|v| within(v, MAX_ANGLE_DEG)))
+        {
+            return Err(format!(
+                "sample {k} holds a value that no telemetry file may hold"
+            ));
+        }
+        if k > 0 && t <= d.times_s[k - 1] {
+            return Err(format!(
+                "sample {k}: time {t} s is not after the previous sample's"
+            ));
+        }
+    }
+    if d.is_empty() {
+        return Err("no samples".into());
+    }
+    Ok(())
+}
+
 /// A job's setup: its header (announcing `protocol`) and bytes.
 pub fn encode_setup_as(job: &Job, protocol: u32) -> (SetupHeader, Vec<u8>) {
     let mut w = Writer(Vec::new());
@@ -87,7 +117,16 @@ pub fn encode_setup_as(job: &Job, protocol: u32) -> (SetupHeader, Vec<u8>) {
     for e in job.events() {
         w.bytes(e.name.as_bytes());
         w.bytes(e.simulator.scenario().to_toml_string().as_bytes());
-        w.bytes(e.data.to_csv_string().as_bytes());
+        let d = &e.data;
+        w.u64(d.len() as u64);
+        w.0.reserve(56 * d.len());
+        for k in 0..d.len() {
+            w.f64(d.times_s[k]);
+            d.pos_m[k]
+                .iter()
+                .chain(&d.att_deg[k])
+                .for_each(|&v| w.f64(v));
+        }
     }
     let bytes = w.0;
     let header = SetupHeader {
@@ -137,14 +176,26 @@ pub fn decode_setup(header: &SetupHeader, bytes: &[u8]) -> Result<Job, SetupErro
     for _ in 0..n {
         let name = r.text("event name")?;
         let scenario_toml = r.text_up_to("scenario", MAX_SETUP)?;
-        let data_csv = r.text_up_to("data", MAX_SETUP)?;
         let content = |message: String| SetupError::Content {
             event: name.clone(),
             message,
         };
         let scenario =
             Scenario::from_toml_str(&scenario_toml, &name).map_err(|x| content(x.to_string()))?;
-        let data = Trajectory::parse(&data_csv, &name).map_err(|x| content(x.to_string()))?;
+        let n = r.count("samples", MAX_SAMPLES, 56)?;
+        let mut data = Trajectory {
+            times_s: Vec::with_capacity(n),
+            pos_m: Vec::with_capacity(n),
+            att_deg: Vec::with_capacity(n),
+            ..Trajectory::default()
+        };
+        for _ in 0..n {
+            let v: [f64; 7] = std::array::from_fn(|_| r.f64().unwrap_or(f64::NAN));
+            data.times_s.push(v[0]);
+            data.pos_m.push([v[1], v[2], v[3]]);
+            data.att_deg.push([v[4], v[5], v[6]]);
+        }
+        check_samples(&data).map_err(content)?;
         events.push(Event {
             name,
             simulator: Simulator::new(&scenario),

@@ -178,7 +178,7 @@ impl UdsLink {
                 Frame::name_of(Some(&other))
             ))),
             Ok(None) => events.push(lost("its socket closed".into())),
-            Err(e) => events.push(lost(e.to_string())),
+            Err(e) => events.push(lost(crate::error_chain(&e))),
         }
     }
 }

@@ -157,8 +157,8 @@ impl WireObservation {
     };
 }
 
-impl From<&Observation> for WireObservation {
-    fn from(o: &Observation) -> Self {
+impl From<Observation> for WireObservation {
+    fn from(o: Observation) -> Self {
         WireObservation {
             pos_m: o.pos_m,
             att_deg: o.att_deg,
@@ -166,8 +166,8 @@ impl From<&Observation> for WireObservation {
     }
 }
 
-impl From<&WireObservation> for Observation {
-    fn from(o: &WireObservation) -> Self {
+impl From<WireObservation> for Observation {
+    fn from(o: WireObservation) -> Self {
         Observation {
             pos_m: o.pos_m,
             att_deg: o.att_deg,
@@ -392,15 +392,23 @@ pub fn serve_chunks<E>(
             let mut responses = Vec::with_capacity(chunk.requests.len());
             for (r, e) in chunk.requests.iter().zip(outcomes.by_ref()) {
                 let e = e.unwrap_or_else(|| Evaluation::from(Outcome::failed("not evaluated")));
+                responses.push(WireResponse::new(r.index, &e.outcome));
                 if with_samples {
-                    match &e.samples {
+                    match e.samples {
                         Some(events) => {
-                            samples.extend(events.iter().flatten().map(WireObservation::from))
+                            for ev in events {
+                                let wire = ev.into_iter().map(WireObservation::from);
+                                if samples.is_empty() {
+                                    // The first event keeps its buffer (one layout).
+                                    samples = wire.collect();
+                                } else {
+                                    samples.extend(wire);
+                                }
+                            }
                         }
                         None => samples.extend(std::iter::repeat_n(WireObservation::MISSING, per)),
                     }
                 }
-                responses.push(WireResponse::new(r.index, &e.outcome));
             }
             Answer {
                 header: ChunkHeader {
@@ -438,9 +446,10 @@ pub fn serve_locally(job: &Job, chunk: &Chunk) -> Answer {
 impl Answer {
     /// The evaluations of the candidates at `indices` (the chunk as sent), refusing an answer
     /// that does not fit it: another count, another candidate, a malformed outcome, samples of
-    /// the wrong length.
+    /// the wrong length. The answer is consumed: its samples become the evaluations' without a
+    /// second copy of the whole answer (a long telemetry record makes them large).
     pub fn evaluations(
-        &self,
+        self,
         indices: &[usize],
         job: &Job,
     ) -> Result<Vec<(usize, Evaluation)>, String> {
@@ -460,36 +469,54 @@ impl Answer {
                 indices.len()
             ));
         }
-        let mut out = Vec::with_capacity(indices.len());
-        for (k, (r, &index)) in self.responses.iter().zip(indices).enumerate() {
+        let mut outcomes = Vec::with_capacity(indices.len());
+        for (r, &index) in self.responses.iter().zip(indices) {
             if r.index as usize != index {
                 return Err(format!(
                     "it answered candidate {} in place of {index}",
                     r.index
                 ));
             }
-            let outcome = r.outcome().map_err(|e| format!("malformed answer: {e}"))?;
-            let samples = (with_samples && outcome.goals().is_some())
-                .then(|| split_events(job, &self.samples[k * per..(k + 1) * per]));
-            out.push((index, Evaluation { outcome, samples }));
+            outcomes.push(r.outcome().map_err(|e| format!("malformed answer: {e}"))?);
         }
-        Ok(out)
+        // Each candidate's samples, taken from the back so that the buffer shrinks as it goes.
+        let mut flat = self.samples;
+        let mut samples: Vec<Option<Vec<Vec<Observation>>>> = vec![None; indices.len()];
+        if with_samples {
+            for k in (0..indices.len()).rev() {
+                let part = if k == 0 {
+                    std::mem::take(&mut flat)
+                } else {
+                    flat.split_off(k * per)
+                };
+                if outcomes[k].goals().is_some() {
+                    samples[k] = Some(split_events(job, part));
+                }
+            }
+        }
+        Ok(indices
+            .iter()
+            .zip(outcomes)
+            .zip(samples)
+            .map(|((&index, outcome), samples)| (index, Evaluation { outcome, samples }))
+            .collect())
     }
 }
 
-/// Flat samples of one candidate, split per event.
-fn split_events(job: &Job, flat: &[WireObservation]) -> Vec<Vec<Observation>> {
+/// One candidate's flat samples, split per event (a single event keeps the buffer: the two
+/// types have one layout).
+fn split_events(job: &Job, mut flat: Vec<WireObservation>) -> Vec<Vec<Observation>> {
     let mut out = Vec::with_capacity(job.events().len());
-    let mut pos = 0;
-    for e in job.events() {
-        out.push(
-            flat[pos..pos + e.data.len()]
-                .iter()
-                .map(Observation::from)
-                .collect(),
-        );
-        pos += e.data.len();
+    for e in job.events().iter().rev() {
+        let start = flat.len() - e.data.len();
+        let part = if start == 0 {
+            std::mem::take(&mut flat)
+        } else {
+            flat.split_off(start)
+        };
+        out.push(part.into_iter().map(Observation::from).collect());
     }
+    out.reverse();
     out
 }
 
@@ -570,14 +597,14 @@ mod tests {
         let mut chunk = Chunk::new(9, &[0, 1, 2], &batch, true);
         chunk.requests[2].effect_count = 77;
         let answer = serve_locally(&job, &chunk);
-        let back = answer.evaluations(&[0, 1, 2], &job).unwrap();
+        let back = answer.clone().evaluations(&[0, 1, 2], &job).unwrap();
         assert_eq!(back[0].1, job.evaluate_with_samples(&batch[0]));
         assert_eq!(back[1].1.outcome, job.evaluate(&batch[1]).outcome);
         assert_eq!(
             back[2].1.outcome,
             Outcome::failed("malformed request: effect count 77 exceeds the maximum of 4")
         );
-        assert!(answer.evaluations(&[0, 1], &job).is_err());
+        assert!(answer.clone().evaluations(&[0, 1], &job).is_err());
         assert!(answer.evaluations(&[0, 2, 1], &job).is_err());
     }
 }

@@ -5,6 +5,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use sepval_coordinator::diagnose::{DiagnoseOptions, diagnose};
 use sepval_coordinator::fit::{FitOptions, Method};
+use sepval_coordinator::out_dir::{Claim, RunDir};
 use sepval_coordinator::refine::LmSettings;
 use sepval_coordinator::search::ga::GaSettings;
 use sepval_coordinator::search::hill::HillSettings;
@@ -16,6 +17,18 @@ use crate::cli::DiagnoseArgs;
 /// Runs `sepval diagnose`.
 pub fn run(args: DiagnoseArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
+    // The output directory, before anything runs (no worker is started for a refused --out).
+    let claim = if args.overwrite {
+        Claim::Overwrite
+    } else {
+        Claim::Fresh
+    };
+    let run_dir = RunDir::claim(&args.out, claim, "diagnose").with_context(|| {
+        format!(
+            "--out {} (--overwrite clears an earlier run)",
+            args.out.display()
+        )
+    })?;
     let ga = GaSettings {
         population: args.population,
         generations: args.generations,
@@ -69,5 +82,6 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
         args.out.join("report.html").display(),
         args.out.join("diagnosis.json").display()
     );
+    drop(run_dir);
     Ok(())
 }

@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_coordinator::checkpoint::Checkpoint;
 use sepval_coordinator::fit::{FitOptions, FitOutput, Method, run_fit, write_fit_figures};
+use sepval_coordinator::out_dir::{Claim, RunDir};
 use sepval_coordinator::refine::LmSettings;
 use sepval_coordinator::search::ga::GaSettings;
 use sepval_coordinator::search::hill::HillSettings;
@@ -29,6 +30,28 @@ pub fn method(m: MethodArg) -> Method {
 pub fn run(args: FitArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let resume = args.resume.as_deref().map(Checkpoint::load).transpose()?;
+    // The run directory, before anything runs (no worker is started for a refused --out).
+    let claim = match (&args.resume, args.overwrite) {
+        (_, true) => Claim::Overwrite,
+        (Some(c), false) => Claim::Resume {
+            checkpoint: c.clone(),
+        },
+        (None, false) => Claim::Fresh,
+    };
+    let run_dir = RunDir::claim(&args.out, claim, "fit").with_context(|| {
+        format!(
+            "--out {} (--overwrite clears an earlier run)",
+            args.out.display()
+        )
+    })?;
+    if let (Some(c), false) = (&resume, args.overwrite) {
+        for removed in run_dir.discard_generations_after(c.state.generation)? {
+            eprintln!(
+                "sepval: removed {} (a later generation of the continuation being replaced)",
+                removed.display()
+            );
+        }
+    }
     // Inputs: the flags, or (when resuming without them) those recorded in the checkpoint.
     let (data_paths, scenario_path) = match (&resume, args.data.is_empty(), &args.scenario) {
         (Some(c), true, None) => (c.inputs.data.clone(), c.inputs.scenario.clone()),
@@ -116,6 +139,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         figures(&args.out, evaluator.job(), &output)?;
     }
     println!("results in {}", args.out.join("result.json").display());
+    drop(run_dir);
     Ok(())
 }
 

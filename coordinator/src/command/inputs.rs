@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use sepval_common::effects::EffectSet;
 use sepval_common::factors::{FactorTable, Factors};
 use sepval_common::scenario::Scenario;
@@ -69,6 +69,17 @@ pub fn job(
 )> {
     use sepval_common::evaluation::{Event, Job};
     use sepval_common::simulation::Simulator;
+    // Each release once: the same file given twice would count its samples twice.
+    let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    for (i, p) in data_paths.iter().enumerate() {
+        if let Some(q) = data_paths[..i].iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--data {} is the same file as --data {}: give each release once",
+                p.display(),
+                q.display()
+            );
+        }
+    }
     let scen = scenario(scenario_path)?;
     let data = data(data_paths)?;
     let names: Vec<String> = if data_paths.is_empty() {
@@ -85,7 +96,6 @@ pub fn job(
             data,
         });
     }
-    let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
     let record = sepval_coordinator::checkpoint::InputsRecord {
         data: data_paths.iter().map(|p| absolute(p)).collect(),
         scenario: scenario_path.map(absolute),

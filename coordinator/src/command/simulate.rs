@@ -1,6 +1,7 @@
 //! `sepval simulate`: one release, written as a trajectory file.
 
 use anyhow::{Context, Result};
+use sepval_common::limits::{check_sampling, check_steps};
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
 
@@ -16,6 +17,9 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     let factors = inputs::factors(&args.factors, &scenario.factors)?;
     let t_end = t_end.unwrap_or(scenario.integrator.t_end_s);
     let rate = rate.unwrap_or(scenario.integrator.rate_hz);
+    // The work of the run, refused before the sample times are made.
+    check_steps(t_end, scenario.integrator.dt_s).with_context(|| format!("--t-end {t_end}"))?;
+    check_sampling(t_end, rate).with_context(|| format!("--t-end {t_end} with --rate {rate}"))?;
     let sim = Simulator::new(&scenario);
     let times = sample_times(t_end, rate);
     let mut traj = synthetic_flight_test(&sim, &factors, &effects, &times, args.noise_seed)

@@ -343,7 +343,7 @@ pub fn diagnose(
     })?;
     let noise = noise_of(&options.fit);
     let floor = [1.1 * noise.pos_m, 1.1 * noise.att_deg];
-    let job = Arc::new(evaluator.job().clone());
+    let job = Arc::clone(evaluator.job());
     let events: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
     let m = 6 * job.sample_count();
 

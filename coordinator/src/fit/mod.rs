@@ -454,7 +454,7 @@ pub fn run_fit(
         path: generations,
         source,
     })?;
-    let job = Arc::new(evaluator.job().clone());
+    let job = Arc::clone(evaluator.job());
     let noise = Noise {
         pos_m: options.sigma.pos_m,
         att_deg: options.sigma.att_deg,
@@ -500,12 +500,12 @@ pub fn run_fit(
         )
     });
     // What one grid step of each factor does at the best fit.
-    let best_factors = methods
-        .values()
-        .min_by(|a, b| a.best.weighted.total_cmp(&b.best.weighted))
-        .map(|m| m.best.factors);
-    let resolution = match best_factors {
-        Some(f) => resolution_advice(evaluator, job.factor_table(), &f, noise)?,
+    let best = methods
+        .iter()
+        .min_by(|a, b| a.1.best.weighted.total_cmp(&b.1.best.weighted))
+        .map(|(name, m)| (m.best.factors, &best_samples[name]));
+    let resolution = match best {
+        Some((f, base)) => resolution_advice(evaluator, job.factor_table(), &f, base, noise)?,
         None => Vec::new(),
     };
 

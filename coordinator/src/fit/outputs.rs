@@ -17,6 +17,7 @@ use crate::results::{
     Best, ChannelRms, FitResult, FrontPoint, HistoryPoint, MethodResult, Probe, Refinement,
     ResolutionRow, channel_rms, residuals,
 };
+use crate::run::{Evaluate, Problem};
 use crate::search::ga::Member;
 
 /// Simulations at which the history first has both goals at the floor.
@@ -73,10 +74,14 @@ pub(super) fn refined_member(
 
 /// One grid step of each factor at `factors` (inward at a bound): the change of the goals and
 /// of the simulated trajectory, coarse when the trajectory moves by more than the noise.
+///
+/// `base` is the simulated samples of `factors` (the best method's, already at hand: a second
+/// copy of a long record is not made).
 pub fn resolution_advice(
     evaluator: &mut dyn Evaluator,
     table: &sepval_common::factors::FactorTable,
     factors: &Factors,
+    base: &[Vec<Observation>],
     noise: Noise,
 ) -> Result<Vec<ResolutionRow>, FitError> {
     use sepval_common::factors::Factor;
@@ -91,49 +96,54 @@ pub fn resolution_advice(
         };
         batch.push(Candidate::baseline(f));
     }
-    let out = evaluator.evaluate(&batch, true)?;
-    let base = out[0]
-        .samples
-        .clone()
-        .ok_or_else(|| FitError::Failed("the best fit did not simulate".into()))?;
-    let g0 = out[0].outcome.objectives();
+    // The base goals, then the steps in parts (each part's samples are dropped once its rows
+    // are made, so that long records stay within memory).
+    let g0 = evaluator.evaluate(&batch[..1], false)?[0]
+        .outcome
+        .objectives();
+    let per = evaluator.job().sample_count().max(1);
+    let part = (crate::run::SAMPLE_BUDGET / per).max(1);
     let mut rows = Vec::new();
-    for (i, e) in out.iter().enumerate().skip(1) {
-        let name = Factor::NAMES[i - 1].to_string();
-        let step = table.0[i - 1].step();
-        let Some(s) = &e.samples else {
+    let mut i = 0;
+    for chunk in batch[1..].chunks(part) {
+        for e in Evaluate(evaluator).evaluate(chunk, true)? {
+            let name = Factor::NAMES[i].to_string();
+            let step = table.0[i].step();
+            i += 1;
+            let Some(s) = &e.samples else {
+                rows.push(ResolutionRow {
+                    factor: name,
+                    step,
+                    d_j_pos_m: None,
+                    d_j_att_deg: None,
+                    traj_rms_pos_m: None,
+                    traj_rms_att_deg: None,
+                    coarse: true,
+                });
+                continue;
+            };
+            let (mut dp, mut da, mut n) = (0.0, 0.0, 0usize);
+            for (ev_a, ev_b) in s.iter().zip(base) {
+                for (a, b) in ev_a.iter().zip(ev_b) {
+                    let (p, q) = residual(a, &b.pos_m, &b.att_deg);
+                    dp += p.iter().map(|v| v * v).sum::<f64>();
+                    da += q.iter().map(|v| v * v).sum::<f64>();
+                    n += 1;
+                }
+            }
+            let n3 = 3.0 * n.max(1) as f64;
+            let (rp, ra) = ((dp / n3).sqrt(), (da / n3).sqrt());
+            let g = e.outcome.objectives();
             rows.push(ResolutionRow {
                 factor: name,
                 step,
-                d_j_pos_m: f64::INFINITY,
-                d_j_att_deg: f64::INFINITY,
-                traj_rms_pos_m: f64::INFINITY,
-                traj_rms_att_deg: f64::INFINITY,
-                coarse: true,
+                d_j_pos_m: Some(g[0] - g0[0]),
+                d_j_att_deg: Some(g[1] - g0[1]),
+                traj_rms_pos_m: Some(rp),
+                traj_rms_att_deg: Some(ra),
+                coarse: rp > noise.pos_m || ra > noise.att_deg,
             });
-            continue;
-        };
-        let (mut dp, mut da, mut n) = (0.0, 0.0, 0usize);
-        for (ev_a, ev_b) in s.iter().zip(&base) {
-            for (a, b) in ev_a.iter().zip(ev_b) {
-                let (p, q) = residual(a, &b.pos_m, &b.att_deg);
-                dp += p.iter().map(|v| v * v).sum::<f64>();
-                da += q.iter().map(|v| v * v).sum::<f64>();
-                n += 1;
-            }
         }
-        let n3 = 3.0 * n.max(1) as f64;
-        let (rp, ra) = ((dp / n3).sqrt(), (da / n3).sqrt());
-        let g = e.outcome.objectives();
-        rows.push(ResolutionRow {
-            factor: name,
-            step,
-            d_j_pos_m: g[0] - g0[0],
-            d_j_att_deg: g[1] - g0[1],
-            traj_rms_pos_m: rp,
-            traj_rms_att_deg: ra,
-            coarse: rp > noise.pos_m || ra > noise.att_deg,
-        });
     }
     Ok(rows)
 }
@@ -198,6 +208,9 @@ pub fn write_result(dir: &Path, result: &FitResult) -> Result<(), FitError> {
     Ok(())
 }
 
+/// Most samples of one series a trajectory figure draws.
+const MAX_PLOTTED_SAMPLES: usize = 20_000;
+
 /// Writes the fit's figures into DIR/figures: the study's Figures 1-6 (trajectories of the
 /// first event against each method's best), Figure 7 (factors beside the truth, when known),
 /// the Pareto fronts and the convergence histories. Returns the files written.
@@ -224,15 +237,31 @@ pub fn write_fit_figures(
         }
     }
     let first = &job.events()[0];
+    // A long record is drawn from every k-th sample (a figure has about a thousand pixels
+    // across; the plotted copies stay small).
+    let stride = first.data.len().div_ceil(MAX_PLOTTED_SAMPLES).max(1);
+    let pick = |n: usize| (0..n).step_by(stride);
+    let data = sepval_common::telemetry::Trajectory {
+        times_s: pick(first.data.len())
+            .map(|k| first.data.times_s[k])
+            .collect(),
+        pos_m: pick(first.data.len())
+            .map(|k| first.data.pos_m[k])
+            .collect(),
+        att_deg: pick(first.data.len())
+            .map(|k| first.data.att_deg[k])
+            .collect(),
+        ..Default::default()
+    };
     let fits: Vec<(String, sepval_common::telemetry::Trajectory)> = output
         .best_samples
         .iter()
         .map(|(m, samples)| {
             let obs = &samples[0];
             let traj = sepval_common::telemetry::Trajectory {
-                times_s: first.data.times_s.clone(),
-                pos_m: obs.iter().map(|o| o.pos_m).collect(),
-                att_deg: obs.iter().map(|o| o.att_deg).collect(),
+                times_s: data.times_s.clone(),
+                pos_m: pick(obs.len()).map(|k| obs[k].pos_m).collect(),
+                att_deg: pick(obs.len()).map(|k| obs[k].att_deg).collect(),
                 ..Default::default()
             };
             (label(m), traj)
@@ -242,7 +271,7 @@ pub fn write_fit_figures(
         .iter()
         .map(|(l, t)| Series { label: l, traj: t })
         .collect();
-    let mut written = trajectory_figures(&fig_dir, &first.data, &series)?;
+    let mut written = trajectory_figures(&fig_dir, &data, &series)?;
 
     let table = job.factor_table();
     let ranges: Vec<(f64, f64)> = table.0.iter().map(|s| (s.min, s.max)).collect();

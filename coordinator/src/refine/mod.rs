@@ -103,20 +103,33 @@ fn solve_damped(jtj: &DMatrix<f64>, free: &[usize], mu: f64, rhs: &[f64]) -> Vec
         }
         a[(p, p)] += mu * jtj[(i, i)].max(1e-12);
     }
-    let d = a
-        .clone()
-        .cholesky()
-        .map(|c| c.solve(&b))
-        .unwrap_or_else(|| {
-            a.svd(true, true)
-                .solve(&b, 1e-14)
-                .unwrap_or_else(|_| DVector::zeros(nf))
-        });
+    let d = solve_bounded(a, b);
     let mut full = vec![0.0; jtj.nrows()];
     for (p, &i) in free.iter().enumerate() {
         full[i] = d[p];
     }
     full
+}
+
+/// Most sweeps of the singular value decomposition that backs up a failed Cholesky factorisation
+/// (it converges in a few dozen on any finite matrix; this bound stops it on a pathological one
+/// instead of spinning for ever).
+const MAX_SVD_ITERATIONS: usize = 1000;
+
+/// Solves `a d = b` (`a` symmetric): Cholesky, else a bounded SVD pseudo-inverse, else (a
+/// non-finite or pathological system) no step at all.
+fn solve_bounded(a: DMatrix<f64>, b: DVector<f64>) -> DVector<f64> {
+    let n = b.len();
+    if !(a.iter().all(|v| v.is_finite()) && b.iter().all(|v| v.is_finite())) {
+        return DVector::zeros(n);
+    }
+    if let Some(c) = a.clone().cholesky() {
+        return c.solve(&b);
+    }
+    nalgebra::SVD::try_new(a, true, true, f64::EPSILON, MAX_SVD_ITERATIONS)
+        .and_then(|svd| svd.solve(&b, 1e-14).ok())
+        .filter(|d| d.iter().all(|v| v.is_finite()))
+        .unwrap_or_else(|| DVector::zeros(n))
 }
 
 /// What a refinement waits for.
@@ -502,8 +515,34 @@ pub fn levenberg_marquardt(
     noise: Noise,
     settings: &LmSettings,
 ) -> Result<LmResult> {
-    let job = std::sync::Arc::new(evaluator.job().clone());
+    let job = std::sync::Arc::clone(evaluator.job());
     let mut lm = LmRun::new(space.clone(), job, x0, noise, settings.clone());
     run(&mut lm, &mut Evaluate(evaluator), &mut [])?;
     Ok(lm.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pathological_systems_give_no_step_at_once() {
+        let huge = DMatrix::from_element(3, 3, 1e308);
+        let d = solve_bounded(huge.clone() * 10.0, DVector::from_element(3, 1.0));
+        assert!(d.iter().all(|v| *v == 0.0), "{d}");
+        let d = solve_bounded(
+            DMatrix::from_element(3, 3, f64::NAN),
+            DVector::from_element(3, 1.0),
+        );
+        assert!(d.iter().all(|v| *v == 0.0), "{d}");
+        // Singular but finite: the pseudo-inverse.
+        let singular = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]);
+        let d = solve_bounded(singular, DVector::from_row_slice(&[2.0, 2.0]));
+        assert!(
+            (d[0] - 1.0).abs() < 1e-12 && (d[1] - 1.0).abs() < 1e-12,
+            "{d}"
+        );
+        let d = solve_bounded(huge, DVector::from_element(3, 1e-300));
+        assert!(d.iter().all(|v| v.is_finite()));
+    }
 }

@@ -15,6 +15,7 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
@@ -88,7 +89,16 @@ pub struct IpcLink {
     options: IpcOptions,
     cfg: Config,
     node: Node<ipc::Service>,
-    setup: Publisher<ipc::Service, [u8], SetupHeader>,
+    job: Arc<Job>,
+    setup_service: iceoryx2::service::port_factory::publish_subscribe::PortFactory<
+        ipc::Service,
+        [u8],
+        SetupHeader,
+    >,
+    /// The setup's publisher while workers may still join (its sample, in the service's
+    /// history, is as large as the data; it is dropped once every worker has joined and made
+    /// again for a replacement).
+    setup: Option<Publisher<ipc::Service, [u8], SetupHeader>>,
     hello: Subscriber<ipc::Service, Hello, ()>,
     wake: Listener<ipc::Service>,
     ports: BTreeMap<WorkerId, Port>,
@@ -107,7 +117,7 @@ impl IpcLink {
     /// Creates the run's services, publishes the job setup, and starts the workers (or
     /// announces that it waits for them). Stale resources of earlier runs whose processes
     /// were killed are cleaned first.
-    pub fn start(job: &Job, options: IpcOptions) -> Result<IpcLink, TransportError> {
+    pub fn start(job: &Arc<Job>, options: IpcOptions) -> Result<IpcLink, TransportError> {
         if options.workers == 0 || options.workers > MAX_WORKERS {
             return Err(TransportError::WorkerCount(options.workers));
         }
@@ -128,7 +138,7 @@ impl IpcLink {
     }
 
     fn create(
-        job: &Job,
+        job: &Arc<Job>,
         options: IpcOptions,
         mut early: Vec<Notice>,
     ) -> Result<IpcLink, TransportError> {
@@ -163,9 +173,7 @@ impl IpcLink {
             .create()
             .map_err(iox("listening for wake-ups"))?;
         // The setup service last: a worker that finds it finds every run service.
-        let (header, bytes) =
-            encode_setup_as(job, options.announce_protocol.unwrap_or(PROTOCOL_VERSION));
-        let setup = node
+        let setup_service = node
             .service_builder(&service_name(names::SETUP)?)
             .publish_subscribe::<[u8]>()
             .user_header::<SetupHeader>()
@@ -174,19 +182,7 @@ impl IpcLink {
             .history_size(1)
             .subscriber_max_buffer_size(1)
             .create()
-            .map_err(iox("creating the setup service"))?
-            .publisher_builder()
-            .initial_max_slice_len(bytes.len())
-            .create()
-            .map_err(iox("publishing the setup"))?;
-        let mut sample = setup
-            .loan_slice_uninit(bytes.len())
-            .map_err(iox("loaning the setup"))?;
-        *sample.user_header_mut() = header;
-        sample
-            .write_from_slice(&bytes)
-            .send()
-            .map_err(iox("sending the setup"))?;
+            .map_err(iox("creating the setup service"))?;
         if options.launch == Launch::Attach {
             early.push(Notice::Waiting {
                 run: options.run_id.to_string(),
@@ -199,7 +195,9 @@ impl IpcLink {
             options,
             cfg,
             node,
-            setup,
+            job: Arc::clone(job),
+            setup_service,
+            setup: None,
             hello,
             wake,
             ports: BTreeMap::new(),
@@ -210,6 +208,7 @@ impl IpcLink {
             early,
             _cleanup: super::RunCleanup(run_id),
         };
+        link.publish_setup()?;
         if matches!(link.options.launch, Launch::Spawn { .. }) {
             for _ in 0..link.options.workers {
                 link.spawn()?;
@@ -218,12 +217,52 @@ impl IpcLink {
         Ok(link)
     }
 
+    /// Publishes the job setup (once per publisher: it stays in the service's history).
+    fn publish_setup(&mut self) -> Result<(), TransportError> {
+        if self.setup.is_some() {
+            return Ok(());
+        }
+        let (header, bytes) = encode_setup_as(
+            &self.job,
+            self.options.announce_protocol.unwrap_or(PROTOCOL_VERSION),
+        );
+        let setup = self
+            .setup_service
+            .publisher_builder()
+            .initial_max_slice_len(bytes.len())
+            .create()
+            .map_err(iox("publishing the setup"))?;
+        let mut sample = setup
+            .loan_slice_uninit(bytes.len())
+            .map_err(iox("loaning the setup"))?;
+        *sample.user_header_mut() = header;
+        sample
+            .write_from_slice(&bytes)
+            .send()
+            .map_err(iox("sending the setup"))?;
+        self.setup = Some(setup);
+        Ok(())
+    }
+
+    /// Drops the setup's publisher once every spawned worker has joined (attached workers may
+    /// come at any time: their setup stays).
+    fn retire_setup(&mut self) {
+        let spawned = matches!(self.options.launch, Launch::Spawn { .. });
+        if spawned && self.starting.is_empty() && self.ports.len() >= self.options.workers {
+            self.setup = None;
+        }
+    }
+
     /// Process ids of the connected workers.
     pub fn worker_pids(&self) -> Vec<u32> {
         self.ports.values().map(|p| p.pid).collect()
     }
 
     fn spawn(&mut self) -> Result<(), TransportError> {
+        if !matches!(self.options.launch, Launch::Spawn { .. }) {
+            return Ok(());
+        }
+        self.publish_setup()?;
         let Launch::Spawn { executable } = &self.options.launch else {
             return Ok(());
         };
@@ -285,9 +324,11 @@ impl IpcLink {
     /// Delivers the setup to newly subscribed workers (from the service's history) and
     /// connects every worker that announced itself.
     fn accept_hellos(&mut self, events: &mut Vec<LinkEvent>) -> Result<(), TransportError> {
-        self.setup
-            .update_connections()
-            .map_err(iox("delivering the setup"))?;
+        if let Some(setup) = &self.setup {
+            setup
+                .update_connections()
+                .map_err(iox("delivering the setup"))?;
+        }
         while let Some(h) = self.hello.receive().map_err(iox("receiving hellos"))? {
             let h: Hello = *h;
             let label = format!("pid {}", h.pid);
@@ -454,6 +495,7 @@ impl IpcLink {
         events.extend(self.early.drain(..).map(LinkEvent::Notice));
         self.accept_hellos(events)?;
         self.reap_starting(events)?;
+        self.retire_setup();
         self.collect(events)
     }
 }

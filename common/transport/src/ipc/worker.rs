@@ -150,8 +150,13 @@ impl IpcWorker {
             if let Some(sample) = setup.receive().map_err(iox("receiving the setup"))? {
                 let header: SetupHeader = *sample.user_header();
                 check_setup_header(&header).map_err(|e| refuse(e.to_string()))?;
-                break decode_setup(&header, sample.payload())
-                    .map_err(|e| refuse(format!("setup {}: {e}", hex(&header.sha256))))?;
+                break decode_setup(&header, sample.payload()).map_err(|e| {
+                    refuse(format!(
+                        "setup {}: {}",
+                        hex(&header.sha256),
+                        crate::error_chain(&e)
+                    ))
+                })?;
             }
             if Instant::now() >= deadline {
                 return Err(refuse(format!(

@@ -73,7 +73,7 @@ fn accept_setup(run: &RunId, bytes: &[u8]) -> Result<(Job, [u8; 32]), TransportE
                     run.as_str()
                 )));
             }
-            let job = decode_setup(&header, &bytes).map_err(|e| refuse(e.to_string()))?;
+            let job = decode_setup(&header, &bytes).map_err(|e| refuse(crate::error_chain(&e)))?;
             Ok((job, header.sha256))
         }
         Ok(other) => Err(refuse(format!(

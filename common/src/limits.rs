@@ -1,0 +1,102 @@
+//! One limit on the work of a run, applied wherever a run is set up (a scenario file, the
+//! `simulate` flags, a telemetry file, a job), each checked before anything is allocated and
+//! refused with the limit in the message; and the bounds of plausible telemetry values.
+//!
+//! The limits are generous for store separation (an event lasts seconds, is sampled at a few
+//! hundred hertz and integrated at a fraction of a millisecond) and small enough that one
+//! simulation stays in memory and finishes in seconds: a run of [`MAX_STEPS`] steps takes about
+//! 1.5 s on one core of the 2026 development machine, and [`MAX_SAMPLES`] samples of one
+//! event take 224 MB (56 bytes each). The values are documented in `docs/model.md` section 6.
+
+/// Most RK4 steps of one run (event span / integration step).
+pub const MAX_STEPS: f64 = 1e7;
+/// Most telemetry samples of one event, and of one job.
+pub const MAX_SAMPLES: usize = 4_000_000;
+/// Longest event: the latest sample time, and the simulated end time \[s\].
+pub const MAX_SPAN_S: f64 = 3600.0;
+/// Largest plausible position coordinate in telemetry \[m\].
+pub const MAX_POSITION_M: f64 = 1e5;
+/// Largest plausible Euler angle in telemetry (ten turns) \[deg\].
+pub const MAX_ANGLE_DEG: f64 = 3600.0;
+
+/// A run beyond the limits.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum LimitError {
+    /// Too long an event.
+    #[error("an event of {span_s} s is longer than the limit of {MAX_SPAN_S} s")]
+    Span {
+        /// The span asked for \[s\].
+        span_s: f64,
+    },
+    /// Too many integration steps.
+    #[error(
+        "{steps:.3e} RK4 steps ({span_s} s at dt = {dt_s} s) exceed the limit of {MAX_STEPS:.0e} steps per run"
+    )]
+    Steps {
+        /// Steps asked for.
+        steps: f64,
+        /// The span \[s\].
+        span_s: f64,
+        /// The step \[s\].
+        dt_s: f64,
+    },
+    /// Too many samples.
+    #[error("{samples} samples exceed the limit of {MAX_SAMPLES} per event")]
+    Samples {
+        /// Samples asked for.
+        samples: f64,
+    },
+}
+
+/// Checks a run that integrates from 0 to `span_s` at step `dt_s` (both finite and > 0).
+pub fn check_steps(span_s: f64, dt_s: f64) -> Result<(), LimitError> {
+    if span_s > MAX_SPAN_S {
+        return Err(LimitError::Span { span_s });
+    }
+    let steps = span_s / dt_s;
+    if steps > MAX_STEPS {
+        return Err(LimitError::Steps {
+            steps,
+            span_s,
+            dt_s,
+        });
+    }
+    Ok(())
+}
+
+/// Checks telemetry sampled from 0 to `span_s` at `rate_hz` (both finite and > 0), before the
+/// sample times are made.
+pub fn check_sampling(span_s: f64, rate_hz: f64) -> Result<(), LimitError> {
+    if span_s > MAX_SPAN_S {
+        return Err(LimitError::Span { span_s });
+    }
+    let samples = (span_s * rate_hz).floor() + 1.0;
+    if samples > MAX_SAMPLES as f64 {
+        return Err(LimitError::Samples { samples });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn limits_refuse_with_the_limit_in_the_message() {
+        check_steps(1.0, 0.0005).unwrap();
+        check_sampling(1.0, 200.0).unwrap();
+        assert_eq!(
+            check_steps(1e5, 0.0005).unwrap_err().to_string(),
+            "an event of 100000 s is longer than the limit of 3600 s"
+        );
+        assert_eq!(
+            check_steps(1000.0, 1e-5).unwrap_err().to_string(),
+            "1.000e8 RK4 steps (1000 s at dt = 0.00001 s) exceed the limit of 1e7 steps per run"
+        );
+        assert_eq!(
+            check_sampling(1.0, 1e9).unwrap_err().to_string(),
+            "1000000001 samples exceed the limit of 4000000 per event"
+        );
+    }
+}

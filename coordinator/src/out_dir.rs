@@ -1,0 +1,326 @@
+//! Output directories of runs (`fit --out`, `diagnose --out`), protected: a run holds a lock in
+//! its directory for its whole life, so a second run into it is refused (naming the holder's
+//! process id); a directory that already holds something is refused unless it is the run being
+//! resumed, or the user asked to clear it; and a directory is only ever cleared when it is a
+//! sepval output directory (it carries the marker file, or a sepval result).
+//!
+//! Files: `DIR/.sepval-lock` (the holder's process id; removed when the run ends, left behind
+//! only by a killed process, and then taken over once that process is gone) and
+//! `DIR/.sepval-run` (the marker: which command made the directory).
+
+use std::fs::OpenOptions;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The lock file of a run directory.
+pub const LOCK_FILE: &str = ".sepval-lock";
+/// The marker of a sepval output directory.
+pub const MARKER_FILE: &str = ".sepval-run";
+
+/// Files whose presence makes a directory (made before the marker existed) a sepval output.
+const SEPVAL_OUTPUTS: [&str; 4] = ["result.json", "generations", "diagnosis.json", "baseline"];
+
+/// How a run uses its directory.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Claim {
+    /// A new run: the directory must be absent or empty.
+    Fresh,
+    /// A new run into a directory whose contents may be cleared first.
+    Overwrite,
+    /// Resuming the run of the checkpoint whose run directory this is: its contents stay.
+    Resume {
+        /// The checkpoint resumed from.
+        checkpoint: PathBuf,
+    },
+}
+
+/// A directory a run cannot use.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OutDirError {
+    /// Another process holds the directory.
+    #[error(
+        "{path} is in use by sepval process {pid} (lock {lock}); wait for it to finish, or remove the lock if that process is gone"
+    )]
+    Locked {
+        /// The directory.
+        path: PathBuf,
+        /// The holder.
+        pid: u32,
+        /// The lock file.
+        lock: PathBuf,
+    },
+    /// A non-empty directory for a fresh run.
+    #[error(
+        "{path} is not empty (it holds {first}); give another directory, resume from one of its checkpoints, or clear it"
+    )]
+    NotEmpty {
+        /// The directory.
+        path: PathBuf,
+        /// One of its entries.
+        first: String,
+    },
+    /// A directory to resume into that is not the checkpoint's.
+    #[error(
+        "{path} is not the run directory of checkpoint {checkpoint} (that is {expected}); resume into it, or give an empty directory"
+    )]
+    OtherRun {
+        /// The directory.
+        path: PathBuf,
+        /// The checkpoint.
+        checkpoint: PathBuf,
+        /// Its run directory.
+        expected: PathBuf,
+    },
+    /// A directory to clear that sepval did not make.
+    #[error(
+        "not clearing {path}: it is not a sepval output directory (no {MARKER_FILE}, no result)"
+    )]
+    NotOurs {
+        /// The directory.
+        path: PathBuf,
+    },
+    /// A path that is not a directory.
+    #[error("{path} exists and is not a directory")]
+    NotADirectory {
+        /// The path.
+        path: PathBuf,
+    },
+    /// The file system refused.
+    #[error("{what} {path}")]
+    Io {
+        /// What was attempted.
+        what: &'static str,
+        /// The path.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+fn io(what: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> OutDirError {
+    let path = path.to_path_buf();
+    move |source| OutDirError::Io { what, path, source }
+}
+
+/// A claimed run directory: locked until dropped.
+#[derive(Debug)]
+pub struct RunDir {
+    path: PathBuf,
+    lock: PathBuf,
+}
+
+impl RunDir {
+    /// Claims `path` for a run of `command` (created if absent).
+    pub fn claim(path: &Path, claim: Claim, command: &str) -> Result<RunDir, OutDirError> {
+        match std::fs::metadata(path) {
+            Ok(m) if !m.is_dir() => {
+                return Err(OutDirError::NotADirectory {
+                    path: path.to_path_buf(),
+                });
+            }
+            Ok(_) => {}
+            Err(_) => std::fs::create_dir_all(path).map_err(io("cannot create", path))?,
+        }
+        let lock = path.join(LOCK_FILE);
+        take_lock(path, &lock)?;
+        let dir = RunDir {
+            path: path.to_path_buf(),
+            lock,
+        };
+        // From here on the lock is ours (released when `dir` drops, on error too).
+        let others = entries(path)?;
+        match claim {
+            Claim::Fresh => {
+                if let Some(first) = others.first() {
+                    return Err(OutDirError::NotEmpty {
+                        path: path.to_path_buf(),
+                        first: first.clone(),
+                    });
+                }
+            }
+            Claim::Overwrite => {
+                if !others.is_empty() {
+                    let ours = others
+                        .iter()
+                        .any(|e| e == MARKER_FILE || SEPVAL_OUTPUTS.contains(&e.as_str()));
+                    if !ours {
+                        return Err(OutDirError::NotOurs {
+                            path: path.to_path_buf(),
+                        });
+                    }
+                    for e in &others {
+                        let p = path.join(e);
+                        if p.is_dir() {
+                            std::fs::remove_dir_all(&p).map_err(io("cannot clear", &p))?;
+                        } else {
+                            std::fs::remove_file(&p).map_err(io("cannot clear", &p))?;
+                        }
+                    }
+                }
+            }
+            Claim::Resume { checkpoint } => {
+                // DIR/generations/gen-NNNN.json belongs to DIR.
+                let expected = checkpoint
+                    .parent()
+                    .and_then(Path::parent)
+                    .map(Path::to_path_buf)
+                    .unwrap_or_default();
+                let same = |a: &Path, b: &Path| {
+                    let canon = |p: &Path| std::fs::canonicalize(p).unwrap_or(p.to_path_buf());
+                    canon(a) == canon(b)
+                };
+                if !others.is_empty() && !same(path, &expected) {
+                    return Err(OutDirError::OtherRun {
+                        path: path.to_path_buf(),
+                        checkpoint: checkpoint.clone(),
+                        expected,
+                    });
+                }
+            }
+        }
+        let marker = format!("{{\"command\": {}}}\n", serde_json::json!(command));
+        sepval_common::atomic_file::write_atomically(&path.join(MARKER_FILE), marker.as_bytes())
+            .map_err(|e| OutDirError::Io {
+                what: "cannot write",
+                path: path.join(MARKER_FILE),
+                source: e.source,
+            })?;
+        Ok(dir)
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Removes the checkpoints of generations after `generation` (those of an abandoned
+    /// continuation, when a run is resumed from an earlier generation) and returns them.
+    pub fn discard_generations_after(
+        &self,
+        generation: usize,
+    ) -> Result<Vec<PathBuf>, OutDirError> {
+        let dir = self.path.join("generations");
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return Ok(Vec::new());
+        };
+        let mut removed = Vec::new();
+        for e in entries.filter_map(Result::ok) {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let later = name
+                .strip_prefix("gen-")
+                .and_then(|n| n.strip_suffix(".json"))
+                .and_then(|n| n.parse::<usize>().ok())
+                .is_some_and(|g| g > generation);
+            if later {
+                std::fs::remove_file(e.path()).map_err(io("cannot remove", &e.path()))?;
+                removed.push(e.path());
+            }
+        }
+        removed.sort();
+        Ok(removed)
+    }
+}
+
+impl Drop for RunDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.lock);
+    }
+}
+
+/// The directory's entries other than the lock and the marker, sorted.
+fn entries(path: &Path) -> Result<Vec<String>, OutDirError> {
+    let mut out: Vec<String> = std::fs::read_dir(path)
+        .map_err(io("cannot read", path))?
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != LOCK_FILE && n != MARKER_FILE)
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+/// Whether process `pid` is alive.
+fn alive(pid: u32) -> bool {
+    // SAFETY: kill(2) with signal 0 only checks that the process exists.
+    let r = unsafe { libc::kill(pid as libc::pid_t, 0) };
+    r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
+}
+
+/// Creates the lock file holding our process id; takes over the lock of a process that is
+/// gone.
+fn take_lock(dir: &Path, lock: &Path) -> Result<(), OutDirError> {
+    for _ in 0..2 {
+        match OpenOptions::new().write(true).create_new(true).open(lock) {
+            Ok(mut f) => {
+                writeln!(f, "{}", std::process::id()).map_err(io("cannot write", lock))?;
+                return Ok(());
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let holder = std::fs::read_to_string(lock)
+                    .ok()
+                    .and_then(|t| t.trim().parse::<u32>().ok());
+                match holder {
+                    Some(pid) if alive(pid) => {
+                        return Err(OutDirError::Locked {
+                            path: dir.to_path_buf(),
+                            pid,
+                            lock: lock.to_path_buf(),
+                        });
+                    }
+                    // A killed run's lock (or one being written): take it over.
+                    _ => {
+                        let _ = std::fs::remove_file(lock);
+                    }
+                }
+            }
+            Err(e) => return Err(io("cannot lock", lock)(e)),
+        }
+    }
+    Err(OutDirError::Locked {
+        path: dir.to_path_buf(),
+        pid: 0,
+        lock: lock.to_path_buf(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_directory_is_claimed_once_and_only_cleared_when_it_is_ours() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path().join("run");
+        let first = RunDir::claim(&d, Claim::Fresh, "fit").unwrap();
+        let e = RunDir::claim(&d, Claim::Overwrite, "fit").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains(&format!("in use by sepval process {}", std::process::id())),
+            "{e}"
+        );
+        std::fs::write(d.join("result.json"), "{}").unwrap();
+        drop(first);
+        assert!(!d.join(LOCK_FILE).exists());
+        let e = RunDir::claim(&d, Claim::Fresh, "fit").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("is not empty (it holds result.json)"),
+            "{e}"
+        );
+        let again = RunDir::claim(&d, Claim::Overwrite, "fit").unwrap();
+        assert!(!d.join("result.json").exists() && d.join(MARKER_FILE).exists());
+        drop(again);
+        // A directory sepval did not make is never cleared.
+        let other = tmp.path().join("mine");
+        std::fs::create_dir(&other).unwrap();
+        std::fs::write(other.join("thesis.tex"), "x").unwrap();
+        let e = RunDir::claim(&other, Claim::Overwrite, "fit").unwrap_err();
+        assert!(e.to_string().starts_with("not clearing"), "{e}");
+        assert!(other.join("thesis.tex").exists() && !other.join(LOCK_FILE).exists());
+        // A killed run's lock is taken over.
+        std::fs::write(d.join(LOCK_FILE), "999999999\n").unwrap();
+        RunDir::claim(&d, Claim::Fresh, "fit").unwrap();
+    }
+}
