@@ -1,7 +1,10 @@
 //! Checkpoints of a genetic search: one JSON file per generation, written atomically, holding
 //! the population with its goals, the archive, the generator state, the settings and the hashes
 //! of the data and scenario it was run on (argmin's checkpointing model: the solver state and
-//! its generator, so a resumed run is identical to an uninterrupted one).
+//! its generator, so a resumed run is identical to an uninterrupted one). Statistics that may
+//! be infinite are written with [`nonfinite`].
+
+pub mod nonfinite;
 
 use std::path::{Path, PathBuf};
 
