@@ -157,11 +157,13 @@ fn rerun_reproduces_a_generation_and_reports_any_member_that_does_not() {
     let ckpt = dir.path().join("r/generations/gen-0003.json");
     let out = ok(&sepval(&["rerun", ckpt.to_str().unwrap()], dir.path()));
     assert!(
-        out.contains("all 10 members reproduce their goals bit for bit"),
+        out.contains("generation 3: all 10 population and")
+            && out.contains("archive members reproduce their goals bit for bit"),
         "{out}"
     );
 
-    // Tamper with one member's goal: rerun must name it and fail (the digest sees it first).
+    // Tamper with one member's goal: rerun must name it and fail (the digest sees it first;
+    // edits sealed again with a matching digest: tests/cli/checkpoint.rs).
     let mut v: Value = serde_json::from_str(&std::fs::read_to_string(&ckpt).unwrap()).unwrap();
     let j = v["state"]["population"][4]["outcome"]["j_pos_m"]
         .as_f64()
