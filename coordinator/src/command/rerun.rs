@@ -37,5 +37,9 @@ pub fn run(args: RerunArgs) -> Result<()> {
     for m in &report.mismatches {
         println!("{m}");
     }
-    bail!("{}", report.failures())
+    bail!(
+        "checkpoint {} does not reproduce: {}",
+        args.checkpoint.display(),
+        report.failures()
+    )
 }
