@@ -52,12 +52,20 @@ impl RngState {
     /// A generator in this state.
     pub fn restore(&self) -> Result<SearchRng, RngStateError> {
         let bad = || RngStateError::Seed(self.seed_hex.clone());
-        if self.seed_hex.len() != 64 {
+        // Checked byte by byte before any slicing: text that is not ASCII (or holds a sign,
+        // which `from_str_radix` would take) is refused, never sliced inside a character.
+        let hex = self.seed_hex.as_bytes();
+        if hex.len() != 64 || !hex.iter().all(u8::is_ascii_hexdigit) {
             return Err(bad());
         }
         let mut seed = [0u8; 32];
-        for (i, b) in seed.iter_mut().enumerate() {
-            *b = u8::from_str_radix(&self.seed_hex[2 * i..2 * i + 2], 16).map_err(|_| bad())?;
+        for (b, pair) in seed.iter_mut().zip(hex.chunks_exact(2)) {
+            let digit = |c: u8| (c as char).to_digit(16).expect("checked hex digit") as u8;
+            *b = digit(pair[0]) << 4 | digit(pair[1]);
+        }
+        let digits = self.word_pos.as_bytes();
+        if digits.is_empty() || !digits.iter().all(u8::is_ascii_digit) {
+            return Err(RngStateError::Position(self.word_pos.clone()));
         }
         let pos: u128 = self
             .word_pos
@@ -91,5 +99,45 @@ mod tests {
         let mut bad = saved.clone();
         bad.seed_hex.pop();
         assert!(bad.restore().is_err());
+    }
+
+    #[test]
+    fn text_that_is_not_a_state_is_refused_not_a_panic() {
+        let good = RngState::of(&seeded(3));
+        let seed = |s: String| RngState {
+            seed_hex: s,
+            ..good.clone()
+        };
+        // 64 bytes, but a two-byte character straddles a pair boundary.
+        let straddling = format!("0{}{}", "é", "0".repeat(61));
+        assert_eq!(straddling.len(), 64);
+        for text in [
+            straddling,
+            format!("+f{}", "0".repeat(62)),
+            format!("{}g", "0".repeat(63)),
+        ] {
+            assert_eq!(
+                seed(text.clone()).restore().map(|_| ()),
+                Err(RngStateError::Seed(text))
+            );
+        }
+        for pos in [
+            "",
+            "+7",
+            "-1",
+            "7 ",
+            "٣",
+            "340282366920938463463374607431768211456",
+        ] {
+            let s = RngState {
+                word_pos: pos.to_string(),
+                ..good.clone()
+            };
+            assert_eq!(
+                s.restore().map(|_| ()),
+                Err(RngStateError::Position(pos.to_string()))
+            );
+        }
+        assert!(good.restore().is_ok());
     }
 }

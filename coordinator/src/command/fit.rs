@@ -133,6 +133,15 @@ pub fn run(args: FitArgs) -> Result<()> {
         },
     };
     let mut evaluator = spec.start(Arc::new(job), notices())?;
+    if let (Some(c), Some(path)) = (&options.resume, args.resume.as_deref()) {
+        // Its members re-evaluated and its generation replayed before going on from it.
+        let report = sepval_coordinator::rerun::confirm(c, path, evaluator.as_mut())?;
+        eprintln!(
+            "sepval: resuming from {}: {}",
+            path.display(),
+            report.checked()
+        );
+    }
     let output = run_fit(&options, evaluator.as_mut(), &mut Bar::new())?;
     print_summary(&output);
     if !args.no_figures {

@@ -1,4 +1,4 @@
-//! `sepval rerun`: a saved generation re-evaluated and checked bit for bit.
+//! `sepval rerun`: a saved generation re-evaluated, replayed and checked bit for bit.
 
 use std::sync::Arc;
 
@@ -23,26 +23,23 @@ pub fn run(args: RerunArgs) -> Result<()> {
     let (job, _) = inputs::job(&data_paths, scenario_path.as_deref())?;
     checkpoint.check_job(&job, &args.checkpoint)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;
-    let mismatches =
-        sepval_coordinator::rerun::rerun(&checkpoint, &args.checkpoint, evaluator.as_mut())?;
-    let n = checkpoint.state.population.len();
-    if mismatches.is_empty() {
+    let report =
+        sepval_coordinator::rerun::check(&checkpoint, &args.checkpoint, evaluator.as_mut())?;
+    println!("{} ({})", report.checked(), evaluator.describe());
+    if report.reproduces() {
         println!(
-            "generation {}: all {n} members reproduce their goals bit for bit ({})",
-            checkpoint.state.generation,
-            evaluator.describe()
+            "generation {}: all {} population and {} archive members reproduce their goals bit \
+             for bit",
+            report.generation, report.population, report.archive
         );
         return Ok(());
     }
-    for m in &mismatches {
-        println!(
-            "member {}: saved {:?}, rerun {:?}",
-            m.member, m.saved, m.rerun
-        );
+    for m in &report.mismatches {
+        println!("{m}");
     }
     bail!(
-        "generation {}: {} of {n} members do not reproduce their goals bit for bit",
-        checkpoint.state.generation,
-        mismatches.len()
+        "checkpoint {} does not reproduce: {}",
+        args.checkpoint.display(),
+        report.failures()
     )
 }

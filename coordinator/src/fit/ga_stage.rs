@@ -209,6 +209,7 @@ impl Observer<GaStage> for Checkpointer {
         };
         let checkpoint = Checkpoint {
             format: CHECKPOINT_FORMAT.to_string(),
+            digest: None,
             method: self.method.clone(),
             settings: self.settings.clone(),
             hill: self.hill.clone(),

@@ -131,7 +131,8 @@ impl Member {
     }
 }
 
-/// The best of one generation.
+/// The best of one generation. The goals are infinite when no member of the population
+/// finished; in JSON they are then the string `"inf"` ([`crate::checkpoint::nonfinite`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GenerationStats {
     /// Generation number (1 = the initial population).
@@ -139,10 +140,13 @@ pub struct GenerationStats {
     /// Simulations run so far.
     pub evaluations: u64,
     /// Smallest first objective in the population.
+    #[serde(with = "crate::checkpoint::nonfinite")]
     pub best_j_pos_m: f64,
     /// Smallest second objective in the population.
+    #[serde(with = "crate::checkpoint::nonfinite")]
     pub best_j_att_deg: f64,
     /// Smallest weighted sum w0 J_pos + w1 J_att in the population.
+    #[serde(with = "crate::checkpoint::nonfinite")]
     pub best_weighted: f64,
 }
 
