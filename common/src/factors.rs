@@ -235,8 +235,14 @@ impl Factors {
 
     /// Parses the JSON object `{ "fwdfac": 0.25, ... }` naming all 17 factors.
     pub fn from_json_str(text: &str, table: &FactorTable) -> Result<Factors, FactorsFileError> {
-        let map: BTreeMap<String, serde_json::Value> =
-            serde_json::from_str(text).map_err(FactorsFileError::Json)?;
+        let Entries(entries) = serde_json::from_str(text).map_err(FactorsFileError::Json)?;
+        let mut map: BTreeMap<String, serde_json::Value> = BTreeMap::new();
+        for (name, value) in entries {
+            if map.contains_key(&name) {
+                return Err(FactorsFileError::Duplicate { name });
+            }
+            map.insert(name, value);
+        }
         let mut pairs = Vec::with_capacity(map.len());
         for (name, value) in &map {
             let number = value.as_f64().ok_or_else(|| FactorsFileError::NotANumber {
@@ -265,9 +271,42 @@ pub enum FactorsFileError {
         /// What was found.
         found: String,
     },
+    /// A name given twice.
+    #[error("factor `{name}` is given twice")]
+    Duplicate {
+        /// The factor name.
+        name: String,
+    },
     /// A bad name or value.
     #[error(transparent)]
     Factor(FactorError),
+}
+
+/// The entries of a JSON object in file order, duplicates kept (serde_json's maps keep only
+/// the last of a repeated key, which would hide a mistake).
+struct Entries(Vec<(String, serde_json::Value)>);
+
+impl<'de> Deserialize<'de> for Entries {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Entries;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a JSON object")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut m: A,
+            ) -> Result<Entries, A::Error> {
+                let mut out = Vec::new();
+                while let Some(entry) = m.next_entry()? {
+                    out.push(entry);
+                }
+                Ok(Entries(out))
+            }
+        }
+        deserializer.deserialize_map(V)
+    }
 }
 
 impl Serialize for Factors {
@@ -497,5 +536,9 @@ mod tests {
         let text = full.replacen("\"aftfac\":0.8", "\"aftfac\":\"x\"", 1);
         let e = Factors::from_json_str(&text, &t).unwrap_err().to_string();
         assert_eq!(e, "factor `aftfac`: expected a number, found \"x\"");
+
+        let twice = full.replacen("\"aftfac\":0.8", "\"aftfac\":0.8,\"aftfac\":0.9", 1);
+        let e = Factors::from_json_str(&twice, &t).unwrap_err().to_string();
+        assert_eq!(e, "factor `aftfac` is given twice");
     }
 }

@@ -176,11 +176,15 @@ pub struct HistoryPoint {
     pub step: usize,
     /// Simulations so far.
     pub evaluations: u64,
-    /// Smallest J_pos in the population (the point itself for the hill climber) \[m\].
+    /// Smallest J_pos in the population (the point itself for the hill climber) \[m\]
+    /// (`"inf"` when no member finished).
+    #[serde(with = "crate::checkpoint::nonfinite")]
     pub best_j_pos_m: f64,
     /// Smallest J_att \[deg\].
+    #[serde(with = "crate::checkpoint::nonfinite")]
     pub best_j_att_deg: f64,
     /// Smallest weighted sum.
+    #[serde(with = "crate::checkpoint::nonfinite")]
     pub best_weighted: f64,
 }
 
