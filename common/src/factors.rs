@@ -237,9 +237,10 @@ impl Factors {
     pub fn from_json_str(text: &str, table: &FactorTable) -> Result<Factors, FactorsFileError> {
         let Entries(entries) = serde_json::from_str(text).map_err(FactorsFileError::Json)?;
         let mut map: BTreeMap<String, serde_json::Value> = BTreeMap::new();
+        let mut repeated = None;
         for (name, value) in entries {
-            if map.contains_key(&name) {
-                return Err(FactorsFileError::Duplicate { name });
+            if map.contains_key(&name) && repeated.is_none() {
+                repeated = Some(name.clone());
             }
             map.insert(name, value);
         }
@@ -251,8 +252,13 @@ impl Factors {
             })?;
             pairs.push((name.as_str(), number));
         }
-        Factors::from_named(pairs.iter().map(|(n, v)| (*n, *v)), table)
-            .map_err(FactorsFileError::Factor)
+        let factors = Factors::from_named(pairs.iter().map(|(n, v)| (*n, *v)), table)
+            .map_err(FactorsFileError::Factor)?;
+        // A repeated name is refused too (reported after the other problems of the file).
+        match repeated {
+            Some(name) => Err(FactorsFileError::Duplicate { name }),
+            None => Ok(factors),
+        }
     }
 }
 

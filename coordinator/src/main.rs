@@ -22,9 +22,6 @@ use cli::{Cli, Command};
 /// A flag's value outside its closed set, as every other refusal reads: `--flag value:
 /// expected a, b or c`.
 fn invalid_value(e: &clap::Error) -> Option<String> {
-    if e.kind() != ErrorKind::InvalidValue {
-        return None;
-    }
     let text = |kind| match e.get(kind) {
         Some(ContextValue::String(s)) => Some(s.clone()),
         _ => None,
@@ -32,6 +29,14 @@ fn invalid_value(e: &clap::Error) -> Option<String> {
     let flag = text(ContextKind::InvalidArg)?;
     let flag = flag.split([' ', '=']).next().unwrap_or(&flag).to_string();
     let value = text(ContextKind::InvalidValue)?;
+    if e.kind() == ErrorKind::ValueValidation {
+        // A typed value that refused itself (a run id): its own message says why.
+        let reason = std::error::Error::source(e)?.to_string();
+        return Some(format!("{flag} {value}: {reason}"));
+    }
+    if e.kind() != ErrorKind::InvalidValue {
+        return None;
+    }
     let valid = match e.get(ContextKind::ValidValue) {
         Some(ContextValue::Strings(v)) if !v.is_empty() => v.clone(),
         _ => return None,

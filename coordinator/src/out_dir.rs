@@ -104,16 +104,20 @@ fn io(what: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> OutDirE
     move |source| OutDirError::Io { what, path, source }
 }
 
-/// A claimed run directory: locked until dropped.
+/// A claimed run directory: locked until dropped. A directory this claim created is removed
+/// again when the run ends before writing anything into it (a refused input, workers that
+/// would not start), so a failed run leaves nothing behind.
 #[derive(Debug)]
 pub struct RunDir {
     path: PathBuf,
     lock: PathBuf,
+    created: bool,
 }
 
 impl RunDir {
     /// Claims `path` for a run of `command` (created if absent).
     pub fn claim(path: &Path, claim: Claim, command: &str) -> Result<RunDir, OutDirError> {
+        let mut created = false;
         match std::fs::metadata(path) {
             Ok(m) if !m.is_dir() => {
                 return Err(OutDirError::NotADirectory {
@@ -121,13 +125,22 @@ impl RunDir {
                 });
             }
             Ok(_) => {}
-            Err(_) => std::fs::create_dir_all(path).map_err(io("cannot create", path))?,
+            Err(_) => {
+                std::fs::create_dir_all(path).map_err(io("cannot create", path))?;
+                created = true;
+            }
         }
         let lock = path.join(LOCK_FILE);
-        take_lock(path, &lock)?;
+        if let Err(e) = take_lock(path, &lock) {
+            if created {
+                let _ = std::fs::remove_dir(path);
+            }
+            return Err(e);
+        }
         let dir = RunDir {
             path: path.to_path_buf(),
             lock,
+            created,
         };
         // From here on the lock is ours (released when `dir` drops, on error too).
         let others = entries(path)?;
@@ -226,6 +239,11 @@ impl RunDir {
 impl Drop for RunDir {
     fn drop(&mut self) {
         let _ = std::fs::remove_file(&self.lock);
+        let untouched = entries(&self.path).is_ok_and(|e| e.is_empty());
+        if self.created && untouched {
+            let _ = std::fs::remove_file(self.path.join(MARKER_FILE));
+            let _ = std::fs::remove_dir(&self.path);
+        }
     }
 }
 

@@ -8,4 +8,5 @@ mod checkpoint;
 mod cli;
 mod diagnose;
 mod fit;
+mod hardening;
 mod refine;
