@@ -36,7 +36,11 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
         ..GaSettings::default()
     };
     ga.validate()?;
-    let (job, inputs) = inputs::job(&args.data, args.scenario.as_deref())?;
+    let (job, inputs) = inputs::job(
+        &args.data,
+        args.scenario.as_deref(),
+        args.extension.as_deref(),
+    )?;
     let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
         .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
     let lm = LmSettings {

@@ -10,12 +10,20 @@ use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
 use sepval_common::telemetry::Trajectory;
 
-/// The scenario of `--scenario FILE`, or the embedded default.
-pub fn scenario(path: Option<&Path>) -> Result<Scenario> {
-    match path {
-        Some(p) => Ok(Scenario::load(p)?),
-        None => Ok(Scenario::embedded_default()),
+/// The scenario of `--scenario FILE`, or the embedded default, extended by the terms of
+/// `--extension FILE` (docs/model.md section 11).
+pub fn scenario(path: Option<&Path>, extension: Option<&Path>) -> Result<Scenario> {
+    let mut s = match path {
+        Some(p) => Scenario::load(p)?,
+        None => Scenario::embedded_default(),
+    };
+    if let Some(e) = extension {
+        let terms = sepval_common::extension::load_extension(e)?;
+        s.extension
+            .extend(terms.iter().map(sepval_common::extension::TermRecord::of));
+        s.validate(&format!("{} extended by {}", s.name, e.display()))?;
     }
+    Ok(s)
 }
 
 /// The factors of `--factors truth|nominal|FILE.json`, checked against `table`.
@@ -63,6 +71,7 @@ pub fn data(paths: &[std::path::PathBuf]) -> Result<Vec<Trajectory>> {
 pub fn job(
     data_paths: &[std::path::PathBuf],
     scenario_path: Option<&Path>,
+    extension_path: Option<&Path>,
 ) -> Result<(
     sepval_common::evaluation::Job,
     sepval_coordinator::checkpoint::InputsRecord,
@@ -80,7 +89,7 @@ pub fn job(
             );
         }
     }
-    let scen = scenario(scenario_path)?;
+    let scen = scenario(scenario_path, extension_path)?;
     let data = data(data_paths)?;
     let names: Vec<String> = if data_paths.is_empty() {
         vec!["embedded default synthetic flight test".to_string()]
@@ -99,6 +108,7 @@ pub fn job(
     let record = sepval_coordinator::checkpoint::InputsRecord {
         data: data_paths.iter().map(|p| absolute(p)).collect(),
         scenario: scenario_path.map(absolute),
+        extension: extension_path.map(absolute),
     };
     Ok((Job::new(events)?, record))
 }
