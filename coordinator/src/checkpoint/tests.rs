@@ -75,6 +75,7 @@ fn checkpoint(job: &Arc<Job>, generations: usize, finish: bool) -> Checkpoint {
         inputs: InputsRecord {
             data: Vec::new(),
             scenario: None,
+            extension: None,
         },
         state: ga.state().unwrap().clone(),
         probes: Vec::new(),
