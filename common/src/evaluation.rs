@@ -181,7 +181,10 @@ impl Job {
         let mut sums = GoalSums::default();
         let mut samples = Vec::new();
         for (k, event) in self.events.iter().enumerate() {
-            let run = match event.simulator.run_setup_with(&c.factors, &c.effects, &c.terms) {
+            let run = match event
+                .simulator
+                .run_setup_with(&c.factors, &c.effects, &c.terms)
+            {
                 Ok(run) => run,
                 Err(e) => return Evaluation::from(Outcome::failed(e.to_string())),
             };

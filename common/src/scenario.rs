@@ -425,7 +425,11 @@ impl Scenario {
         if self.extension.len() > crate::extension::MAX_TERMS {
             return Err(bad(
                 "extension",
-                format!("has {} terms, at most {}", self.extension.len(), crate::extension::MAX_TERMS),
+                format!(
+                    "has {} terms, at most {}",
+                    self.extension.len(),
+                    crate::extension::MAX_TERMS
+                ),
             ));
         }
         for (k, r) in self.extension.iter().enumerate() {

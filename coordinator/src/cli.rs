@@ -142,6 +142,10 @@ pub struct DiagnoseArgs {
     /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
     #[arg(long, value_name = "FILE")]
     pub extension: Option<PathBuf>,
+    /// A release not used for fitting (CSV; repeatable): the baseline and the answer predict it
+    /// and their errors are reported, the honest measure of an extension.
+    #[arg(long, value_name = "FILE.csv")]
+    pub validate: Vec<PathBuf>,
     /// Seed of the baseline fit's genetic search.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,

@@ -32,8 +32,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::atmosphere::isa_troposphere;
 use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
-use crate::extension::{TermError, TermInput, TermSet};
 use crate::elementary::atan2_asin;
+use crate::extension::{TermError, TermInput, TermSet};
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
 

@@ -8,11 +8,11 @@
 //! bounded ([`MAX_CHUNK`], [`MAX_TEXT`], [`MAX_SETUP`]) and checked against the bytes actually
 //! present before anything is allocated, and trailing bytes are refused.
 
+use crate::wire::WireTerm;
 use crate::wire::{
     Answer, Chunk, ChunkHeader, MAGIC, MAX_CHUNK, PROTOCOL_VERSION, REASON_CAPACITY, SetupHeader,
     WireObservation, WireRequest, WireResponse,
 };
-use crate::wire::WireTerm;
 use sepval_common::effects::{MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::extension::MAX_TERMS;
 use sepval_common::factors::FACTOR_COUNT;

@@ -291,7 +291,12 @@ impl WireRequest {
                 .ok_or_else(|| bad(format!("axis index {} is not an axis", w.axis)))?;
             let regressor = Regressor::ALL
                 .get(w.regressor as usize)
-                .ok_or_else(|| bad(format!("regressor index {} is not a regressor", w.regressor)))?
+                .ok_or_else(|| {
+                    bad(format!(
+                        "regressor index {} is not a regressor",
+                        w.regressor
+                    ))
+                })?
                 .0;
             terms
                 .push(Term {
@@ -640,7 +645,12 @@ mod tests {
         );
         let mut bad = w;
         bad.terms[0].axis = 6; // ejector: a flow-angle regressor cannot act on it
-        assert!(bad.candidate().unwrap_err().to_string().contains("cannot act on axis ejector"));
+        assert!(
+            bad.candidate()
+                .unwrap_err()
+                .to_string()
+                .contains("cannot act on axis ejector")
+        );
         let mut bad = w;
         bad.effect_params[0][1] = f64::INFINITY;
         assert!(

@@ -53,19 +53,23 @@ pub fn run(args: FitArgs) -> Result<()> {
         }
     }
     // Inputs: the flags, or (when resuming without them) those recorded in the checkpoint.
-    let (data_paths, scenario_path, extension_path) =
-        match (&resume, args.data.is_empty(), &args.scenario, &args.extension) {
-            (Some(c), true, None, None) => (
-                c.inputs.data.clone(),
-                c.inputs.scenario.clone(),
-                c.inputs.extension.clone(),
-            ),
-            _ => (
-                args.data.clone(),
-                args.scenario.clone(),
-                args.extension.clone(),
-            ),
-        };
+    let (data_paths, scenario_path, extension_path) = match (
+        &resume,
+        args.data.is_empty(),
+        &args.scenario,
+        &args.extension,
+    ) {
+        (Some(c), true, None, None) => (
+            c.inputs.data.clone(),
+            c.inputs.scenario.clone(),
+            c.inputs.extension.clone(),
+        ),
+        _ => (
+            args.data.clone(),
+            args.scenario.clone(),
+            args.extension.clone(),
+        ),
+    };
     let (job, inputs) = inputs::job(
         &data_paths,
         scenario_path.as_deref(),

@@ -139,3 +139,48 @@ pub fn event_scenario(
     s.validate(&format!("{name} (flight condition from its metadata)"))?;
     Ok(s)
 }
+
+/// The events of `--validate FILE` (none: `None`), read like `--data` with the same scenario
+/// and extension; a file given both to fit and to validate is refused.
+pub fn validation_job(
+    paths: &[std::path::PathBuf],
+    data_paths: &[std::path::PathBuf],
+    scenario_path: Option<&Path>,
+    extension_path: Option<&Path>,
+) -> Result<Option<sepval_common::evaluation::Job>> {
+    use sepval_common::evaluation::{Event, Job};
+    use sepval_common::simulation::Simulator;
+    if paths.is_empty() {
+        return Ok(None);
+    }
+    let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    for (i, p) in paths.iter().enumerate() {
+        if let Some(q) = data_paths.iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--validate {} is the same file as --data {}: a release used for fitting cannot measure prediction",
+                p.display(),
+                q.display()
+            );
+        }
+        if let Some(q) = paths[..i].iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--validate {} is the same file as --validate {}: give each release once",
+                p.display(),
+                q.display()
+            );
+        }
+    }
+    let scen = scenario(scenario_path, extension_path)?;
+    let mut events = Vec::with_capacity(paths.len());
+    for p in paths {
+        let data = Trajectory::read(p).with_context(|| format!("--validate {}", p.display()))?;
+        let name = p.display().to_string();
+        let scenario = event_scenario(&scen, &data, &name)?;
+        events.push(Event {
+            name,
+            simulator: Simulator::new(&scenario),
+            data,
+        });
+    }
+    Ok(Some(Job::new(events)?))
+}

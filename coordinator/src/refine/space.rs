@@ -159,7 +159,9 @@ impl ParamSpace {
             term.coefficient = x[i];
             i += 1;
             if t.locator.is_some() {
-                term.locator[0] = x[i];
+                // Held within its bounds (which lie inside its domain): a probe of the
+                // refinement may stray beyond them, and a decay length must stay positive.
+                term.locator[0] = x[i].clamp(self.lo[i], self.hi[i]);
                 i += 1;
             }
             terms.push(term).map_err(search_error)?;

@@ -7,6 +7,7 @@
 mod checkpoint;
 mod cli;
 mod diagnose;
+mod discover;
 mod fit;
 mod hardening;
 mod refine;
