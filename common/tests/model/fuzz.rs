@@ -1,7 +1,8 @@
 //! Property-based hardening of the model library's readers of outside input: telemetry CSV
 //! ([`Trajectory::parse`], and [`Trajectory::read`] on files of arbitrary bytes, invalid UTF-8
-//! included), scenario TOML ([`Scenario::from_toml_str`]) and factors JSON
-//! ([`Factors::from_json_str`]).
+//! included), scenario TOML ([`Scenario::from_toml_str`]), factors JSON
+//! ([`Factors::from_json_str`]) and effect specs of the command line
+//! ([`EffectSet::push_spec`]).
 //!
 //! Each is fed arbitrary text and structured mutations of a valid input (the embedded default
 //! flight test, the embedded default scenario, the truth factors): bytes flipped, inserted and
@@ -19,7 +20,9 @@
 //! --test model fuzz`.
 
 use proptest::prelude::*;
+use proptest::sample::select;
 use proptest::test_runner::TestCaseError;
+use sepval_common::effects::{CATALOGUE, EffectSet};
 use sepval_common::factors::{FactorTable, Factors};
 use sepval_common::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
 use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
@@ -27,7 +30,7 @@ use sepval_common::synthetic::default_flight_test;
 use sepval_common::telemetry::{TelemetryError, Trajectory};
 use sepval_tests::fuzz::{
     CountingAllocator, Edit, apply, check_cost, check_typed, config, edits, measure, number_edits,
-    text_edit,
+    number_text, text_edit,
 };
 
 #[global_allocator]
@@ -280,6 +283,58 @@ fn factors_text(text: &str) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// Adds effect specs to an empty set (as `--effect` flags do) and checks every property: the
+/// set holds what was added, and its text form reads back the same.
+fn effect_specs(specs: &[String]) -> Result<(), TestCaseError> {
+    let mut set = EffectSet::NONE;
+    for spec in specs {
+        let before = set.len();
+        let (result, cost) = measure(|| set.push_spec(spec));
+        check_cost(
+            "EffectSet::push_spec",
+            cost,
+            max_allocation(spec.len(), PER_BYTE),
+        )?;
+        check_typed("EffectSet::push_spec", &result)?;
+        prop_assert_eq!(set.len(), before + usize::from(result.is_ok()));
+    }
+    prop_assert!(set.iter().all(|a| a.values().iter().all(|v| v.is_finite())));
+    if !set.is_empty() {
+        let mut again = EffectSet::NONE;
+        for spec in set.to_string().split(' ') {
+            again.push_spec(spec).expect("a set's text reads back");
+        }
+        prop_assert_eq!(again, set);
+    }
+    Ok(())
+}
+
+/// An effect spec: a catalogue id (or another name) and a list of numbers (mostly as many as
+/// the effect takes), then perhaps edited.
+fn effect_spec() -> BoxedStrategy<String> {
+    let id_and_count = prop_oneof![
+        4 => (0..CATALOGUE.len()).prop_map(|k| (CATALOGUE[k].id(), CATALOGUE[k].params().len())),
+        1 => select(&["", " ", "x", "release_rates ", "=", "release_rates=1"][..]).prop_map(|id| (id, 1)),
+    ];
+    let value = || prop_oneof![3 => (-2.0..2.0f64).prop_map(|v| v.to_string()), 1 => number_text()];
+    (id_and_count, any::<bool>())
+        .prop_flat_map(move |((id, n), exact)| {
+            let count = if exact { n..n + 1 } else { 0..6 };
+            (Just(id), prop::collection::vec(value(), count))
+        })
+        .prop_map(|(id, values)| format!("{id}={}", values.join(",")))
+        .prop_flat_map(|spec| {
+            prop_oneof![
+                2 => Just(spec.clone()),
+                1 => edits(text_edit(EFFECT_TOKENS), 2).prop_map(move |e| mutated(&spec, &e)),
+            ]
+        })
+        .boxed()
+}
+
+/// The syntax of an effect spec.
+const EFFECT_TOKENS: &[&str] = &["=", ",", ",,", " ", "-", "e", ".", "NaN", "inf", "é"];
+
 /// Mutated text as a string (edits may cut characters: lossy, as a file would be read by a
 /// caller that decodes it first).
 fn mutated(base: &str, e: &[Edit]) -> String {
@@ -302,6 +357,11 @@ proptest! {
     #[test]
     fn factors_arbitrary_text(text in arbitrary_text("[-0-9a-z.:{},\\[\\]\" \\n]")) {
         factors_text(&text)?;
+    }
+
+    #[test]
+    fn effect_specs_of_the_command_line(specs in prop::collection::vec(effect_spec(), 1..6)) {
+        effect_specs(&specs)?;
     }
 
     #[test]
