@@ -304,7 +304,10 @@ mod tests {
         assert!(first.rho < -0.9, "{}", first.rho);
         let white = id.parameters[0].std_error_white.unwrap();
         let m_inv = (jac.tr_mul(&jac)).try_inverse().unwrap();
-        assert!((white - m_inv[(0, 0)].sqrt()).abs() < 1e-9 * white, "{white}");
+        assert!(
+            (white - m_inv[(0, 0)].sqrt()).abs() < 1e-9 * white,
+            "{white}"
+        );
     }
 
     #[test]
