@@ -700,7 +700,7 @@ fn validate(
         .iter()
         .map(|e| {
             let one = Job::new(vec![e.clone()]);
-            let goals = |c: &Candidate| -> std::result::Result<(f64, f64), String> {
+            let goals = |c: &Candidate| -> Prediction {
                 let job = one.as_ref().map_err(|e| e.to_string())?;
                 let ev = job.evaluate(c);
                 ev.outcome
@@ -709,7 +709,7 @@ fn validate(
                     .ok_or_else(|| format!("{:?}", ev.outcome))
             };
             let (b, a) = (goals(base), goals(answer));
-            let others: Vec<(String, std::result::Result<(f64, f64), String>)> = alternatives
+            let others: Vec<(String, Prediction)> = alternatives
                 .iter()
                 .map(|(n, c)| (n.clone(), goals(c)))
                 .collect();
@@ -744,6 +744,9 @@ fn validate(
         .collect()
 }
 
+/// A model's goals on a validation event (J_pos \[m\], J_att \[deg\]), or why it did not simulate.
+type Prediction = std::result::Result<(f64, f64), String>;
+
 /// A caveat for the verdict when an alternative predicts the events not fitted clearly better
 /// than the answer (its sum over events of `(J_pos/sigma_pos)^2 + (J_att/sigma_att)^2` below
 /// 0.8 of the answer's): the answer may fit its own data by mimicry.
@@ -770,7 +773,7 @@ fn prediction_caveat(validation: &[ValidationReport], noise: Noise) -> Option<St
         .into_iter()
         .filter(|a| a.1.is_finite())
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
-    if n == 0.0 || !(s < 0.8 * answer) {
+    if n == 0.0 || s >= 0.8 * answer || !s.is_finite() {
         return None;
     }
     let kind = model.split(':').next().unwrap_or("an");
@@ -810,7 +813,10 @@ mod tests {
         // Answer 0.012 m / 0.75 deg against the alternative's 0.008 m / 0.26 deg: caveat.
         let better = [event((0.012, 0.75), (0.008, 0.26))];
         let note = prediction_caveat(&better, noise).expect("a caveat");
-        assert!(note.contains("catalogue alternative predicts better"), "{note}");
+        assert!(
+            note.contains("catalogue alternative predicts better"),
+            "{note}"
+        );
         assert!(note.contains("0.0080 m"), "{note}");
         // Within 20 % of the answer's score: no caveat.
         let close = [event((0.010, 0.5), (0.0095, 0.48))];
