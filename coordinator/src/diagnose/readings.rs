@@ -4,16 +4,16 @@
 //!
 //! | family | reading |
 //! |---|---|
-//! | `flow_angle` | "<quantity> changing with <alpha, beta, ...>: a static derivative or nonlinearity the model lacks" |
-//! | `rate` (own axis: Cl-p, Cm-q, Cn-r) | "<roll/pitch/yaw> damping differs from the model's (stronger or weaker)" |
-//! | `rate` (cross axis) | "<quantity> due to <roll/pitch/yaw> rate: a cross derivative the model lacks" |
-//! | `interference` | "<quantity> near the aircraft decaying over about lambda m: interference stronger (or weaker) or shaped otherwise than modelled" |
-//! | `interference_flow_angle` | "<quantity> growing with <sideslip/angle of attack/rate> near the aircraft: attitude-dependent interference" |
-//! | `mach` | "<quantity> changing with Mach number: compressibility (for example a transonic drag rise)" |
-//! | `step` | "<quantity> step at t s: a gust or a release transient" |
-//! | `oscillation` | "<quantity> oscillating at f Hz: buffet (or a structural or flow oscillation)" |
-//! | `ejector_stroke` (`stroke`) | "ejector force falls (or rises) along the stroke" |
-//! | `ejector_stroke` (`stroke2`) | "ejector force peaks (or dips) mid-stroke" |
+//! | `flow_angle` | `<quantity> changing with <alpha, beta, ...>: a static derivative or nonlinearity the model lacks` |
+//! | `rate` (own axis: Cl-p, Cm-q, Cn-r) | `<roll/pitch/yaw> damping differs from the model's (stronger or weaker)` |
+//! | `rate` (cross axis) | `<quantity> due to <roll/pitch/yaw> rate: a cross derivative the model lacks` |
+//! | `interference` | `<quantity> near the aircraft decaying over about lambda m: interference stronger (or weaker) or shaped otherwise than modelled` |
+//! | `interference_flow_angle` | `<quantity> growing with <sideslip/angle of attack/rate> near the aircraft: attitude-dependent interference` |
+//! | `mach` | `<quantity> changing with Mach number: compressibility (for example a transonic drag rise)` |
+//! | `step` | `<quantity> step at t s: a gust or a release transient` |
+//! | `oscillation` | `<quantity> oscillating at f Hz: buffet (or a structural or flow oscillation)` |
+//! | `ejector_stroke` (`stroke`) | `ejector force falls (or rises) along the stroke` |
+//! | `ejector_stroke` (`stroke2`) | `ejector force peaks (or dips) mid-stroke` |
 
 use sepval_common::extension::{Axis, Family, Regressor, Term};
 
