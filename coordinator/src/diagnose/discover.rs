@@ -733,7 +733,7 @@ pub(super) fn discover(
             mach0: (family == Family::Mach).then_some(locator),
             locator_std_error: loc_pos.and_then(se),
             gain: gains.get(k).cloned().unwrap_or_else(|| gain.clone()),
-            reading: readings::reading(&lead),
+            reading: readings::reading(&lead, &job.events()[0].simulator.scenario().interference),
             group: groups[k].clone(),
         });
     }
