@@ -270,8 +270,11 @@ pub struct Diagnosis {
     /// The catalogue effects named as causes, in the order chosen (empty when the baseline
     /// explains the data, or when a discovered extension explains it better).
     pub causes: Vec<String>,
-    /// Whether the catalogue's answer (`causes`; the baseline when empty) leaves nothing but
-    /// noise. A discovered extension's own verdict is `extension.explained`.
+    /// Whether the catalogue's answer leaves nothing but noise: the model with the effects it
+    /// chose (the baseline when it chose none), even when those effects are not the answer
+    /// (`causes` is then empty because a discovered extension explains better). A discovered
+    /// extension's own verdict is `extension.explained`; the terminal summary shows the
+    /// answer's.
     pub explained: bool,
     /// The verdict in one sentence.
     pub verdict: String,
