@@ -219,22 +219,22 @@ impl ChannelRms {
     }
 }
 
-/// Residuals of simulated samples against the job's data, per event, per sample:
-/// (dx, dy, dz \[m\], droll, dpitch, dyaw \[deg\]), angle differences wrapped.
-pub fn residuals(job: &Job, samples: &[Vec<Observation>]) -> Vec<Vec<[f64; 6]>> {
-    job.events()
-        .iter()
-        .zip(samples)
-        .map(|(e, sim)| {
-            sim.iter()
-                .enumerate()
-                .map(|(k, o)| {
-                    let (p, a) = residual(o, &e.data.pos_m[k], &e.data.att_deg[k]);
-                    [p[0], p[1], p[2], a[0], a[1], a[2]]
-                })
-                .collect()
-        })
-        .collect()
+/// RMS of each channel of the residuals of simulated samples against the job's data, pooled
+/// over events: (dx, dy, dz \[m\], droll, dpitch, dyaw \[deg\]), angle differences wrapped.
+/// Streams the samples: a long record's residuals are never held at once.
+pub fn residual_rms(job: &Job, samples: &[Vec<Observation>]) -> ChannelRms {
+    let mut sums = [0.0; 6];
+    let mut n = 0usize;
+    for (e, sim) in job.events().iter().zip(samples) {
+        for (k, o) in sim.iter().enumerate() {
+            let (p, a) = residual(o, &e.data.pos_m[k], &e.data.att_deg[k]);
+            for (s, r) in sums.iter_mut().zip(p.iter().chain(&a)) {
+                *s += r * r;
+            }
+            n += 1;
+        }
+    }
+    rms_of(sums, n)
 }
 
 /// RMS of each channel of residuals pooled over events.
@@ -247,6 +247,11 @@ pub fn channel_rms(residuals: &[Vec<[f64; 6]>]) -> ChannelRms {
         }
         n += 1;
     }
+    rms_of(sums, n)
+}
+
+/// Channel RMS from sums of squares over `n` samples.
+fn rms_of(sums: [f64; 6], n: usize) -> ChannelRms {
     let v = sums.map(|s| (s / n.max(1) as f64).sqrt());
     ChannelRms {
         x_m: v[0],

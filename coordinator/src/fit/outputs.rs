@@ -15,7 +15,7 @@ use crate::problem::factors_of;
 use crate::refine::{LmResult, Noise};
 use crate::results::{
     Best, ChannelRms, FitResult, FrontPoint, HistoryPoint, MethodResult, Probe, Refinement,
-    ResolutionRow, channel_rms, residuals,
+    ResolutionRow, residual_rms,
 };
 use crate::run::{Evaluate, Problem};
 use crate::search::ga::Member;
@@ -61,7 +61,7 @@ pub(super) fn refined_member(
             j_att_deg: lm.goals.j_att_deg,
         },
     };
-    let rms = channel_rms(&residuals(evaluator.job(), &lm.samples));
+    let rms = residual_rms(evaluator.job(), &lm.samples);
     let refinement = Refinement {
         start_goals: start.objectives(),
         evaluations: lm.evaluations,
@@ -158,7 +158,7 @@ pub(super) fn best_samples_of(
     let samples = e.samples.ok_or_else(|| {
         FitError::Failed("the best member did not finish when re-evaluated".into())
     })?;
-    Ok((channel_rms(&residuals(evaluator.job(), &samples)), samples))
+    Ok((residual_rms(evaluator.job(), &samples), samples))
 }
 
 #[allow(clippy::too_many_arguments)]

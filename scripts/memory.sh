@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Peak memory of a fit on a long record: coordinator and worker processes together, as PSS
+# (proportional set size: shared memory counted once across the processes that map it).
+#
+#   scripts/memory.sh [ROWS]      (default 2 000 000 rows, the limit issue 13 set: under 500 MB)
+#
+# Simulates ROWS telemetry rows at 10 kHz (200 s for 2 million: a long record that stays within the plausible-position bound) with noise, fits them with a one-generation GA of four
+# candidates on one worker, samples /proc/PID/smaps_rollup of `sepval` and `sepval-worker`
+# every 0.1 s, and prints the peak of their sum. Build first: cargo build --release.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+rows=${1:-2000000}
+bin=./target/release
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+rate=10000
+# The last sample is at (rows - 1) / rate: t_end gives exactly `rows` samples from t = 0.
+t_end=$(python3 -c "print(($rows - 1) / $rate)")
+"$bin/sepval" simulate --t-end "$t_end" --rate "$rate" --noise-seed 1 --out "$dir/long.csv" >/dev/null
+echo "telemetry: $(($(grep -vc '^#' "$dir/long.csv") - 1)) rows, $(du -m "$dir/long.csv" | cut -f1) MB"
+
+"$bin/sepval" fit --data "$dir/long.csv" --method ga --generations 1 --population 4 \
+    --workers 1 --out "$dir/run" >"$dir/fit.log" 2>&1 &
+fit=$!
+peak=0 peak_coordinator=0 peak_worker=0
+while kill -0 "$fit" 2>/dev/null; do
+    total=0 coordinator=0 worker=0
+    for pid in $(pgrep -f "$bin/sepval" || true); do
+        kb=$(awk '/^Pss:/ {print $2}' "/proc/$pid/smaps_rollup" 2>/dev/null || echo 0)
+        kb=${kb:-0}
+        total=$((total + kb))
+        if grep -q sepval-worker "/proc/$pid/cmdline" 2>/dev/null; then
+            worker=$((worker + kb))
+        else
+            coordinator=$((coordinator + kb))
+        fi
+    done
+    ((total > peak)) && peak=$total
+    ((coordinator > peak_coordinator)) && peak_coordinator=$coordinator
+    ((worker > peak_worker)) && peak_worker=$worker
+    sleep 0.1
+done
+wait "$fit" || { cat "$dir/fit.log"; exit 1; }
+echo "peak PSS, coordinator + worker: $((peak / 1024)) MB" \
+    "(coordinator alone $((peak_coordinator / 1024)) MB, worker alone $((peak_worker / 1024)) MB)"
