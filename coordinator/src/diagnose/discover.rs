@@ -31,162 +31,18 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector};
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Candidate, Evaluator, Job};
-use sepval_common::extension::{Axis, Family, Regressor, Term};
+use sepval_common::extension::{Family, Regressor, Term};
 use sepval_common::factors::FACTOR_COUNT;
-use serde::{Deserialize, Serialize};
 
-use super::library::{self, Entry, Sample};
-use super::reconstruct::{Reconstruction, reconstruct};
-use super::{ALPHA, DiagnoseError, Fitted, Result, bic, probe, readings, stepwise};
+use super::found::{
+    DiscoveredTerm, Discovery, DiscoveryStep, Gain, GroupMember, Screened, Verified,
+};
+use super::library::{self, Entry};
+use super::reconstruct::reconstruct;
+use super::verify::{leave_one_out, refit_run};
+use super::{ALPHA, DiagnoseError, Fitted, Result, probe, readings, stepwise};
 use crate::identifiability::identifiability;
-use crate::refine::{FreeTerm, LmRun, LmSettings, Noise, ParamSpace, refine_together};
-use crate::stats::f_test;
-
-/// The gain of a model change, by nested least squares.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Gain {
-    /// Chi-square drop.
-    pub chi2_drop: f64,
-    /// Parameters added.
-    pub parameters: usize,
-    /// F statistic of the added parameters.
-    pub f: f64,
-    /// Its p-value.
-    pub p_value: f64,
-    /// BIC change (negative: better even after charging the parameters).
-    pub delta_bic: f64,
-}
-
-impl Gain {
-    /// The gain of `with` (chi-square, `p_with` parameters) over `without` (chi-square, `q`
-    /// parameters fewer), on `m` residuals.
-    pub fn of(without: f64, with: f64, q: usize, p_with: usize, m: usize) -> Gain {
-        let (f, p_value) = f_test(without, with, q, m, p_with);
-        Gain {
-            chi2_drop: without - with,
-            parameters: q,
-            f,
-            p_value,
-            delta_bic: bic(with, p_with, m) - bic(without, p_with - q, m),
-        }
-    }
-
-    /// Significant at `alpha` and better by BIC.
-    pub fn significant(&self, alpha: f64) -> bool {
-        self.p_value < alpha && self.delta_bic < 0.0
-    }
-}
-
-/// A library entry the data cannot tell from a discovered one.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GroupMember {
-    /// Its axis.
-    pub axis: String,
-    /// Its family.
-    pub family: String,
-    /// Its formula.
-    pub term: String,
-    /// Correlation of its sensitivity with the discovered one's (beyond the model's own
-    /// sensitivities); null for a rival whose output-error refit came within 2 of its
-    /// chi-square.
-    pub correlation: Option<f64>,
-}
-
-/// One discovered term (an oscillation: its sine-cosine pair as one amplitude and phase).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DiscoveredTerm {
-    /// `CA`, `CY`, `CZ`, `Cl`, `Cm`, `Cn` or `ejector`.
-    pub axis: String,
-    /// The library family.
-    pub family: String,
-    /// A readable formula.
-    pub term: String,
-    /// Its coefficient (an oscillation: its amplitude).
-    pub coefficient: f64,
-    /// The coefficient's standard error (null when the data do not determine it).
-    pub std_error: Option<f64>,
-    /// An oscillation's phase \[deg\]: A sin(2 pi f t + phase).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub phase_deg: Option<f64>,
-    /// A step's time \[s\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub t_on_s: Option<f64>,
-    /// An oscillation's frequency \[Hz\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub f_hz: Option<f64>,
-    /// An interference decay length \[m\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lambda_m: Option<f64>,
-    /// The Mach reference of a Mach term.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mach0: Option<f64>,
-    /// The locator's standard error, when the refit estimates it.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub locator_std_error: Option<f64>,
-    /// What it brings: the refit without it against the refit with it (with one term: the
-    /// baseline against the extension).
-    pub gain: Gain,
-    /// A plain-language physical reading (`docs/model.md` section 11.4).
-    pub reading: String,
-    /// Entries the data cannot tell from it (|correlation| >= 0.95).
-    pub group: Vec<GroupMember>,
-}
-
-/// What discovery found.
-pub(super) struct Discovery {
-    /// Per event, the reconstructed increments.
-    pub reconstruction: Vec<Reconstruction>,
-    /// The verified extension, when one is significant: the refitted model, its terms (most
-    /// important first) and its gain over the baseline.
-    pub found: Option<(Fitted, Vec<DiscoveredTerm>, Gain)>,
-    /// What happened (why nothing was found, or what was dropped).
-    pub notes: Vec<String>,
-    /// Each step of the selection: what the regression ranked, what the refits gave.
-    pub steps: Vec<DiscoveryStep>,
-    /// Simulations run.
-    pub evaluations: u64,
-}
-
-/// One library entry as the regression ranked it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Screened {
-    /// Its axis.
-    pub axis: String,
-    /// Its formula.
-    pub term: String,
-    /// F-to-enter.
-    pub f: f64,
-    /// Its p-value.
-    pub p_value: f64,
-}
-
-/// One entry refitted by output error.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Verified {
-    /// Its axis.
-    pub axis: String,
-    /// Its formula (locator as refined).
-    pub term: String,
-    /// Chi-square of the refit.
-    pub chi2: f64,
-}
-
-/// One step of the forward selection.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DiscoveryStep {
-    /// The step (1: against the baseline).
-    pub step: usize,
-    /// Chi-square of the model the step starts from.
-    pub chi2: f64,
-    /// The Bonferroni-corrected F-to-enter threshold.
-    pub threshold: f64,
-    /// The ten best entries by F-to-enter.
-    pub screened: Vec<Screened>,
-    /// The entries refitted, best first.
-    pub verified: Vec<Verified>,
-    /// The entry that entered, with its gain; none when the step ended the selection.
-    pub accepted: Option<String>,
-}
+use crate::refine::{FreeTerm, LmSettings, Noise, refine_together};
 
 /// Per event, per axis: (times \[s\], values).
 pub(super) type Curves = Vec<Vec<(Vec<f64>, Vec<f64>)>>;
@@ -241,7 +97,7 @@ fn locator_bounds(term: &Term) -> Option<(f64, f64)> {
 }
 
 /// The candidate of `fitted` at its optimum.
-fn candidate_of(job: &Job, fitted: &Fitted) -> Result<Candidate> {
+pub(super) fn candidate_of(job: &Job, fitted: &Fitted) -> Result<Candidate> {
     Ok(fitted.space(job).candidate(&fitted.lm.x)?)
 }
 
@@ -751,7 +607,7 @@ pub(super) fn discover(
 }
 
 /// Terms of the entries before entry `k`.
-fn found_terms_before(picked: &[Entry], k: usize) -> usize {
+pub(super) fn found_terms_before(picked: &[Entry], k: usize) -> usize {
     picked[..k].iter().map(|e| e.terms.len()).sum()
 }
 
@@ -768,7 +624,7 @@ pub(super) fn entry_formula(terms: &[Term]) -> String {
 
 /// The free terms of `picked`: coefficients bounded to ten times their estimate, step times and
 /// decay lengths free near their refined values.
-fn free_terms(picked: &[Entry]) -> Vec<FreeTerm> {
+pub(super) fn free_terms(picked: &[Entry]) -> Vec<FreeTerm> {
     picked
         .iter()
         .flat_map(|e| {
@@ -783,125 +639,4 @@ fn free_terms(picked: &[Entry]) -> Vec<FreeTerm> {
             })
         })
         .collect()
-}
-
-/// The refinement of the factors of `current` and the terms of `with` together, by output
-/// error, from `current`'s factors, the values of the terms already in and the last entry's
-/// coefficients at zero.
-fn refit_run(
-    job: &Arc<Job>,
-    current: &Fitted,
-    with: &[Entry],
-    noise: Noise,
-    settings: &LmSettings,
-) -> LmRun {
-    let terms = free_terms(with);
-    let space = ParamSpace::with_terms(job.factor_table(), &EffectSet::NONE, &terms);
-    let new_from = terms.len() - with.last().map_or(0, |e| e.terms.len());
-    let mut x0 = current.lm.x[..FACTOR_COUNT].to_vec();
-    for (k, t) in terms.iter().enumerate() {
-        x0.push(if k < new_from {
-            t.term.coefficient
-        } else {
-            0.0
-        });
-        if t.locator.is_some() {
-            x0.push(t.term.locator[0]);
-        }
-    }
-    LmRun::new(space, Arc::clone(job), &x0, noise, settings.clone())
-}
-
-/// For each entry of `fitted` (made of `picked`), the refit without it, from `fitted`'s
-/// optimum; all refits share each batch.
-fn leave_one_out(
-    evaluator: &mut dyn Evaluator,
-    job: &Arc<Job>,
-    fitted: &Fitted,
-    picked: &[Entry],
-    noise: Noise,
-    settings: &LmSettings,
-) -> Result<Vec<Fitted>> {
-    // Parameter positions of each free term.
-    let mut positions = Vec::new();
-    let mut i = FACTOR_COUNT;
-    for t in &fitted.terms {
-        let n = 1 + usize::from(t.locator.is_some());
-        positions.push(i..i + n);
-        i += n;
-    }
-    let mut runs = Vec::new();
-    let mut kept_terms = Vec::new();
-    for k in 0..picked.len() {
-        let from = found_terms_before(picked, k);
-        let to = from + picked[k].terms.len();
-        let terms: Vec<FreeTerm> = fitted
-            .terms
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| *j < from || *j >= to)
-            .map(|(_, t)| *t)
-            .collect();
-        let mut x0 = fitted.lm.x[..FACTOR_COUNT].to_vec();
-        for (j, range) in positions.iter().enumerate() {
-            if j < from || j >= to {
-                x0.extend(&fitted.lm.x[range.clone()]);
-            }
-        }
-        let space = ParamSpace::with_terms(job.factor_table(), &EffectSet::NONE, &terms);
-        runs.push(LmRun::new(
-            space,
-            Arc::clone(job),
-            &x0,
-            noise,
-            settings.clone(),
-        ));
-        kept_terms.push(terms);
-    }
-    refine_together(evaluator, &mut runs)?;
-    Ok(runs
-        .into_iter()
-        .zip(kept_terms)
-        .map(|(run, terms)| Fitted {
-            effects: EffectSet::NONE,
-            terms,
-            lm: run.finish(),
-        })
-        .collect())
-}
-
-/// Per event and axis, the increment the extension's terms give along its fitted trajectory:
-/// (times \[s\], values), the ejector's while the forward foot strokes.
-pub(super) fn model_increments(job: &Job, fitted: &Fitted) -> Result<Curves> {
-    let c = candidate_of(job, fitted)?;
-    let history = library::flow_history(job, &c);
-    Ok(history
-        .iter()
-        .map(|samples| {
-            Axis::ALL
-                .iter()
-                .map(|&axis| {
-                    let pick = |s: &Sample| -> Option<f64> {
-                        if axis == Axis::Ejector {
-                            (s.sigma[0] < 1.0).then(|| {
-                                c.terms
-                                    .iter()
-                                    .filter(|t| t.axis == axis)
-                                    .map(|t| {
-                                        t.coefficient * t.ejector_value(s.input.t_s, s.sigma[0])
-                                    })
-                                    .sum()
-                            })
-                        } else {
-                            Some(c.terms.aero_increments(&s.input)[axis.index()])
-                        }
-                    };
-                    samples
-                        .iter()
-                        .filter_map(|s| pick(s).map(|v| (s.input.t_s, v)))
-                        .unzip()
-                })
-                .collect()
-        })
-        .collect())
 }

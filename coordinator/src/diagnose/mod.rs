@@ -38,13 +38,11 @@ use sepval_common::atomic_file::{WriteError, write_atomically};
 use sepval_common::effects::{CATALOGUE, EffectSet};
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
 use sepval_common::extension::{TermRecord, extension_toml};
-use sepval_common::factors::{FACTOR_COUNT, Factors};
-use serde::{Deserialize, Serialize};
+use sepval_common::factors::FACTOR_COUNT;
 
 use crate::figures::FigureError;
 use crate::fit::{FitError, FitOptions, Method, run_fit};
 use crate::refine::{FreeTerm, LmResult, LmSettings, Noise, ParamSpace};
-use crate::results::ChannelRms;
 use crate::run::{ProgressObserver, RunError};
 
 /// Errors of a diagnosis.
@@ -86,7 +84,9 @@ impl From<EvalError> for DiagnoseError {
 type Result<T> = std::result::Result<T, DiagnoseError>;
 
 mod catalogue;
+mod diagnosis;
 mod discover;
+mod found;
 mod library;
 mod probe;
 pub mod readings;
@@ -94,8 +94,13 @@ mod reconstruct;
 mod report;
 mod residuals;
 mod stepwise;
+mod validation;
+mod verify;
 
-pub use discover::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
+pub use diagnosis::{
+    Alternative, CandidateReport, Diagnosis, ExtensionReport, ModelSummary, ParamValue,
+};
+pub use found::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
 pub use reconstruct::{IncrementSeries, Reconstruction};
 pub use report::fmt_discovered;
 pub use residuals::{
@@ -103,6 +108,8 @@ pub use residuals::{
     residual_report,
 };
 use residuals::{residual_figures, rms_channels};
+pub use validation::{AlternativePrediction, ValidationReport};
+use validation::{prediction_caveat, validate};
 
 /// Format tag of diagnosis files.
 pub const DIAGNOSIS_FORMAT: &str = "sepval-diagnosis/2";
@@ -121,197 +128,6 @@ pub struct DiagnoseOptions {
     pub candidate_lm: LmSettings,
     /// Events not used for fitting, on which the baseline and the answer predict.
     pub validation: Option<Job>,
-}
-
-/// One parameter's estimate.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ParamValue {
-    /// Parameter name.
-    pub name: String,
-    /// Unit.
-    pub unit: String,
-    /// Estimate.
-    pub value: f64,
-    /// Standard error (null when the data do not determine it).
-    pub std_error: Option<f64>,
-}
-
-/// Summary of one model's fit.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ModelSummary {
-    /// Its effects (empty: the baseline).
-    pub effects: Vec<String>,
-    /// Its extension terms (`axis: formula`).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub terms: Vec<String>,
-    /// Free parameters.
-    pub parameters: usize,
-    /// RMS position error \[m\].
-    pub j_pos_m: f64,
-    /// RMS attitude error \[deg\].
-    pub j_att_deg: f64,
-    /// Sum of squared normalised residuals.
-    pub chi2: f64,
-    /// RMS residual per channel.
-    pub channel_rms: ChannelRms,
-    /// The 17 factors as fitted with it (absent in files written before they were recorded).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub factors: Option<Factors>,
-}
-
-/// One candidate extension, tried against the model of its round.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CandidateReport {
-    /// Effect id.
-    pub id: String,
-    /// What it adds.
-    pub adds: String,
-    /// Forward-selection round (1: against the baseline).
-    pub round: usize,
-    /// Its parameters' estimates.
-    pub parameters: Vec<ParamValue>,
-    /// Chi-square of the extended fit.
-    pub chi2: f64,
-    /// Chi-square drop from the round's model.
-    pub chi2_drop: f64,
-    /// F statistic of the extra parameters.
-    pub f: f64,
-    /// Its p-value.
-    pub p_value: f64,
-    /// The Bonferroni-corrected threshold of the round.
-    pub p_threshold: f64,
-    /// BIC change (negative: better even after charging the parameters).
-    pub delta_bic: f64,
-    /// Whether the extension is significant.
-    pub significant: bool,
-    /// Goals after the extension: J_pos \[m\], J_att \[deg\].
-    pub goals: [f64; 2],
-    /// RMS residual per channel after the extension.
-    pub channel_rms: ChannelRms,
-    /// A remark (for example a weak effect's bound).
-    pub note: String,
-    /// Why its refinement stopped, and after how many iterations.
-    pub refinement: String,
-}
-
-/// The discovered extension: the model with the discovered terms, refitted, and its gain.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ExtensionReport {
-    /// Whether it is the answer (else the catalogue's effects are, and it is an alternative).
-    pub answer: bool,
-    /// The extension file written (relative to DIR), when it is the answer.
-    pub file: Option<String>,
-    /// The extended model's fit.
-    pub model: ModelSummary,
-    /// Its gain over the baseline (chi-square drop, F test, BIC).
-    pub gain: Gain,
-    /// Whether every channel's residuals are white.
-    pub white: bool,
-    /// Whether both goals are within 1.1 sigma.
-    pub at_noise_floor: bool,
-    /// Whether it explains the data to the noise (white and at the floor).
-    pub explained: bool,
-    /// Why its refinement stopped.
-    pub refinement: String,
-}
-
-/// A model that explains part of the data but is not the answer.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Alternative {
-    /// `catalogue` (effects) or `discovered` (terms).
-    pub kind: String,
-    /// Its effects or terms.
-    pub names: Vec<String>,
-    /// Its fit.
-    pub model: ModelSummary,
-    /// Its BIC minus the answer's (positive: worse).
-    pub delta_bic_vs_answer: f64,
-    /// Why it is not the answer.
-    pub note: String,
-}
-
-/// Prediction of one event that took no part in the fits.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ValidationReport {
-    /// The event.
-    pub event: String,
-    /// The baseline's RMS position error on it \[m\].
-    pub baseline_j_pos_m: Option<f64>,
-    /// The baseline's RMS attitude error \[deg\].
-    pub baseline_j_att_deg: Option<f64>,
-    /// The answer's RMS position error \[m\].
-    pub extended_j_pos_m: Option<f64>,
-    /// The answer's RMS attitude error \[deg\].
-    pub extended_j_att_deg: Option<f64>,
-    /// The alternatives' predictions.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub alternatives: Vec<AlternativePrediction>,
-    /// Why a model did not simulate it, if one did not.
-    #[serde(default, skip_serializing_if = "String::is_empty")]
-    pub note: String,
-}
-
-/// An alternative's prediction of a validation event.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct AlternativePrediction {
-    /// The alternative (`catalogue: ...` or `discovered: ...`).
-    pub model: String,
-    /// RMS position error \[m\].
-    pub j_pos_m: f64,
-    /// RMS attitude error \[deg\].
-    pub j_att_deg: f64,
-}
-
-/// DIR/diagnosis.json.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Diagnosis {
-    /// [`DIAGNOSIS_FORMAT`].
-    pub format: String,
-    /// The catalogue effects named as causes, in the order chosen (empty when the baseline
-    /// explains the data, or when a discovered extension explains it better).
-    pub causes: Vec<String>,
-    /// Whether the catalogue's answer leaves nothing but noise: the model with the effects it
-    /// chose (the baseline when it chose none), even when those effects are not the answer
-    /// (`causes` is then empty because a discovered extension explains better). A discovered
-    /// extension's own verdict is `extension.explained`; the terminal summary shows the
-    /// answer's.
-    pub explained: bool,
-    /// The verdict in one sentence.
-    pub verdict: String,
-    /// Terms found beyond the catalogue, most important first, when they are the answer.
-    pub discovered: Vec<DiscoveredTerm>,
-    /// Models that explain part of the data but not as well as the answer (mimics).
-    pub alternatives: Vec<Alternative>,
-    /// The discovered extension and its gain, when discovery verified one.
-    pub extension: Option<ExtensionReport>,
-    /// What discovery did beyond its findings (why nothing was named, terms dropped).
-    pub discovery_notes: Vec<String>,
-    /// Each step of discovery's selection: the entries ranked, the refits, what entered.
-    pub discovery_steps: Vec<DiscoveryStep>,
-    /// Position noise \[m\].
-    pub sigma_pos_m: f64,
-    /// Attitude noise \[deg\].
-    pub sigma_att_deg: f64,
-    /// Where the sigmas came from.
-    pub sigma_source: String,
-    /// The baseline fit.
-    pub baseline: ModelSummary,
-    /// The answer's model; the baseline when nothing is named.
-    pub extended: ModelSummary,
-    /// Each named effect's parameters with standard errors.
-    pub parameters: BTreeMap<String, Vec<ParamValue>>,
-    /// Every candidate tried, every round.
-    pub candidates: Vec<CandidateReport>,
-    /// Residual analysis before and after.
-    pub residuals: BTreeMap<String, ResidualReport>,
-    /// Per event, the reconstructed coefficient increments with their bands.
-    pub reconstruction: Vec<Reconstruction>,
-    /// Prediction of the `--validate` events.
-    pub validation: Vec<ValidationReport>,
-    /// Simulations run (baseline fit included).
-    pub evaluations: u64,
-    /// Wall time \[s\].
-    pub wall_s: f64,
 }
 
 /// A fitted model: its effects, its free extension terms and its refinement.
@@ -633,7 +449,7 @@ pub fn diagnose(
         &events,
     )?;
     let model_curves = match &disc.found {
-        Some((f, _, _)) => discover::model_increments(&job, f)?,
+        Some((f, _, _)) => verify::model_increments(&job, f)?,
         None => Vec::new(),
     };
     if !diagnosis.reconstruction.is_empty() {
@@ -702,142 +518,4 @@ fn extension_file(job: &Job, f: &Fitted, found: &[DiscoveredTerm], gain: &Gain) 
         DiagnoseError::Model(format!("the extension written does not read back: {e}"))
     })?;
     Ok(text)
-}
-
-/// Goals of the baseline, the answer and the alternatives (named) on each validation event.
-fn validate(
-    v: &Job,
-    base: &Candidate,
-    answer: &Candidate,
-    alternatives: &[(String, Candidate)],
-) -> Vec<ValidationReport> {
-    v.events()
-        .iter()
-        .map(|e| {
-            let one = Job::new(vec![e.clone()]);
-            let goals = |c: &Candidate| -> Prediction {
-                let job = one.as_ref().map_err(|e| e.to_string())?;
-                let ev = job.evaluate(c);
-                ev.outcome
-                    .goals()
-                    .map(|g| (g.j_pos_m, g.j_att_deg))
-                    .ok_or_else(|| format!("{:?}", ev.outcome))
-            };
-            let (b, a) = (goals(base), goals(answer));
-            let others: Vec<(String, Prediction)> = alternatives
-                .iter()
-                .map(|(n, c)| (n.clone(), goals(c)))
-                .collect();
-            let mut note: Vec<String> = [("baseline", &b), ("extended model", &a)]
-                .iter()
-                .filter_map(|(n, r)| r.as_ref().err().map(|e| format!("{n}: {e}")))
-                .collect();
-            note.extend(
-                others
-                    .iter()
-                    .filter_map(|(n, r)| r.as_ref().err().map(|e| format!("{n}: {e}"))),
-            );
-            ValidationReport {
-                event: e.name.clone(),
-                baseline_j_pos_m: b.as_ref().ok().map(|g| g.0),
-                baseline_j_att_deg: b.as_ref().ok().map(|g| g.1),
-                extended_j_pos_m: a.as_ref().ok().map(|g| g.0),
-                extended_j_att_deg: a.as_ref().ok().map(|g| g.1),
-                alternatives: others
-                    .iter()
-                    .filter_map(|(n, r)| {
-                        r.as_ref().ok().map(|g| AlternativePrediction {
-                            model: n.clone(),
-                            j_pos_m: g.0,
-                            j_att_deg: g.1,
-                        })
-                    })
-                    .collect(),
-                note: note.join("; "),
-            }
-        })
-        .collect()
-}
-
-/// A model's goals on a validation event (J_pos \[m\], J_att \[deg\]), or why it did not simulate.
-type Prediction = std::result::Result<(f64, f64), String>;
-
-/// A caveat for the verdict when an alternative predicts the events not fitted clearly better
-/// than the answer (its sum over events of `(J_pos/sigma_pos)^2 + (J_att/sigma_att)^2` below
-/// 0.8 of the answer's): the answer may fit its own data by mimicry.
-fn prediction_caveat(validation: &[ValidationReport], noise: Noise) -> Option<String> {
-    let score = |p: f64, a: f64| (p / noise.pos_m).powi(2) + (a / noise.att_deg).powi(2);
-    let mut answer = 0.0;
-    let mut alts: Vec<(String, f64, f64, f64)> = Vec::new();
-    for v in validation {
-        let (Some(p), Some(a)) = (v.extended_j_pos_m, v.extended_j_att_deg) else {
-            return None;
-        };
-        answer += score(p, a);
-        for (i, alt) in v.alternatives.iter().enumerate() {
-            if alts.len() <= i {
-                alts.push((alt.model.clone(), 0.0, 0.0, 0.0));
-            }
-            alts[i].1 += score(alt.j_pos_m, alt.j_att_deg);
-            alts[i].2 += alt.j_pos_m.powi(2);
-            alts[i].3 += alt.j_att_deg.powi(2);
-        }
-    }
-    let n = validation.len() as f64;
-    let (model, s, p2, a2) = alts
-        .into_iter()
-        .filter(|a| a.1.is_finite())
-        .min_by(|a, b| a.1.total_cmp(&b.1))?;
-    if n == 0.0 || s >= 0.8 * answer || !s.is_finite() {
-        return None;
-    }
-    let kind = model.split(':').next().unwrap_or("an");
-    Some(format!(
-        "; caution: on the events not fitted the {kind} alternative predicts better (RMS over events J_pos {:.4} m, J_att {:.3} deg): the answer may fit these data without naming their cause",
-        (p2 / n).sqrt(),
-        (a2 / n).sqrt()
-    ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn event(answer: (f64, f64), alt: (f64, f64)) -> ValidationReport {
-        ValidationReport {
-            event: "e".into(),
-            baseline_j_pos_m: Some(0.1),
-            baseline_j_att_deg: Some(1.0),
-            extended_j_pos_m: Some(answer.0),
-            extended_j_att_deg: Some(answer.1),
-            alternatives: vec![AlternativePrediction {
-                model: "catalogue: cg_offset".into(),
-                j_pos_m: alt.0,
-                j_att_deg: alt.1,
-            }],
-            note: String::new(),
-        }
-    }
-
-    #[test]
-    fn an_alternative_that_predicts_clearly_better_is_a_caveat() {
-        let noise = Noise {
-            pos_m: 0.001,
-            att_deg: 0.1,
-        };
-        // Answer 0.012 m / 0.75 deg against the alternative's 0.008 m / 0.26 deg: caveat.
-        let better = [event((0.012, 0.75), (0.008, 0.26))];
-        let note = prediction_caveat(&better, noise).expect("a caveat");
-        assert!(
-            note.contains("catalogue alternative predicts better"),
-            "{note}"
-        );
-        assert!(note.contains("0.0080 m"), "{note}");
-        // Within 20 % of the answer's score: no caveat.
-        let close = [event((0.010, 0.5), (0.0095, 0.48))];
-        assert_eq!(prediction_caveat(&close, noise), None);
-        // The answer predicts better: no caveat.
-        let worse = [event((0.008, 0.26), (0.012, 0.75))];
-        assert_eq!(prediction_caveat(&worse, noise), None);
-    }
 }
