@@ -43,7 +43,7 @@
 //! M. H. Payne and R. N. Hanek, "Radian reduction for trigonometric functions", SIGNUM
 //! Newsletter 18 (1983).
 
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+use std::f64::consts::{FRAC_2_PI, FRAC_PI_2, FRAC_PI_4};
 
 use crate::lanes::{Bits, Mask, Real};
 
@@ -330,8 +330,6 @@ pub fn pow<R: Real>(x: R, y: R) -> R {
 // ---------------------------------------------------------------------------------------------
 // sin and cos
 
-/// 2 / pi.
-const TWO_OVER_PI: f64 = 0.636_619_772_367_581_4;
 /// pi/2 in four parts, the first three of 33 bits (fdlibm's `pio2_1`, `pio2_2`, `pio2_3`), so
 /// that n times each is exact for |n| < 2^20.
 const PIO2_1: f64 = 1.570_796_326_734_125_6;
@@ -352,11 +350,11 @@ const SIN: [f64; 6] = [
 ];
 /// fdlibm `k_cos.c`: cos(x) ~ 1 - x^2/2 + C1 x^4 + ... + C6 x^14 on [-pi/4, pi/4].
 const COS: [f64; 6] = [
-    4.166_666_666_666_660_2e-2,
+    4.166_666_666_666_66e-2,
     -1.388_888_888_887_411e-3,
     2.480_158_728_947_673e-5,
     -2.755_731_435_139_066_3e-7,
-    2.087_572_321_298_174_8e-9,
+    2.087_572_321_298_175e-9,
     -1.135_964_755_778_819_5e-11,
 ];
 
@@ -401,7 +399,7 @@ pub fn cos<R: Real>(x: R) -> R {
 /// returned as (1.5 * 2^52 + n, r, r_lo): n mod 4 in the low bits of the first.
 #[inline(always)]
 fn reduce_pio2<R: Real>(x: R) -> (R, R, R) {
-    let n_shifted = x.mul_add(c(TWO_OVER_PI), c(SHIFT));
+    let n_shifted = x.mul_add(c(FRAC_2_PI), c(SHIFT));
     let n = n_shifted - c(SHIFT);
     // Cody and Waite: x - n P1 is exact (P1 has 33 bits, |n| < 2^20, and the difference is a
     // multiple of x's last bit no larger than x); n P2 and n P3 are exact and subtracted in
