@@ -102,7 +102,7 @@ const EXP_MAX_ARG: f64 = 710.0;
 /// branch.
 const EXP_SPLIT_ARG: f64 = 700.0;
 
-/// e^x (to within about 1 ulp; 0 below -745.2, +inf above 709.8, NaN for NaN).
+/// e^x (error below 1 ulp; 0 below -745.2, +inf above 709.8, NaN for NaN).
 ///
 /// Tang's table method, without a division: x = (64 e + j) ln 2 / 64 + r with |r| <= ln 2 / 128,
 /// e^x = 2^e 2^(j/64) e^r, 2^(j/64) from a table of its rounded values and their relative
@@ -307,13 +307,13 @@ const fn tail_coefficients() -> [f64; 11] {
     t
 }
 
-/// Natural logarithm (to within about 0.5 ulp): -inf at 0, NaN below 0 and for NaN.
+/// Natural logarithm (error about 0.5 ulp): -inf at 0, NaN below 0 and for NaN.
 #[inline(always)]
 pub fn ln<R: Real>(x: R) -> R {
     ln_dd(x).0
 }
 
-/// x^y for x >= 0 (to within about 1 ulp), as exp(y ln x) with ln x and the product carried
+/// x^y for x >= 0 (error below 1 ulp), as exp(y ln x) with ln x and the product carried
 /// in double-double. x^0 = 1 and 1^y = 1 (also for NaN), 0^y is 0 for y > 0 and +inf for
 /// y < 0, NaN for x < 0 (the sign of a zero x is ignored: (-0)^3 is +0).
 #[inline(always)]
@@ -358,7 +358,7 @@ const COS: [f64; 6] = [
     -1.135_964_755_778_819_5e-11,
 ];
 
-/// (sin x, cos x) (each to within about 1 ulp; NaN for infinite or NaN x).
+/// (sin x, cos x) (each with an error below 1 ulp; NaN for infinite or NaN x).
 ///
 /// x = n pi/2 + r with |r| <= pi/4 (r as a double-double), then fdlibm's kernels for sin r and
 /// cos r, swapped and negated by n mod 4.
@@ -619,7 +619,7 @@ fn asin_ratio<R: Real>(z: R) -> R {
     z * p / q
 }
 
-/// Four-quadrant arc tangent of y / x in [-pi, pi] (to within about 1 ulp), with the IEEE
+/// Four-quadrant arc tangent of y / x in [-pi, pi] (error below 1 ulp), with the IEEE
 /// special values: atan2(+-0, +0) = +-0, atan2(+-0, -0) = +-pi, +-pi/4 and +-3 pi/4 for two
 /// infinities, the sign of y kept, NaN for NaN.
 ///
@@ -675,7 +675,7 @@ pub fn atan2<R: Real>(y: R, x: R) -> R {
     angle.copysign(y)
 }
 
-/// Arc sine (to within about 1 ulp), for x in [-1, 1]; NaN outside and for NaN; the sign of
+/// Arc sine (error below 1 ulp), for x in [-1, 1]; NaN outside and for NaN; the sign of
 /// a zero kept.
 ///
 /// Cephes's rational for |x| <= 0.625; above, asin |x| = pi/2 - 2 asin s with
