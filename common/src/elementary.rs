@@ -19,9 +19,11 @@
 //! (both arguments formed, one selected), special values (zeros, infinities, NaN, subnormals)
 //! follow from the same arithmetic or are selected at the end. The four lanes of an `F64x4`
 //! give bit for bit the scalar results (the rule of [`crate::lanes`]; tested with random and
-//! special inputs). Two kernels branch on "any lane" for a rare, expensive case, computed then
-//! lane by lane with the scalar code: `sin`/`cos` for |x| > 2^20 (Payne and Hanek's reduction)
-//! and `atan2_asin` outside the store's range (the general `atan2` and `asin`).
+//! special inputs). Three kernels keep their common case short and branch on "any lane" for a
+//! rare one, where every lane takes the general form (which gives the common form's bits where
+//! both apply): `exp` outside [-700, 700] (clamped argument, scale in two steps), `sin`/`cos`
+//! for |x| > 2^20 (Payne and Hanek's reduction, lane by lane with the scalar code) and
+//! `atan2_asin` outside the store's range (the general `atan2` and `asin`).
 //!
 //! **Methods and accuracy**: the largest error found against a 300-bit reference (`mpmath`),
 //! over 8 000 values per function (12 000 for `atan2`) spread across its whole domain, boundaries
@@ -98,8 +100,7 @@ const LN2_OVER_N_LO: f64 = 3.623_510_646_634_843e-19;
 const EXP_MIN_ARG: f64 = -746.0;
 const EXP_MAX_ARG: f64 = 710.0;
 /// Beyond +-700 the result is scaled in two steps (2^(e -+ 128), then 2^(+-128)), so that each
-/// factor is a normal double: the ends of the range (overflow, gradual underflow) without a
-/// branch.
+/// factor is a normal double: the ends of the range (overflow, gradual underflow).
 const EXP_SPLIT_ARG: f64 = 700.0;
 
 /// e^x (error below 1 ulp; 0 below -745.2, +inf above 709.8, NaN for NaN).
@@ -108,40 +109,46 @@ const EXP_SPLIT_ARG: f64 = 700.0;
 /// e^x = 2^e 2^(j/64) e^r, 2^(j/64) from a table of its rounded values and their relative
 /// errors, and e^r - 1 by its Taylor polynomial of degree 6 (truncation error below 6e-20
 /// relative).
+///
+/// Within [-700, 700] (the force evaluation's range) 2^e is a normal double and the result is
+/// one scaling of the table entry. When any lane is outside (or NaN), all lanes take the
+/// general form (clamped argument, the scale in two steps near the ends of the range), which
+/// gives the same bits inside: a lane's result depends only on its own argument.
 #[inline(always)]
 pub fn exp<R: Real>(x: R) -> R {
-    let x = clamp_exp_argument(x);
+    if !x.abs().le(c(EXP_SPLIT_ARG)).all() {
+        return exp_general(x, c(0.0));
+    }
     // k = 64 e + j = round(64 x / ln 2), in the low bits of `shifted`.
     let shifted = x.mul_add(c(N_OVER_LN2), c(SHIFT));
     let k = shifted - c(SHIFT);
     let r = (-k).mul_add(c(LN2_OVER_N_LO), (-k).mul_add(c(LN2_OVER_N_HI), x));
-    exp_reconstruct(x, shifted, r)
+    exp_table(shifted, r)
 }
 
 /// e^(hi + lo) for a double-double argument (|lo| <= ulp(hi)), as [`exp`].
 #[inline(always)]
 fn exp_dd<R: Real>(hi: R, lo: R) -> R {
-    let x = clamp_exp_argument(hi);
+    exp_general(hi, lo)
+}
+
+/// e^(x + lo) over the whole range ([`exp`] outside [-700, 700]; `lo` is a tail of x, or 0).
+#[cold]
+#[inline(never)]
+fn exp_general<R: Real>(x: R, lo: R) -> R {
+    // Beyond these the result is 0 or +inf; clamping keeps the reduction's integer small. NaN
+    // stays NaN.
+    let clamped = R::select(x.gt(c(EXP_MAX_ARG)), c(EXP_MAX_ARG), x);
+    let clamped = R::select(clamped.lt(c(EXP_MIN_ARG)), c(EXP_MIN_ARG), clamped);
     // A clamped (or NaN) argument drops its tail.
-    let lo = R::select(x.eq(hi), lo, c(0.0));
+    let lo = R::select(clamped.eq(x), lo, c(0.0));
+    let x = clamped;
     let shifted = x.mul_add(c(N_OVER_LN2), c(SHIFT));
     let k = shifted - c(SHIFT);
     let r = (-k).mul_add(c(LN2_OVER_N_LO), (-k).mul_add(c(LN2_OVER_N_HI), x)) + lo;
-    exp_reconstruct(x, shifted, r)
-}
-
-/// x clamped to [`EXP_MIN_ARG`, `EXP_MAX_ARG`] (NaN stays NaN).
-#[inline(always)]
-fn clamp_exp_argument<R: Real>(x: R) -> R {
-    let x = R::select(x.gt(c(EXP_MAX_ARG)), c(EXP_MAX_ARG), x);
-    R::select(x.lt(c(EXP_MIN_ARG)), c(EXP_MIN_ARG), x)
-}
-
-/// 2^e 2^(j/64) e^r from k = 64 e + j (in the low bits of `shifted`) and r.
-#[inline(always)]
-fn exp_reconstruct<R: Real>(x: R, shifted: R, r: R) -> R {
-    // Near the ends of the range, 2^e is not a normal double: take 2^(e -+ 128) here and
-    // 2^(+-128) at the end. Elsewhere the last factor is 1 (exact).
+    // Near the ends of the range 2^e is not a normal double: take 2^(e -+ 128) in the table
+    // scaling and 2^(+-128) after. Elsewhere the shift is 0 and the last factor 1 (exact), as
+    // in `exp`.
     let high = x.gt(c(EXP_SPLIT_ARG));
     let low = x.lt(c(-EXP_SPLIT_ARG));
     let k_shift = R::select(
@@ -154,9 +161,15 @@ fn exp_reconstruct<R: Real>(x: R, shifted: R, r: R) -> R {
         c(f64::from_bits(0x47f0_0000_0000_0000)), // 2^128
         R::select(low, c(f64::from_bits(0x37f0_0000_0000_0000)), c(1.0)), // 2^-128
     );
-    // 2^e 2^(j/64): e added to the exponent field of the table entry (exact: k_shift is a
-    // multiple of 64 and `shifted` an integer below 2^53).
-    let bits = (shifted - k_shift).to_bits();
+    // k_shift is a multiple of 64 and `shifted` an integer below 2^53: exact.
+    exp_table(shifted - k_shift, r) * last
+}
+
+/// 2^e 2^(j/64) e^r for k = 64 e + j in the low bits of `shifted` (2^e a normal double).
+#[inline(always)]
+fn exp_table<R: Real>(shifted: R, r: R) -> R {
+    // 2^e 2^(j/64): e added to the exponent field of the table entry.
+    let bits = shifted.to_bits();
     let j = bits.and(Bits::splat(63));
     let scale = R::from_bits(
         j.lookup(&EXP2_TABLE)
@@ -170,7 +183,7 @@ fn exp_reconstruct<R: Real>(x: R, shifted: R, r: R) -> R {
     let low_terms = r.mul_add(c(1.0 / 6.0), c(0.5));
     let high_terms = r.mul_add(r.mul_add(c(1.0 / 720.0), c(1.0 / 120.0)), c(1.0 / 24.0));
     let expm1 = (r2 * r2).mul_add(high_terms, r2.mul_add(low_terms, r + correction));
-    scale.mul_add(expm1, scale) * last
+    scale.mul_add(expm1, scale)
 }
 
 /// 2^(j/64), j = 0..63, rounded to nearest (bit patterns; computed with 200-bit arithmetic).

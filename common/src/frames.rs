@@ -56,8 +56,33 @@ pub fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {
 
 /// 3-2-1 Euler angles `(roll, pitch, yaw)` in degrees of the rotation `C_LB`, roll and yaw in
 /// (-180, 180], pitch in [-90, 90] (with sepval's `asin` and `atan2`, docs/model.md section 9).
+///
+/// Called at every sample from code compiled for any x86-64, where each fused multiply-add of
+/// those kernels would be a call to the C library's `fma`; on x86-64 hosts with AVX2 and FMA it
+/// runs a copy compiled for them, as `propagator::propagate` does (the same bits).
 #[inline]
 pub fn euler_321_deg(c_lb: &Matrix3<f64>) -> [f64; 3] {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports the features `euler_321_deg_fma` is compiled for.
+        return unsafe { euler_321_deg_fma(c_lb) };
+    }
+    euler_321_deg_inline(c_lb)
+}
+
+/// [`euler_321_deg`] compiled for x86-64 hosts with AVX2 and FMA.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn euler_321_deg_fma(c_lb: &Matrix3<f64>) -> [f64; 3] {
+    euler_321_deg_inline(c_lb)
+}
+
+/// The body of [`euler_321_deg`].
+#[inline(always)]
+fn euler_321_deg_inline(c_lb: &Matrix3<f64>) -> [f64; 3] {
     let sin_theta = (-c_lb[(2, 0)]).clamp(-1.0, 1.0);
     let theta = asin(sin_theta);
     let phi = atan2(c_lb[(2, 1)], c_lb[(2, 2)]);

@@ -20,10 +20,12 @@
 //!
 //! Kernels are branch-free: they compute every case a lane may need and pick with
 //! [`Real::select`] on a mask made by a comparison, so the four lanes of an [`F64x4`] follow one
-//! instruction stream. Where a case is both rare and expensive (the argument reduction of `sin`
-//! and `cos` for |x| > 2^20), a kernel branches on "any lane needs it" ([`Mask::any`]) and then
-//! computes that case lane by lane with the scalar code ([`Real::map`]) and selects: still the
-//! same bits in every lane as the scalar kernel.
+//! instruction stream. Where a case is rare and would cost the common one time (the ends of
+//! `exp`'s range, the argument reduction of `sin` and `cos` for |x| > 2^20), a kernel branches
+//! on "any lane needs it" ([`Mask::any`]) and then computes the general form for every lane
+//! (or lane by lane with the scalar code, [`Real::map`]) and selects: still the same bits in
+//! every lane as the scalar kernel, because the general form gives the common one's bits where
+//! both apply.
 //!
 //! [`F64x4`] is a plain array of four doubles (aligned to 32 bytes) whose operations are
 //! `#[inline(always)]` loops over the lanes: inside a function compiled for AVX2 and FMA
