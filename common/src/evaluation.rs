@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::effects::EffectSet;
+use crate::extension::TermSet;
 use crate::factors::{FactorTable, Factors};
 use crate::goals::{GoalAccumulator, GoalSums, Goals};
 use crate::propagator::{Observation, propagate};
@@ -180,7 +181,10 @@ impl Job {
         let mut sums = GoalSums::default();
         let mut samples = Vec::new();
         for (k, event) in self.events.iter().enumerate() {
-            let run = match event.simulator.run_setup(&c.factors, &c.effects) {
+            let run = match event
+                .simulator
+                .run_setup_with(&c.factors, &c.effects, &c.terms)
+            {
                 Ok(run) => run,
                 Err(e) => return Evaluation::from(Outcome::failed(e.to_string())),
             };
@@ -227,14 +231,17 @@ impl Job {
     }
 }
 
-/// One point of a search: the 17 factors and the effects of the model variant with their
-/// parameter values. `Copy`, fixed size.
+/// One point of a search: the 17 factors, the effects of the model variant with their
+/// parameter values, and extension terms (docs/model.md section 11) beyond the scenario's.
+/// `Copy`, fixed size.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate {
     /// The factors.
     pub factors: Factors,
     /// The active effects and their values (empty for the baseline model).
     pub effects: EffectSet,
+    /// Extension terms of this candidate (the scenario's own apply too).
+    pub terms: TermSet,
 }
 
 impl Candidate {
@@ -243,6 +250,16 @@ impl Candidate {
         Candidate {
             factors,
             effects: EffectSet::NONE,
+            terms: TermSet::NONE,
+        }
+    }
+
+    /// A candidate of a model variant with catalogue effects.
+    pub fn with_effects(factors: Factors, effects: EffectSet) -> Self {
+        Candidate {
+            factors,
+            effects,
+            terms: TermSet::NONE,
         }
     }
 }

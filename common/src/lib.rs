@@ -26,6 +26,7 @@ pub mod effects;
 pub mod elementary;
 pub mod encoding;
 pub mod evaluation;
+pub mod extension;
 pub mod factors;
 pub mod frames;
 pub mod goals;

@@ -246,17 +246,18 @@ struct Engine<'a> {
 }
 
 impl Engine<'_> {
-    /// One classic RK4 step of length `h` from `x` with the modes held, q renormalised.
+    /// One classic RK4 step of length `h` from `x` at time `t` with the modes held, q
+    /// renormalised (each stage at its own time: t, t + h/2, t + h/2, t + h).
     #[inline(always)]
-    fn rk4(&self, x: &StateVector, h: f64, modes: [FootMode; 2]) -> StateVector {
+    fn rk4(&self, x: &StateVector, t: f64, h: f64, modes: [FootMode; 2]) -> StateVector {
         let on = [modes[0] == FootMode::On, modes[1] == FootMode::On];
-        let f = |y: &StateVector| self.equations.derivative(y, on);
+        let f = |y: &StateVector, t: f64| self.equations.derivative(y, t, on);
         let half = 0.5 * h;
         let sixth = h / 6.0;
-        let k1 = f(x);
-        let k2 = f(&axpy(x, half, &k1));
-        let k3 = f(&axpy(x, half, &k2));
-        let k4 = f(&axpy(x, h, &k3));
+        let k1 = f(x, t);
+        let k2 = f(&axpy(x, half, &k1), t + half);
+        let k3 = f(&axpy(x, half, &k2), t + half);
+        let k4 = f(&axpy(x, h, &k3), t + h);
         let mut y = *x;
         for j in 0..y.len() {
             y[j] = sixth.mul_add(2.0f64.mul_add(k2[j] + k3[j], k1[j]) + k4[j], x[j]);
@@ -282,7 +283,7 @@ impl Engine<'_> {
     ) -> Result<(StateVector, f64), Diverged> {
         for j in k + 1..=end {
             let t_next = j as f64 * self.dt_s;
-            x = self.rk4(&x, t_next - t_s, [FootMode::Off; 2]);
+            x = self.rk4(&x, t_s, t_next - t_s, [FootMode::Off; 2]);
             t_s = t_next;
             check_divergence(&x, t_s)?;
         }
@@ -318,7 +319,7 @@ impl Engine<'_> {
             if to_tau {
                 h = tau - c.t_s;
             }
-            let trial = self.rk4(&c.x, h, c.modes);
+            let trial = self.rk4(&c.x, c.t_s, h, c.modes);
             // Earliest stroke end inside the trial step.
             let mut first: Option<(usize, f64, StateVector)> = None;
             for i in 0..2 {
@@ -409,7 +410,7 @@ impl Engine<'_> {
             } else {
                 secant
             };
-            let x_mid = self.rk4(&c.x, mid, c.modes);
+            let x_mid = self.rk4(&c.x, c.t_s, mid, c.modes);
             let g_mid = g(&x_mid);
             if g_mid > 0.0 {
                 hi = mid;

@@ -162,6 +162,9 @@ pub struct Scenario {
     /// Factor table overrides by factor name.
     #[serde(default, with = "factor_table_serde")]
     pub factors: FactorTable,
+    /// Model-extension terms (docs/model.md section 11), written as `[[extension]]` tables.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub extension: Vec<crate::extension::TermRecord>,
 }
 
 fn is_default_initial(i: &Initial) -> bool {
@@ -256,6 +259,16 @@ impl Scenario {
     /// The scenario as TOML (values round-trip exactly).
     pub fn to_toml_string(&self) -> String {
         toml::to_string(self).expect("a scenario always serialises")
+    }
+
+    /// The extension's terms (checked by [`Scenario::validate`]).
+    pub fn extension_terms(&self) -> crate::extension::TermSet {
+        let terms: Vec<crate::extension::Term> = self
+            .extension
+            .iter()
+            .filter_map(|r| r.term().ok())
+            .collect();
+        crate::extension::TermSet::of(&terms).unwrap_or_default()
     }
 
     /// SHA-256 of the scenario's canonical form (its JSON serialisation), hex. Two scenarios
@@ -408,6 +421,20 @@ impl Scenario {
         }
         for (k, v) in self.initial.rates_deg_s.iter().enumerate() {
             finite(&format!("initial.rates_deg_s[{k}]"), *v)?;
+        }
+        if self.extension.len() > crate::extension::MAX_TERMS {
+            return Err(bad(
+                "extension",
+                format!(
+                    "has {} terms, at most {}",
+                    self.extension.len(),
+                    crate::extension::MAX_TERMS
+                ),
+            ));
+        }
+        for (k, r) in self.extension.iter().enumerate() {
+            r.term()
+                .map_err(|(field, message)| bad(&format!("extension[{k}].{field}"), message))?;
         }
         self.factors
             .validate()

@@ -68,6 +68,16 @@ impl Simulator {
         RunSetup::new(&self.model, factors, effects)
     }
 
+    /// The run of `factors`, `effects` and extension `terms` (beyond the scenario's own).
+    pub fn run_setup_with(
+        &self,
+        factors: &Factors,
+        effects: &EffectSet,
+        terms: &crate::extension::TermSet,
+    ) -> Result<RunSetup, ModelError> {
+        RunSetup::with_terms(&self.model, factors, effects, terms)
+    }
+
     /// Simulates at `times_s` (strictly increasing) and returns the trajectory with its log.
     pub fn simulate_logged(
         &self,

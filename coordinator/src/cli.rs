@@ -79,6 +79,9 @@ pub struct FitArgs {
     /// Scenario file (TOML); the embedded default when absent.
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
+    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
+    #[arg(long, value_name = "FILE")]
+    pub extension: Option<PathBuf>,
     /// Searches to run [default: both; when resuming: the checkpoint's].
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
@@ -136,6 +139,13 @@ pub struct DiagnoseArgs {
     /// Scenario file (TOML); the embedded default when absent.
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
+    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
+    #[arg(long, value_name = "FILE")]
+    pub extension: Option<PathBuf>,
+    /// A release not used for fitting (CSV; repeatable): the baseline and the answer predict it
+    /// and their errors are reported, the honest measure of an extension.
+    #[arg(long, value_name = "FILE.csv")]
+    pub validate: Vec<PathBuf>,
     /// Seed of the baseline fit's genetic search.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -219,6 +229,9 @@ pub struct RerunArgs {
     /// Scenario file (default: the one recorded in the checkpoint).
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
+    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
+    #[arg(long, value_name = "FILE")]
+    pub extension: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,
 }
@@ -278,6 +291,9 @@ pub struct SimulateArgs {
     /// Scenario file (TOML); the embedded default (Eglin benchmark store) when absent.
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
+    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
+    #[arg(long, value_name = "FILE")]
+    pub extension: Option<PathBuf>,
     /// Factors: `truth`, `nominal`, or a JSON file mapping the 17 factor names to values.
     #[arg(long, default_value = "truth", value_name = "truth|nominal|FILE.json")]
     pub factors: String,

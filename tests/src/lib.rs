@@ -1,8 +1,11 @@
 //! Shared fixtures of every test that runs a built binary (the end-to-end tests of this crate,
 //! the `sepval` command-line tests of sepval-coordinator and the `sepval-worker` test): the
 //! binaries under test, unique run ids, process lookup by run id, and waits that always have a
-//! deadline. This library depends on no sepval crate, so any of them can use it as a
+//! deadline; and the shared parts of the property-based tests of every reader of outside input
+//! ([`fuzz`]). This library depends on no sepval crate, so any of them can use it as a
 //! dev-dependency without a cycle.
+
+pub mod fuzz;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};

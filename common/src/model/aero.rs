@@ -31,6 +31,12 @@ pub struct Flow {
     pub speed_m_s: f64,
     /// Interference decay factor f(s) in [0, 1].
     pub interference_factor: f64,
+    /// Time of the evaluation (the RK4 stage's) \[s\].
+    pub t_s: f64,
+    /// Distance of the CG from carriage \[m\].
+    pub distance_m: f64,
+    /// The store's Mach number V / a.
+    pub mach: f64,
 }
 
 /// Body-axis force and moment coefficients.

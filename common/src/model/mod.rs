@@ -33,6 +33,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::atmosphere::isa_troposphere;
 use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
 use crate::elementary::{atan2_asin, cos, sin};
+use crate::extension::{TermError, TermInput, TermSet};
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
 
@@ -59,6 +60,9 @@ pub enum ModelError {
     /// An effect's parameters are invalid.
     #[error(transparent)]
     Effect(#[from] EffectError),
+    /// Extension terms that cannot be run.
+    #[error(transparent)]
+    Term(#[from] TermError),
     /// The resulting inertia tensor is not positive definite.
     #[error("inertia tensor is not positive definite (xz block determinant {det_kg2_m4} <= 0)")]
     InertiaNotPositiveDefinite {
@@ -89,6 +93,10 @@ pub struct Model {
     pub density_kg_m3: f64,
     /// Free-stream speed V_inf = Mach a [m/s].
     pub v_inf_m_s: f64,
+    /// Speed of sound at the flight condition [m/s].
+    pub speed_of_sound_m_s: f64,
+    /// The scenario's model extension (docs/model.md section 11), in every run.
+    pub extension: TermSet,
     /// Aircraft velocity relative to the air in L:
     /// V_inf (cos a cos b, sin b, sin a cos b) (docs/model.md section 2).
     pub v_aircraft_air_l_m_s: Vector3<f64>,
@@ -122,6 +130,8 @@ impl Model {
             curve: EjectorCurve::new(&scenario.ejector.curve),
             density_kg_m3: air.density_kg_m3,
             v_inf_m_s: v_inf,
+            speed_of_sound_m_s: air.speed_of_sound_m_s,
+            extension: scenario.extension_terms(),
             v_aircraft_air_l_m_s: Vector3::new(
                 v_inf * cos(a) * cos(b),
                 v_inf * sin(b),
@@ -215,6 +225,10 @@ pub struct RunSetup {
     pub attitude_bias_rad: [f64; 3],
     /// Measurement: the tracked body point relative to the CG, body axes \[m\].
     pub tracked_point_b_m: Vector3<f64>,
+    /// Model-extension terms (the scenario's and the candidate's; docs/model.md section 11).
+    pub terms: TermSet,
+    /// 1 / a, the speed of sound's reciprocal [s/m] (the store's Mach number is V / a).
+    pub inv_speed_of_sound_s_m: f64,
 }
 
 fn no_term(_: &[f64; MAX_EFFECT_PARAMS], _: &Flow, _: &mut Coefficients) {}
@@ -223,8 +237,21 @@ impl RunSetup {
     /// The run of `model` with `factors` (checked against the scenario's factor table) and
     /// `effects` applied.
     pub fn new(model: &Model, factors: &Factors, effects: &EffectSet) -> Result<Self, ModelError> {
+        Self::with_terms(model, factors, effects, &TermSet::NONE)
+    }
+
+    /// The run of `model` with `factors`, `effects` and the extension `terms` (added to the
+    /// scenario's own) applied.
+    pub fn with_terms(
+        model: &Model,
+        factors: &Factors,
+        effects: &EffectSet,
+        terms: &TermSet,
+    ) -> Result<Self, ModelError> {
         model.scenario.factors.check(factors)?;
-        Self::new_unchecked_bounds(model, factors, effects)
+        let mut run = Self::new_unchecked_bounds(model, factors, effects)?;
+        run.terms = model.extension.merged(terms)?;
+        Ok(run)
     }
 
     /// As [`RunSetup::new`], but factors need only be finite (not within the table's bounds):
@@ -297,6 +324,8 @@ impl RunSetup {
             time_offset_s: 0.0,
             attitude_bias_rad: [0.0; 3],
             tracked_point_b_m: Vector3::zeros(),
+            terms: model.extension,
+            inv_speed_of_sound_s_m: 1.0 / model.speed_of_sound_m_s,
         };
         effects.apply(&mut run)?;
         run.inertia_inv = invert_inertia(&run.inertia_kg_m2)?;
@@ -346,7 +375,18 @@ impl RunSetup {
     /// propagator calls with the run's constant products formed once.
     #[inline(always)]
     pub fn derivative(&self, curve: &EjectorCurve, x: &StateVector, on: [bool; 2]) -> StateVector {
-        EquationsOfMotion::new(self, curve).derivative(x, on)
+        EquationsOfMotion::new(self, curve).derivative(x, 0.0, on)
+    }
+
+    /// [`RunSetup::derivative`] at time `t_s` (time matters to extension terms only).
+    pub fn derivative_at(
+        &self,
+        curve: &EjectorCurve,
+        x: &StateVector,
+        t_s: f64,
+        on: [bool; 2],
+    ) -> StateVector {
+        EquationsOfMotion::new(self, curve).derivative(x, t_s, on)
     }
 
     /// Adds the catalogue's coefficient terms (section 7). Out of line, so that the flow and
@@ -357,6 +397,41 @@ impl RunSetup {
             term(params, &flow, &mut k);
         }
         k
+    }
+
+    /// Adds the extension's coefficient increments (section 11; CA is positive aft, so
+    /// `CX -= dCA`). Out of line, as the catalogue's terms.
+    #[inline(never)]
+    fn add_extension_terms(&self, flow: &Flow, mut k: Coefficients) -> Coefficients {
+        if !self.terms.has_aero() {
+            return k;
+        }
+        let d = self.terms.aero_increments(&TermInput {
+            t_s: flow.t_s,
+            alpha_rad: flow.alpha_rad,
+            beta_rad: flow.beta_rad,
+            rates_hat: [flow.p_hat, flow.q_hat, flow.r_hat],
+            mach: flow.mach,
+            distance_m: flow.distance_m,
+            s_end_m: self.decay.s_end_m,
+        });
+        k.cx -= d[0];
+        k.cy += d[1];
+        k.cz += d[2];
+        k.cl += d[3];
+        k.cm += d[4];
+        k.cn += d[5];
+        k
+    }
+
+    /// The extension's factor on a foot's force at displacement `s_i` (section 11).
+    #[inline(never)]
+    fn ejector_factor(&self, t_s: f64, s_i: f64) -> f64 {
+        if !self.terms.has_ejector() {
+            return 1.0;
+        }
+        let sigma = s_i.clamp(0.0, self.stroke_m) / self.stroke_m;
+        self.terms.ejector_factor(t_s, sigma)
     }
 
     /// I^-1 (M - omega x (I omega)) (docs/model.md section 2), with a short path for the diagonal
@@ -415,22 +490,16 @@ impl<'a> EquationsOfMotion<'a> {
         }
     }
 
-    /// The state derivative with the ejector feet in the given modes (`on[i]`: foot i
-    /// pushes).
-    ///
-    /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
-    /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
-    /// allocation. Each block cites the docs/model.md line it implements.
-    ///
-    /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
-    /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
+    /// The flow of a stage (section 3) with its direction cosines and V^2: the first half of
+    /// [`EquationsOfMotion::derivative`], inlined there.
     #[inline(always)]
-    pub fn derivative(&self, x: &StateVector, on: [bool; 2]) -> StateVector {
+    fn flow_frame(&self, x: &StateVector, t_s: f64) -> (Flow, Dcm, f64) {
         let run = self.run;
         let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
         // Section 1: interference decay with s = |r|. First: its input is ready long before
         // the stage's velocity and attitude, so the exponential overlaps the rest.
-        let f_s = run.decay.factor(dot([rx, ry, rz], [rx, ry, rz]).sqrt());
+        let distance_m = dot([rx, ry, rz], [rx, ry, rz]).sqrt();
+        let f_s = run.decay.factor(distance_m);
         // Section 2: C_LB of the stage's quaternion scaled to unit length, kept as
         // |q|^2 C_LB and 1 / |q|^2 (the scale is applied where it is needed, off the chain
         // from the stage's state to the flow angles).
@@ -462,11 +531,41 @@ impl<'a> EquationsOfMotion<'a> {
             r_hat: r * rate_scale,
             speed_m_s: speed2 * inv_speed,
             interference_factor: f_s,
+            t_s,
+            distance_m,
+            mach: (speed2 * inv_speed) * run.inv_speed_of_sound_s_m,
         };
-        // Section 3: the six coefficients, then the catalogue's extra terms (section 7).
+        (flow, c, speed2)
+    }
+
+    /// The flow the store sees in state `x` at time `t_s` (docs/model.md section 3): what the
+    /// catalogue's and the extension's terms read, for reports and diagnoses.
+    pub fn flow(&self, x: &StateVector, t_s: f64) -> Flow {
+        self.flow_frame(x, t_s).0
+    }
+
+    /// The state derivative with the ejector feet in the given modes (`on[i]`: foot i
+    /// pushes).
+    ///
+    /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
+    /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
+    /// allocation. Each block cites the docs/model.md line it implements.
+    ///
+    /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
+    /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
+    #[inline(always)]
+    pub fn derivative(&self, x: &StateVector, t_s: f64, on: [bool; 2]) -> StateVector {
+        let run = self.run;
+        let (flow, c, speed2) = self.flow_frame(x, t_s);
+        let [_, _, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
+        // Section 3: the six coefficients, then the catalogue's extra terms (section 7) and
+        // the extension's (section 11).
         let mut k = run.aero.coefficients(&flow, &run.interference_increments);
         if run.coefficient_term_count > 0 {
             k = run.add_coefficient_terms(flow, k);
+        }
+        if !run.terms.is_empty() {
+            k = run.add_extension_terms(&flow, k);
         }
         // Section 3: M_aero_B = qbar S d (Cl, Cm, Cn), moved from the moment reference point
         // (x_ref, 0, 0) to the CG: M += (x_ref, 0, 0) x F_aero_B.
@@ -492,7 +591,10 @@ impl<'a> EquationsOfMotion<'a> {
             let (mut force_n, mut arm_force_n_m) = (0.0, 0.0);
             for (foot, _) in run.feet.iter().zip(on).filter(|(_, on)| *on) {
                 let s_i = c20.mul_add(foot.x_m, rz);
-                let f_i = foot.fac * self.curve.force_n(s_i.clamp(0.0, run.stroke_m));
+                let mut f_i = foot.fac * self.curve.force_n(s_i.clamp(0.0, run.stroke_m));
+                if !run.terms.is_empty() {
+                    f_i *= run.ejector_factor(t_s, s_i);
+                }
                 force_n += f_i;
                 arm_force_n_m = foot.x_m.mul_add(f_i, arm_force_n_m);
             }

@@ -8,11 +8,13 @@
 //! bounded ([`MAX_CHUNK`], [`MAX_TEXT`], [`MAX_SETUP`]) and checked against the bytes actually
 //! present before anything is allocated, and trailing bytes are refused.
 
+use crate::wire::WireTerm;
 use crate::wire::{
     Answer, Chunk, ChunkHeader, MAGIC, MAX_CHUNK, PROTOCOL_VERSION, REASON_CAPACITY, SetupHeader,
     WireObservation, WireRequest, WireResponse,
 };
 use sepval_common::effects::{MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
+use sepval_common::extension::MAX_TERMS;
 use sepval_common::factors::FACTOR_COUNT;
 
 /// Longest text field (a host name, a reason, a run id) \[bytes\].
@@ -245,6 +247,15 @@ fn put_request(w: &mut Writer, r: &WireRequest) {
     r.effect_index.iter().for_each(|&v| w.u32(v));
     w.u32(r.reserved);
     r.effect_params.iter().flatten().for_each(|&v| w.f64(v));
+    w.u32(r.term_count);
+    w.u32(r.reserved_terms);
+    for t in &r.terms {
+        w.u32(t.axis);
+        w.u32(t.regressor);
+        w.f64(t.locator[0]);
+        w.f64(t.locator[1]);
+        w.f64(t.coefficient);
+    }
 }
 
 fn get_request(r: &mut Reader) -> Result<WireRequest, CodecError> {
@@ -263,6 +274,17 @@ fn get_request(r: &mut Reader) -> Result<WireRequest, CodecError> {
     for v in effect_params.iter_mut().flatten() {
         *v = r.f64()?;
     }
+    let term_count = r.u32()?;
+    let reserved_terms = r.u32()?;
+    let mut terms = [WireTerm::default(); MAX_TERMS];
+    for t in &mut terms {
+        *t = WireTerm {
+            axis: r.u32()?,
+            regressor: r.u32()?,
+            locator: [r.f64()?, r.f64()?],
+            coefficient: r.f64()?,
+        };
+    }
     Ok(WireRequest {
         index,
         factors,
@@ -270,6 +292,9 @@ fn get_request(r: &mut Reader) -> Result<WireRequest, CodecError> {
         effect_index,
         reserved,
         effect_params,
+        term_count,
+        reserved_terms,
+        terms,
     })
 }
 

@@ -32,6 +32,9 @@ pub mod wire;
 #[cfg(feature = "zenoh")]
 pub mod zenoh;
 
+#[cfg(test)]
+mod fuzz_tests;
+
 pub use run_id::RunId;
 
 use sepval_common::evaluation::EvalError;

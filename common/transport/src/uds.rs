@@ -32,8 +32,12 @@ fn write_frame(w: &mut impl Write, frame: &Frame) -> std::io::Result<()> {
     w.flush()
 }
 
+/// Bytes of a frame read at a time: the most a frame's length allocates before its bytes
+/// have arrived.
+const READ_STEP: usize = 64 << 10;
+
 /// Reads one frame; `Ok(None)` at a clean end of the stream.
-fn read_frame(r: &mut impl Read) -> Result<Option<Frame>, TransportError> {
+pub(crate) fn read_frame(r: &mut impl Read) -> Result<Option<Frame>, TransportError> {
     let mut len = [0u8; 4];
     match r.read_exact(&mut len) {
         Ok(()) => {}
@@ -46,8 +50,15 @@ fn read_frame(r: &mut impl Read) -> Result<Option<Frame>, TransportError> {
             "frame of {len} bytes exceeds the {MAX_FRAME}-byte limit"
         )));
     }
-    let mut buf = vec![0u8; len];
-    r.read_exact(&mut buf).map_err(io("reading a frame"))?;
+    // The buffer grows with the bytes that arrive, a step at a time: a corrupt length (up to
+    // MAX_FRAME) allocates one step, not the gigabyte it announces.
+    let mut buf = Vec::new();
+    while buf.len() < len {
+        let at = buf.len();
+        buf.resize(at + (len - at).min(READ_STEP), 0);
+        r.read_exact(&mut buf[at..])
+            .map_err(io(format!("reading a frame of {len} bytes")))?;
+    }
     Frame::decode(&buf)
         .map(Some)
         .map_err(|source| TransportError::Codec {
@@ -326,5 +337,38 @@ impl WorkerLink for UdsWorker {
     fn answer(&mut self, answer: &Answer) -> Result<(), TransportError> {
         write_frame(&mut self.stream, &Frame::Answer(answer.clone()))
             .map_err(io("answering a chunk"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A length far beyond the bytes that follow is refused without allocating it (found by
+    /// `fuzz_tests::stream_frames`: it allocated the whole announced length, up to 1 GiB,
+    /// before reading).
+    #[test]
+    fn a_frame_longer_than_its_stream_allocates_one_step() {
+        let mut stream = (MAX_FRAME as u32).to_le_bytes().to_vec();
+        stream.extend_from_slice(&Frame::Quit("x".into()).encode());
+        let (result, cost) =
+            sepval_tests::fuzz::measure(|| read_frame(&mut std::io::Cursor::new(&stream)));
+        let e = result.unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("reading a frame of {MAX_FRAME} bytes")),
+            "{e}"
+        );
+        // The test binary counts allocations (crate::fuzz_tests).
+        assert!(cost.largest_allocation <= READ_STEP, "{cost:?}");
+        // A frame that is all there reads whatever its size.
+        let setup = Frame::Setup {
+            run_id: "r".into(),
+            header: crate::wire::SetupHeader::default(),
+            bytes: vec![7; 3 * READ_STEP + 5],
+        };
+        let mut stream = (setup.encode().len() as u32).to_le_bytes().to_vec();
+        stream.extend_from_slice(&setup.encode());
+        let back = read_frame(&mut std::io::Cursor::new(&stream)).unwrap();
+        assert_eq!(back, Some(setup));
     }
 }

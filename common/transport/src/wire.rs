@@ -18,17 +18,18 @@
 use iceoryx2::prelude::ZeroCopySend;
 use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::evaluation::{Candidate, Evaluation, Job, MAX_REASON_BYTES, Outcome};
+use sepval_common::extension::{Axis, MAX_TERMS, Regressor, Term, TermSet};
 use sepval_common::factors::{FACTOR_COUNT, Factors};
 use sepval_common::propagator::Observation;
 
 /// Version of the coordinator-worker protocol. A coordinator and a worker refuse each other
 /// unless they agree on it. Version 2: one wire format for every transport (failure reasons of
-/// up to 240 bytes, explicit padding). Version 3: the same messages, but the goals a worker
-/// returns are those of sepval's own elementary functions (`sepval_common::elementary`: no C
-/// library in the simulation, results changed in their last bits), so a version-2 worker, which
-/// computes with the C library, must not serve a version-3 fit whose results are to be
-/// bit-identical across hosts.
-pub const PROTOCOL_VERSION: u32 = 3;
+/// up to 240 bytes, explicit padding). Version 3: candidates carry extension terms. Version 4:
+/// the same messages, but the goals a worker returns are those of sepval's own elementary
+/// functions (`sepval_common::elementary`: no C library in the simulation, extension terms
+/// included, results changed in their last bits), so a version-3 worker, which computes with the
+/// C library, must not serve a version-4 fit whose results are to be bit-identical across hosts.
+pub const PROTOCOL_VERSION: u32 = 4;
 
 /// "SEPVAL01" as a little-endian integer: the first field of [`Hello`], [`SetupHeader`] and
 /// every byte-stream frame.
@@ -105,6 +106,27 @@ pub struct WireRequest {
     pub reserved: u32,
     /// Parameters of each active effect (unused entries zero).
     pub effect_params: [[f64; MAX_EFFECT_PARAMS]; MAX_ACTIVE_EFFECTS],
+    /// Number of extension terms.
+    pub term_count: u32,
+    /// Reserved (zero).
+    pub reserved_terms: u32,
+    /// The extension terms (unused entries zero).
+    pub terms: [WireTerm; MAX_TERMS],
+}
+
+/// One extension term of a candidate (docs/model.md section 11).
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("sepval.WireTerm")]
+#[repr(C)]
+pub struct WireTerm {
+    /// Index of its axis in `Axis::ALL`.
+    pub axis: u32,
+    /// Index of its regressor in `Regressor::ALL`.
+    pub regressor: u32,
+    /// Its locator.
+    pub locator: [f64; 2],
+    /// Its coefficient.
+    pub coefficient: f64,
 }
 
 /// Status codes of [`WireResponse`].
@@ -192,6 +214,14 @@ pub enum WireError {
     /// Effect parameters the catalogue refuses.
     #[error("{0}")]
     Effect(String),
+    /// Extension terms that cannot be run.
+    #[error("extension term {index}: {reason}")]
+    Term {
+        /// Its index in the request.
+        index: usize,
+        /// Why.
+        reason: String,
+    },
     /// An unknown response status.
     #[error("unknown response status {0}")]
     Status(u32),
@@ -210,10 +240,21 @@ impl WireRequest {
             effect_index: [0; MAX_ACTIVE_EFFECTS],
             reserved: 0,
             effect_params: [[0.0; MAX_EFFECT_PARAMS]; MAX_ACTIVE_EFFECTS],
+            term_count: c.terms.len() as u32,
+            reserved_terms: 0,
+            terms: [WireTerm::default(); MAX_TERMS],
         };
         for (k, a) in c.effects.iter().enumerate() {
             r.effect_index[k] = a.index as u32;
             r.effect_params[k][..a.values().len()].copy_from_slice(a.values());
+        }
+        for (k, t) in c.terms.iter().enumerate() {
+            r.terms[k] = WireTerm {
+                axis: t.axis.index() as u32,
+                regressor: t.regressor as u32,
+                locator: t.locator,
+                coefficient: t.coefficient,
+            };
         }
         r
     }
@@ -239,9 +280,41 @@ impl WireRequest {
                 .push(index as usize, params)
                 .map_err(|e| WireError::Effect(e.to_string()))?;
         }
+        let n = self.term_count as usize;
+        if n > MAX_TERMS {
+            return Err(WireError::Term {
+                index: n,
+                reason: format!("term count {n} exceeds the maximum of {MAX_TERMS}"),
+            });
+        }
+        let mut terms = TermSet::NONE;
+        for (k, w) in self.terms[..n].iter().enumerate() {
+            let bad = |reason: String| WireError::Term { index: k, reason };
+            let axis = *Axis::ALL
+                .get(w.axis as usize)
+                .ok_or_else(|| bad(format!("axis index {} is not an axis", w.axis)))?;
+            let regressor = Regressor::ALL
+                .get(w.regressor as usize)
+                .ok_or_else(|| {
+                    bad(format!(
+                        "regressor index {} is not a regressor",
+                        w.regressor
+                    ))
+                })?
+                .0;
+            terms
+                .push(Term {
+                    axis,
+                    regressor,
+                    locator: w.locator,
+                    coefficient: w.coefficient,
+                })
+                .map_err(|e| bad(e.to_string()))?;
+        }
         Ok(Candidate {
             factors: Factors(self.factors),
             effects,
+            terms,
         })
     }
 }
@@ -536,9 +609,19 @@ mod tests {
     fn requests_and_responses_round_trip_and_bad_ones_are_refused() {
         let mut effects = EffectSet::NONE;
         effects.push_spec("release_rates=0.1,0.2,0.3").unwrap();
+        let mut terms = TermSet::NONE;
+        terms
+            .push(Term {
+                axis: Axis::Cn,
+                regressor: Regressor::FBeta,
+                locator: [0.6, 0.0],
+                coefficient: -0.7,
+            })
+            .unwrap();
         let c = Candidate {
             factors: Factors::TRUTH,
             effects,
+            terms,
         };
         let w = WireRequest::new(5, &c);
         assert_eq!(w.candidate().unwrap(), c);
@@ -557,6 +640,20 @@ mod tests {
         assert_eq!(
             bad.candidate().unwrap_err().to_string(),
             "effect index 99 is not in the catalogue"
+        );
+        let mut bad = w;
+        bad.terms[0].regressor = 999;
+        assert_eq!(
+            bad.candidate().unwrap_err().to_string(),
+            "extension term 0: regressor index 999 is not a regressor"
+        );
+        let mut bad = w;
+        bad.terms[0].axis = 6; // ejector: a flow-angle regressor cannot act on it
+        assert!(
+            bad.candidate()
+                .unwrap_err()
+                .to_string()
+                .contains("cannot act on axis ejector")
         );
         let mut bad = w;
         bad.effect_params[0][1] = f64::INFINITY;

@@ -151,6 +151,9 @@ pub struct InputsRecord {
     pub data: Vec<PathBuf>,
     /// Scenario file (absolute path); none for the embedded default.
     pub scenario: Option<PathBuf>,
+    /// Model-extension file (absolute path), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extension: Option<PathBuf>,
 }
 
 /// One generation's checkpoint.

@@ -75,6 +75,7 @@ fn checkpoint(job: &Arc<Job>, generations: usize, finish: bool) -> Checkpoint {
         inputs: InputsRecord {
             data: Vec::new(),
             scenario: None,
+            extension: None,
         },
         state: ga.state().unwrap().clone(),
         probes: Vec::new(),
@@ -458,6 +459,48 @@ fn probes_of_ga_lm_must_count_their_simulations() {
     assert!(
         err.contains(
             "probe 1: 18 simulations before it recorded, the generations and earlier probes make 48"
+        ),
+        "{err}"
+    );
+}
+
+/// Counts are compared exactly, never after wrapping (found by the property
+/// `checkpoint_probes_sealed` of the cli tests: an attempt of 2^64 - 2 simulations made the next
+/// one's count wrap to 2, and the checkpoint was accepted; in a debug build it panicked).
+#[test]
+fn counts_that_overflow_are_refused_not_wrapped() {
+    let (job, dir) = (job(), tempfile::tempdir().unwrap());
+    let path = dir.path().join("gen-0003.json");
+    let mut c = checkpoint(&job, 3, true);
+    c.method = "ga+lm".into();
+    let probe = |generation, evaluations_before, evaluations| crate::results::Probe {
+        generation,
+        evaluations_before,
+        evaluations,
+        goals: [0.1, 0.2],
+        reached_floor: false,
+    };
+    c.probes = vec![probe(0, 0, u64::MAX - 1), probe(1, 4, 0)];
+    c.save(&path).unwrap();
+    let err = refusal(&path, &job).unwrap();
+    assert!(
+        err.contains(
+            "probe 1: 4 simulations before it recorded, the generations and earlier probes make \
+             18446744073709551620"
+        ),
+        "{err}"
+    );
+    // A generation whose count of simulations wraps to the one recorded.
+    let mut c = checkpoint(&job, 3, true);
+    c.settings.generations = usize::MAX;
+    c.state.generation = 1 << 63;
+    c.state.evaluations = 0;
+    c.save(&path).unwrap();
+    let err = refusal(&path, &job).unwrap();
+    assert!(
+        err.contains(
+            "0 simulations recorded, but 9223372036854775808 generations of 6 make \
+             55340232221128654848"
         ),
         "{err}"
     );

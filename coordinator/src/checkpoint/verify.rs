@@ -94,8 +94,9 @@ impl Checkpoint {
                 s.population
             ));
         }
-        let expected = st.generation as u64 * s.population as u64;
-        if st.evaluations != expected {
+        // Exact: a generation near usize::MAX must not wrap to a count that matches.
+        let expected = st.generation as u128 * s.population as u128;
+        if u128::from(st.evaluations) != expected {
             return Err(format!(
                 "{} simulations recorded, but {} generations of {} make {expected}",
                 st.evaluations, st.generation, s.population
@@ -269,8 +270,10 @@ impl Checkpoint {
                 self.method
             ));
         }
-        let pop = self.settings.population as u64;
-        let mut probed = 0u64;
+        // Exact sums: an attempt of nearly 2^64 simulations must not wrap the count of the
+        // next one's back to a value that matches.
+        let pop = self.settings.population as u128;
+        let mut probed = 0u128;
         let mut generation = 0;
         for (i, p) in self.probes.iter().enumerate() {
             if p.generation < generation || p.generation > self.state.generation {
@@ -279,8 +282,8 @@ impl Checkpoint {
                     p.generation, self.state.generation
                 ));
             }
-            let before = p.generation as u64 * pop + probed;
-            if p.evaluations_before != before {
+            let before = p.generation as u128 * pop + probed;
+            if u128::from(p.evaluations_before) != before {
                 return Err(format!(
                     "probe {i}: {} simulations before it recorded, the generations and earlier \
                      probes make {before}",
@@ -293,7 +296,7 @@ impl Checkpoint {
                     p.goals
                 ));
             }
-            probed += p.evaluations;
+            probed += u128::from(p.evaluations);
             generation = p.generation;
         }
         Ok(())

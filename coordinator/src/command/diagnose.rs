@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
-use sepval_coordinator::diagnose::{DiagnoseOptions, diagnose};
+use sepval_coordinator::diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
 use sepval_coordinator::fit::{FitOptions, Method};
 use sepval_coordinator::out_dir::{Claim, RunDir};
 use sepval_coordinator::refine::LmSettings;
@@ -36,7 +36,17 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
         ..GaSettings::default()
     };
     ga.validate()?;
-    let (job, inputs) = inputs::job(&args.data, args.scenario.as_deref())?;
+    let (job, inputs) = inputs::job(
+        &args.data,
+        args.scenario.as_deref(),
+        args.extension.as_deref(),
+    )?;
+    let validation = inputs::validation_job(
+        &args.validate,
+        &args.data,
+        args.scenario.as_deref(),
+        args.extension.as_deref(),
+    )?;
     let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
         .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
     let lm = LmSettings {
@@ -66,22 +76,90 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
             budget: 10_000,
             ..lm
         },
+        validation,
     };
     let mut evaluator = spec.start(Arc::new(job), notices())?;
     let d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
-    println!("{}", d.verdict);
-    println!(
-        "causes: [{}]  explained: {}  ({} simulations, {:.1} s)",
-        d.causes.join(", "),
-        d.explained,
-        d.evaluations,
-        d.wall_s
-    );
-    println!(
-        "report: {}  data: {}",
-        args.out.join("report.html").display(),
-        args.out.join("diagnosis.json").display()
-    );
+    print!("{}", summary_lines(&d, &args.out));
     drop(run_dir);
     Ok(())
+}
+
+/// The terminal summary: a few short lines.
+fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
+    let mut s = String::new();
+    let answer = if !d.discovered.is_empty() {
+        "terms found beyond the catalogue"
+    } else if !d.causes.is_empty() {
+        "catalogue effects"
+    } else {
+        "nothing named"
+    };
+    s.push_str(&format!("answer:    {answer}\n"));
+    for c in &d.causes {
+        let values: Vec<String> = d
+            .parameters
+            .get(c)
+            .map(|v| {
+                v.iter()
+                    .map(|p| match p.std_error {
+                        Some(se) => format!("{} = {:.4} ± {:.2}", p.name, p.value, se),
+                        None => format!("{} = {:.4}", p.name, p.value),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        s.push_str(&format!("cause:     {c} ({})\n", values.join(", ")));
+    }
+    for t in &d.discovered {
+        s.push_str(&format!("found:     {}\n", fmt_discovered(t)));
+        s.push_str(&format!("           {}\n", t.reading));
+    }
+    s.push_str(&format!(
+        "fit:       J_pos {:.4} -> {:.4} m, J_att {:.3} -> {:.3} deg (noise {:.4} m, {:.3} deg)\n",
+        d.baseline.j_pos_m,
+        d.extended.j_pos_m,
+        d.baseline.j_att_deg,
+        d.extended.j_att_deg,
+        d.sigma_pos_m,
+        d.sigma_att_deg
+    ));
+    let explained = match &d.extension {
+        Some(x) if x.answer => x.explained,
+        _ => d.explained,
+    };
+    s.push_str(&format!(
+        "explained: {} ({} simulations, {:.1} s)\n",
+        if explained {
+            "yes, to the noise"
+        } else {
+            "no, structure remains"
+        },
+        d.evaluations,
+        d.wall_s
+    ));
+    for v in &d.validation {
+        let f = |v: Option<f64>, p: usize| {
+            v.map_or("-".to_string(), |v| format!("{v:.prec$}", prec = p))
+        };
+        s.push_str(&format!(
+            "predicts:  {}: J_pos {} -> {} m, J_att {} -> {} deg\n",
+            v.event,
+            f(v.baseline_j_pos_m, 4),
+            f(v.extended_j_pos_m, 4),
+            f(v.baseline_j_att_deg, 3),
+            f(v.extended_j_att_deg, 3)
+        ));
+    }
+    if d.extension.as_ref().is_some_and(|x| x.answer) {
+        s.push_str(&format!(
+            "extension: {}\n",
+            out.join("extension.toml").display()
+        ));
+    }
+    s.push_str(&format!(
+        "report:    {}\n",
+        out.join("report.html").display()
+    ));
+    s
 }

@@ -53,11 +53,28 @@ pub fn run(args: FitArgs) -> Result<()> {
         }
     }
     // Inputs: the flags, or (when resuming without them) those recorded in the checkpoint.
-    let (data_paths, scenario_path) = match (&resume, args.data.is_empty(), &args.scenario) {
-        (Some(c), true, None) => (c.inputs.data.clone(), c.inputs.scenario.clone()),
-        _ => (args.data.clone(), args.scenario.clone()),
+    let (data_paths, scenario_path, extension_path) = match (
+        &resume,
+        args.data.is_empty(),
+        &args.scenario,
+        &args.extension,
+    ) {
+        (Some(c), true, None, None) => (
+            c.inputs.data.clone(),
+            c.inputs.scenario.clone(),
+            c.inputs.extension.clone(),
+        ),
+        _ => (
+            args.data.clone(),
+            args.scenario.clone(),
+            args.extension.clone(),
+        ),
     };
-    let (job, inputs) = inputs::job(&data_paths, scenario_path.as_deref())?;
+    let (job, inputs) = inputs::job(
+        &data_paths,
+        scenario_path.as_deref(),
+        extension_path.as_deref(),
+    )?;
     let method = match (args.method, &resume) {
         (Some(m), _) => method(m),
         (None, Some(c)) => Method::from_name(&c.method).ok_or_else(|| {

@@ -10,12 +10,20 @@ use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
 use sepval_common::telemetry::Trajectory;
 
-/// The scenario of `--scenario FILE`, or the embedded default.
-pub fn scenario(path: Option<&Path>) -> Result<Scenario> {
-    match path {
-        Some(p) => Ok(Scenario::load(p)?),
-        None => Ok(Scenario::embedded_default()),
+/// The scenario of `--scenario FILE`, or the embedded default, extended by the terms of
+/// `--extension FILE` (docs/model.md section 11).
+pub fn scenario(path: Option<&Path>, extension: Option<&Path>) -> Result<Scenario> {
+    let mut s = match path {
+        Some(p) => Scenario::load(p)?,
+        None => Scenario::embedded_default(),
+    };
+    if let Some(e) = extension {
+        let terms = sepval_common::extension::load_extension(e)?;
+        s.extension
+            .extend(terms.iter().map(sepval_common::extension::TermRecord::of));
+        s.validate(&format!("{} extended by {}", s.name, e.display()))?;
     }
+    Ok(s)
 }
 
 /// The factors of `--factors truth|nominal|FILE.json`, checked against `table`.
@@ -63,6 +71,7 @@ pub fn data(paths: &[std::path::PathBuf]) -> Result<Vec<Trajectory>> {
 pub fn job(
     data_paths: &[std::path::PathBuf],
     scenario_path: Option<&Path>,
+    extension_path: Option<&Path>,
 ) -> Result<(
     sepval_common::evaluation::Job,
     sepval_coordinator::checkpoint::InputsRecord,
@@ -80,7 +89,7 @@ pub fn job(
             );
         }
     }
-    let scen = scenario(scenario_path)?;
+    let scen = scenario(scenario_path, extension_path)?;
     let data = data(data_paths)?;
     let names: Vec<String> = if data_paths.is_empty() {
         vec!["embedded default synthetic flight test".to_string()]
@@ -99,6 +108,7 @@ pub fn job(
     let record = sepval_coordinator::checkpoint::InputsRecord {
         data: data_paths.iter().map(|p| absolute(p)).collect(),
         scenario: scenario_path.map(absolute),
+        extension: extension_path.map(absolute),
     };
     Ok((Job::new(events)?, record))
 }
@@ -128,4 +138,49 @@ pub fn event_scenario(
     }
     s.validate(&format!("{name} (flight condition from its metadata)"))?;
     Ok(s)
+}
+
+/// The events of `--validate FILE` (none: `None`), read like `--data` with the same scenario
+/// and extension; a file given both to fit and to validate is refused.
+pub fn validation_job(
+    paths: &[std::path::PathBuf],
+    data_paths: &[std::path::PathBuf],
+    scenario_path: Option<&Path>,
+    extension_path: Option<&Path>,
+) -> Result<Option<sepval_common::evaluation::Job>> {
+    use sepval_common::evaluation::{Event, Job};
+    use sepval_common::simulation::Simulator;
+    if paths.is_empty() {
+        return Ok(None);
+    }
+    let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    for (i, p) in paths.iter().enumerate() {
+        if let Some(q) = data_paths.iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--validate {} is the same file as --data {}: a release used for fitting cannot measure prediction",
+                p.display(),
+                q.display()
+            );
+        }
+        if let Some(q) = paths[..i].iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--validate {} is the same file as --validate {}: give each release once",
+                p.display(),
+                q.display()
+            );
+        }
+    }
+    let scen = scenario(scenario_path, extension_path)?;
+    let mut events = Vec::with_capacity(paths.len());
+    for p in paths {
+        let data = Trajectory::read(p).with_context(|| format!("--validate {}", p.display()))?;
+        let name = p.display().to_string();
+        let scenario = event_scenario(&scen, &data, &name)?;
+        events.push(Event {
+            name,
+            simulator: Simulator::new(&scenario),
+            data,
+        });
+    }
+    Ok(Some(Job::new(events)?))
 }

@@ -12,15 +12,25 @@ use crate::cli::RerunArgs;
 pub fn run(args: RerunArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let checkpoint = Checkpoint::load(&args.checkpoint)?;
-    let (data_paths, scenario_path) = if args.data.is_empty() && args.scenario.is_none() {
-        (
-            checkpoint.inputs.data.clone(),
-            checkpoint.inputs.scenario.clone(),
-        )
-    } else {
-        (args.data.clone(), args.scenario.clone())
-    };
-    let (job, _) = inputs::job(&data_paths, scenario_path.as_deref())?;
+    let (data_paths, scenario_path, extension_path) =
+        if args.data.is_empty() && args.scenario.is_none() && args.extension.is_none() {
+            (
+                checkpoint.inputs.data.clone(),
+                checkpoint.inputs.scenario.clone(),
+                checkpoint.inputs.extension.clone(),
+            )
+        } else {
+            (
+                args.data.clone(),
+                args.scenario.clone(),
+                args.extension.clone(),
+            )
+        };
+    let (job, _) = inputs::job(
+        &data_paths,
+        scenario_path.as_deref(),
+        extension_path.as_deref(),
+    )?;
     checkpoint.check_job(&job, &args.checkpoint)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;
     let report =

@@ -7,7 +7,7 @@ use crate::cli::ScenarioArgs;
 
 /// Runs `sepval scenario`.
 pub fn run(args: ScenarioArgs) -> Result<()> {
-    let scenario = inputs::scenario(args.scenario.as_deref())?;
+    let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
     let text = format!(
         "# sepval scenario (SI units, angles in degrees); docs/model.md section 1 describes each field.\n{}",
         scenario.to_toml_string()

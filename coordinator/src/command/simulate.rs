@@ -13,7 +13,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     let t_end = args.t_end.map(|t| positive("--t-end", t)).transpose()?;
     let rate = args.rate.map(|r| positive("--rate", r)).transpose()?;
     let effects = inputs::effects(&args.effects)?;
-    let scenario = inputs::scenario(args.scenario.as_deref())?;
+    let scenario = inputs::scenario(args.scenario.as_deref(), args.extension.as_deref())?;
     let factors = inputs::factors(&args.factors, &scenario.factors)?;
     let t_end = t_end.unwrap_or(scenario.integrator.t_end_s);
     let rate = rate.unwrap_or(scenario.integrator.rate_hz);

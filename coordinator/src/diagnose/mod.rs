@@ -1,24 +1,30 @@
 //! `sepval diagnose`: what the simulation still gets wrong after a fit, why, and what the best
 //! extension of the model gains.
 //!
-//! 1. The baseline model is fitted by the fit pipeline (genetic search, then refinement to
-//!    the optimum) and its residuals are analysed per channel and over time: RMS against the
-//!    noise, where in time the misfit sits (ejector stroke, interference zone, free flight),
-//!    and whiteness (autocorrelation against its 95 % band, Ljung-Box portmanteau test).
-//! 2. Every effect of the catalogue (docs/model.md section 7) extends the model in turn and is
-//!    refitted from the baseline optimum; all candidate refits share each batch sent to the
-//!    workers. Each is judged by the statistics of nested least squares: the chi-square drop,
-//!    the F test of the extra parameters (Bonferroni-corrected over the candidates tried), and
-//!    the Bayesian information criterion, which charges the extra parameters
-//!    (BIC = m ln(RSS / m) + k ln m, G. Schwarz 1978). An extension is significant when its F
-//!    test passes at 1 % family-wise and its BIC is lower; among significant ones the lowest BIC
-//!    is chosen, not the largest raw drop.
-//! 3. Forward selection: further effects are added to the chosen ones while each addition is
-//!    itself significant, so that effects hidden together are all named.
-//! 4. The verdict: `causes` are the chosen effects; `explained` says whether the final model
-//!    leaves nothing but noise (both goals within 1.1 sigma and every channel's residuals white
-//!    by the Ljung-Box test at 0.1 %). When structure remains, the report says the catalogue does
-//!    not hold the cause rather than naming one with confidence.
+//! 1. **Baseline.** The 17 factors are fitted by the fit pipeline (genetic search, then
+//!    refinement to the optimum) and the residuals analysed per channel and over time: RMS
+//!    against the noise, where in time the misfit sits (ejector stroke, interference zone, free
+//!    flight), and whiteness (autocorrelation against its 95 % band, Ljung-Box test).
+//! 2. **Catalogue** (`catalogue`): every effect of the catalogue (docs/model.md section 7)
+//!    extends the model in turn and is refitted; an extension is significant when its F test
+//!    passes at 1 % family-wise (Bonferroni over the round) and it lowers the Bayesian
+//!    information criterion (BIC = m ln(RSS / m) + k ln m, G. Schwarz 1978); the lowest BIC
+//!    among significant ones is chosen, and further effects are added while each addition is
+//!    itself significant (forward selection).
+//! 3. **Discovery** (`discover`): beyond the catalogue, the missing force and moment are
+//!    reconstructed as time histories, and terms of a documented library (docs/model.md
+//!    section 11) are selected by stepwise regression and verified by an output-error refit.
+//! 4. **The answer.** The catalogue's effects (`causes`) stay the answer unless the discovered
+//!    extension beats them by more than [`BIC_MARGIN`] in BIC (R. E. Kass and A. E. Raftery,
+//!    JASA 90, 1995: a difference above 6 is strong evidence), in which case the catalogue's
+//!    effects are listed as `alternatives`, mimics of the better explanation. With no
+//!    catalogue effect significant, a significant discovered extension is the answer. Null
+//!    data name nothing. `explained` says whether the catalogue's answer (the baseline when it
+//!    names no effect) leaves nothing but noise (both goals within 1.1 sigma and every
+//!    channel's residuals white by the Ljung-Box test at 0.1 %); whether a discovered extension
+//!    does is `extension.explained`.
+//! 5. **Prediction.** Events given with `--validate` take no part in any fit: the baseline's
+//!    and the answer's goals on them are reported.
 //!
 //! The analysis lives here; the HTML page that presents it (DIR/report.html) is written by the
 //! `report` submodule.
@@ -29,18 +35,17 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use sepval_common::atomic_file::{WriteError, write_atomically};
-use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS};
-use sepval_common::evaluation::{Evaluator, Job};
+use sepval_common::effects::{CATALOGUE, EffectSet};
+use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
+use sepval_common::extension::{TermRecord, extension_toml};
 use sepval_common::factors::FACTOR_COUNT;
 use serde::{Deserialize, Serialize};
 
 use crate::figures::FigureError;
 use crate::fit::{FitError, FitOptions, Method, run_fit};
-use crate::identifiability::identifiability;
-use crate::refine::{LmResult, LmRun, LmSettings, Noise, ParamSpace, refine_together};
+use crate::refine::{FreeTerm, LmResult, LmSettings, Noise, ParamSpace};
 use crate::results::ChannelRms;
 use crate::run::{ProgressObserver, RunError};
-use crate::stats::f_test;
 
 /// Errors of a diagnosis.
 #[derive(Debug, thiserror::Error)]
@@ -72,12 +77,27 @@ pub enum DiagnoseError {
     Model(String),
 }
 
+impl From<EvalError> for DiagnoseError {
+    fn from(e: EvalError) -> Self {
+        DiagnoseError::Run(RunError::from(e))
+    }
+}
+
 type Result<T> = std::result::Result<T, DiagnoseError>;
 
+mod catalogue;
+mod discover;
+mod library;
+mod probe;
+pub mod readings;
+mod reconstruct;
 mod report;
-use report::verdict;
 mod residuals;
+mod stepwise;
 
+pub use discover::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
+pub use reconstruct::{IncrementSeries, Reconstruction};
+pub use report::fmt_discovered;
 pub use residuals::{
     CHANNELS, ChannelReport, LAGS, ResidualReport, SegmentRms, WHITENESS_P, physical_residuals,
     residual_report,
@@ -85,9 +105,12 @@ pub use residuals::{
 use residuals::{residual_figures, rms_channels};
 
 /// Format tag of diagnosis files.
-pub const DIAGNOSIS_FORMAT: &str = "sepval-diagnosis/1";
+pub const DIAGNOSIS_FORMAT: &str = "sepval-diagnosis/2";
 /// Family-wise significance level of the candidate tests.
 pub const ALPHA: f64 = 0.01;
+/// The BIC lead by which a discovered extension must beat the catalogue's answer to replace it.
+pub const BIC_MARGIN: f64 = 6.0;
+
 /// Settings of a diagnosis.
 pub struct DiagnoseOptions {
     /// The baseline fit (its method is forced to `ga+lm`; its output goes to DIR/baseline).
@@ -96,6 +119,8 @@ pub struct DiagnoseOptions {
     pub out: PathBuf,
     /// Refinement settings of each candidate.
     pub candidate_lm: LmSettings,
+    /// Events not used for fitting, on which the baseline and the answer predict.
+    pub validation: Option<Job>,
 }
 
 /// One parameter's estimate.
@@ -116,6 +141,9 @@ pub struct ParamValue {
 pub struct ModelSummary {
     /// Its effects (empty: the baseline).
     pub effects: Vec<String>,
+    /// Its extension terms (`axis: formula`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub terms: Vec<String>,
     /// Free parameters.
     pub parameters: usize,
     /// RMS position error \[m\].
@@ -163,18 +191,83 @@ pub struct CandidateReport {
     pub refinement: String,
 }
 
+/// The discovered extension: the model with the discovered terms, refitted, and its gain.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExtensionReport {
+    /// Whether it is the answer (else the catalogue's effects are, and it is an alternative).
+    pub answer: bool,
+    /// The extension file written (relative to DIR), when it is the answer.
+    pub file: Option<String>,
+    /// The extended model's fit.
+    pub model: ModelSummary,
+    /// Its gain over the baseline (chi-square drop, F test, BIC).
+    pub gain: Gain,
+    /// Whether every channel's residuals are white.
+    pub white: bool,
+    /// Whether both goals are within 1.1 sigma.
+    pub at_noise_floor: bool,
+    /// Whether it explains the data to the noise (white and at the floor).
+    pub explained: bool,
+    /// Why its refinement stopped.
+    pub refinement: String,
+}
+
+/// A model that explains part of the data but is not the answer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Alternative {
+    /// `catalogue` (effects) or `discovered` (terms).
+    pub kind: String,
+    /// Its effects or terms.
+    pub names: Vec<String>,
+    /// Its fit.
+    pub model: ModelSummary,
+    /// Its BIC minus the answer's (positive: worse).
+    pub delta_bic_vs_answer: f64,
+    /// Why it is not the answer.
+    pub note: String,
+}
+
+/// Prediction of one event that took no part in the fits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ValidationReport {
+    /// The event.
+    pub event: String,
+    /// The baseline's RMS position error on it \[m\].
+    pub baseline_j_pos_m: Option<f64>,
+    /// The baseline's RMS attitude error \[deg\].
+    pub baseline_j_att_deg: Option<f64>,
+    /// The answer's RMS position error \[m\].
+    pub extended_j_pos_m: Option<f64>,
+    /// The answer's RMS attitude error \[deg\].
+    pub extended_j_att_deg: Option<f64>,
+    /// Why a model did not simulate it, if one did not.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub note: String,
+}
+
 /// DIR/diagnosis.json.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
     /// [`DIAGNOSIS_FORMAT`].
     pub format: String,
-    /// The effects named as causes, in the order chosen (empty when the baseline explains the
-    /// data).
+    /// The catalogue effects named as causes, in the order chosen (empty when the baseline
+    /// explains the data, or when a discovered extension explains it better).
     pub causes: Vec<String>,
-    /// False when structure beyond noise remains after the best extension.
+    /// Whether the catalogue's answer (`causes`; the baseline when empty) leaves nothing but
+    /// noise. A discovered extension's own verdict is `extension.explained`.
     pub explained: bool,
     /// The verdict in one sentence.
     pub verdict: String,
+    /// Terms found beyond the catalogue, most important first, when they are the answer.
+    pub discovered: Vec<DiscoveredTerm>,
+    /// Models that explain part of the data but not as well as the answer (mimics).
+    pub alternatives: Vec<Alternative>,
+    /// The discovered extension and its gain, when discovery verified one.
+    pub extension: Option<ExtensionReport>,
+    /// What discovery did beyond its findings (why nothing was named, terms dropped).
+    pub discovery_notes: Vec<String>,
+    /// Each step of discovery's selection: the entries ranked, the refits, what entered.
+    pub discovery_steps: Vec<DiscoveryStep>,
     /// Position noise \[m\].
     pub sigma_pos_m: f64,
     /// Attitude noise \[deg\].
@@ -183,7 +276,7 @@ pub struct Diagnosis {
     pub sigma_source: String,
     /// The baseline fit.
     pub baseline: ModelSummary,
-    /// The final (extended) model; the baseline when no cause is named.
+    /// The answer's model; the baseline when nothing is named.
     pub extended: ModelSummary,
     /// Each named effect's parameters with standard errors.
     pub parameters: BTreeMap<String, Vec<ParamValue>>,
@@ -191,16 +284,40 @@ pub struct Diagnosis {
     pub candidates: Vec<CandidateReport>,
     /// Residual analysis before and after.
     pub residuals: BTreeMap<String, ResidualReport>,
+    /// Per event, the reconstructed coefficient increments with their bands.
+    pub reconstruction: Vec<Reconstruction>,
+    /// Prediction of the `--validate` events.
+    pub validation: Vec<ValidationReport>,
     /// Simulations run (baseline fit included).
     pub evaluations: u64,
     /// Wall time \[s\].
     pub wall_s: f64,
 }
 
-/// A fitted model: its effects and refinement.
+/// A fitted model: its effects, its free extension terms and its refinement.
+#[derive(Clone)]
 struct Fitted {
     effects: EffectSet,
+    terms: Vec<FreeTerm>,
     lm: LmResult,
+}
+
+impl Fitted {
+    /// Its parameter space.
+    fn space(&self, job: &Job) -> ParamSpace {
+        ParamSpace::with_terms(job.factor_table(), &self.effects, &self.terms)
+    }
+
+    /// Its candidate at the optimum.
+    fn candidate(&self, job: &Job) -> Result<Candidate> {
+        Ok(self.space(job).candidate(&self.lm.x)?)
+    }
+}
+
+/// BIC = m ln(chi2 / m) + k ln m of a fit of `k` parameters to `m` residuals.
+fn bic(chi2: f64, k: usize, m: usize) -> f64 {
+    let m = m as f64;
+    m * (chi2.max(1e-300) / m).ln() + k as f64 * m.ln()
 }
 
 fn noise_of(options: &FitOptions) -> Noise {
@@ -210,14 +327,22 @@ fn noise_of(options: &FitOptions) -> Noise {
     }
 }
 
-fn summary(fitted: &Fitted, noise: Noise, events: &[usize]) -> ModelSummary {
+fn summary(job: &Job, fitted: &Fitted, noise: Noise, events: &[usize]) -> ModelSummary {
+    let terms = fitted
+        .space(job)
+        .terms_at(&fitted.lm.x)
+        .unwrap_or_default()
+        .iter()
+        .map(|t| format!("{}: {}", t.axis.name(), t.formula()))
+        .collect();
     ModelSummary {
         effects: fitted
             .effects
             .iter()
             .map(|a| a.effect().id().to_string())
             .collect(),
-        parameters: FACTOR_COUNT + fitted.effects.param_count(),
+        terms,
+        parameters: fitted.space(job).len(),
         j_pos_m: fitted.lm.goals.j_pos_m,
         j_att_deg: fitted.lm.goals.j_att_deg,
         chi2: fitted.lm.cost,
@@ -225,112 +350,16 @@ fn summary(fitted: &Fitted, noise: Noise, events: &[usize]) -> ModelSummary {
     }
 }
 
-/// Refines a model again from its optimum until it converges (a reference model must be
-/// converged for the drops of its extensions to measure them); keeps the better of the two.
-fn converge(
-    evaluator: &mut dyn Evaluator,
-    job: &Arc<Job>,
-    fitted: Fitted,
-    noise: Noise,
-    settings: &LmSettings,
-    evaluations: &mut u64,
-) -> Result<Fitted> {
-    let space = ParamSpace::new(job.factor_table(), &fitted.effects);
-    let mut run = [LmRun::new(
-        space,
-        Arc::clone(job),
-        &fitted.lm.x,
-        noise,
-        settings.clone(),
-    )];
-    refine_together(evaluator, &mut run)?;
-    let [run] = run;
-    let lm = run.finish();
-    *evaluations += lm.evaluations;
-    Ok(if lm.cost < fitted.lm.cost {
-        Fitted {
-            effects: fitted.effects,
-            lm,
-        }
-    } else {
-        fitted
-    })
+/// Which model answers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Answer {
+    Baseline,
+    Catalogue,
+    Discovered,
 }
 
-/// The extensions of `base` by each effect of `ids`, refitted together from `base`'s optimum.
-fn try_extensions(
-    evaluator: &mut dyn Evaluator,
-    job: &Arc<Job>,
-    base: &Fitted,
-    ids: &[usize],
-    noise: Noise,
-    settings: &LmSettings,
-) -> Result<Vec<(usize, Fitted)>> {
-    let table = *job.factor_table();
-    let mut runs = Vec::new();
-    let mut sets = Vec::new();
-    for &index in ids {
-        let mut set = base.effects;
-        let neutral: Vec<f64> = CATALOGUE[index]
-            .params()
-            .iter()
-            .map(|p| p.neutral)
-            .collect();
-        set.push(index, &neutral)
-            .map_err(|e| DiagnoseError::Model(e.to_string()))?;
-        let space = ParamSpace::new(&table, &set);
-        let mut x0 = base.lm.x.clone();
-        x0.extend(neutral);
-        runs.push(LmRun::new(
-            space,
-            Arc::clone(job),
-            &x0,
-            noise,
-            settings.clone(),
-        ));
-        sets.push((index, set));
-    }
-    refine_together(evaluator, &mut runs)?;
-    Ok(sets
-        .into_iter()
-        .zip(runs)
-        .map(|((index, effects), run)| {
-            (
-                index,
-                Fitted {
-                    effects,
-                    lm: run.finish(),
-                },
-            )
-        })
-        .collect())
-}
-
-fn param_values(
-    space: &ParamSpace,
-    fitted: &Fitted,
-    events: &[usize],
-    from: usize,
-) -> Vec<ParamValue> {
-    let id = identifiability(
-        space,
-        &fitted.lm.x,
-        &fitted.lm.residuals,
-        &fitted.lm.jacobian,
-        events,
-    );
-    id.parameters[from..]
-        .iter()
-        .map(|p| ParamValue {
-            name: p.name.clone(),
-            unit: p.unit.clone(),
-            value: p.value,
-            std_error: p.std_error,
-        })
-        .collect()
-}
-
-/// Runs the diagnosis and writes DIR/diagnosis.json, DIR/report.html and the figures.
+/// Runs the diagnosis and writes DIR/diagnosis.json, DIR/report.html, the figures and (when
+/// the answer is a discovered extension) DIR/extension.toml.
 pub fn diagnose(
     options: &DiagnoseOptions,
     evaluator: &mut dyn Evaluator,
@@ -367,11 +396,12 @@ pub fn diagnose(
         .values()
         .map(|m| m.best.evaluations)
         .sum();
-    let baseline = converge(
+    let baseline = catalogue::converge(
         evaluator,
         &job,
         Fitted {
             effects: EffectSet::NONE,
+            terms: Vec::new(),
             lm: baseline_lm,
         },
         noise,
@@ -379,138 +409,139 @@ pub fn diagnose(
         &mut evaluations,
     )?;
 
-    // 2-3. Candidates and forward selection.
-    let mut current = Fitted {
-        effects: EffectSet::NONE,
-        lm: baseline.lm.clone(),
-    };
-    let mut chosen: Vec<usize> = Vec::new();
-    let mut candidates = Vec::new();
-    for round in 1..=MAX_ACTIVE_EFFECTS {
-        let remaining: Vec<usize> = (0..CATALOGUE.len())
-            .filter(|i| !chosen.contains(i))
-            .collect();
-        if remaining.is_empty() {
-            break;
-        }
-        let threshold = ALPHA / remaining.len() as f64;
-        let tried = try_extensions(
-            evaluator,
-            &job,
-            &current,
-            &remaining,
-            noise,
-            &options.candidate_lm,
-        )?;
-        let mut best: Option<(usize, f64)> = None;
-        let mut fitted_by_index = BTreeMap::new();
-        for (index, fitted) in tried {
-            evaluations += fitted.lm.evaluations;
-            let effect = CATALOGUE[index];
-            let q = effect.params().len();
-            let p1 = FACTOR_COUNT + fitted.effects.param_count();
-            let (f, p) = f_test(current.lm.cost, fitted.lm.cost, q, m, p1);
-            let delta_bic =
-                m as f64 * (fitted.lm.cost / current.lm.cost).ln() + q as f64 * (m as f64).ln();
-            let space = ParamSpace::new(job.factor_table(), &fitted.effects);
-            let from = space.len() - q;
-            let parameters = param_values(&space, &fitted, &events, from);
-            let significant = p < threshold && delta_bic < 0.0;
-            let note = if significant {
-                String::new()
-            } else {
-                format!(
-                    "not significant (p = {p:.2e}, threshold {threshold:.1e}; BIC change {delta_bic:+.1}); the data bound it to {}",
-                    parameters
-                        .iter()
-                        .map(|v| match v.std_error {
-                            Some(se) => format!(
-                                "|{}| <~ {:.3e} {} (2 SE)",
-                                v.name,
-                                v.value.abs() + 2.0 * se,
-                                v.unit
-                            ),
-                            None => format!("{}: undetermined", v.name),
-                        })
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            };
-            if significant && best.is_none_or(|(_, b)| delta_bic < b) {
-                best = Some((index, delta_bic));
-            }
-            candidates.push(CandidateReport {
-                id: effect.id().to_string(),
-                adds: effect.adds().to_string(),
-                round,
-                parameters,
-                chi2: fitted.lm.cost,
-                chi2_drop: current.lm.cost - fitted.lm.cost,
-                f,
-                p_value: p,
-                p_threshold: threshold,
-                delta_bic,
-                significant,
-                goals: fitted.lm.goals.as_array(),
-                channel_rms: rms_channels(&physical_residuals(
-                    &fitted.lm.residuals,
-                    noise,
-                    &events,
-                )),
-                note,
-                refinement: format!(
-                    "{} after {} iterations",
-                    fitted.lm.stop, fitted.lm.iterations
-                ),
-            });
-            fitted_by_index.insert(index, fitted);
-        }
-        match best {
-            Some((index, _)) => {
-                chosen.push(index);
-                let picked = fitted_by_index.remove(&index).expect("tried");
-                current = converge(
-                    evaluator,
-                    &job,
-                    picked,
-                    noise,
-                    &options.candidate_lm,
-                    &mut evaluations,
-                )?;
-            }
-            None => break,
-        }
-    }
+    // 2. The catalogue.
+    let cat = catalogue::select(
+        evaluator,
+        &job,
+        &baseline,
+        noise,
+        &options.candidate_lm,
+        &mut evaluations,
+    )?;
 
-    // 4. The verdict.
-    let final_report = residual_report(&job, &current.lm, noise, floor);
-    let base_report = residual_report(&job, &baseline.lm, noise, floor);
-    let explained = final_report.white && final_report.at_noise_floor;
-    let causes: Vec<String> = chosen
-        .iter()
-        .map(|&i| CATALOGUE[i].id().to_string())
-        .collect();
+    // 3. Discovery.
+    let disc = discover::discover(evaluator, &job, &baseline, noise, &options.candidate_lm)?;
+    evaluations += disc.evaluations;
+
+    // 4. The answer.
+    let k_of = |f: &Fitted| f.space(&job).len();
+    let cat_bic = bic(cat.fitted.lm.cost, k_of(&cat.fitted), m);
+    let answer = match (&disc.found, cat.chosen.is_empty()) {
+        (None, true) => Answer::Baseline,
+        (None, false) => Answer::Catalogue,
+        (Some(_), true) => Answer::Discovered,
+        (Some((f, _, _)), false) => {
+            if bic(f.lm.cost, k_of(f), m) < cat_bic - BIC_MARGIN {
+                Answer::Discovered
+            } else {
+                Answer::Catalogue
+            }
+        }
+    };
+    let answer_fit: &Fitted = match (answer, &disc.found) {
+        (Answer::Discovered, Some((f, _, _))) => f,
+        (Answer::Catalogue, _) => &cat.fitted,
+        _ => &baseline,
+    };
+    let answer_bic = bic(answer_fit.lm.cost, k_of(answer_fit), m);
+    let cat_report = residual_report(&job, &cat.fitted.lm, noise, floor);
+    let explained = cat_report.white && cat_report.at_noise_floor;
+    let causes: Vec<String> = if answer == Answer::Catalogue {
+        cat.chosen
+            .iter()
+            .map(|&i| CATALOGUE[i].id().to_string())
+            .collect()
+    } else {
+        Vec::new()
+    };
     let mut parameters = BTreeMap::new();
-    if !chosen.is_empty() {
-        let space = ParamSpace::new(job.factor_table(), &current.effects);
-        let all = param_values(&space, &current, &events, FACTOR_COUNT);
+    if !cat.chosen.is_empty() {
+        let space = cat.fitted.space(&job);
+        let all = catalogue::param_values(&space, &cat.fitted, &events, FACTOR_COUNT);
         let mut pos = 0;
-        for a in current.effects.iter() {
+        for a in cat.fitted.effects.iter() {
             let n = a.effect().params().len();
             parameters.insert(a.effect().id().to_string(), all[pos..pos + n].to_vec());
             pos += n;
         }
     }
-    let base_summary = summary(&baseline, noise, &events);
-    let ext_summary = summary(&current, noise, &events);
-    let verdict = verdict(
-        &causes,
+    let mut alternatives = Vec::new();
+    let mut extension = None;
+    let mut discovered = Vec::new();
+    if answer == Answer::Discovered && !cat.chosen.is_empty() {
+        alternatives.push(Alternative {
+            kind: "catalogue".into(),
+            names: cat
+                .chosen
+                .iter()
+                .map(|&i| CATALOGUE[i].id().to_string())
+                .collect(),
+            model: summary(&job, &cat.fitted, noise, &events),
+            delta_bic_vs_answer: cat_bic - answer_bic,
+            note: format!(
+                "significant on its own, but the discovered terms explain the data better by {:.1} in BIC (more than {BIC_MARGIN}): a mimic, not the cause{}",
+                cat_bic - answer_bic,
+                if explained {
+                    " (it even reaches the noise floor: the data alone cannot rule it out)"
+                } else {
+                    ""
+                }
+            ),
+        });
+    }
+    if let Some((f, terms, gain)) = &disc.found {
+        let report = residual_report(&job, &f.lm, noise, floor);
+        let is_answer = answer == Answer::Discovered;
+        if is_answer {
+            discovered = terms.clone();
+        } else {
+            let d_bic = bic(f.lm.cost, k_of(f), m) - answer_bic;
+            alternatives.push(Alternative {
+                kind: "discovered".into(),
+                names: terms
+                    .iter()
+                    .map(|t| format!("{}: {}", t.axis, t.term))
+                    .collect(),
+                model: summary(&job, f, noise, &events),
+                delta_bic_vs_answer: d_bic,
+                note: format!(
+                    "significant against the baseline, but it does not beat the catalogue's answer by more than {BIC_MARGIN} in BIC (difference {d_bic:+.1}): the catalogue effect stays the cause"
+                ),
+            });
+        }
+        extension = Some(ExtensionReport {
+            answer: is_answer,
+            file: is_answer.then(|| "extension.toml".to_string()),
+            model: summary(&job, f, noise, &events),
+            gain: gain.clone(),
+            white: report.white,
+            at_noise_floor: report.at_noise_floor,
+            explained: report.white && report.at_noise_floor,
+            refinement: format!("{} after {} iterations", f.lm.stop, f.lm.iterations),
+        });
+    }
+    let final_report = residual_report(&job, &answer_fit.lm, noise, floor);
+    let base_report = residual_report(&job, &baseline.lm, noise, floor);
+    let base_summary = summary(&job, &baseline, noise, &events);
+    let ext_summary = summary(&job, answer_fit, noise, &events);
+    let verdict = report::verdict(&report::VerdictInput {
+        causes: &causes,
         explained,
-        &parameters,
-        &base_summary,
-        &ext_summary,
+        parameters: &parameters,
+        discovered: &discovered,
+        extension: extension.as_ref().filter(|e| e.answer),
+        alternatives: &alternatives,
+        base: &base_summary,
+        ext: &ext_summary,
         noise,
-    );
+    });
+
+    // 5. Prediction of the validation events.
+    let validation = match &options.validation {
+        Some(v) => validate(v, &baseline.candidate(&job)?, &answer_fit.candidate(&job)?),
+        None => Vec::new(),
+    };
+
     let mut residuals = BTreeMap::new();
     residuals.insert("baseline".to_string(), base_report);
     residuals.insert("extended".to_string(), final_report);
@@ -519,25 +550,49 @@ pub fn diagnose(
         causes,
         explained,
         verdict,
+        discovered,
+        alternatives,
+        extension,
+        discovery_notes: disc.notes.clone(),
+        discovery_steps: disc.steps.clone(),
         sigma_pos_m: noise.pos_m,
         sigma_att_deg: noise.att_deg,
         sigma_source: options.fit.sigma.source.clone(),
         baseline: base_summary,
         extended: ext_summary,
         parameters,
-        candidates,
+        candidates: cat.candidates,
         residuals,
+        reconstruction: disc.reconstruction.clone(),
+        validation,
         evaluations,
         wall_s: t0.elapsed().as_secs_f64(),
     };
-    let figures = residual_figures(
+    let mut figures = residual_figures(
         &options.out,
         &job,
         &baseline.lm,
-        &current.lm,
+        &answer_fit.lm,
         noise,
         &events,
     )?;
+    let model_curves = match &disc.found {
+        Some((f, _, _)) => discover::model_increments(&job, f)?,
+        None => Vec::new(),
+    };
+    if !diagnosis.reconstruction.is_empty() {
+        let name = "figures/increments.png";
+        report::increment_figure(
+            &options.out.join(name),
+            &diagnosis.reconstruction,
+            &model_curves,
+        )?;
+        figures.insert(0, name.to_string());
+    }
+    if let (Answer::Discovered, Some((f, terms, gain))) = (answer, &disc.found) {
+        let text = extension_file(&job, f, terms, gain)?;
+        write_atomically(&options.out.join("extension.toml"), text.as_bytes())?;
+    }
     let json = serde_json::to_vec_pretty(&diagnosis).expect("a diagnosis serialises");
     write_atomically(&options.out.join("diagnosis.json"), &json)?;
     write_atomically(
@@ -545,4 +600,74 @@ pub fn diagnose(
         report::report_html(&diagnosis, &figures).as_bytes(),
     )?;
     Ok(diagnosis)
+}
+
+/// DIR/extension.toml: the discovered terms at their refitted values, with a header that says
+/// where they came from.
+fn extension_file(job: &Job, f: &Fitted, found: &[DiscoveredTerm], gain: &Gain) -> Result<String> {
+    let terms = f.space(job).terms_at(&f.lm.x)?;
+    let records: Vec<TermRecord> = terms
+        .iter()
+        .map(|t| {
+            let mut r = TermRecord::of(t);
+            r.reading = Some(readings::reading(t));
+            r
+        })
+        .collect();
+    let mut text = format!(
+        "# Found by `sepval diagnose` beyond the effect catalogue, from: {}\n",
+        job.events()
+            .iter()
+            .map(|e| e.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    for d in found {
+        text.push_str(&format!(
+            "# {} {} ({}): {}\n",
+            d.axis, d.term, d.family, d.reading
+        ));
+    }
+    text.push_str(&format!(
+        "# Gain over the baseline: chi-square drop {:.1}, F = {:.1}, p = {:.2e}, BIC change {:+.1}\n",
+        gain.chi2_drop, gain.f, gain.p_value, gain.delta_bic
+    ));
+    text.push_str(&extension_toml(&records));
+    // What is written must read back.
+    sepval_common::extension::parse_extension(&text, "extension.toml").map_err(|e| {
+        DiagnoseError::Model(format!("the extension written does not read back: {e}"))
+    })?;
+    Ok(text)
+}
+
+/// Goals of the baseline and the answer on each validation event.
+fn validate(v: &Job, base: &Candidate, answer: &Candidate) -> Vec<ValidationReport> {
+    v.events()
+        .iter()
+        .map(|e| {
+            let one = Job::new(vec![e.clone()]);
+            let goals = |c: &Candidate| -> std::result::Result<(f64, f64), String> {
+                let job = one.as_ref().map_err(|e| e.to_string())?;
+                let ev = job.evaluate(c);
+                ev.outcome
+                    .goals()
+                    .map(|g| (g.j_pos_m, g.j_att_deg))
+                    .ok_or_else(|| format!("{:?}", ev.outcome))
+            };
+            let (b, a) = (goals(base), goals(answer));
+            let note = [("baseline", &b), ("extended model", &a)]
+                .iter()
+                .filter_map(|(n, r)| r.as_ref().err().map(|e| format!("{n}: {e}")))
+                .collect::<Vec<_>>()
+                .join("; ");
+            ValidationReport {
+                event: e.name.clone(),
+                baseline_j_pos_m: b.as_ref().ok().map(|g| g.0),
+                baseline_j_att_deg: b.as_ref().ok().map(|g| g.1),
+                extended_j_pos_m: a.as_ref().ok().map(|g| g.0),
+                extended_j_att_deg: a.as_ref().ok().map(|g| g.1),
+                note,
+            }
+        })
+        .collect()
 }

@@ -1,5 +1,6 @@
 //! The plotting kit every figure is drawn with: the embedded font, rendering into a PNG file,
-//! axis ranges, tick labels, the palette, legends, lines and legend marks.
+//! axis ranges, tick labels, the palette, legends (in a chart or in a strip of their own), lines
+//! and legend marks.
 
 use std::error::Error;
 use std::panic::AssertUnwindSafe;
@@ -11,6 +12,7 @@ use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, register_font};
 use sepval_common::atomic_file::write_atomically;
 
@@ -233,8 +235,24 @@ pub(super) fn text(size: f64) -> TextStyle<'static> {
     TextStyle::from((FONT, size).into_font()).color(&BLACK)
 }
 
+/// `c` mixed with white, `white` of it white (0: `c` itself, 1: white): the light tint of a
+/// series colour that bands are filled with.
+pub(super) fn tint(c: RGBColor, white: f64) -> RGBColor {
+    let w = if white.is_finite() {
+        white.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let mix = |v: u8| {
+        (f64::from(v) * (1.0 - w) + 255.0 * w)
+            .round()
+            .clamp(0.0, 255.0) as u8
+    };
+    RGBColor(mix(c.0), mix(c.1), mix(c.2))
+}
+
 /// Splits a polyline where a point cannot be drawn.
-fn segments(points: impl IntoIterator<Item = (f64, f64)>) -> Vec<Vec<(f64, f64)>> {
+pub(super) fn segments(points: impl IntoIterator<Item = (f64, f64)>) -> Vec<Vec<(f64, f64)>> {
     let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
     let mut current = Vec::new();
     for p in points {
@@ -339,6 +357,53 @@ where
         .background_style(WHITE.mix(0.88))
         .border_style(RGBColor(150, 150, 150))
         .draw()?;
+    Ok(())
+}
+
+/// A legend mark in a legend strip.
+pub(super) enum LegendMark {
+    /// A line in the colour.
+    Line(RGBColor),
+    /// A filled box in the colour (a band).
+    Band(RGBColor),
+    /// A dashed line in the colour.
+    Dashed(RGBColor),
+}
+
+/// Draws a one-row legend centred in `area`.
+pub(super) fn draw_legend_strip(area: &Root<'_>, entries: &[(String, LegendMark)]) -> DrawResult {
+    let style = text(17.0);
+    let (w, h) = area.dim_in_pixel();
+    let widths: Vec<i32> = entries
+        .iter()
+        .map(|(label, _)| area.estimate_text_size(label, &style).map(|s| s.0 as i32))
+        .collect::<Result<_, _>>()?;
+    let gap = 30;
+    let mark = 30;
+    let total: i32 =
+        widths.iter().map(|w| w + mark + 8).sum::<i32>() + gap * (entries.len() as i32 - 1).max(0);
+    let mut x = ((w as i32 - total) / 2).max(4);
+    let y = h as i32 / 2;
+    for ((label, m), width) in entries.iter().zip(widths) {
+        match m {
+            LegendMark::Line(c) => area.draw(&PathElement::new(
+                vec![(x, y), (x + mark, y)],
+                c.stroke_width(3),
+            ))?,
+            LegendMark::Band(c) => {
+                area.draw(&Rectangle::new([(x, y - 8), (x + mark, y + 8)], c.filled()))?
+            }
+            LegendMark::Dashed(c) => area.draw(&DashedPathElement::new(
+                vec![(x, y), (x + mark, y)],
+                7,
+                4,
+                c.stroke_width(2),
+            ))?,
+        }
+        let style = style.pos(Pos::new(HPos::Left, VPos::Center));
+        area.draw(&Text::new(label.as_str(), (x + mark + 8, y), style))?;
+        x += mark + 8 + width + gap;
+    }
     Ok(())
 }
 

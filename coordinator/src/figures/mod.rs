@@ -13,6 +13,8 @@
 //!   the measurement noise floor below which no fit can honestly go.
 //! - [`convergence_figure`]: the best weighted goal against the number of simulations run.
 //! - [`residual_figure`]: simulated minus measured for the six channels, with the noise bands.
+//! - [`increment_figure`]: what force and moment a fitted model lacks, as reconstructed
+//!   coefficient increments per axis with ±2σ bands, beside what the found model terms give.
 //! - [`correlation_figure`]: a heat map of a correlation matrix (for example of the fitted
 //!   factors over the final population).
 //! - [`throughput_figure`]: simulations per second against worker count, per transport.
@@ -26,17 +28,19 @@
 //! - Odd data never panics: values that are not finite (or beyond ±1e100, which no axis can
 //!   show) are skipped, a line is broken where they were; empty series draw empty axes;
 //!   degenerate axis ranges (one value, or none) are widened. Inputs whose lengths must agree
-//!   (factor names and ranges, residual sets and times, a square correlation matrix) are
-//!   checked and refused with [`FigureError::Input`]. Within a [`Trajectory`] the samples are
-//!   paired up to the shortest of its vectors.
-//! - Colours follow label order: the i-th fit, method, residual set or transport always gets
-//!   the i-th colour of one ten-colour palette (Tableau 10); measured data and the truth are
-//!   black, noise floors grey.
+//!   (factor names and ranges, residual sets and times, an increment's times, values and
+//!   standard deviations, a square correlation matrix) are checked and refused with
+//!   [`FigureError::Input`]. Within a [`Trajectory`] the samples are paired up to the shortest
+//!   of its vectors.
+//! - Colours follow label order: the i-th fit, method, residual set, event or transport always
+//!   gets the i-th colour of one ten-colour palette (Tableau 10); measured data, the truth and
+//!   found model terms are black, noise floors grey.
 //!
 //! Layout: the plotting kit every figure is drawn with (font, rendering and PNG encoding,
 //! ranges, ticks, palette, legends, lines and marks) is the private submodule `kit`; each
 //! figure family has a submodule of its own (`trajectory`, `factors`, `pareto`,
-//! `convergence`, `residuals`, `correlation`, `throughput`) whose function is re-exported here.
+//! `convergence`, `residuals`, `increments`, `correlation`, `throughput`) whose function is
+//! re-exported here.
 
 use std::path::{Path, PathBuf};
 
@@ -45,6 +49,7 @@ use sepval_common::telemetry::Trajectory;
 mod convergence;
 mod correlation;
 mod factors;
+mod increments;
 mod kit;
 mod pareto;
 mod residuals;
@@ -56,6 +61,7 @@ mod trajectory;
 pub use convergence::convergence_figure;
 pub use correlation::correlation_figure;
 pub use factors::factor_figure;
+pub use increments::{IncrementPanel, IncrementSeries, increment_figure};
 pub use pareto::pareto_figure;
 pub use residuals::residual_figure;
 pub use throughput::throughput_figure;

@@ -3,12 +3,11 @@
 use std::path::Path;
 
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::FigureError;
 use super::kit::{
-    DrawResult, FLOOR_GREY, Root, colour, draw_mesh, draw_polyline, fmt_tick, padded_range,
-    plottable, render, text,
+    FLOOR_GREY, LegendMark, colour, draw_legend_strip, draw_mesh, draw_polyline, fmt_tick,
+    padded_range, plottable, render, text,
 };
 
 /// The six residual channels: caption, unit, whether the channel is a position.
@@ -20,43 +19,6 @@ const RESIDUAL_CHANNELS: [(&str, &str, bool); 6] = [
     ("Pitch θ", "deg", false),
     ("Yaw ψ", "deg", false),
 ];
-
-/// A legend mark in a legend strip.
-enum Mark {
-    Line(RGBColor),
-    Band(RGBColor),
-}
-
-/// Draws a one-row legend centred in `area`.
-fn draw_legend_strip(area: &Root<'_>, entries: &[(String, Mark)]) -> DrawResult {
-    let style = text(17.0);
-    let (w, h) = area.dim_in_pixel();
-    let widths: Vec<i32> = entries
-        .iter()
-        .map(|(label, _)| area.estimate_text_size(label, &style).map(|s| s.0 as i32))
-        .collect::<Result<_, _>>()?;
-    let gap = 30;
-    let mark = 30;
-    let total: i32 =
-        widths.iter().map(|w| w + mark + 8).sum::<i32>() + gap * (entries.len() as i32 - 1).max(0);
-    let mut x = ((w as i32 - total) / 2).max(4);
-    let y = h as i32 / 2;
-    for ((label, m), width) in entries.iter().zip(widths) {
-        match m {
-            Mark::Line(c) => area.draw(&PathElement::new(
-                vec![(x, y), (x + mark, y)],
-                c.stroke_width(3),
-            ))?,
-            Mark::Band(c) => {
-                area.draw(&Rectangle::new([(x, y - 8), (x + mark, y + 8)], c.filled()))?
-            }
-        }
-        let style = style.pos(Pos::new(HPos::Left, VPos::Center));
-        area.draw(&Text::new(label.as_str(), (x + mark + 8, y), style))?;
-        x += mark + 8 + width + gap;
-    }
-    Ok(())
-}
 
 /// The fill of the ±σ bands.
 const BAND: RGBColor = RGBColor(222, 222, 222);
@@ -93,10 +55,10 @@ pub fn residual_figure(
         let (_, body) = root.split_vertically(8);
         let body = body.titled(title, text(28.0))?;
         let (legend, grid) = body.split_vertically(44);
-        let mut entries: Vec<(String, Mark)> = sets
+        let mut entries: Vec<(String, LegendMark)> = sets
             .iter()
             .enumerate()
-            .map(|(i, (label, _))| ((*label).to_string(), Mark::Line(colour(i))))
+            .map(|(i, (label, _))| ((*label).to_string(), LegendMark::Line(colour(i))))
             .collect();
         if band(true).is_some() || band(false).is_some() {
             let fmt_sigma = |s: Option<f64>, unit| match s {
@@ -109,7 +71,7 @@ pub fn residual_figure(
                     fmt_sigma(band(true), "m"),
                     fmt_sigma(band(false), "deg")
                 ),
-                Mark::Band(BAND),
+                LegendMark::Band(BAND),
             ));
         }
         draw_legend_strip(&legend, &entries)?;

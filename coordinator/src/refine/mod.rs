@@ -21,7 +21,7 @@ use sepval_common::propagator::Observation;
 use crate::run::{Ask, Evaluate, Progress, RunError, Solver, run};
 
 mod space;
-pub use space::{Noise, ParamSpace, goals_of, residual_vector};
+pub use space::{FreeTerm, Noise, ParamSpace, goals_of, residual_vector};
 
 type Result<T> = std::result::Result<T, RunError>;
 

@@ -3,13 +3,27 @@
 
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Candidate, Job};
+use sepval_common::extension::{Term, TermSet};
 use sepval_common::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
 use sepval_common::goals::{Goals, residual};
 use sepval_common::propagator::Observation;
 
 use super::{Result, search_error};
 
-/// The continuous parameters of a fit: the 17 factors, then the effects' parameters.
+/// An extension term whose coefficient (and, for the families that have one, locator) a fit
+/// estimates, within bounds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FreeTerm {
+    /// The term (its coefficient and locator are the parameters' start values).
+    pub term: Term,
+    /// Bounds of the coefficient.
+    pub coefficient: (f64, f64),
+    /// Bounds of the locator, when it is estimated too.
+    pub locator: Option<(f64, f64)>,
+}
+
+/// The continuous parameters of a fit: the 17 factors, then the effects' parameters, then the
+/// extension terms' coefficients (and free locators).
 #[derive(Debug, Clone)]
 pub struct ParamSpace {
     /// Names (factor names; `effect.param` for effect parameters).
@@ -24,6 +38,8 @@ pub struct ParamSpace {
     pub grid_step: Vec<Option<f64>>,
     /// The model variant (its values are replaced by the parameter vector).
     pub effects: EffectSet,
+    /// The extension terms estimated (their values are replaced by the parameter vector).
+    pub terms: Vec<FreeTerm>,
 }
 
 impl ParamSpace {
@@ -36,6 +52,7 @@ impl ParamSpace {
             hi: table.0.iter().map(|f| f.max).collect(),
             grid_step: table.0.iter().map(|f| Some(f.step())).collect(),
             effects: *effects,
+            terms: Vec::new(),
         };
         for a in effects.iter() {
             for p in a.effect().params() {
@@ -47,6 +64,53 @@ impl ParamSpace {
             }
         }
         s
+    }
+
+    /// The space of the factor table, `effects` and the extension `terms`.
+    pub fn with_terms(table: &FactorTable, effects: &EffectSet, terms: &[FreeTerm]) -> Self {
+        let mut s = ParamSpace::new(table, effects);
+        for t in terms {
+            let name = format!(
+                "{}.{}",
+                t.term.axis.name(),
+                t.term.formula().replace(' ', "")
+            );
+            s.names.push(name.clone());
+            s.units.push("-".into());
+            s.lo.push(t.coefficient.0);
+            s.hi.push(t.coefficient.1);
+            s.grid_step.push(None);
+            if let (Some((lo, hi)), Some(loc)) = (t.locator, t.term.regressor.family().locator()) {
+                s.names.push(format!("{name}.{loc}"));
+                s.units.push(
+                    match loc {
+                        "lambda_m" => "m",
+                        "t_on_s" => "s",
+                        "f_hz" => "Hz",
+                        _ => "-",
+                    }
+                    .into(),
+                );
+                s.lo.push(lo);
+                s.hi.push(hi);
+                s.grid_step.push(None);
+            }
+        }
+        s.terms = terms.to_vec();
+        s
+    }
+
+    /// The start vector: `factors`, the effects' current values, the terms' coefficients and
+    /// free locators.
+    pub fn start(&self, factors: &Factors) -> Vec<f64> {
+        let mut x = self.vector(factors, &self.effects);
+        for t in &self.terms {
+            x.push(t.term.coefficient);
+            if t.locator.is_some() {
+                x.push(t.term.locator[0]);
+            }
+        }
+        x
     }
 
     /// Number of parameters.
@@ -83,13 +147,35 @@ impl ParamSpace {
     pub fn candidate(&self, x: &[f64]) -> Result<Candidate> {
         let mut f = [0.0; FACTOR_COUNT];
         f.copy_from_slice(&x[..FACTOR_COUNT]);
+        let n_effects = self.effects.param_count();
+        let effects = self
+            .effects
+            .with_values(&x[FACTOR_COUNT..FACTOR_COUNT + n_effects])
+            .map_err(search_error)?;
+        let mut terms = TermSet::NONE;
+        let mut i = FACTOR_COUNT + n_effects;
+        for t in &self.terms {
+            let mut term = t.term;
+            term.coefficient = x[i];
+            i += 1;
+            if t.locator.is_some() {
+                // Held within its bounds (which lie inside its domain): a probe of the
+                // refinement may stray beyond them, and a decay length must stay positive.
+                term.locator[0] = x[i].clamp(self.lo[i], self.hi[i]);
+                i += 1;
+            }
+            terms.push(term).map_err(search_error)?;
+        }
         Ok(Candidate {
             factors: Factors(f),
-            effects: self
-                .effects
-                .with_values(&x[FACTOR_COUNT..])
-                .map_err(search_error)?,
+            effects,
+            terms,
         })
+    }
+
+    /// The terms at parameter vector `x`.
+    pub fn terms_at(&self, x: &[f64]) -> Result<Vec<Term>> {
+        Ok(self.candidate(x)?.terms.iter().copied().collect())
     }
 }
 

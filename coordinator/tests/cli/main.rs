@@ -1,12 +1,15 @@
 //! The `sepval` command line end to end, in one test binary: the commands as a user runs them,
-//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, and `diagnose`. The
-//! binary is run through the shared support of the end-to-end tests (`sepval-tests`). Keep this
-//! the package's only integration test: it is also what makes `cargo test --workspace` build
+//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, `diagnose`, and
+//! property-based hardening of the checkpoint reader on arbitrary and mutated files. The binary
+//! is run through the shared support of the end-to-end tests (`sepval-tests`). Keep this the
+//! package's only integration test: it is also what makes `cargo test --workspace` build
 //! `sepval`.
 
 mod checkpoint;
 mod cli;
 mod diagnose;
+mod discover;
 mod fit;
+mod fuzz;
 mod hardening;
 mod refine;

@@ -32,18 +32,9 @@ fn candidates() -> Vec<Candidate> {
         Candidate::baseline(Factors::NOMINAL),
         Candidate::baseline(out_of_bounds),
         Candidate::baseline(not_finite),
-        Candidate {
-            factors: Factors::TRUTH,
-            effects: with("inertia_product_xz=1000"),
-        },
-        Candidate {
-            factors: Factors::TRUTH,
-            effects: with("release_rates=60,60,60"),
-        },
-        Candidate {
-            factors: Factors::NOMINAL,
-            effects: with("telemetry_time_offset=0.01"),
-        },
+        Candidate::with_effects(Factors::TRUTH, with("inertia_product_xz=1000")),
+        Candidate::with_effects(Factors::TRUTH, with("release_rates=60,60,60")),
+        Candidate::with_effects(Factors::NOMINAL, with("telemetry_time_offset=0.01")),
     ];
     // Enough for several chunks per worker.
     for k in 0..40 {

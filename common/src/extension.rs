@@ -1,0 +1,951 @@
+//! Model extensions: terms added to the baseline model beyond the effect catalogue, each a
+//! coefficient times a regressor evaluated at every force evaluation (`docs/model.md` section
+//! 11). A diagnosis discovers them (`sepval diagnose` writes `DIR/extension.toml`), and
+//! `simulate`, `fit` and `diagnose` accept them back with `--extension FILE`, so an extended
+//! model is usable, not only reported.
+//!
+//! A term acts on one axis: an aerodynamic coefficient increment (`CA` positive aft, so
+//! `CX -= dCA`; `CY`, `CZ`, `Cl`, `Cm`, `Cn` added as they are), or the ejector force (`ejector`:
+//! a fraction of each foot's force, `F_i (1 + dE)`, while the foot pushes). Its regressor comes
+//! from a documented library of families (the names are the ones the diagnosis reports):
+//!
+//! | family | regressors | locator |
+//! |---|---|---|
+//! | `flow_angle` | `alpha`, `beta`, `alpha2`, `beta2`, `alpha3`, `beta3`, `alpha_beta` (local flow angles \[rad\]) | - |
+//! | `rate` | `p`, `q`, `r` (p d/2V, q d/2V, r d/2V) | - |
+//! | `interference` | `f` = f_lambda(s), the decay shape of section 1 with decay length lambda | `lambda_m` |
+//! | `interference_flow_angle` | `f_alpha`, `f_beta`, `f_p`, `f_q`, `f_r`: f_lambda(s) times alpha, beta or a rate | `lambda_m` |
+//! | `mach` | `dm`, `dm2`: (M - M0) and its square, M = V / a the store's own Mach number | `mach0` |
+//! | `step` | `step`: (1 + tanh((t - t_on) / w)) / 2, w = 5 ms | `t_on_s` |
+//! | `oscillation` | `sin`, `cos`: sin(2 pi f t), cos(2 pi f t) | `f_hz` |
+//! | `ejector_stroke` | `stroke`, `stroke2`: sigma - 1/2 and (sigma - 1/2)^2 - 1/12, sigma = clamp(s_i, 0, stroke) / stroke (ejector axis only) | - |
+//!
+//! A diagnosis also uses time windows (`window`: 1 for t0 <= t < t1) to reconstruct the missing
+//! force and moment as time histories; they are not a family of the library and cannot be
+//! written to an extension file.
+//!
+//! Terms are `Copy` and fixed in number ([`MAX_TERMS`] per run), like effects, so a candidate
+//! with terms travels to the workers without allocation.
+
+use serde::{Deserialize, Serialize};
+
+/// Most terms one run carries (an extension's and a candidate's together).
+pub const MAX_TERMS: usize = 8;
+/// Width of the smooth step \[s\].
+pub const STEP_WIDTH_S: f64 = 0.005;
+
+/// The quantity a term changes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Axis {
+    /// Axial force coefficient (positive aft).
+    CA,
+    /// Side force coefficient.
+    CY,
+    /// Normal-axis force coefficient (body z).
+    CZ,
+    /// Rolling moment coefficient.
+    Cl,
+    /// Pitching moment coefficient.
+    Cm,
+    /// Yawing moment coefficient.
+    Cn,
+    /// The ejector force, as a fraction of each foot's force.
+    #[serde(rename = "ejector")]
+    Ejector,
+}
+
+impl Axis {
+    /// Every axis, in this order.
+    pub const ALL: [Axis; 7] = [
+        Axis::CA,
+        Axis::CY,
+        Axis::CZ,
+        Axis::Cl,
+        Axis::Cm,
+        Axis::Cn,
+        Axis::Ejector,
+    ];
+
+    /// Its name in files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Axis::CA => "CA",
+            Axis::CY => "CY",
+            Axis::CZ => "CZ",
+            Axis::Cl => "Cl",
+            Axis::Cm => "Cm",
+            Axis::Cn => "Cn",
+            Axis::Ejector => "ejector",
+        }
+    }
+
+    /// The axis of a name.
+    pub fn from_name(name: &str) -> Option<Axis> {
+        Axis::ALL.into_iter().find(|a| a.name() == name)
+    }
+
+    /// Index 0..7.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// A family of regressors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Family {
+    /// Local flow angles and their powers.
+    FlowAngle,
+    /// Non-dimensional body rates.
+    Rate,
+    /// An interference decay shape.
+    Interference,
+    /// An interference decay shape times a flow angle or rate.
+    InterferenceFlowAngle,
+    /// The store's Mach number.
+    Mach,
+    /// A smooth step in time.
+    Step,
+    /// A sine or cosine in time.
+    Oscillation,
+    /// The ejector force's shape along the stroke.
+    EjectorStroke,
+    /// A time window (reconstruction only).
+    Window,
+}
+
+impl Family {
+    /// The families of the library, in report order.
+    pub const LIBRARY: [Family; 8] = [
+        Family::FlowAngle,
+        Family::Rate,
+        Family::Interference,
+        Family::InterferenceFlowAngle,
+        Family::Mach,
+        Family::Step,
+        Family::Oscillation,
+        Family::EjectorStroke,
+    ];
+
+    /// Its name in files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::FlowAngle => "flow_angle",
+            Family::Rate => "rate",
+            Family::Interference => "interference",
+            Family::InterferenceFlowAngle => "interference_flow_angle",
+            Family::Mach => "mach",
+            Family::Step => "step",
+            Family::Oscillation => "oscillation",
+            Family::EjectorStroke => "ejector_stroke",
+            Family::Window => "window",
+        }
+    }
+
+    /// The family of a name (the library's only).
+    pub fn from_name(name: &str) -> Option<Family> {
+        Family::LIBRARY.into_iter().find(|f| f.name() == name)
+    }
+
+    /// The name of its locator in files, if it has one.
+    pub fn locator(self) -> Option<&'static str> {
+        match self {
+            Family::Interference | Family::InterferenceFlowAngle => Some("lambda_m"),
+            Family::Mach => Some("mach0"),
+            Family::Step => Some("t_on_s"),
+            Family::Oscillation => Some("f_hz"),
+            Family::Window => Some("t0_s"),
+            _ => None,
+        }
+    }
+}
+
+/// One regressor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[allow(missing_docs)]
+pub enum Regressor {
+    Alpha,
+    Beta,
+    Alpha2,
+    Beta2,
+    Alpha3,
+    Beta3,
+    AlphaBeta,
+    P,
+    Q,
+    R,
+    F,
+    FAlpha,
+    FBeta,
+    FP,
+    FQ,
+    FR,
+    Dm,
+    Dm2,
+    Step,
+    Sin,
+    Cos,
+    Stroke,
+    Stroke2,
+    Window,
+}
+
+impl Regressor {
+    /// Every regressor, with its family and name.
+    pub const ALL: [(Regressor, Family, &'static str); 24] = [
+        (Regressor::Alpha, Family::FlowAngle, "alpha"),
+        (Regressor::Beta, Family::FlowAngle, "beta"),
+        (Regressor::Alpha2, Family::FlowAngle, "alpha2"),
+        (Regressor::Beta2, Family::FlowAngle, "beta2"),
+        (Regressor::Alpha3, Family::FlowAngle, "alpha3"),
+        (Regressor::Beta3, Family::FlowAngle, "beta3"),
+        (Regressor::AlphaBeta, Family::FlowAngle, "alpha_beta"),
+        (Regressor::P, Family::Rate, "p"),
+        (Regressor::Q, Family::Rate, "q"),
+        (Regressor::R, Family::Rate, "r"),
+        (Regressor::F, Family::Interference, "f"),
+        (Regressor::FAlpha, Family::InterferenceFlowAngle, "f_alpha"),
+        (Regressor::FBeta, Family::InterferenceFlowAngle, "f_beta"),
+        (Regressor::FP, Family::InterferenceFlowAngle, "f_p"),
+        (Regressor::FQ, Family::InterferenceFlowAngle, "f_q"),
+        (Regressor::FR, Family::InterferenceFlowAngle, "f_r"),
+        (Regressor::Dm, Family::Mach, "dm"),
+        (Regressor::Dm2, Family::Mach, "dm2"),
+        (Regressor::Step, Family::Step, "step"),
+        (Regressor::Sin, Family::Oscillation, "sin"),
+        (Regressor::Cos, Family::Oscillation, "cos"),
+        (Regressor::Stroke, Family::EjectorStroke, "stroke"),
+        (Regressor::Stroke2, Family::EjectorStroke, "stroke2"),
+        (Regressor::Window, Family::Window, "window"),
+    ];
+
+    /// Its family.
+    pub fn family(self) -> Family {
+        Regressor::ALL[self as usize].1
+    }
+
+    /// Its name in files and reports.
+    pub fn name(self) -> &'static str {
+        Regressor::ALL[self as usize].2
+    }
+
+    /// The regressor `name` of `family`.
+    pub fn from_names(family: Family, name: &str) -> Option<Regressor> {
+        Regressor::ALL
+            .iter()
+            .find(|(_, f, n)| *f == family && *n == name)
+            .map(|(r, _, _)| *r)
+    }
+
+    /// Whether it may act on `axis` (the stroke shapes act on the ejector only, the ejector
+    /// only through them, time windows and steps).
+    pub fn fits(self, axis: Axis) -> bool {
+        match (self.family(), axis) {
+            (Family::EjectorStroke, a) => a == Axis::Ejector,
+            (Family::Window | Family::Step, _) => true,
+            (_, a) => a != Axis::Ejector,
+        }
+    }
+}
+
+/// What a regressor reads at one force evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TermInput {
+    /// Time \[s\].
+    pub t_s: f64,
+    /// Angle of attack \[rad\].
+    pub alpha_rad: f64,
+    /// Sideslip \[rad\].
+    pub beta_rad: f64,
+    /// p d / 2V, q d / 2V, r d / 2V.
+    pub rates_hat: [f64; 3],
+    /// The store's Mach number V / a.
+    pub mach: f64,
+    /// Distance of the CG from carriage \[m\].
+    pub distance_m: f64,
+    /// The interference cut-off distance \[m\].
+    pub s_end_m: f64,
+}
+
+/// One term: `coefficient * regressor(locator)` on `axis`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Term {
+    /// The axis.
+    pub axis: Axis,
+    /// The regressor.
+    pub regressor: Regressor,
+    /// Its locator (`lambda_m`, `mach0`, `t_on_s`, `f_hz`; a window's `[t0_s, t1_s]`).
+    pub locator: [f64; 2],
+    /// Its coefficient (dimensionless; for the ejector, a fraction of the force).
+    pub coefficient: f64,
+}
+
+/// Terms that cannot be run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TermError {
+    /// More terms than a run holds.
+    #[error("more than {MAX_TERMS} terms")]
+    TooMany,
+    /// A regressor on an axis it cannot act on.
+    #[error("the {family} regressor `{regressor}` cannot act on axis {axis}")]
+    Axis {
+        /// The family.
+        family: &'static str,
+        /// The regressor.
+        regressor: &'static str,
+        /// The axis.
+        axis: &'static str,
+    },
+    /// A value that is not a finite number, or outside its domain.
+    #[error("{what} = {value}: {expected}")]
+    Value {
+        /// Which value.
+        what: &'static str,
+        /// The value.
+        value: f64,
+        /// What is expected.
+        expected: &'static str,
+    },
+}
+
+impl Term {
+    /// Checks the term: its axis fits its regressor, its numbers are finite and its locator in
+    /// its domain.
+    pub fn check(&self) -> Result<(), TermError> {
+        let value = |what, value: f64, ok: bool, expected| {
+            if ok && value.is_finite() {
+                Ok(())
+            } else {
+                Err(TermError::Value {
+                    what,
+                    value,
+                    expected,
+                })
+            }
+        };
+        if !self.regressor.fits(self.axis) {
+            return Err(TermError::Axis {
+                family: self.regressor.family().name(),
+                regressor: self.regressor.name(),
+                axis: self.axis.name(),
+            });
+        }
+        value(
+            "coefficient",
+            self.coefficient,
+            true,
+            "expected a finite number",
+        )?;
+        let [a, b] = self.locator;
+        match self.regressor.family() {
+            Family::Interference | Family::InterferenceFlowAngle => {
+                value("lambda_m", a, a > 0.0, "expected a decay length > 0")
+            }
+            Family::Mach => value("mach0", a, a > 0.0, "expected a Mach number > 0"),
+            Family::Step => value("t_on_s", a, true, "expected a finite time"),
+            Family::Oscillation => value("f_hz", a, a >= 0.0, "expected a frequency >= 0"),
+            Family::Window => {
+                value("t0_s", a, true, "expected a finite time")?;
+                value("t1_s", b, b > a, "expected a time after t0_s")
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The regressor's value (aerodynamic axes).
+    #[inline]
+    pub fn regressor_value(&self, x: &TermInput) -> f64 {
+        let [a, b] = self.locator;
+        let f = || decay(x.distance_m, a, x.s_end_m);
+        match self.regressor {
+            Regressor::Alpha => x.alpha_rad,
+            Regressor::Beta => x.beta_rad,
+            Regressor::Alpha2 => x.alpha_rad * x.alpha_rad,
+            Regressor::Beta2 => x.beta_rad * x.beta_rad,
+            Regressor::Alpha3 => x.alpha_rad * x.alpha_rad * x.alpha_rad,
+            Regressor::Beta3 => x.beta_rad * x.beta_rad * x.beta_rad,
+            Regressor::AlphaBeta => x.alpha_rad * x.beta_rad,
+            Regressor::P => x.rates_hat[0],
+            Regressor::Q => x.rates_hat[1],
+            Regressor::R => x.rates_hat[2],
+            Regressor::F => f(),
+            Regressor::FAlpha => f() * x.alpha_rad,
+            Regressor::FBeta => f() * x.beta_rad,
+            Regressor::FP => f() * x.rates_hat[0],
+            Regressor::FQ => f() * x.rates_hat[1],
+            Regressor::FR => f() * x.rates_hat[2],
+            Regressor::Dm => x.mach - a,
+            Regressor::Dm2 => (x.mach - a) * (x.mach - a),
+            Regressor::Step => step(x.t_s, a),
+            Regressor::Sin => (std::f64::consts::TAU * a * x.t_s).sin(),
+            Regressor::Cos => (std::f64::consts::TAU * a * x.t_s).cos(),
+            Regressor::Window => f64::from(u8::from(x.t_s >= a && x.t_s < b)),
+            Regressor::Stroke | Regressor::Stroke2 => 0.0,
+        }
+    }
+
+    /// The regressor's value on the ejector axis, for a foot at stroke fraction `sigma`.
+    #[inline]
+    pub fn ejector_value(&self, t_s: f64, sigma: f64) -> f64 {
+        let [a, b] = self.locator;
+        match self.regressor {
+            Regressor::Stroke => sigma - 0.5,
+            Regressor::Stroke2 => (sigma - 0.5) * (sigma - 0.5) - 1.0 / 12.0,
+            Regressor::Step => step(t_s, a),
+            Regressor::Window => f64::from(u8::from(t_s >= a && t_s < b)),
+            _ => 0.0,
+        }
+    }
+
+    /// A readable formula, e.g. `beta*exp(-s/0.6)` or `sin(2 pi 5 t)`.
+    pub fn formula(&self) -> String {
+        let [a, b] = self.locator.map(short);
+        let f = |x: &str| format!("{x}*f(s; lambda={a} m)");
+        match self.regressor {
+            Regressor::Alpha => "alpha".into(),
+            Regressor::Beta => "beta".into(),
+            Regressor::Alpha2 => "alpha^2".into(),
+            Regressor::Beta2 => "beta^2".into(),
+            Regressor::Alpha3 => "alpha^3".into(),
+            Regressor::Beta3 => "beta^3".into(),
+            Regressor::AlphaBeta => "alpha*beta".into(),
+            Regressor::P => "p d/2V".into(),
+            Regressor::Q => "q d/2V".into(),
+            Regressor::R => "r d/2V".into(),
+            Regressor::F => format!("f(s; lambda={a} m)"),
+            Regressor::FAlpha => f("alpha"),
+            Regressor::FBeta => f("beta"),
+            Regressor::FP => f("p d/2V"),
+            Regressor::FQ => f("q d/2V"),
+            Regressor::FR => f("r d/2V"),
+            Regressor::Dm => format!("(M - {a})"),
+            Regressor::Dm2 => format!("(M - {a})^2"),
+            Regressor::Step => format!("step(t - {a} s)"),
+            Regressor::Sin => format!("sin(2 pi {a} Hz t)"),
+            Regressor::Cos => format!("cos(2 pi {a} Hz t)"),
+            Regressor::Stroke => "(sigma - 1/2)".into(),
+            Regressor::Stroke2 => "((sigma - 1/2)^2 - 1/12)".into(),
+            Regressor::Window => format!("[{a} s <= t < {b} s]"),
+        }
+    }
+}
+
+/// A locator for formulas: at most four decimals, no trailing zeros.
+fn short(v: f64) -> String {
+    let s = format!("{v:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
+}
+
+/// f_lambda(s) of docs/model.md section 1 for decay length `lambda_m`.
+#[inline]
+fn decay(s_m: f64, lambda_m: f64, s_end_m: f64) -> f64 {
+    if s_m >= s_end_m {
+        return 0.0;
+    }
+    let e_end = crate::elementary::exp(-s_end_m / lambda_m);
+    (crate::elementary::exp(-s_m / lambda_m) - e_end) / (1.0 - e_end)
+}
+
+/// The smooth step (1 + tanh((t - t_on) / w)) / 2 = 1 / (1 + exp(-2 (t - t_on) / w)).
+#[inline]
+fn step(t_s: f64, t_on_s: f64) -> f64 {
+    1.0 / (1.0 + crate::elementary::exp(-2.0 * (t_s - t_on_s) / STEP_WIDTH_S))
+}
+
+/// The terms of one run (fixed capacity, `Copy`: no allocation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TermSet {
+    len: usize,
+    items: [Option<Term>; MAX_TERMS],
+}
+
+impl Default for TermSet {
+    fn default() -> Self {
+        TermSet::NONE
+    }
+}
+
+impl TermSet {
+    /// No terms.
+    pub const NONE: TermSet = TermSet {
+        len: 0,
+        items: [None; MAX_TERMS],
+    };
+
+    /// Adds a (checked) term.
+    pub fn push(&mut self, term: Term) -> Result<(), TermError> {
+        term.check()?;
+        if self.len == MAX_TERMS {
+            return Err(TermError::TooMany);
+        }
+        self.items[self.len] = Some(term);
+        self.len += 1;
+        Ok(())
+    }
+
+    /// The terms of `terms` (checked).
+    pub fn of(terms: &[Term]) -> Result<TermSet, TermError> {
+        let mut s = TermSet::NONE;
+        for t in terms {
+            s.push(*t)?;
+        }
+        Ok(s)
+    }
+
+    /// Number of terms.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The terms.
+    pub fn iter(&self) -> impl Iterator<Item = &Term> {
+        self.items[..self.len].iter().flatten()
+    }
+
+    /// These terms followed by `other`'s.
+    pub fn merged(&self, other: &TermSet) -> Result<TermSet, TermError> {
+        let mut s = *self;
+        for t in other.iter() {
+            s.push(*t)?;
+        }
+        Ok(s)
+    }
+
+    /// Whether any term acts on the ejector.
+    pub fn has_ejector(&self) -> bool {
+        self.iter().any(|t| t.axis == Axis::Ejector)
+    }
+
+    /// Whether any term acts on an aerodynamic coefficient.
+    pub fn has_aero(&self) -> bool {
+        self.iter().any(|t| t.axis != Axis::Ejector)
+    }
+
+    /// The increments of (CA, CY, CZ, Cl, Cm, Cn) at one force evaluation.
+    #[inline]
+    pub fn aero_increments(&self, x: &TermInput) -> [f64; 6] {
+        let mut d = [0.0; 6];
+        for t in self.iter().filter(|t| t.axis != Axis::Ejector) {
+            d[t.axis.index()] += t.coefficient * t.regressor_value(x);
+        }
+        d
+    }
+
+    /// The ejector force factor 1 + dE of a foot at stroke fraction `sigma` at time `t_s`.
+    #[inline]
+    pub fn ejector_factor(&self, t_s: f64, sigma: f64) -> f64 {
+        let mut d = 0.0;
+        for t in self.iter().filter(|t| t.axis == Axis::Ejector) {
+            d += t.coefficient * t.ejector_value(t_s, sigma);
+        }
+        1.0 + d
+    }
+}
+
+/// A term as files write it: `axis`, `family`, `regressor`, the family's locator by name, and
+/// `coefficient` (with `std_error` and `reading` kept as the diagnosis wrote them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TermRecord {
+    /// `CA`, `CY`, `CZ`, `Cl`, `Cm`, `Cn` or `ejector`.
+    pub axis: String,
+    /// A family of the library.
+    pub family: String,
+    /// The family's regressor.
+    pub regressor: String,
+    /// Decay length (`interference`, `interference_flow_angle`) \[m\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lambda_m: Option<f64>,
+    /// Reference Mach number (`mach`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mach0: Option<f64>,
+    /// Step time (`step`) \[s\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t_on_s: Option<f64>,
+    /// Frequency (`oscillation`) \[Hz\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub f_hz: Option<f64>,
+    /// The coefficient.
+    pub coefficient: f64,
+    /// Its standard error, as estimated (informational).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_error: Option<f64>,
+    /// What it means physically (informational).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reading: Option<String>,
+}
+
+impl TermRecord {
+    /// The record of a term.
+    pub fn of(term: &Term) -> TermRecord {
+        let family = term.regressor.family();
+        let loc = term.locator[0];
+        let pick = |name: &str| (family.locator() == Some(name)).then_some(loc);
+        TermRecord {
+            axis: term.axis.name().to_string(),
+            family: family.name().to_string(),
+            regressor: term.regressor.name().to_string(),
+            lambda_m: pick("lambda_m"),
+            mach0: pick("mach0"),
+            t_on_s: pick("t_on_s"),
+            f_hz: pick("f_hz"),
+            coefficient: term.coefficient,
+            std_error: None,
+            reading: None,
+        }
+    }
+
+    /// The term of a record: `Err((field, message))` names what is wrong.
+    pub fn term(&self) -> Result<Term, (&'static str, String)> {
+        let axis = Axis::from_name(&self.axis).ok_or_else(|| {
+            (
+                "axis",
+                format!(
+                    "`{}` is not an axis (expected CA, CY, CZ, Cl, Cm, Cn or ejector)",
+                    self.axis
+                ),
+            )
+        })?;
+        let family = Family::from_name(&self.family).ok_or_else(|| {
+            (
+                "family",
+                format!(
+                    "`{}` is not a family of the library (expected {})",
+                    self.family,
+                    Family::LIBRARY.map(Family::name).join(", ")
+                ),
+            )
+        })?;
+        let regressor = Regressor::from_names(family, &self.regressor).ok_or_else(|| {
+            let names: Vec<&str> = Regressor::ALL
+                .iter()
+                .filter(|(_, f, _)| *f == family)
+                .map(|(_, _, n)| *n)
+                .collect();
+            (
+                "regressor",
+                format!(
+                    "`{}` is not a regressor of {} (expected {})",
+                    self.regressor,
+                    family.name(),
+                    names.join(", ")
+                ),
+            )
+        })?;
+        let given = [
+            ("lambda_m", self.lambda_m),
+            ("mach0", self.mach0),
+            ("t_on_s", self.t_on_s),
+            ("f_hz", self.f_hz),
+        ];
+        let mut locator = 0.0;
+        for (name, value) in given {
+            match (family.locator() == Some(name), value) {
+                (true, Some(v)) => locator = v,
+                (true, None) => {
+                    return Err((name, format!("is missing: {} needs it", family.name())));
+                }
+                (false, Some(_)) => {
+                    return Err((name, format!("is not a locator of {}", family.name())));
+                }
+                (false, None) => {}
+            }
+        }
+        let term = Term {
+            axis,
+            regressor,
+            locator: [locator, 0.0],
+            coefficient: self.coefficient,
+        };
+        term.check().map_err(|e| {
+            let field = match &e {
+                TermError::Axis { .. } => "axis",
+                TermError::Value { what, .. } => what,
+                TermError::TooMany => "term",
+            };
+            (field, e.to_string())
+        })?;
+        Ok(term)
+    }
+}
+
+/// DIR/extension.toml: `format` and the terms.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExtensionFile {
+    format: String,
+    #[serde(default)]
+    term: Vec<toml::Spanned<TermRecord>>,
+}
+
+/// Format tag of extension files.
+pub const EXTENSION_FORMAT: &str = "sepval-extension/1";
+
+/// An extension file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExtensionError {
+    /// The file cannot be read.
+    #[error("cannot read extension {path}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Not TOML, or not the expected fields (the parser names line and column).
+    #[error("extension {path}: {message}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A term that cannot be run.
+    #[error("extension {path}: line {line}, term {index}, `{field}` {message}")]
+    Term {
+        /// The file.
+        path: String,
+        /// The line of the field (of the term's table when the field is missing).
+        line: usize,
+        /// The term's number (1-based).
+        index: usize,
+        /// The field.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The line of `field` within the term spanning `span` of `text` (its `[[term]]` line when the
+/// field is not written, e.g. a missing coefficient).
+fn field_line(text: &str, span: std::ops::Range<usize>, field: &str) -> usize {
+    // The term's lines: from its span to the next table header.
+    let start = span.start.min(text.len());
+    let first = text[..start].matches('\n').count() + 1;
+    text.get(start..)
+        .unwrap_or_default()
+        .lines()
+        .enumerate()
+        .take_while(|(k, l)| *k == 0 || !l.trim_start().starts_with('['))
+        .map(|(_, l)| l)
+        .position(|l| {
+            l.trim_start()
+                .strip_prefix(field)
+                .is_some_and(|rest| rest.trim_start().starts_with('='))
+        })
+        .map_or(first, |k| first + k)
+}
+
+/// Reads extension TOML; `path` names it in errors.
+pub fn parse_extension(text: &str, path: &str) -> Result<Vec<Term>, ExtensionError> {
+    let file: ExtensionFile = toml::from_str(text).map_err(|e| ExtensionError::Parse {
+        path: path.to_string(),
+        message: e.to_string().trim_end().to_string(),
+    })?;
+    if file.format != EXTENSION_FORMAT {
+        return Err(ExtensionError::Parse {
+            path: path.to_string(),
+            message: format!(
+                "format `{}`, this sepval reads `{EXTENSION_FORMAT}`",
+                file.format
+            ),
+        });
+    }
+    if file.term.len() > MAX_TERMS {
+        return Err(ExtensionError::Parse {
+            path: path.to_string(),
+            message: format!("{} terms, at most {MAX_TERMS}", file.term.len()),
+        });
+    }
+    file.term
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            t.get_ref()
+                .term()
+                .map_err(|(field, message)| ExtensionError::Term {
+                    path: path.to_string(),
+                    line: field_line(text, t.span(), field),
+                    index: k + 1,
+                    field,
+                    message,
+                })
+        })
+        .collect()
+}
+
+/// Reads an extension file.
+pub fn load_extension(path: &std::path::Path) -> Result<Vec<Term>, ExtensionError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| ExtensionError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    parse_extension(&text, &name)
+}
+
+/// The extension file of `records` (a comment line first).
+pub fn extension_toml(records: &[TermRecord]) -> String {
+    #[derive(Serialize)]
+    struct Out<'a> {
+        format: &'a str,
+        term: &'a [TermRecord],
+    }
+    format!(
+        "# sepval model extension (docs/model.md section 11): give it to simulate, fit or\n\
+         # diagnose with --extension FILE.\n{}",
+        toml::to_string(&Out {
+            format: EXTENSION_FORMAT,
+            term: records,
+        })
+        .expect("records serialise")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn input() -> TermInput {
+        TermInput {
+            t_s: 0.3,
+            alpha_rad: 0.1,
+            beta_rad: -0.05,
+            rates_hat: [0.01, 0.02, 0.03],
+            mach: 0.9,
+            distance_m: 0.6,
+            s_end_m: 9.144,
+        }
+    }
+
+    #[test]
+    fn regressors_are_what_the_table_says() {
+        let t = |regressor, locator: [f64; 2]| Term {
+            axis: Axis::Cn,
+            regressor,
+            locator,
+            coefficient: 2.0,
+        };
+        let x = input();
+        assert!((t(Regressor::AlphaBeta, [0.0; 2]).regressor_value(&x) + 0.005).abs() < 1e-15);
+        let e1 = (-1.0f64).exp();
+        let e_end = (-9.144f64 / 0.6).exp();
+        let f = (e1 - e_end) / (1.0 - e_end);
+        let got = t(Regressor::FBeta, [0.6, 0.0]).regressor_value(&x);
+        assert!((got - f * -0.05).abs() < 1e-15, "{got}");
+        assert!((t(Regressor::Dm2, [0.95, 0.0]).regressor_value(&x) - 0.0025).abs() < 1e-15);
+        assert!((t(Regressor::Step, [0.3, 0.0]).regressor_value(&x) - 0.5).abs() < 1e-15);
+        assert!(t(Regressor::Step, [0.2, 0.0]).regressor_value(&x) > 1.0 - 1e-15);
+        assert!((t(Regressor::Sin, [5.0, 0.0]).regressor_value(&x)).abs() < 1e-12);
+        assert!((t(Regressor::Window, [0.3, 0.31]).regressor_value(&x) - 1.0).abs() < 1e-15);
+        let mut s = TermSet::NONE;
+        s.push(t(Regressor::Beta, [0.0; 2])).unwrap();
+        s.push(Term {
+            axis: Axis::Ejector,
+            regressor: Regressor::Stroke,
+            locator: [0.0; 2],
+            coefficient: -0.4,
+        })
+        .unwrap();
+        assert!((s.aero_increments(&x)[5] + 0.1).abs() < 1e-15);
+        assert!((s.ejector_factor(0.0, 1.0) - 0.8).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bad_terms_are_refused_by_name() {
+        let bad = Term {
+            axis: Axis::Ejector,
+            regressor: Regressor::Beta,
+            locator: [0.0; 2],
+            coefficient: 1.0,
+        };
+        assert_eq!(
+            bad.check().unwrap_err().to_string(),
+            "the flow_angle regressor `beta` cannot act on axis ejector"
+        );
+        let nan = Term {
+            axis: Axis::Cl,
+            regressor: Regressor::F,
+            locator: [0.0; 2],
+            coefficient: f64::NAN,
+        };
+        assert_eq!(
+            nan.check().unwrap_err().to_string(),
+            "coefficient = NaN: expected a finite number"
+        );
+        let lam = Term {
+            coefficient: 1.0,
+            ..nan
+        };
+        assert_eq!(
+            lam.check().unwrap_err().to_string(),
+            "lambda_m = 0: expected a decay length > 0"
+        );
+    }
+
+    #[test]
+    fn extension_files_round_trip_and_bad_ones_name_line_and_field() {
+        let terms = [
+            Term {
+                axis: Axis::Cn,
+                regressor: Regressor::FBeta,
+                locator: [0.6, 0.0],
+                coefficient: -0.8,
+            },
+            Term {
+                axis: Axis::Ejector,
+                regressor: Regressor::Stroke,
+                locator: [0.0; 2],
+                coefficient: -0.3,
+            },
+        ];
+        let text = extension_toml(&terms.iter().map(TermRecord::of).collect::<Vec<_>>());
+        assert_eq!(parse_extension(&text, "e.toml").unwrap(), terms);
+        let err = |text: &str| parse_extension(text, "e.toml").unwrap_err().to_string();
+        let head = "format = \"sepval-extension/1\"\n\n";
+        assert_eq!(
+            err(&format!(
+                "{head}[[term]]\naxis = \"Cn\"\nfamily = \"wobble\"\nregressor = \"x\"\ncoefficient = 1.0\n"
+            )),
+            "extension e.toml: line 5, term 1, `family` `wobble` is not a family of the library (expected flow_angle, rate, interference, interference_flow_angle, mach, step, oscillation, ejector_stroke)"
+        );
+        assert!(
+            err(&format!(
+                "{head}[[term]]\naxis = \"Cn\"\nfamily = \"rate\"\nregressor = \"r\"\n"
+            ))
+            .contains("missing field `coefficient`")
+        );
+        assert_eq!(
+            err(&format!(
+                "{head}[[term]]\naxis = \"Cn\"\nfamily = \"rate\"\nregressor = \"r\"\ncoefficient = nan\n"
+            )),
+            "extension e.toml: line 7, term 1, `coefficient` coefficient = NaN: expected a finite number"
+        );
+        assert_eq!(
+            err(&format!(
+                "{head}[[term]]\naxis = \"Cz\"\nfamily = \"rate\"\nregressor = \"r\"\ncoefficient = 1\n"
+            )),
+            "extension e.toml: line 4, term 1, `axis` `Cz` is not an axis (expected CA, CY, CZ, Cl, Cm, Cn or ejector)"
+        );
+        assert_eq!(
+            err(&format!(
+                "{head}[[term]]\naxis = \"ejector\"\nfamily = \"rate\"\nregressor = \"r\"\ncoefficient = 1\n"
+            )),
+            "extension e.toml: line 4, term 1, `axis` the rate regressor `r` cannot act on axis ejector"
+        );
+        assert_eq!(
+            err(&format!(
+                "{head}[[term]]\naxis = \"Cn\"\nfamily = \"step\"\nregressor = \"step\"\ncoefficient = 1\n"
+            )),
+            "extension e.toml: line 3, term 1, `t_on_s` is missing: step needs it"
+        );
+    }
+}

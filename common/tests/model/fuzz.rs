@@ -1,0 +1,491 @@
+//! Property-based hardening of the model library's readers of outside input: telemetry CSV
+//! ([`Trajectory::parse`], and [`Trajectory::read`] on files of arbitrary bytes, invalid UTF-8
+//! included), scenario TOML ([`Scenario::from_toml_str`]), factors JSON
+//! ([`Factors::from_json_str`]) and effect specs of the command line
+//! ([`EffectSet::push_spec`]).
+//!
+//! Each is fed arbitrary text and structured mutations of a valid input (the embedded default
+//! flight test, the embedded default scenario, the truth factors): bytes flipped, inserted and
+//! deleted, the format's own syntax inserted, lines duplicated, deleted and swapped, the text cut,
+//! numbers replaced by huge, non-finite, negative or malformed ones (`sepval_tests::fuzz`), and
+//! nesting thousands of levels deep. Every call must return, `Ok` or an error with a message,
+//! without a panic, within [`MAX_CALL`](sepval_tests::fuzz::MAX_CALL), and without any single
+//! allocation beyond a small multiple of its input's size (this test binary counts allocations:
+//! [`CountingAllocator`]). What is read must hold what the reader promises (times strictly
+//! increasing and within the plausible bounds, a valid scenario, factors within their bounds),
+//! and must read back the same after being written.
+//!
+//! The cases are bounded (about a second in all) and drawn from a fixed seed; run more, or
+//! others, with `PROPTEST_CASES=20000 PROPTEST_RNG_SEED=7 cargo test --release -p sepval-common
+//! --test model fuzz`.
+
+use proptest::prelude::*;
+use proptest::sample::select;
+use proptest::test_runner::TestCaseError;
+use sepval_common::effects::{CATALOGUE, EffectSet};
+use sepval_common::factors::{FactorTable, Factors};
+use sepval_common::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
+use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
+use sepval_common::synthetic::default_flight_test;
+use sepval_common::telemetry::{TelemetryError, Trajectory};
+use sepval_tests::fuzz::{
+    CountingAllocator, Edit, apply, check_cost, check_typed, config, edits, measure, number_edits,
+    number_text, text_edit,
+};
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+/// Largest single allocation a reader may make for `len` bytes of input: `per_byte` times
+/// them (vectors grow by doubling) and a little more.
+fn max_allocation(len: usize, per_byte: usize) -> usize {
+    per_byte * len + (64 << 10)
+}
+
+/// Bytes a telemetry or JSON reader may allocate at once per byte of input.
+const PER_BYTE: usize = 16;
+
+/// Bytes the TOML parser may allocate at once per byte of input: it lists the input's tokens
+/// (events of about 30 bytes each) before building the tables, and a token can be one byte.
+const PER_BYTE_TOML: usize = 64;
+
+/// The syntax of a telemetry file, where its reader decides.
+const TELEMETRY_TOKENS: &[&str] = &[
+    ",",
+    ",,,,,,,",
+    "\"",
+    "\"\"",
+    ",\"0\"",
+    "#",
+    "# event = x",
+    "# : v",
+    "\n",
+    "\r\n",
+    "\r",
+    "\u{feff}",
+    " ",
+    "\t",
+    "t_s",
+    "x_m",
+    "x_ft",
+    "z_ft",
+    "x_km",
+    "roll_rad",
+    "yaw_deg",
+    "mach",
+    "_",
+    "NaN",
+    "inf",
+    "1e308",
+    "é",
+    "\u{0}",
+    "\u{2028}",
+];
+
+/// The syntax of TOML, where its parser decides, and nesting far beyond any scenario's.
+const TOML_TOKENS: &[&str] = &[
+    "[",
+    "]",
+    "[[",
+    "]]",
+    "{",
+    "}",
+    "=",
+    ",",
+    "\"",
+    "'",
+    "'''",
+    "\"\"\"",
+    ".",
+    "#",
+    "\n",
+    "\r\n",
+    "\\",
+    "\\u0000",
+    "\\uD800",
+    "\\U0010FFFF",
+    "é",
+    "\u{feff}",
+    "a.b.c = 1\n",
+    "\n[store]\n",
+    "\n[factors]\n",
+    "\n[initial]\nvelocity_m_s = [1, 2, 3]\n",
+    "\n[[ejector.curve]]\n",
+    "curve = []\n",
+    "curve = [[0.0, 1.0]]\n",
+    "curve = [[0.0, 1.0, 2.0], [1, 2]]\n",
+    "fwdfac = { min = 0.2, max = 1.0, bits = 64 }\n",
+    "fwdfac = { min = 0.2, max = 0.2, bits = 5 }\n",
+    "bits = 4294967296\n",
+    "bits = -1\n",
+    "unknown = 1\n",
+    "mass_kg = 1\n",
+    "inf",
+    "nan",
+    "-inf",
+    "true",
+    "1979-05-27T07:32:00Z",
+    "0x7FFFFFFFFFFFFFFF",
+    "1_000",
+    "x = [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[\n",
+    "x = {a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a={a=\n",
+    "a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a = 1\n",
+    "[a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a]\n",
+];
+
+/// The syntax of JSON, where its parser decides.
+const JSON_TOKENS: &[&str] = &[
+    "{",
+    "}",
+    "[",
+    "]",
+    ",",
+    ":",
+    "\"",
+    "\\",
+    "\\u0000",
+    "\\ud800",
+    "null",
+    "true",
+    "\"fwdfac\": 0.5,",
+    "\"clintfac\": 1,",
+    "\"unknown\": 1,",
+    "\"fwdfac\": [0.5],",
+    "\"fwdfac\": {\"a\": 1},",
+    "1e999",
+    "-0",
+    " ",
+    "\n",
+    "é",
+    "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[",
+    "{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":{\"a\":",
+];
+
+/// Arbitrary text: any characters, or mostly the characters of a format (`alphabet`, a regex
+/// class) so that the parser gets past its first check.
+fn arbitrary_text(alphabet: &'static str) -> BoxedStrategy<String> {
+    prop_oneof![
+        any::<String>(),
+        proptest::string::string_regex(&format!("{alphabet}{{0,1500}}")).expect("a valid regex"),
+    ]
+    .boxed()
+}
+
+/// The embedded default flight test as its file, its comments and first 40 samples: a few
+/// kilobytes.
+fn telemetry_base() -> String {
+    let text = default_flight_test().to_csv_string();
+    let header = text.find("t_s,").expect("a header");
+    let mut end = header;
+    for _ in 0..41 {
+        end += text[end..].find('\n').expect("samples") + 1;
+    }
+    text[..end].to_string()
+}
+
+/// What a trajectory read from a file promises.
+fn check_trajectory(t: &Trajectory, name: &str) -> Result<(), TestCaseError> {
+    prop_assert!(!t.is_empty());
+    prop_assert_eq!(t.pos_m.len(), t.len());
+    prop_assert_eq!(t.att_deg.len(), t.len());
+    prop_assert!(t.metadata.len() <= t.comments.len());
+    for k in 0..t.len() {
+        let within = |v: f64, bound: f64| v.is_finite() && v.abs() <= bound;
+        prop_assert!(within(t.times_s[k], MAX_SPAN_S), "time {}", t.times_s[k]);
+        prop_assert!(t.pos_m[k].iter().all(|&v| within(v, MAX_POSITION_M)));
+        prop_assert!(t.att_deg[k].iter().all(|&v| within(v, MAX_ANGLE_DEG)));
+        prop_assert!(k == 0 || t.times_s[k] > t.times_s[k - 1]);
+    }
+    // Written and read again: the same trajectory, to the bit.
+    let again = Trajectory::parse(&t.to_csv_string(), name);
+    prop_assert_eq!(again.as_ref(), Ok(t));
+    Ok(())
+}
+
+/// Parses telemetry text and checks every property.
+fn telemetry_text(text: &str) -> Result<(), TestCaseError> {
+    let (result, cost) = measure(|| Trajectory::parse(text, "fuzz.csv"));
+    check_cost(
+        "Trajectory::parse",
+        cost,
+        max_allocation(text.len(), PER_BYTE),
+    )?;
+    check_typed("Trajectory::parse", &result)?;
+    if let Ok(t) = &result {
+        check_trajectory(t, "fuzz.csv")?;
+    }
+    Ok(())
+}
+
+/// Reads telemetry bytes from a file and checks every property: as the text parses when they
+/// are UTF-8, refused naming a line that is not otherwise.
+fn telemetry_file(bytes: &[u8]) -> Result<(), TestCaseError> {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let path = dir.path().join("fuzz.csv");
+    std::fs::write(&path, bytes).expect("write the file");
+    let (result, cost) = measure(|| Trajectory::read(&path));
+    check_cost(
+        "Trajectory::read",
+        cost,
+        max_allocation(bytes.len(), PER_BYTE),
+    )?;
+    check_typed("Trajectory::read", &result)?;
+    let name = path.display().to_string();
+    match std::str::from_utf8(bytes) {
+        Ok(text) => prop_assert_eq!(&result, &Trajectory::parse(text, &name)),
+        Err(_) => {
+            if let Err(TelemetryError::NotText { line, .. }) = &result {
+                let raw = bytes.split(|&b| b == b'\n').nth(line - 1);
+                prop_assert!(raw.is_some_and(|l| std::str::from_utf8(l).is_err()));
+            }
+        }
+    }
+    if let Ok(t) = &result {
+        check_trajectory(t, &name)?;
+    }
+    Ok(())
+}
+
+/// Parses scenario TOML and checks every property: a scenario read is valid and reads back the
+/// same after being written.
+fn scenario_text(text: &str) -> Result<(), TestCaseError> {
+    let (result, cost) = measure(|| Scenario::from_toml_str(text, "fuzz.toml"));
+    check_cost(
+        "Scenario::from_toml_str",
+        cost,
+        max_allocation(text.len(), PER_BYTE_TOML),
+    )?;
+    check_typed("Scenario::from_toml_str", &result)?;
+    if let Ok(s) = &result {
+        prop_assert!(s.validate("fuzz.toml").is_ok());
+        let again = Scenario::from_toml_str(&s.to_toml_string(), "again.toml");
+        prop_assert!(again.as_ref().is_ok_and(|a| a == s), "{again:?}");
+    }
+    Ok(())
+}
+
+/// Parses factors JSON and checks every property: the factors read are within the table's
+/// bounds and read back the same after being written.
+fn factors_text(text: &str) -> Result<(), TestCaseError> {
+    let table = FactorTable::default();
+    let (result, cost) = measure(|| Factors::from_json_str(text, &table));
+    check_cost(
+        "Factors::from_json_str",
+        cost,
+        max_allocation(text.len(), PER_BYTE),
+    )?;
+    check_typed("Factors::from_json_str", &result)?;
+    if let Ok(f) = &result {
+        prop_assert!(table.check(f).is_ok());
+        let json = serde_json::to_string(f).expect("factors serialise");
+        prop_assert_eq!(Factors::from_json_str(&json, &table).ok(), Some(*f));
+    }
+    Ok(())
+}
+
+/// Adds effect specs to an empty set (as `--effect` flags do) and checks every property: the
+/// set holds what was added, and its text form reads back the same.
+fn effect_specs(specs: &[String]) -> Result<(), TestCaseError> {
+    let mut set = EffectSet::NONE;
+    for spec in specs {
+        let before = set.len();
+        let (result, cost) = measure(|| set.push_spec(spec));
+        check_cost(
+            "EffectSet::push_spec",
+            cost,
+            max_allocation(spec.len(), PER_BYTE),
+        )?;
+        check_typed("EffectSet::push_spec", &result)?;
+        prop_assert_eq!(set.len(), before + usize::from(result.is_ok()));
+    }
+    prop_assert!(set.iter().all(|a| a.values().iter().all(|v| v.is_finite())));
+    if !set.is_empty() {
+        let mut again = EffectSet::NONE;
+        for spec in set.to_string().split(' ') {
+            again.push_spec(spec).expect("a set's text reads back");
+        }
+        prop_assert_eq!(again, set);
+    }
+    Ok(())
+}
+
+/// An effect spec: a catalogue id (or another name) and a list of numbers (mostly as many as
+/// the effect takes), then perhaps edited.
+fn effect_spec() -> BoxedStrategy<String> {
+    let id_and_count = prop_oneof![
+        4 => (0..CATALOGUE.len()).prop_map(|k| (CATALOGUE[k].id(), CATALOGUE[k].params().len())),
+        1 => select(&["", " ", "x", "release_rates ", "=", "release_rates=1"][..]).prop_map(|id| (id, 1)),
+    ];
+    let value = || prop_oneof![3 => (-2.0..2.0f64).prop_map(|v| v.to_string()), 1 => number_text()];
+    (id_and_count, any::<bool>())
+        .prop_flat_map(move |((id, n), exact)| {
+            let count = if exact { n..n + 1 } else { 0..6 };
+            (Just(id), prop::collection::vec(value(), count))
+        })
+        .prop_map(|(id, values)| format!("{id}={}", values.join(",")))
+        .prop_flat_map(|spec| {
+            prop_oneof![
+                2 => Just(spec.clone()),
+                1 => edits(text_edit(EFFECT_TOKENS), 2).prop_map(move |e| mutated(&spec, &e)),
+            ]
+        })
+        .boxed()
+}
+
+/// The syntax of an effect spec.
+const EFFECT_TOKENS: &[&str] = &["=", ",", ",,", " ", "-", "e", ".", "NaN", "inf", "é"];
+
+/// Mutated text as a string (edits may cut characters: lossy, as a file would be read by a
+/// caller that decodes it first).
+fn mutated(base: &str, e: &[Edit]) -> String {
+    String::from_utf8_lossy(&apply(base.as_bytes(), e, &[])).into_owned()
+}
+
+proptest! {
+    #![proptest_config(config(512))]
+
+    #[test]
+    fn telemetry_arbitrary_text(text in arbitrary_text("[-0-9a-z_,.\"#=: \\r\\n]")) {
+        telemetry_text(&text)?;
+    }
+
+    #[test]
+    fn scenario_arbitrary_text(text in arbitrary_text("[-0-9a-z_.=\\[\\]{},\"' #\\n]")) {
+        scenario_text(&text)?;
+    }
+
+    #[test]
+    fn factors_arbitrary_text(text in arbitrary_text("[-0-9a-z.:{},\\[\\]\" \\n]")) {
+        factors_text(&text)?;
+    }
+
+    #[test]
+    fn effect_specs_of_the_command_line(specs in prop::collection::vec(effect_spec(), 1..6)) {
+        effect_specs(&specs)?;
+    }
+
+    #[test]
+    fn telemetry_files_of_arbitrary_bytes(bytes in prop::collection::vec(any::<u8>(), 0..2000)) {
+        telemetry_file(&bytes)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(2048))]
+
+    #[test]
+    fn telemetry_mutations(e in edits(text_edit(TELEMETRY_TOKENS), 8)) {
+        telemetry_text(&mutated(&telemetry_base(), &e))?;
+    }
+
+    #[test]
+    fn scenario_mutations(written in any::<bool>(), e in edits(text_edit(TOML_TOKENS), 8)) {
+        // The file as a user has it (comments, layout) or as sepval writes it.
+        let base = if written {
+            Scenario::embedded_default().to_toml_string()
+        } else {
+            DEFAULT_SCENARIO_TOML.to_string()
+        };
+        scenario_text(&mutated(&base, &e))?;
+    }
+
+    #[test]
+    fn factors_mutations(pretty in any::<bool>(), e in edits(text_edit(JSON_TOKENS), 8)) {
+        let base = if pretty {
+            serde_json::to_string_pretty(&Factors::TRUTH)
+        } else {
+            serde_json::to_string(&Factors::TRUTH)
+        }
+        .expect("factors serialise");
+        factors_text(&mutated(&base, &e))?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(1024))]
+
+    /// Numbers replaced by huge, non-finite, negative or malformed ones: the checks of values.
+    #[test]
+    fn telemetry_numbers(e in number_edits(3)) {
+        telemetry_text(&mutated(&telemetry_base(), &e))?;
+    }
+
+    #[test]
+    fn scenario_numbers(written in any::<bool>(), e in number_edits(3)) {
+        let base = if written {
+            Scenario::embedded_default().to_toml_string()
+        } else {
+            DEFAULT_SCENARIO_TOML.to_string()
+        };
+        scenario_text(&mutated(&base, &e))?;
+    }
+
+    #[test]
+    fn factors_numbers(e in number_edits(3)) {
+        let base = serde_json::to_string_pretty(&Factors::TRUTH).expect("factors serialise");
+        factors_text(&mutated(&base, &e))?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(64))]
+
+    /// Files of mutated bytes, invalid UTF-8 included (edits here keep every byte they make).
+    #[test]
+    fn telemetry_file_mutations(e in edits(text_edit(TELEMETRY_TOKENS), 8)) {
+        telemetry_file(&apply(telemetry_base().as_bytes(), &e, &[]))?;
+    }
+
+    /// A line of thousands of columns, as header or as row.
+    #[test]
+    fn telemetry_with_many_columns(extra in 0..20_000usize, row_extra in 0..20_000usize, quoted in any::<bool>()) {
+        let q = |s: &str| if quoted { format!("\"{s}\"") } else { s.to_string() };
+        let mut header = ["t_s", "x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"]
+            .map(q)
+            .join(",");
+        header.push_str(&",other_v".repeat(extra));
+        let mut row = "0,0,0,0,0,0,0".to_string();
+        row.push_str(&",1".repeat(row_extra));
+        telemetry_text(&format!("{header}\n{row}\n"))?;
+    }
+
+    /// Nesting thousands of levels deep: arrays, inline tables, dotted keys, table headers.
+    #[test]
+    fn scenario_deeply_nested(kind in 0..5usize, depth in 1..20_000usize) {
+        let text = match kind {
+            0 => format!("x = {}{}", "[".repeat(depth), "]".repeat(depth)),
+            1 => format!("x = {}1{}", "{a=".repeat(depth), "}".repeat(depth)),
+            2 => format!("{} = 1", vec!["a"; depth].join(".")),
+            3 => format!("[{}]\nb = 1", vec!["a"; depth].join(".")),
+            _ => format!("{DEFAULT_SCENARIO_TOML}\n[initial]\nvelocity_m_s = {}", "[".repeat(depth)),
+        };
+        scenario_text(&text)?;
+    }
+
+    /// Nesting thousands of levels deep.
+    #[test]
+    fn factors_deeply_nested(array in any::<bool>(), depth in 1..20_000usize) {
+        let text = if array {
+            format!("{}{}", "[".repeat(depth), "]".repeat(depth))
+        } else {
+            format!("{}1{}", "{\"fwdfac\":".repeat(depth), "}".repeat(depth))
+        };
+        factors_text(&text)?;
+    }
+}
+
+/// The bases are valid, so that the mutations start from what the readers accept.
+#[test]
+fn the_bases_read() {
+    let t = Trajectory::parse(&telemetry_base(), "base.csv").unwrap();
+    assert_eq!(t.len(), 40);
+    check_trajectory(&t, "base.csv").unwrap();
+    scenario_text(DEFAULT_SCENARIO_TOML).unwrap();
+    Scenario::from_toml_str(DEFAULT_SCENARIO_TOML, "base").unwrap();
+    let json = serde_json::to_string(&Factors::TRUTH).unwrap();
+    assert_eq!(
+        Factors::from_json_str(&json, &FactorTable::default()).unwrap(),
+        Factors::TRUTH
+    );
+    telemetry_file(telemetry_base().as_bytes()).unwrap();
+}

@@ -1,0 +1,181 @@
+//! Plain-language physical readings of discovered terms: one sentence per family and axis, from
+//! the table in `docs/model.md` section 11.4. A reading says what a store-separation engineer
+//! would suspect first; it is a reading of the term's shape, not a proof of the mechanism.
+//!
+//! | family | reading |
+//! |---|---|
+//! | `flow_angle` | "<quantity> changing with <alpha, beta, ...>: a static derivative or nonlinearity the model lacks" |
+//! | `rate` (own axis: Cl-p, Cm-q, Cn-r) | "<roll/pitch/yaw> damping differs from the model's (stronger or weaker)" |
+//! | `rate` (cross axis) | "<quantity> due to <roll/pitch/yaw> rate: a cross derivative the model lacks" |
+//! | `interference` | "<quantity> near the aircraft decaying over about lambda m: interference stronger (or weaker) or shaped otherwise than modelled" |
+//! | `interference_flow_angle` | "<quantity> growing with <sideslip/angle of attack/rate> near the aircraft: attitude-dependent interference" |
+//! | `mach` | "<quantity> changing with Mach number: compressibility (for example a transonic drag rise)" |
+//! | `step` | "<quantity> step at t s: a gust or a release transient" |
+//! | `oscillation` | "<quantity> oscillating at f Hz: buffet (or a structural or flow oscillation)" |
+//! | `ejector_stroke` (`stroke`) | "ejector force falls (or rises) along the stroke" |
+//! | `ejector_stroke` (`stroke2`) | "ejector force peaks (or dips) mid-stroke" |
+
+use sepval_common::extension::{Axis, Family, Regressor, Term};
+
+/// The quantity an axis changes, in words.
+pub fn quantity(axis: Axis) -> &'static str {
+    match axis {
+        Axis::CA => "axial force",
+        Axis::CY => "side force",
+        Axis::CZ => "normal force",
+        Axis::Cl => "roll moment",
+        Axis::Cm => "pitch moment",
+        Axis::Cn => "yaw moment",
+        Axis::Ejector => "ejector force",
+    }
+}
+
+fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+        None => String::new(),
+    }
+}
+
+/// What a regressor reads, in words.
+fn variable(r: Regressor) -> &'static str {
+    match r {
+        Regressor::Alpha | Regressor::FAlpha => "angle of attack",
+        Regressor::Beta | Regressor::FBeta => "sideslip",
+        Regressor::Alpha2 => "the square of angle of attack",
+        Regressor::Beta2 => "the square of sideslip",
+        Regressor::Alpha3 => "the cube of angle of attack",
+        Regressor::Beta3 => "the cube of sideslip",
+        Regressor::AlphaBeta => "angle of attack times sideslip",
+        Regressor::P | Regressor::FP => "roll rate",
+        Regressor::Q | Regressor::FQ => "pitch rate",
+        Regressor::R | Regressor::FR => "yaw rate",
+        _ => "",
+    }
+}
+
+/// The reading of `term` (its coefficient signed as fitted; for an oscillation, either of its
+/// pair).
+pub fn reading(term: &Term) -> String {
+    let q = quantity(term.axis);
+    let [locator, _] = term.locator;
+    let c = term.coefficient;
+    match term.regressor.family() {
+        Family::FlowAngle => format!(
+            "{} changing with {}: a static derivative or nonlinearity the model lacks",
+            capitalised(q),
+            variable(term.regressor)
+        ),
+        Family::Rate => {
+            let own = matches!(
+                (term.axis, term.regressor),
+                (Axis::Cl, Regressor::P) | (Axis::Cm, Regressor::Q) | (Axis::Cn, Regressor::R)
+            );
+            if own {
+                let motion = match term.axis {
+                    Axis::Cl => "roll",
+                    Axis::Cm => "pitch",
+                    _ => "yaw",
+                };
+                // A negative derivative opposes the motion: more damping.
+                let how = if c < 0.0 { "stronger" } else { "weaker" };
+                format!("{} damping {how} than the model's", capitalised(motion))
+            } else {
+                format!(
+                    "{} due to {}: a cross derivative the model lacks",
+                    capitalised(q),
+                    variable(term.regressor)
+                )
+            }
+        }
+        Family::Interference => format!(
+            "{} near the aircraft decaying over about {} m: interference {} or shaped otherwise than modelled",
+            capitalised(q),
+            fmt_num(locator),
+            if c >= 0.0 { "stronger" } else { "weaker" }
+        ),
+        Family::InterferenceFlowAngle => format!(
+            "{} growing with {} near the aircraft: attitude-dependent interference",
+            capitalised(q),
+            variable(term.regressor)
+        ),
+        Family::Mach => format!(
+            "{} changing with Mach number: compressibility{}",
+            capitalised(q),
+            if term.axis == Axis::CA {
+                " (for example a transonic drag rise)"
+            } else {
+                ""
+            }
+        ),
+        Family::Step => format!(
+            "{} step at {} s: a gust or a release transient",
+            capitalised(q),
+            fmt_num(locator)
+        ),
+        Family::Oscillation => format!(
+            "{} oscillating at {} Hz: buffet (or a structural or flow oscillation)",
+            capitalised(q),
+            fmt_num(locator)
+        ),
+        Family::EjectorStroke => match term.regressor {
+            Regressor::Stroke2 => format!(
+                "Ejector force {} mid-stroke",
+                if c < 0.0 { "peaks" } else { "dips" }
+            ),
+            _ => format!(
+                "Ejector force {} along the stroke",
+                if c < 0.0 { "falls" } else { "rises" }
+            ),
+        },
+        Family::Window => format!("{} differs in a window of time", capitalised(q)),
+    }
+}
+
+/// A number with at most three decimals and no trailing zeros.
+pub fn fmt_num(v: f64) -> String {
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn term(axis: Axis, regressor: Regressor, locator: f64, c: f64) -> Term {
+        Term {
+            axis,
+            regressor,
+            locator: [locator, 0.0],
+            coefficient: c,
+        }
+    }
+
+    #[test]
+    fn readings_name_the_physics() {
+        assert_eq!(
+            reading(&term(Axis::CY, Regressor::Step, 0.45, 0.01)),
+            "Side force step at 0.45 s: a gust or a release transient"
+        );
+        assert_eq!(
+            reading(&term(Axis::Cl, Regressor::Sin, 5.0, 0.01)),
+            "Roll moment oscillating at 5 Hz: buffet (or a structural or flow oscillation)"
+        );
+        assert_eq!(
+            reading(&term(Axis::Cn, Regressor::FBeta, 0.6, 0.2)),
+            "Yaw moment growing with sideslip near the aircraft: attitude-dependent interference"
+        );
+        assert_eq!(
+            reading(&term(Axis::Ejector, Regressor::Stroke, 0.0, -0.4)),
+            "Ejector force falls along the stroke"
+        );
+        assert_eq!(
+            reading(&term(Axis::Cl, Regressor::P, 0.0, -0.5)),
+            "Roll damping stronger than the model's"
+        );
+        assert!(reading(&term(Axis::Cm, Regressor::P, 0.0, -0.5)).contains("cross derivative"));
+        assert!(reading(&term(Axis::CA, Regressor::Dm, 0.9, 0.1)).contains("drag rise"));
+    }
+}
