@@ -13,7 +13,7 @@
 //! |---|---|---|
 //! | `flow_angle` | `alpha`, `beta`, `alpha2`, `beta2`, `alpha3`, `beta3`, `alpha_beta` (local flow angles \[rad\]) | - |
 //! | `rate` | `p`, `q`, `r` (p d/2V, q d/2V, r d/2V) | - |
-//! | `interference` | `f` = f_lambda(s), the decay shape of section 1 with decay length lambda | `lambda_m` |
+//! | `interference` | `f` = f_lambda(s), the decay shape of section 3 with decay length lambda | `lambda_m` |
 //! | `interference_flow_angle` | `f_alpha`, `f_beta`, `f_p`, `f_q`, `f_r`: f_lambda(s) times alpha, beta or a rate | `lambda_m` |
 //! | `mach` | `dm`, `dm2`: (M - M0) and its square, M = V / a the store's own Mach number | `mach0` |
 //! | `step` | `step`: (1 + tanh((t - t_on) / w)) / 2, w = 5 ms | `t_on_s` |
@@ -437,7 +437,7 @@ fn short(v: f64) -> String {
     if s == "-0" { "0".into() } else { s.to_string() }
 }
 
-/// f_lambda(s) of docs/model.md section 1 for decay length `lambda_m`.
+/// f_lambda(s) of docs/model.md section 3 for decay length `lambda_m`.
 #[inline]
 fn decay(s_m: f64, lambda_m: f64, s_end_m: f64) -> f64 {
     if s_m >= s_end_m {

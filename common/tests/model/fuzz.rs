@@ -1,8 +1,8 @@
 //! Property-based hardening of the model library's readers of outside input: telemetry CSV
 //! ([`Trajectory::parse`], and [`Trajectory::read`] on files of arbitrary bytes, invalid UTF-8
 //! included), scenario TOML ([`Scenario::from_toml_str`]), factors JSON
-//! ([`Factors::from_json_str`]) and effect specs of the command line
-//! ([`EffectSet::push_spec`]).
+//! ([`Factors::from_json_str`]), effect specs of the command line ([`EffectSet::push_spec`])
+//! and model-extension TOML ([`parse_extension`], `docs/model.md` section 11).
 //!
 //! Each is fed arbitrary text and structured mutations of a valid input (the embedded default
 //! flight test, the embedded default scenario, the truth factors): bytes flipped, inserted and
@@ -12,8 +12,9 @@
 //! without a panic, within [`MAX_CALL`](sepval_tests::fuzz::MAX_CALL), and without any single
 //! allocation beyond a small multiple of its input's size (this test binary counts allocations:
 //! [`CountingAllocator`]). What is read must hold what the reader promises (times strictly
-//! increasing and within the plausible bounds, a valid scenario, factors within their bounds),
-//! and must read back the same after being written.
+//! increasing and within the plausible bounds, a valid scenario, factors within their bounds,
+//! terms that can be run), and must read back the same after being written. An extension file
+//! that is refused names the line at fault (the field's own line when one field is wrong).
 //!
 //! The cases are bounded (about a second in all) and drawn from a fixed seed; run more, or
 //! others, with `PROPTEST_CASES=20000 PROPTEST_RNG_SEED=7 cargo test --release -p sepval-common
@@ -23,6 +24,10 @@ use proptest::prelude::*;
 use proptest::sample::select;
 use proptest::test_runner::TestCaseError;
 use sepval_common::effects::{CATALOGUE, EffectSet};
+use sepval_common::extension::{
+    Axis, EXTENSION_FORMAT, ExtensionError, Family, MAX_TERMS, Regressor, Term, TermRecord,
+    extension_toml, parse_extension,
+};
 use sepval_common::factors::{FactorTable, Factors};
 use sepval_common::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
 use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
@@ -474,6 +479,450 @@ proptest! {
     }
 }
 
+/// The syntax of an extension file, where its reader decides: TOML's own, and the fields,
+/// names and values of terms.
+const EXTENSION_TOKENS: &[&str] = &[
+    "[",
+    "]",
+    "[[",
+    "]]",
+    "{",
+    "}",
+    "=",
+    ",",
+    "\"",
+    "'",
+    "\"\"\"",
+    ".",
+    "#",
+    "\n",
+    "\r\n",
+    "\\",
+    "é",
+    "\u{feff}",
+    "\n[[term]]\n",
+    "\n[term]\n",
+    "term = []\n",
+    "term = [{ axis = \"Cn\", family = \"rate\", regressor = \"r\", coefficient = 1 }]\n",
+    "format = \"sepval-extension/2\"\n",
+    "axis = \"ejector\"\n",
+    "axis = \"CZ\"\n",
+    "family = \"step\"\n",
+    "family = \"window\"\n",
+    "regressor = \"sin\"\n",
+    "regressor = \"stroke\"\n",
+    "lambda_m = 0\n",
+    "mach0 = -1\n",
+    "t_on_s = nan\n",
+    "f_hz = -1\n",
+    "coefficient = inf\n",
+    "coefficient = \"1\"\n",
+    "std_error = -1\n",
+    "reading = \"\"\"\naxis = 1\n\"\"\"\n",
+    "colour = 1\n",
+    "nan",
+    "inf",
+    "-0",
+    "1e309",
+];
+
+/// A positive finite number: ordinary, tiny or huge.
+fn positive() -> BoxedStrategy<f64> {
+    prop_oneof![
+        4 => 0.01..10.0f64,
+        1 => select(&[f64::MIN_POSITIVE, 5e-324, 1e-300, 1e300, f64::MAX][..]),
+    ]
+    .boxed()
+}
+
+/// Any finite number, the extremes included.
+fn finite() -> BoxedStrategy<f64> {
+    use prop::num::f64::{NEGATIVE, NORMAL, POSITIVE, SUBNORMAL, ZERO};
+    prop_oneof![
+        2 => -10.0..10.0f64,
+        1 => POSITIVE | NEGATIVE | NORMAL | SUBNORMAL | ZERO,
+    ]
+    .boxed()
+}
+
+/// A term an extension file can hold: a regressor of the library on an axis it may act on, a
+/// locator in its family's domain, any finite coefficient.
+fn valid_term() -> BoxedStrategy<Term> {
+    let library: Vec<Regressor> = Regressor::ALL
+        .iter()
+        .filter(|(_, f, _)| *f != Family::Window)
+        .map(|(r, _, _)| *r)
+        .collect();
+    select(library)
+        .prop_flat_map(|regressor| {
+            let axes: Vec<Axis> = Axis::ALL
+                .into_iter()
+                .filter(|a| regressor.fits(*a))
+                .collect();
+            let locator = match regressor.family() {
+                Family::Interference | Family::InterferenceFlowAngle | Family::Mach => positive(),
+                Family::Step => finite(),
+                Family::Oscillation => prop_oneof![
+                    3 => 0.0..60.0f64,
+                    1 => select(&[0.0, -0.0, 1e300, f64::MAX][..]),
+                ]
+                .boxed(),
+                _ => Just(0.0).boxed(),
+            };
+            (Just(regressor), select(axes), locator, finite())
+        })
+        .prop_map(|(regressor, axis, locator, coefficient)| Term {
+            axis,
+            regressor,
+            locator: [locator, 0.0],
+            coefficient,
+        })
+        .boxed()
+}
+
+/// A valid extension's terms, with (or without) the informational fields a diagnosis writes:
+/// a standard error and a reading of any text.
+fn valid_extension() -> BoxedStrategy<(Vec<Term>, Vec<TermRecord>)> {
+    prop::collection::vec(
+        (
+            valid_term(),
+            prop::option::of(finite()),
+            prop::option::of(any::<String>()),
+        ),
+        0..=MAX_TERMS,
+    )
+    .prop_map(|items| {
+        let terms = items.iter().map(|(t, _, _)| *t).collect();
+        let records = items
+            .into_iter()
+            .map(|(t, std_error, reading)| TermRecord {
+                std_error,
+                reading,
+                ..TermRecord::of(&t)
+            })
+            .collect();
+        (terms, records)
+    })
+    .boxed()
+}
+
+/// The same terms to the bit (`==` would let -0 pass for 0).
+fn same_terms(a: &[Term], b: &[Term]) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(x, y)| {
+            x.axis == y.axis
+                && x.regressor == y.regressor
+                && x.coefficient.to_bits() == y.coefficient.to_bits()
+                && x.locator.map(f64::to_bits) == y.locator.map(f64::to_bits)
+        })
+}
+
+/// What an extension error promises: it names a line of the text (the parser's `line N`, or
+/// the term's own line), except the two refusals of the whole file (its format tag, its number
+/// of terms), which name what they refuse.
+fn check_extension_error(e: &ExtensionError, text: &str) -> Result<(), TestCaseError> {
+    let lines = text.split('\n').count();
+    match e {
+        ExtensionError::Term {
+            path,
+            line,
+            index,
+            field,
+            ..
+        } => {
+            prop_assert_eq!(path, "fuzz.toml");
+            prop_assert!((1..=lines).contains(line), "line {line} of {lines}: {e}");
+            prop_assert!((1..=MAX_TERMS).contains(index), "{e}");
+            // The field's own line, or (a field not written) the line where its term opens.
+            let named = text
+                .split('\n')
+                .nth(line - 1)
+                .unwrap_or_default()
+                .trim_start();
+            let own = named
+                .strip_prefix(*field)
+                .is_some_and(|rest| rest.trim_start().starts_with('='));
+            prop_assert!(
+                own || named.starts_with('[') || named.contains('{'),
+                "{e}: line {line} is `{named}`"
+            );
+        }
+        ExtensionError::Parse { path, message } => {
+            prop_assert_eq!(path, "fuzz.toml");
+            let whole_file = (message.starts_with("format `")
+                && message.ends_with(&format!("this sepval reads `{EXTENSION_FORMAT}`")))
+                || message.ends_with(&format!(" terms, at most {MAX_TERMS}"));
+            prop_assert!(
+                whole_file || message.contains("line "),
+                "an error that names no line: {e}"
+            );
+        }
+        other => prop_assert!(false, "reading text gave {other}"),
+    }
+    Ok(())
+}
+
+/// Reads extension TOML and checks every property: the terms read can be run, are at most
+/// [`MAX_TERMS`], and read back the same after being written; an error names its line.
+fn extension_text(text: &str) -> Result<(), TestCaseError> {
+    let (result, cost) = measure(|| parse_extension(text, "fuzz.toml"));
+    check_cost(
+        "parse_extension",
+        cost,
+        max_allocation(text.len(), PER_BYTE_TOML),
+    )?;
+    check_typed("parse_extension", &result)?;
+    match &result {
+        Ok(terms) => {
+            prop_assert!(terms.len() <= MAX_TERMS);
+            for t in terms {
+                prop_assert!(t.check().is_ok(), "{t:?}: {:?}", t.check());
+            }
+            let records: Vec<TermRecord> = terms.iter().map(TermRecord::of).collect();
+            let again = parse_extension(&extension_toml(&records), "again.toml");
+            prop_assert!(
+                again.as_ref().is_ok_and(|a| same_terms(a, terms)),
+                "{again:?} against {terms:?}"
+            );
+        }
+        Err(e) => check_extension_error(e, text)?,
+    }
+    Ok(())
+}
+
+/// An example extension of several terms, as a diagnosis writes it.
+fn extension_base() -> String {
+    let term = |axis, regressor, locator, coefficient| Term {
+        axis,
+        regressor,
+        locator: [locator, 0.0],
+        coefficient,
+    };
+    let terms = [
+        term(Axis::Cn, Regressor::FBeta, 0.5, -2.0),
+        term(Axis::CY, Regressor::Step, 0.43, 0.2),
+        term(Axis::Cl, Regressor::Sin, 6.25, 0.015),
+        term(Axis::Cl, Regressor::Cos, 6.25, 0.012),
+        term(Axis::CA, Regressor::Dm, 0.9, 0.5),
+        term(Axis::Ejector, Regressor::Stroke, 0.0, -0.6),
+    ];
+    let records: Vec<TermRecord> = terms
+        .iter()
+        .map(|t| TermRecord {
+            std_error: Some(0.01),
+            reading: Some("a reading".into()),
+            ..TermRecord::of(t)
+        })
+        .collect();
+    extension_toml(&records)
+}
+
+/// One field of a valid file made invalid: what is written there instead, and whether the
+/// refusal is the parser's (a value of the wrong type, an unknown key) or the term check's.
+#[derive(Debug, Clone)]
+enum Spoil {
+    /// A name that is no axis.
+    AxisName,
+    /// An axis the term's regressor cannot act on.
+    AxisUnfit,
+    /// A name that is no family of the library.
+    FamilyName,
+    /// A name that is no regressor of the term's family.
+    RegressorName,
+    /// A coefficient that is not finite.
+    CoefficientNotFinite(&'static str),
+    /// A coefficient that is not a number.
+    CoefficientType,
+    /// A locator outside its domain.
+    LocatorDomain(&'static str),
+    /// A locator of another family added.
+    LocatorExtra,
+    /// A key no term has.
+    UnknownKey,
+}
+
+fn spoil() -> BoxedStrategy<Spoil> {
+    prop_oneof![
+        Just(Spoil::AxisName),
+        Just(Spoil::AxisUnfit),
+        Just(Spoil::FamilyName),
+        Just(Spoil::RegressorName),
+        select(&["nan", "inf", "-inf", "+nan"][..]).prop_map(Spoil::CoefficientNotFinite),
+        Just(Spoil::CoefficientType),
+        select(&["0", "-0.0", "-1", "nan", "inf", "-inf"][..]).prop_map(Spoil::LocatorDomain),
+        Just(Spoil::LocatorExtra),
+        Just(Spoil::UnknownKey),
+    ]
+    .boxed()
+}
+
+/// The line (1-based) of `field` in the `k`-th `[[term]]` table of `text` as
+/// [`extension_toml`] lays it out.
+fn field_line_of(text: &str, k: usize, field: &str) -> Option<usize> {
+    let mut table = None;
+    for (n, line) in text.lines().enumerate() {
+        if line == "[[term]]" {
+            table = Some(table.map_or(0, |t| t + 1));
+        } else if table == Some(k) && line.starts_with(&format!("{field} = ")) {
+            return Some(n + 1);
+        }
+    }
+    None
+}
+
+/// `text` with line `line` (1-based) replaced by `with`.
+fn replace_line(text: &str, line: usize, with: &str) -> String {
+    text.split('\n')
+        .enumerate()
+        .map(|(n, l)| if n + 1 == line { with } else { l })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Spoils one field of term `k` of a valid extension and checks that the refusal names that
+/// field and its line.
+fn spoiled_field(terms: &[Term], k: usize, how: &Spoil) -> Result<(), TestCaseError> {
+    let records: Vec<TermRecord> = terms.iter().map(TermRecord::of).collect();
+    let text = extension_toml(&records);
+    let term = terms[k];
+    let locator = term.regressor.family().locator();
+    let line = |field: &str| field_line_of(&text, k, field).expect("the field is written");
+    // A field's line rewritten: (its line, the new text).
+    let rewrite = |field: &str, value: String| (line(field), format!("{field} = {value}"));
+    // A line added after the regressor's: (the regressor's line, it and the new one).
+    let added = |extra: String| {
+        let at = line("regressor");
+        let own = text.split('\n').nth(at - 1).unwrap_or_default();
+        (at, format!("{own}\n{extra}"))
+    };
+    // (the field named, the line rewritten and its new text, the line named, whether the
+    // parser refuses it rather than the term check).
+    let (field, (at, with), parser) = match how {
+        Spoil::AxisName => ("axis", rewrite("axis", "\"Cz\"".into()), false),
+        Spoil::AxisUnfit => {
+            // The ejector for an aerodynamic regressor, an aerodynamic axis for a stroke
+            // shape; a step fits every axis, so it gets a name that is no axis.
+            let axis = match term.regressor.family() {
+                Family::Step => "ejector axis",
+                Family::EjectorStroke => "Cm",
+                _ => "ejector",
+            };
+            ("axis", rewrite("axis", format!("\"{axis}\"")), false)
+        }
+        Spoil::FamilyName => ("family", rewrite("family", "\"window\"".into()), false),
+        Spoil::RegressorName => (
+            "regressor",
+            rewrite("regressor", "\"window\"".into()),
+            false,
+        ),
+        Spoil::CoefficientNotFinite(v) => {
+            ("coefficient", rewrite("coefficient", v.to_string()), false)
+        }
+        Spoil::CoefficientType => (
+            "coefficient",
+            rewrite("coefficient", "\"0.5\"".into()),
+            true,
+        ),
+        Spoil::LocatorDomain(v) => match locator {
+            // A step time may be any finite time, a frequency zero.
+            Some("t_on_s") if !matches!(*v, "nan" | "inf" | "-inf") => return Ok(()),
+            Some("f_hz") if matches!(*v, "0" | "-0.0") => return Ok(()),
+            Some(name) => (name, rewrite(name, v.to_string()), false),
+            None => return Ok(()),
+        },
+        Spoil::LocatorExtra => {
+            let extra = ["lambda_m", "mach0", "t_on_s", "f_hz"]
+                .into_iter()
+                .find(|n| Some(*n) != locator)
+                .expect("four locators");
+            (extra, added(format!("{extra} = 0.5")), false)
+        }
+        Spoil::UnknownKey => ("colour", added("colour = 1".into()), true),
+    };
+    let named_line = if with.contains('\n') { at + 1 } else { at };
+    let spoilt = replace_line(&text, at, &with);
+    let result = parse_extension(&spoilt, "fuzz.toml");
+    prop_assert!(result.is_err(), "{how:?} accepted:\n{spoilt}");
+    let e = result.unwrap_err();
+    check_extension_error(&e, &spoilt)?;
+    if parser {
+        let ExtensionError::Parse { message, .. } = &e else {
+            return Err(TestCaseError::fail(format!(
+                "{how:?}: not the parser's: {e}"
+            )));
+        };
+        prop_assert!(
+            message.contains(&format!("line {named_line}")),
+            "{how:?} on line {named_line}: {e}\n{spoilt}"
+        );
+    } else {
+        let ExtensionError::Term {
+            line,
+            index,
+            field: named,
+            ..
+        } = &e
+        else {
+            return Err(TestCaseError::fail(format!(
+                "{how:?}: not a term error: {e}"
+            )));
+        };
+        prop_assert_eq!(
+            (*line, *index, *named),
+            (named_line, k + 1, field),
+            "{}\n{}",
+            e,
+            spoilt
+        );
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(config(512))]
+
+    #[test]
+    fn extension_arbitrary_text(text in arbitrary_text("[-0-9a-zA-Z_.=\\[\\]{},\"' #\\n]")) {
+        extension_text(&text)?;
+    }
+
+    /// A valid extension written by `extension_toml` reads back as the same terms, to the bit.
+    #[test]
+    fn extension_round_trip((terms, records) in valid_extension()) {
+        let text = extension_toml(&records);
+        let read = parse_extension(&text, "fuzz.toml");
+        prop_assert!(
+            read.as_ref().is_ok_and(|r| same_terms(r, &terms)),
+            "{read:?} against {terms:?}\n{text}"
+        );
+        extension_text(&text)?;
+    }
+
+    /// One field of one term made invalid: the refusal names that field and its line.
+    #[test]
+    fn extension_spoiled_field(
+        (terms, k) in prop::collection::vec(valid_term(), 1..=MAX_TERMS)
+            .prop_flat_map(|t| { let n = t.len(); (Just(t), 0..n) }),
+        how in spoil(),
+    ) {
+        spoiled_field(&terms, k, &how)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(2048))]
+
+    #[test]
+    fn extension_mutations(e in edits(text_edit(EXTENSION_TOKENS), 8)) {
+        extension_text(&mutated(&extension_base(), &e))?;
+    }
+
+    #[test]
+    fn extension_numbers(e in number_edits(3)) {
+        extension_text(&mutated(&extension_base(), &e))?;
+    }
+}
+
 /// The bases are valid, so that the mutations start from what the readers accept.
 #[test]
 fn the_bases_read() {
@@ -488,4 +937,6 @@ fn the_bases_read() {
         Factors::TRUTH
     );
     telemetry_file(telemetry_base().as_bytes()).unwrap();
+    assert_eq!(parse_extension(&extension_base(), "base").unwrap().len(), 6);
+    extension_text(&extension_base()).unwrap();
 }

@@ -150,6 +150,16 @@ fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
             f(v.baseline_j_att_deg, 3),
             f(v.extended_j_att_deg, 3)
         ));
+        for a in &v.alternatives {
+            let kind = a.model.split(':').next().unwrap_or("alternative");
+            s.push_str(&format!(
+                "           the {kind} alternative would give J_pos {:.4} m, J_att {:.3} deg\n",
+                a.j_pos_m, a.j_att_deg
+            ));
+        }
+    }
+    if let Some((_, caution)) = d.verdict.split_once("; caution: ") {
+        s.push_str(&format!("caution:   {caution}\n"));
     }
     if d.extension.as_ref().is_some_and(|x| x.answer) {
         s.push_str(&format!(

@@ -189,6 +189,10 @@ pub struct DiscoveryStep {
 /// Per event, per axis: (times \[s\], values).
 pub(super) type Curves = Vec<Vec<(Vec<f64>, Vec<f64>)>>;
 
+/// Most iterations of a candidate's verification refit (the winner then runs on to
+/// convergence).
+const VERIFY_ITERATIONS: usize = 40;
+
 /// The data's sample rate \[Hz\] (of the first event with two samples).
 fn sample_rate_hz(job: &Job) -> f64 {
     job.events()
@@ -313,6 +317,11 @@ pub(super) fn discover(
     let mut groups: Vec<Vec<GroupMember>> = Vec::new();
     let mut reconstruction = Vec::new();
     let mut steps: Vec<DiscoveryStep> = Vec::new();
+    // The candidates' refits compare entries: a few dozen iterations rank them.
+    let screening = LmSettings {
+        max_iterations: settings.max_iterations.min(VERIFY_ITERATIONS),
+        ..settings.clone()
+    };
     for step in 0..stepwise::MAX_ENTRIES {
         let base = candidate_of(job, &current)?;
         let history = library::flow_history(job, &base);
@@ -493,7 +502,7 @@ pub(super) fn discover(
         for e in &tried {
             let mut with = now.clone();
             with.push(e.clone());
-            runs.push(refit_run(job, &current, &with, noise, settings));
+            runs.push(refit_run(job, &current, &with, noise, &screening));
         }
         refine_together(evaluator, &mut runs)?;
         let mut refits: Vec<(Entry, Fitted, usize)> = Vec::new();
@@ -524,6 +533,9 @@ pub(super) fn discover(
             steps.push(record);
             break;
         };
+        // The winner's refit runs on to convergence.
+        let fitted =
+            super::catalogue::converge(evaluator, job, fitted, noise, settings, &mut evaluations)?;
         let p_with = fitted.space(job).len();
         let q = p_with - current.space(job).len();
         let gain = Gain::of(current.lm.cost, fitted.lm.cost, q, p_with, m);
@@ -728,7 +740,7 @@ pub(super) fn discover(
             mach0: (family == Family::Mach).then_some(locator),
             locator_std_error: loc_pos.and_then(se),
             gain: gains.get(k).cloned().unwrap_or_else(|| gain.clone()),
-            reading: readings::reading(&lead),
+            reading: readings::reading(&lead, &job.events()[0].simulator.scenario().interference),
             group: groups[k].clone(),
         });
     }

@@ -4,18 +4,19 @@
 //!
 //! | family | reading |
 //! |---|---|
-//! | `flow_angle` | "<quantity> changing with <alpha, beta, ...>: a static derivative or nonlinearity the model lacks" |
-//! | `rate` (own axis: Cl-p, Cm-q, Cn-r) | "<roll/pitch/yaw> damping differs from the model's (stronger or weaker)" |
-//! | `rate` (cross axis) | "<quantity> due to <roll/pitch/yaw> rate: a cross derivative the model lacks" |
-//! | `interference` | "<quantity> near the aircraft decaying over about lambda m: interference stronger (or weaker) or shaped otherwise than modelled" |
-//! | `interference_flow_angle` | "<quantity> growing with <sideslip/angle of attack/rate> near the aircraft: attitude-dependent interference" |
-//! | `mach` | "<quantity> changing with Mach number: compressibility (for example a transonic drag rise)" |
-//! | `step` | "<quantity> step at t s: a gust or a release transient" |
-//! | `oscillation` | "<quantity> oscillating at f Hz: buffet (or a structural or flow oscillation)" |
-//! | `ejector_stroke` (`stroke`) | "ejector force falls (or rises) along the stroke" |
-//! | `ejector_stroke` (`stroke2`) | "ejector force peaks (or dips) mid-stroke" |
+//! | `flow_angle` | `<quantity> changing with <alpha, beta, ...>: a static derivative or nonlinearity the model lacks` |
+//! | `rate` (own axis: Cl-p, Cm-q, Cn-r) | `<roll/pitch/yaw> damping differs from the model's (stronger or weaker)` |
+//! | `rate` (cross axis) | `<quantity> due to <roll/pitch/yaw> rate: a cross derivative the model lacks` |
+//! | `interference` | `<quantity> near the aircraft decaying over about lambda m: interference stronger (or weaker) or shaped otherwise than modelled` (stronger when the term has the sign of the scenario's carriage increment on that axis) |
+//! | `interference_flow_angle` | `<quantity> growing with <sideslip/angle of attack/rate> near the aircraft: attitude-dependent interference` |
+//! | `mach` | `<quantity> changing with Mach number: compressibility (for example a transonic drag rise)` |
+//! | `step` | `<quantity> step at t s: a gust or a release transient` |
+//! | `oscillation` | `<quantity> oscillating at f Hz: buffet (or a structural or flow oscillation)` |
+//! | `ejector_stroke` (`stroke`) | `ejector force falls (or rises) along the stroke` |
+//! | `ejector_stroke` (`stroke2`) | `ejector force peaks (or dips) mid-stroke` |
 
 use sepval_common::extension::{Axis, Family, Regressor, Term};
+use sepval_common::scenario::Interference;
 
 /// The quantity an axis changes, in words.
 pub fn quantity(axis: Axis) -> &'static str {
@@ -55,9 +56,25 @@ fn variable(r: Regressor) -> &'static str {
     }
 }
 
+/// The modelled carriage increment on `axis`, signed as a term on that axis adds (a term on
+/// `CA` subtracts from CX, docs/model.md section 11.2); `None` for the ejector.
+pub fn carriage_increment(interference: &Interference, axis: Axis) -> Option<f64> {
+    let i = interference;
+    match axis {
+        Axis::CA => Some(-i.dcx0),
+        Axis::CY => Some(i.dcy0),
+        Axis::CZ => Some(i.dcz0),
+        Axis::Cl => Some(i.dcl0),
+        Axis::Cm => Some(i.dcm0),
+        Axis::Cn => Some(i.dcn0),
+        Axis::Ejector => None,
+    }
+}
+
 /// The reading of `term` (its coefficient signed as fitted; for an oscillation, either of its
-/// pair).
-pub fn reading(term: &Term) -> String {
+/// pair). `interference` is the scenario's carriage interference: an interference term with the
+/// sign of its increment makes the interference stronger, one against it weaker.
+pub fn reading(term: &Term, interference: &Interference) -> String {
     let q = quantity(term.axis);
     let [locator, _] = term.locator;
     let c = term.coefficient;
@@ -89,12 +106,18 @@ pub fn reading(term: &Term) -> String {
                 )
             }
         }
-        Family::Interference => format!(
-            "{} near the aircraft decaying over about {} m: interference {} or shaped otherwise than modelled",
-            capitalised(q),
-            fmt_num(locator),
-            if c >= 0.0 { "stronger" } else { "weaker" }
-        ),
+        Family::Interference => {
+            let how = match carriage_increment(interference, term.axis) {
+                Some(c0) if c0 != 0.0 && (c0 > 0.0) == (c > 0.0) => "stronger",
+                Some(c0) if c0 != 0.0 => "weaker",
+                _ => "that the model lacks,",
+            };
+            format!(
+                "{} near the aircraft decaying over about {} m: interference {how} or shaped otherwise than modelled",
+                capitalised(q),
+                fmt_num(locator),
+            )
+        }
         Family::InterferenceFlowAngle => format!(
             "{} growing with {} near the aircraft: attitude-dependent interference",
             capitalised(q),
@@ -151,6 +174,35 @@ mod tests {
             locator: [locator, 0.0],
             coefficient: c,
         }
+    }
+
+    fn reading(term: &Term) -> String {
+        super::reading(term, &carriage())
+    }
+
+    fn carriage() -> Interference {
+        Interference {
+            dcx0: 0.1,
+            dcy0: 0.0,
+            dcz0: -0.2,
+            dcl0: 0.0,
+            dcm0: -0.05,
+            dcn0: 0.02,
+            lambda_m: 0.6,
+            s_end_m: 3.0,
+        }
+    }
+
+    #[test]
+    fn interference_strength_reads_against_the_carriage_increment() {
+        // dCZ0 < 0: a negative CZ term strengthens it, a positive one weakens it.
+        assert!(reading(&term(Axis::CZ, Regressor::F, 0.5, -0.1)).contains("stronger"));
+        assert!(reading(&term(Axis::CZ, Regressor::F, 0.5, 0.1)).contains("weaker"));
+        // dCX0 > 0 is -0.1 in CA: a negative CA term strengthens it.
+        assert!(reading(&term(Axis::CA, Regressor::F, 0.5, -0.1)).contains("stronger"));
+        // No modelled increment on CY: neither.
+        let cy = reading(&term(Axis::CY, Regressor::F, 0.5, 0.1));
+        assert!(cy.contains("that the model lacks"), "{cy}");
     }
 
     #[test]

@@ -138,15 +138,21 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> String {
         let f = |v: Option<f64>, p: usize| {
             v.map_or("-".to_string(), |v| format!("{v:.prec$}", prec = p))
         };
-        h.push_str("<h2>Prediction of events not fitted</h2>\n<table><tr><th>event</th><th>baseline J_pos [m]</th><th>answer J_pos [m]</th><th>baseline J_att [deg]</th><th>answer J_att [deg]</th><th>note</th></tr>\n");
+        h.push_str("<h2>Prediction of events not fitted</h2>\n<table><tr><th>event</th><th>baseline J_pos [m]</th><th>answer J_pos [m]</th><th>baseline J_att [deg]</th><th>answer J_att [deg]</th><th>alternatives (J_pos [m], J_att [deg])</th><th>note</th></tr>\n");
         for v in &d.validation {
             h.push_str(&format!(
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td></tr>\n",
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td></tr>\n",
                 esc(&v.event),
                 f(v.baseline_j_pos_m, 5),
                 f(v.extended_j_pos_m, 5),
                 f(v.baseline_j_att_deg, 4),
                 f(v.extended_j_att_deg, 4),
+                esc(&v
+                    .alternatives
+                    .iter()
+                    .map(|a| format!("{}: {:.5}, {:.4}", a.model, a.j_pos_m, a.j_att_deg))
+                    .collect::<Vec<_>>()
+                    .join("; ")),
                 esc(&v.note)
             ));
         }

@@ -168,6 +168,7 @@ pub fn service_name(name: &str) -> Result<ServiceName, TransportError> {
 pub fn runs_with_resources() -> Vec<(String, std::time::Duration)> {
     let mut ids: std::collections::BTreeMap<String, std::time::Duration> =
         std::collections::BTreeMap::new();
+    quiet_logs();
     let root = Config::global_config().global.root_path().to_string();
     let mut dirs = vec![std::path::PathBuf::from("/dev/shm")];
     let root = std::path::PathBuf::from(root);
