@@ -659,7 +659,10 @@ fn extension_file(job: &Job, f: &Fitted, found: &[DiscoveredTerm], gain: &Gain) 
         .iter()
         .map(|t| {
             let mut r = TermRecord::of(t);
-            r.reading = Some(readings::reading(t, &job.events()[0].simulator.scenario().interference));
+            r.reading = Some(readings::reading(
+                t,
+                &job.events()[0].simulator.scenario().interference,
+            ));
             r
         })
         .collect();
