@@ -537,14 +537,15 @@ impl TermSet {
         d
     }
 
-    /// The ejector force factor 1 + dE of a foot at stroke fraction `sigma` at time `t_s`.
+    /// The ejector force factor max(0, 1 + dE) of a foot at stroke fraction `sigma` at time
+    /// `t_s`: an ejector pushes, it never pulls, however large a negative term.
     #[inline]
     pub fn ejector_factor(&self, t_s: f64, sigma: f64) -> f64 {
         let mut d = 0.0;
         for t in self.iter().filter(|t| t.axis == Axis::Ejector) {
             d += t.coefficient * t.ejector_value(t_s, sigma);
         }
-        1.0 + d
+        (1.0 + d).max(0.0)
     }
 }
 
@@ -857,6 +858,16 @@ mod tests {
         .unwrap();
         assert!((s.aero_increments(&x)[5] + 0.1).abs() < 1e-15);
         assert!((s.ejector_factor(0.0, 1.0) - 0.8).abs() < 1e-15);
+        // However negative the term, the foot does not pull.
+        let mut pull = TermSet::NONE;
+        pull.push(Term {
+            axis: Axis::Ejector,
+            regressor: Regressor::Stroke,
+            locator: [0.0; 2],
+            coefficient: -5.0,
+        })
+        .unwrap();
+        assert!(pull.ejector_factor(0.0, 1.0).abs() < f64::MIN_POSITIVE);
     }
 
     #[test]

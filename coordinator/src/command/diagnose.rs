@@ -163,8 +163,9 @@ fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
     }
     if d.extension.as_ref().is_some_and(|x| x.answer) {
         s.push_str(&format!(
-            "extension: {}\n",
-            out.join("extension.toml").display()
+            "extension: {} with factors {}\n",
+            out.join("extension.toml").display(),
+            out.join("factors.json").display()
         ));
     }
     s.push_str(&format!(

@@ -17,9 +17,12 @@
 //!    on a grid eight times finer than the library's, around the selected one.
 //! 5. **Verification.** The baseline's 17 factors and the selected terms' coefficients (and the
 //!    step times and decay lengths) are refitted together by output error on every sample
-//!    (the real trajectory fit, not the regression). The extension is kept when its F test
-//!    against the baseline passes at 1 % and its BIC is lower; with several terms, each is
-//!    refitted out in turn, and a term whose removal is not significant leaves.
+//!    (the real trajectory fit, not the regression), each candidate for at most
+//!    `VERIFY_ITERATIONS`, the best on to convergence. An entry is kept when its F test against
+//!    the current model (the previous step's) passes at 1 % divided by the number of library
+//!    entries screened in that step, and its BIC is lower; with several terms, each is refitted
+//!    out in turn, and a term whose removal is not significant leaves. The gain over the
+//!    baseline is reported, not tested again.
 //!
 //! The sensitivities are linear about the fit: they screen, the refit decides.
 

@@ -38,7 +38,7 @@ use sepval_common::atomic_file::{WriteError, write_atomically};
 use sepval_common::effects::{CATALOGUE, EffectSet};
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
 use sepval_common::extension::{TermRecord, extension_toml};
-use sepval_common::factors::FACTOR_COUNT;
+use sepval_common::factors::{FACTOR_COUNT, Factors};
 use serde::{Deserialize, Serialize};
 
 use crate::figures::FigureError;
@@ -154,6 +154,9 @@ pub struct ModelSummary {
     pub chi2: f64,
     /// RMS residual per channel.
     pub channel_rms: ChannelRms,
+    /// The 17 factors as fitted with it (absent in files written before they were recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factors: Option<Factors>,
 }
 
 /// One candidate extension, tried against the model of its round.
@@ -267,8 +270,11 @@ pub struct Diagnosis {
     /// The catalogue effects named as causes, in the order chosen (empty when the baseline
     /// explains the data, or when a discovered extension explains it better).
     pub causes: Vec<String>,
-    /// Whether the catalogue's answer (`causes`; the baseline when empty) leaves nothing but
-    /// noise. A discovered extension's own verdict is `extension.explained`.
+    /// Whether the catalogue's answer leaves nothing but noise: the model with the effects it
+    /// chose (the baseline when it chose none), even when those effects are not the answer
+    /// (`causes` is then empty because a discovered extension explains better). A discovered
+    /// extension's own verdict is `extension.explained`; the terminal summary shows the
+    /// answer's.
     pub explained: bool,
     /// The verdict in one sentence.
     pub verdict: String,
@@ -361,6 +367,7 @@ fn summary(job: &Job, fitted: &Fitted, noise: Noise, events: &[usize]) -> ModelS
         j_att_deg: fitted.lm.goals.j_att_deg,
         chi2: fitted.lm.cost,
         channel_rms: rms_channels(&physical_residuals(&fitted.lm.residuals, noise, events)),
+        factors: fitted.candidate(job).ok().map(|c| c.factors),
     }
 }
 
@@ -641,6 +648,11 @@ pub fn diagnose(
     if let (Answer::Discovered, Some((f, terms, gain))) = (answer, &disc.found) {
         let text = extension_file(&job, f, terms, gain)?;
         write_atomically(&options.out.join("extension.toml"), text.as_bytes())?;
+        // The factors fitted with the terms: `--factors DIR/factors.json --extension
+        // DIR/extension.toml` reproduces the answer.
+        let factors =
+            serde_json::to_vec_pretty(&f.candidate(&job)?.factors).expect("factors serialise");
+        write_atomically(&options.out.join("factors.json"), &factors)?;
     }
     let json = serde_json::to_vec_pretty(&diagnosis).expect("a diagnosis serialises");
     write_atomically(&options.out.join("diagnosis.json"), &json)?;

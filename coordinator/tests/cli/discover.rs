@@ -156,7 +156,7 @@ fn found_first<'a>(d: &'a Value, dir: &Path, axis: &str, family: &str) -> &'a Va
         x["model"]["j_att_deg"].as_f64().unwrap(),
     );
     assert!(jp < 1.2 * sp && ja < 1.2 * sa, "{jp} {ja} vs {sp} {sa}");
-    // The extension is a usable file: it reads back and simulates.
+    // The extension and the factors fitted with it are usable files: they read back and simulate.
     let ext = dir.join("diag/extension.toml");
     assert!(
         std::fs::read_to_string(&ext)
@@ -167,7 +167,7 @@ fn found_first<'a>(d: &'a Value, dir: &Path, axis: &str, family: &str) -> &'a Va
         &[
             "simulate",
             "--factors",
-            "truth",
+            "diag/factors.json",
             "--extension",
             "diag/extension.toml",
             "--out",
