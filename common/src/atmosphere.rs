@@ -3,7 +3,10 @@
 //! Source: `docs/model.md` section 1, "atmosphere" row:
 //! `T = 288.15 - 0.0065 h`, `p = 101325 (T/288.15)^5.25588`, `rho = p / (287.053 T)`,
 //! `a = sqrt(1.4 * 287.053 * T)`. Valid in the troposphere (h < 11 000 m); a scenario above it
-//! is refused by the scenario validation rather than extrapolated silently.
+//! is refused by the scenario validation rather than extrapolated silently. The power is
+//! sepval's [`pow`] (docs/model.md section 9), not the C library's.
+
+use crate::elementary::pow;
 
 /// Sea-level standard temperature \[K\].
 pub const T0_K: f64 = 288.15;
@@ -36,7 +39,7 @@ pub struct AirState {
 /// ISA troposphere at geometric altitude `altitude_m` (docs/model.md section 1).
 pub fn isa_troposphere(altitude_m: f64) -> AirState {
     let temperature_k = T0_K - LAPSE_K_PER_M * altitude_m;
-    let pressure_pa = P0_PA * (temperature_k / T0_K).powf(PRESSURE_EXPONENT);
+    let pressure_pa = P0_PA * pow(temperature_k / T0_K, PRESSURE_EXPONENT);
     let density_kg_m3 = pressure_pa / (R_AIR_J_PER_KG_K * temperature_k);
     let speed_of_sound_m_s = (GAMMA_AIR * R_AIR_J_PER_KG_K * temperature_k).sqrt();
     AirState {

@@ -377,8 +377,8 @@ impl Term {
             Regressor::Dm => x.mach - a,
             Regressor::Dm2 => (x.mach - a) * (x.mach - a),
             Regressor::Step => step(x.t_s, a),
-            Regressor::Sin => (std::f64::consts::TAU * a * x.t_s).sin(),
-            Regressor::Cos => (std::f64::consts::TAU * a * x.t_s).cos(),
+            Regressor::Sin => crate::elementary::sin(std::f64::consts::TAU * a * x.t_s),
+            Regressor::Cos => crate::elementary::cos(std::f64::consts::TAU * a * x.t_s),
             Regressor::Window => f64::from(u8::from(x.t_s >= a && x.t_s < b)),
             Regressor::Stroke | Regressor::Stroke2 => 0.0,
         }

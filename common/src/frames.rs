@@ -15,6 +15,8 @@
 
 use nalgebra::Matrix3;
 
+use crate::elementary::{asin, atan2, sin_cos};
+
 /// Direction-cosine matrix `C_LB` (body to launch frame) of the rotation described by the
 /// quaternion `(q0, q1, q2, q3)`, scalar first. The quaternion need not be of unit length: the
 /// matrix is that of `q / |q|`.
@@ -53,13 +55,38 @@ pub fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {
 }
 
 /// 3-2-1 Euler angles `(roll, pitch, yaw)` in degrees of the rotation `C_LB`, roll and yaw in
-/// (-180, 180], pitch in [-90, 90].
+/// (-180, 180], pitch in [-90, 90] (with sepval's `asin` and `atan2`, docs/model.md section 9).
+///
+/// Called at every sample from code compiled for any x86-64, where each fused multiply-add of
+/// those kernels would be a call to the C library's `fma`; on x86-64 hosts with AVX2 and FMA it
+/// runs a copy compiled for them, as `propagator::propagate` does (the same bits).
 #[inline]
 pub fn euler_321_deg(c_lb: &Matrix3<f64>) -> [f64; 3] {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports the features `euler_321_deg_fma` is compiled for.
+        return unsafe { euler_321_deg_fma(c_lb) };
+    }
+    euler_321_deg_inline(c_lb)
+}
+
+/// [`euler_321_deg`] compiled for x86-64 hosts with AVX2 and FMA.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn euler_321_deg_fma(c_lb: &Matrix3<f64>) -> [f64; 3] {
+    euler_321_deg_inline(c_lb)
+}
+
+/// The body of [`euler_321_deg`].
+#[inline(always)]
+fn euler_321_deg_inline(c_lb: &Matrix3<f64>) -> [f64; 3] {
     let sin_theta = (-c_lb[(2, 0)]).clamp(-1.0, 1.0);
-    let theta = sin_theta.asin();
-    let phi = c_lb[(2, 1)].atan2(c_lb[(2, 2)]);
-    let psi = c_lb[(1, 0)].atan2(c_lb[(0, 0)]);
+    let theta = asin(sin_theta);
+    let phi = atan2(c_lb[(2, 1)], c_lb[(2, 2)]);
+    let psi = atan2(c_lb[(1, 0)], c_lb[(0, 0)]);
     [
         wrap_deg(phi.to_degrees()),
         theta.to_degrees(),
@@ -84,9 +111,9 @@ pub fn wrap_deg(angle_deg: f64) -> f64 {
 
 /// Quaternion `(q0, q1, q2, q3)` of the 3-2-1 Euler angles (radians).
 pub fn quaternion_from_euler_321(roll_rad: f64, pitch_rad: f64, yaw_rad: f64) -> [f64; 4] {
-    let (sr, cr) = (0.5 * roll_rad).sin_cos();
-    let (sp, cp) = (0.5 * pitch_rad).sin_cos();
-    let (sy, cy) = (0.5 * yaw_rad).sin_cos();
+    let (sr, cr) = sin_cos(0.5 * roll_rad);
+    let (sp, cp) = sin_cos(0.5 * pitch_rad);
+    let (sy, cy) = sin_cos(0.5 * yaw_rad);
     [
         cr * cp * cy + sr * sp * sy,
         sr * cp * cy - cr * sp * sy,

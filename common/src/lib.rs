@@ -12,7 +12,9 @@
 //! - [`goals`]: section 5;
 //! - [`telemetry`]: section 6;
 //! - [`effects`]: section 7, the effect catalogue;
-//! - [`noise`]: the measurement noise of the synthetic flight test (section 4).
+//! - [`noise`]: the measurement noise of the synthetic flight test (section 4);
+//! - [`elementary`], [`lanes`]: section 9, sepval's own elementary functions (no C library),
+//!   written once for one double and for four lanes.
 
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
@@ -28,6 +30,7 @@ pub mod extension;
 pub mod factors;
 pub mod frames;
 pub mod goals;
+pub mod lanes;
 pub mod limits;
 pub mod model;
 pub mod noise;

@@ -6,6 +6,11 @@
 //! `rand_distr::StandardNormal`: both portable across platforms, so a seed gives the same file
 //! everywhere. Deviates are drawn sample by sample in the order x, y, z, roll, pitch, yaw; roll
 //! and yaw are rewrapped to (-180, 180] after adding.
+//!
+//! Unlike the simulation (docs/model.md section 9), the noise may use the standard library's
+//! elementary functions (`rand_distr`'s ziggurat calls `exp` and `ln` on its rare slow paths):
+//! a noisy flight test is made once, on the coordinator's host, and workers receive its data,
+//! never regenerate it.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -6,6 +6,10 @@
 //! of nested least-squares models; the Ljung-Box portmanteau statistic
 //! Q = N (N + 2) sum_{k=1}^{h} rho_k^2 / (N - k) (G. M. Ljung and G. E. P. Box, Biometrika 65,
 //! 1978), chi-square with h degrees of freedom for white residuals.
+//!
+//! These run on the coordinator only, after the simulations, so they use the standard library's
+//! elementary functions (`exp`, `ln`, ...); the simulation itself uses none (docs/model.md
+//! section 9, `sepval_common::elementary`).
 
 /// ln Gamma(x), x > 0 (Lanczos, g = 7, n = 9).
 pub fn ln_gamma(x: f64) -> f64 {

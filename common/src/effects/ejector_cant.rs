@@ -4,6 +4,7 @@
 use nalgebra::Vector3;
 
 use super::{Effect, EffectError, ParamSpec};
+use crate::elementary::sin_cos;
 use crate::model::RunSetup;
 
 /// Ejector force direction canted about the launch-frame x axis.
@@ -27,7 +28,7 @@ impl Effect for EjectorCant {
         }]
     }
     fn apply(&self, p: &[f64], run: &mut RunSetup) -> Result<(), EffectError> {
-        let (s, c) = p[0].sin_cos();
+        let (s, c) = sin_cos(p[0]);
         run.ejector_direction_l = Vector3::new(0.0, -s, c);
         Ok(())
     }

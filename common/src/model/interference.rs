@@ -6,6 +6,10 @@
 //! f(s) = (exp(-s/lambda) - exp(-s_end/lambda)) / (1 - exp(-s_end/lambda))   for s < s_end
 //! f(s) = 0                                                                    for s >= s_end
 //! ```
+//!
+//! Both exponentials are sepval's [`exp`] (docs/model.md section 9).
+
+use crate::elementary::exp;
 
 /// Precomputed constants of f(s) for one lambda and s_end.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -22,7 +26,7 @@ pub struct InterferenceDecay {
 impl InterferenceDecay {
     /// Constants for decay length `lambda_m` and cut-off `s_end_m`.
     pub fn new(lambda_m: f64, s_end_m: f64) -> Self {
-        let exp_end = (-s_end_m / lambda_m).exp();
+        let exp_end = exp(-s_end_m / lambda_m);
         InterferenceDecay {
             lambda_m,
             s_end_m,
@@ -36,8 +40,7 @@ impl InterferenceDecay {
     #[inline(always)]
     pub fn factor(&self, s_m: f64) -> f64 {
         if s_m < self.s_end_m {
-            (crate::elementary::exp(-s_m * self.inv_lambda_per_m) - self.exp_end)
-                * self.inv_denominator
+            (exp(-s_m * self.inv_lambda_per_m) - self.exp_end) * self.inv_denominator
         } else {
             0.0
         }

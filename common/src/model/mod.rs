@@ -32,7 +32,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::atmosphere::isa_troposphere;
 use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
-use crate::elementary::atan2_asin;
+use crate::elementary::{atan2_asin, cos, sin};
 use crate::extension::{TermError, TermInput, TermSet};
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
@@ -133,11 +133,11 @@ impl Model {
             speed_of_sound_m_s: air.speed_of_sound_m_s,
             extension: scenario.extension_terms(),
             v_aircraft_air_l_m_s: Vector3::new(
-                v_inf * a.cos() * b.cos(),
-                v_inf * b.sin(),
-                v_inf * a.sin() * b.cos(),
+                v_inf * cos(a) * cos(b),
+                v_inf * sin(b),
+                v_inf * sin(a) * cos(b),
             ),
-            gravity_l_m_s2: Vector3::new(-G_M_S2 * theta_a.sin(), 0.0, G_M_S2 * theta_a.cos()),
+            gravity_l_m_s2: Vector3::new(-G_M_S2 * sin(theta_a), 0.0, G_M_S2 * cos(theta_a)),
             dt_s: scenario.integrator.dt_s,
             initial_velocity_m_s: Vector3::from(scenario.initial.velocity_m_s),
             initial_rates_rad_s: Vector3::from(scenario.initial.rates_deg_s.map(f64::to_radians)),

@@ -24,8 +24,12 @@ use sepval_common::propagator::Observation;
 
 /// Version of the coordinator-worker protocol. A coordinator and a worker refuse each other
 /// unless they agree on it. Version 2: one wire format for every transport (failure reasons of
-/// up to 240 bytes, explicit padding). Version 3: candidates carry extension terms.
-pub const PROTOCOL_VERSION: u32 = 3;
+/// up to 240 bytes, explicit padding). Version 3: candidates carry extension terms. Version 4:
+/// the same messages, but the goals a worker returns are those of sepval's own elementary
+/// functions (`sepval_common::elementary`: no C library in the simulation, extension terms
+/// included, results changed in their last bits), so a version-3 worker, which computes with the
+/// C library, must not serve a version-4 fit whose results are to be bit-identical across hosts.
+pub const PROTOCOL_VERSION: u32 = 4;
 
 /// "SEPVAL01" as a little-endian integer: the first field of [`Hello`], [`SetupHeader`] and
 /// every byte-stream frame.

@@ -30,6 +30,7 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 use sepval_common::effects::EffectSet;
+use sepval_common::elementary;
 use sepval_common::evaluation::{Candidate, Evaluator, Job};
 use sepval_common::extension::{Family, Regressor, Term};
 use sepval_common::factors::FACTOR_COUNT;
@@ -71,7 +72,13 @@ fn fine_grid(term: &Term) -> Option<Vec<f64>> {
         Family::Step => library::STEP_SPACING_S,
         Family::Oscillation => library::FREQUENCY_SPACING_HZ,
         Family::Interference | Family::InterferenceFlowAngle => {
-            return Some((-8..=8).map(|k| l * 1.5f64.powf(k as f64 / 8.0)).collect());
+            // sepval's own pow, not the C library's: these decay lengths are simulated (and may
+            // end up in DIR/extension.toml), so they must be the same bits on every host.
+            return Some(
+                (-8..=8)
+                    .map(|k| l * elementary::pow(1.5, k as f64 / 8.0))
+                    .collect(),
+            );
         }
         _ => return None,
     };
