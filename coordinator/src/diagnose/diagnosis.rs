@@ -121,7 +121,7 @@ pub struct Alternative {
 /// DIR/diagnosis.json.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
-    /// [`DIAGNOSIS_FORMAT`].
+    /// [`DIAGNOSIS_FORMAT`](super::DIAGNOSIS_FORMAT).
     pub format: String,
     /// The catalogue effects named as causes, in the order chosen (empty when the baseline
     /// explains the data, or when a discovered extension explains it better).
