@@ -39,6 +39,7 @@ pub mod scenario;
 pub mod simulation;
 pub mod synthetic;
 pub mod telemetry;
+pub mod toml_error;
 pub mod units;
 
 pub use effects::EffectSet;

@@ -241,7 +241,7 @@ impl Scenario {
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
         let scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             origin: origin.to_string(),
-            message: e.to_string().trim_end().to_string(),
+            message: crate::toml_error::one_line(text, &e),
         })?;
         scenario.validate(origin)?;
         Ok(scenario)

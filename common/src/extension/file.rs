@@ -206,7 +206,7 @@ fn field_line(text: &str, span: std::ops::Range<usize>, field: &str) -> usize {
 pub fn parse_extension(text: &str, path: &str) -> Result<Vec<Term>, ExtensionError> {
     let file: ExtensionFile = toml::from_str(text).map_err(|e| ExtensionError::Parse {
         path: path.to_string(),
-        message: e.to_string().trim_end().to_string(),
+        message: crate::toml_error::one_line(text, &e),
     })?;
     if file.format != EXTENSION_FORMAT {
         return Err(ExtensionError::Parse {
