@@ -35,6 +35,7 @@ pub mod propagator;
 pub mod scenario;
 pub mod simulation;
 pub mod synthetic;
+pub mod table;
 pub mod telemetry;
 pub mod units;
 
