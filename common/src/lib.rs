@@ -12,6 +12,7 @@
 //! - [`goals`]: section 5;
 //! - [`telemetry`]: section 6;
 //! - [`effects`]: section 7, the effect catalogue;
+//! - [`table`], [`table_form`]: sections 1 and 3, tabulated coefficients and interference;
 //! - [`noise`]: the measurement noise of the synthetic flight test (section 4).
 
 #![warn(missing_docs)]
@@ -36,6 +37,7 @@ pub mod scenario;
 pub mod simulation;
 pub mod synthetic;
 pub mod table;
+pub mod table_form;
 pub mod telemetry;
 pub mod units;
 

@@ -6,4 +6,5 @@
 mod conformance;
 mod effects;
 mod fuzz;
+mod tables;
 mod verification;
