@@ -1107,9 +1107,9 @@ pub fn write_csv(axes: &[Axis], columns: &[(&str, &str, &[f64])]) -> String {
 
 /// Most tables one scenario can hold (13 aerodynamic fields and 6 interference increments).
 pub const MAX_TABLES: usize = 19;
-/// Most distinct run-time axes (6 static tables over alpha and beta, 6 interference tables over
-/// distance, alpha and lateral offset).
-const MAX_AXES: usize = 30;
+/// Most run-time groups (tables sharing their axes): one per static coefficient and per
+/// interference increment at most.
+const MAX_GROUPS: usize = 12;
 
 /// Where a run-time table's value goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -1118,6 +1118,16 @@ pub enum Target {
     Static(usize),
     /// An interference increment: 0 dCX, ..., 5 dCn (times its multiplier).
     Interference(usize),
+}
+
+impl Target {
+    /// Its place in the output of [`PreparedTables::evaluate`].
+    fn slot(self) -> usize {
+        match self {
+            Target::Static(k) => k,
+            Target::Interference(k) => 6 + k,
+        }
+    }
 }
 
 /// What a scenario's table spans, for reports.
@@ -1129,25 +1139,119 @@ pub struct TableInfo {
     pub axes: Vec<(Variable, f64, f64)>,
 }
 
-/// One distinct run-time axis: breakpoints in the force evaluation's units (angles in rad).
+/// One axis of a run-time group: breakpoints in the force evaluation's units (angles in rad).
 #[derive(Debug, Clone)]
 struct RuntimeAxis {
     variable: Variable,
+    /// Index of its input in [`PreparedTables::evaluate`]'s `inputs`.
+    input: usize,
     breakpoints: Vec<f64>,
-    inv_widths: Vec<f64>,
     /// Excursions are reported in the variable's unit: degrees per radian for angles.
     report_scale: f64,
 }
 
-/// Run-time tables sharing their axes: values interleaved by grid point, one channel a table.
+/// Run-time tables of one block (static coefficients or interference increments) sharing their
+/// axes: each grid point holds the block's six lanes (CA, CY, CZ, Cl, Cm, Cn or dCX, ..., dCn;
+/// 0 in a lane no table of the group fills), so that one interval search and one set of
+/// weights serve them all and the six lanes are interpolated together.
 #[derive(Debug, Clone)]
 struct Group {
-    axes: [usize; 3],
-    n_axes: usize,
-    /// Values of one grid point (the channels) times the sizes of the faster axes.
+    axes: Vec<RuntimeAxis>,
+    /// Values of one grid point (6) times the sizes of the faster axes.
     strides: [usize; 3],
-    channels: Vec<(usize, Target)>,
+    /// 0 for the static coefficients, 6 for the interference increments.
+    block: usize,
+    /// The tables (indices into `info`) of the group.
+    ids: Vec<usize>,
     values: Vec<f64>,
+    /// Per grid cell, the multilinear interpolant as a polynomial in the inputs, 2^k
+    /// coefficient lanes (bit j of a coefficient's index: times x_j) of six values each.
+    cells: Vec<f64>,
+    /// Doubles of one cell times the cell counts of the faster axes.
+    cell_strides: [usize; 3],
+}
+
+impl Group {
+    /// The group's six lanes at `inputs` (held at the edges; `outside` set when held).
+    #[inline(always)]
+    fn interpolate(
+        &self,
+        cursors: &[Cell<u32>; 3],
+        inputs: &Inputs,
+        outside: &mut bool,
+    ) -> [f64; 6] {
+        let g = self;
+        let mut cell = 0usize;
+        let mut x = [0.0f64; 3];
+        for (k, a) in g.axes.iter().enumerate() {
+            let (i, x_k, out_k) = locate(a, pick(a.input, inputs), &cursors[k]);
+            cell += i * g.cell_strides[k];
+            x[k] = x_k;
+            *outside |= out_k;
+        }
+        let c = &g.cells;
+        // The cell's polynomial, nested: (c0 + c1 x) + y (c2 + c3 x), and so on. (Helper
+        // functions, not closures: closures are not inlined into the FMA-compiled propagator.)
+        match g.axes.len() {
+            0 => *lanes(c, cell),
+            1 => lin(x[0], lanes(c, cell), lanes(c, cell + 6)),
+            2 => bilinear(c, cell, x[0], x[1]),
+            _ => lin(
+                x[2],
+                &bilinear(c, cell, x[0], x[1]),
+                &bilinear(c, cell + 24, x[0], x[1]),
+            ),
+        }
+    }
+
+    /// Expands the grid values into each cell's polynomial (docs/model.md section 3): on
+    /// [x0, x1] the linear interpolant is v0 (x1 - x)/dx + v1 (x - x0)/dx, and the
+    /// multilinear one the product of such factors summed over the cell's 2^k corners; its
+    /// monomial coefficients make an evaluation two fused multiply-adds deep per axis less than
+    /// weights and differences would (the value is the same to rounding).
+    fn build_cells(&mut self) {
+        let k = self.axes.len();
+        let intervals: Vec<usize> = self.axes.iter().map(|a| a.breakpoints.len() - 1).collect();
+        let per_cell = 6 << k;
+        let mut stride = per_cell;
+        for j in (0..k).rev() {
+            self.cell_strides[j] = stride;
+            stride *= intervals[j];
+        }
+        let cells: usize = intervals.iter().product();
+        self.cells = vec![0.0; cells * per_cell];
+        for cell in 0..cells {
+            let mut idx = [0usize; 3];
+            let mut rem = cell;
+            for j in (0..k).rev() {
+                idx[j] = rem % intervals[j];
+                rem /= intervals[j];
+            }
+            for corner in 0..(1usize << k) {
+                let point: usize = (0..k)
+                    .map(|j| (idx[j] + ((corner >> j) & 1)) * self.strides[j])
+                    .sum();
+                for mask in 0..(1usize << k) {
+                    let mut factor = 1.0;
+                    for (j, a) in self.axes.iter().enumerate() {
+                        let (x0, x1) = (a.breakpoints[idx[j]], a.breakpoints[idx[j] + 1]);
+                        let dx = x1 - x0;
+                        let upper = (corner >> j) & 1 == 1;
+                        factor *= match ((mask >> j) & 1 == 1, upper) {
+                            (true, false) => -1.0 / dx,
+                            (true, true) => 1.0 / dx,
+                            (false, false) => x1 / dx,
+                            (false, true) => -x0 / dx,
+                        };
+                    }
+                    let at = cell * per_cell + mask * 6;
+                    for c in 0..6 {
+                        self.cells[at + c] += factor * self.values[point + c];
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The tables of one scenario at its flight Mach, ready for the force evaluation.
@@ -1157,8 +1261,10 @@ pub struct PreparedTables {
     pub info: Vec<TableInfo>,
     /// Each table's excursion beyond its Mach axis (0 inside, or without one).
     mach_excursion: Vec<f64>,
-    axes: Vec<RuntimeAxis>,
+    /// The static coefficients' groups first, then the interference increments'.
     groups: Vec<Group>,
+    /// How many groups are of static coefficients.
+    static_groups: usize,
     /// Constant static coefficients (CY, CZ, Cl, Cm, Cn given as numbers; CA is never here).
     constants: [f64; 6],
 }
@@ -1168,8 +1274,8 @@ impl PreparedTables {
     pub const NONE: PreparedTables = PreparedTables {
         info: Vec::new(),
         mach_excursion: Vec::new(),
-        axes: Vec::new(),
         groups: Vec::new(),
+        static_groups: 0,
         constants: [0.0; 6],
     };
 
@@ -1227,167 +1333,134 @@ impl PreparedTables {
         (id, table.axes[1..].to_vec(), values)
     }
 
-    /// Adds a table (already sliced at the Mach, registered as `id`) for the force evaluation.
+    /// Adds a table (already sliced at the Mach, registered as `id`) for the force evaluation:
+    /// a channel of the group with the same axes, or a new group.
     pub fn add_runtime(&mut self, id: usize, target: Target, axes: Vec<Axis>, values: Vec<f64>) {
-        let mut ids = [0usize; 3];
-        for (k, a) in axes.iter().enumerate() {
-            let breakpoints: Vec<f64> = match a.variable {
-                Variable::Alpha | Variable::Beta => {
-                    a.breakpoints.iter().map(|d| d.to_radians()).collect()
+        let runtime: Vec<RuntimeAxis> = axes
+            .iter()
+            .map(|a| {
+                let (breakpoints, report_scale): (Vec<f64>, f64) = match a.variable {
+                    Variable::Alpha | Variable::Beta => (
+                        a.breakpoints.iter().map(|d| d.to_radians()).collect(),
+                        1.0f64.to_degrees(),
+                    ),
+                    _ => (a.breakpoints.clone(), 1.0),
+                };
+                RuntimeAxis {
+                    variable: a.variable,
+                    input: match a.variable {
+                        Variable::Alpha => 0,
+                        Variable::Beta => 1,
+                        Variable::Distance => 2,
+                        // Mach never reaches the run time (sliced above).
+                        Variable::Lateral | Variable::Mach => 3,
+                    },
+                    breakpoints,
+                    report_scale,
                 }
-                _ => a.breakpoints.clone(),
-            };
-            ids[k] = match self
-                .axes
-                .iter()
-                .position(|r| r.variable == a.variable && r.breakpoints == breakpoints)
-            {
-                Some(p) => p,
-                None => {
-                    let inv_widths = breakpoints
-                        .windows(2)
-                        .map(|w| 1.0 / (w[1] - w[0]))
-                        .collect();
-                    self.axes.push(RuntimeAxis {
-                        variable: a.variable,
-                        breakpoints,
-                        inv_widths,
-                        report_scale: match a.variable {
-                            Variable::Alpha | Variable::Beta => 1.0f64.to_degrees(),
-                            _ => 1.0,
-                        },
-                    });
-                    self.axes.len() - 1
-                }
-            };
-        }
-        assert!(
-            self.axes.len() <= MAX_AXES,
-            "at most {MAX_AXES} run-time axes"
-        );
-        let n_axes = axes.len();
-        // Same axes: one more channel of an existing group (values re-interleaved).
-        if let Some(g) = self
-            .groups
-            .iter_mut()
-            .find(|g| g.n_axes == n_axes && g.axes[..n_axes] == ids[..n_axes])
-        {
-            let m = g.channels.len();
-            let points = values.len();
-            let mut merged = Vec::with_capacity(points * (m + 1));
-            for p in 0..points {
-                merged.extend_from_slice(&g.values[p * m..(p + 1) * m]);
-                merged.push(values[p]);
-            }
-            g.values = merged;
-            g.channels.push((id, target));
-            let sizes: Vec<usize> = (0..n_axes)
-                .map(|k| self.axes[ids[k]].breakpoints.len())
-                .collect();
-            g.strides = strides(&sizes, m + 1);
-            return;
-        }
+            })
+            .collect();
         let sizes: Vec<usize> = axes.iter().map(|a| a.breakpoints.len()).collect();
-        self.groups.push(Group {
-            axes: ids,
-            n_axes,
-            strides: strides(&sizes, 1),
-            channels: vec![(id, target)],
-            values,
-        });
+        let slot = target.slot();
+        let (block, lane) = (slot / 6 * 6, slot % 6);
+        let same = |g: &Group| {
+            g.block == block
+                && g.axes.len() == runtime.len()
+                && g.axes
+                    .iter()
+                    .zip(&runtime)
+                    .all(|(a, b)| a.variable == b.variable && a.breakpoints == b.breakpoints)
+        };
+        let g = match self.groups.iter().position(same) {
+            Some(k) => &mut self.groups[k],
+            None => {
+                assert!(
+                    self.groups.len() < MAX_GROUPS,
+                    "at most {MAX_GROUPS} run-time groups"
+                );
+                // Static groups before interference groups.
+                let at = if block == 0 {
+                    self.static_groups += 1;
+                    self.static_groups - 1
+                } else {
+                    self.groups.len()
+                };
+                self.groups.insert(
+                    at,
+                    Group {
+                        axes: runtime,
+                        strides: strides(&sizes, 6),
+                        block,
+                        ids: Vec::new(),
+                        values: vec![0.0; 6 * values.len()],
+                        cells: Vec::new(),
+                        cell_strides: [0; 3],
+                    },
+                );
+                &mut self.groups[at]
+            }
+        };
+        g.ids.push(id);
+        for (p, v) in values.iter().enumerate() {
+            // Two tables of one coefficient in one group add (a static table and a constant
+            // never meet here; the scenario has one field per coefficient).
+            g.values[6 * p + lane] += v;
+        }
+        g.build_cells();
     }
 
     /// The tables' contributions at the inputs of one force evaluation: static coefficients
-    /// (CA, CY, CZ, Cl, Cm, Cn) and interference increments (before their multipliers).
-    /// `inputs` are (alpha \[rad\], beta \[rad\], distance \[m\], lateral offset \[m\]).
+    /// (CA, CY, CZ, Cl, Cm, Cn) and interference increments (before their multipliers), without
+    /// the constant static coefficients ([`PreparedTables::constants`]).
     #[inline(always)]
-    pub fn evaluate(&self, state: &TableState, inputs: [f64; 4]) -> ([f64; 6], [f64; 6]) {
-        let mut outside = false;
-        for (k, a) in self.axes.iter().enumerate() {
-            let x = match a.variable {
-                Variable::Alpha => inputs[0],
-                Variable::Beta => inputs[1],
-                Variable::Distance => inputs[2],
-                Variable::Lateral => inputs[3],
-                Variable::Mach => 0.0,
-            };
-            let (i, t, excursion) = locate(&a.breakpoints, &a.inv_widths, x, &state.cursor[k]);
-            state.index[k].set(i as u32);
-            state.weight[k].set(t);
-            state.excursion[k].set(excursion);
-            outside |= excursion != 0.0;
-        }
-        let mut statics = self.constants;
+    pub fn evaluate(&self, state: &TableState, inputs: &Inputs) -> ([f64; 6], [f64; 6]) {
+        let mut statics = [0.0; 6];
         let mut increments = [0.0; 6];
-        for g in &self.groups {
-            let pos = |k: usize| {
-                let a = g.axes[k];
-                (
-                    state.index[a].get() as usize * g.strides[k],
-                    state.weight[a].get(),
-                )
+        let mut outside = false;
+        for (g, cursors) in self.groups.iter().zip(&state.cursor) {
+            let r = g.interpolate(cursors, inputs, &mut outside);
+            let sum = if g.block == 0 {
+                &mut statics
+            } else {
+                &mut increments
             };
-            for (c, &(_, target)) in g.channels.iter().enumerate() {
-                let v = &g.values;
-                let lerp = |lo: usize, step: usize, t: f64| {
-                    let v0 = v[lo];
-                    t.mul_add(v[lo + step] - v0, v0)
-                };
-                let value = match g.n_axes {
-                    0 => v[c],
-                    1 => {
-                        let (i, t) = pos(0);
-                        lerp(i + c, g.strides[0], t)
-                    }
-                    2 => {
-                        let ((i, t), (j, u)) = (pos(0), pos(1));
-                        let r0 = lerp(i + j + c, g.strides[1], u);
-                        let r1 = lerp(i + g.strides[0] + j + c, g.strides[1], u);
-                        t.mul_add(r1 - r0, r0)
-                    }
-                    _ => {
-                        let ((i, t), (j, u), (k, w)) = (pos(0), pos(1), pos(2));
-                        let plane = |p: usize| {
-                            let r0 = lerp(p + j + k + c, g.strides[2], w);
-                            let r1 = lerp(p + j + g.strides[1] + k + c, g.strides[2], w);
-                            u.mul_add(r1 - r0, r0)
-                        };
-                        let (p0, p1) = (plane(i), plane(i + g.strides[0]));
-                        t.mul_add(p1 - p0, p0)
-                    }
-                };
-                match target {
-                    Target::Static(s) => statics[s] += value,
-                    Target::Interference(s) => increments[s] += value,
-                }
+            for c in 0..6 {
+                sum[c] += r[c];
             }
         }
         if outside {
-            self.record_outside(state);
+            self.record_outside(state, inputs);
         }
         (statics, increments)
+    }
+
+    /// The constant static coefficients (CY, CZ, Cl, Cm, Cn given as numbers next to tables).
+    #[inline(always)]
+    pub fn constants(&self) -> &[f64; 6] {
+        &self.constants
     }
 
     /// Counts, per table, an evaluation outside it and its worst excursion per variable.
     #[cold]
     #[inline(never)]
-    fn record_outside(&self, state: &TableState) {
+    fn record_outside(&self, state: &TableState, inputs: &Inputs) {
         for g in &self.groups {
             let mut out = false;
-            for &a in &g.axes[..g.n_axes] {
-                let e = state.excursion[a].get();
-                if e != 0.0 {
+            for a in &g.axes {
+                let x = pick(a.input, inputs);
+                let b = &a.breakpoints;
+                let e = (b[0] - x).max(x - b[b.len() - 1]);
+                if e > 0.0 {
                     out = true;
-                    let axis = &self.axes[a];
-                    let e = e.abs() * axis.report_scale;
-                    for &(id, _) in &g.channels {
-                        let w = &state.worst[id][axis.variable.index()];
+                    let e = e * a.report_scale;
+                    for &id in &g.ids {
+                        let w = &state.worst[id][a.variable.index()];
                         w.set(w.get().max(e));
                     }
                 }
             }
             if out {
-                for &(id, _) in &g.channels {
+                for &id in &g.ids {
                     state.count[id].set(state.count[id].get() + 1);
                 }
             }
@@ -1554,16 +1627,18 @@ fn locate_cold(b: &[f64], x: f64) -> (usize, f64, f64) {
     (i, (x - b[i]) / (b[i + 1] - b[i]), 0.0)
 }
 
-/// [`locate_cold`] hunting from the previous interval (`cursor`); at an edge, t is 0 or 1 and
-/// the value is the edge's. A NaN input gives a NaN weight (the run then diverges).
+/// [`locate_cold`] hunting from the previous interval (`cursor`): the interval, `x` held at
+/// the table's edges, and whether it was outside. A NaN input stays NaN (the run then
+/// diverges).
 #[inline(always)]
-fn locate(b: &[f64], inv_widths: &[f64], x: f64, cursor: &Cell<u32>) -> (usize, f64, f64) {
+fn locate(a: &RuntimeAxis, x: f64, cursor: &Cell<u32>) -> (usize, f64, bool) {
+    let b = &a.breakpoints;
     let n = b.len();
     if x < b[0] {
-        return (0, 0.0, x - b[0]);
+        return (0, b[0], true);
     }
     if x > b[n - 1] {
-        return (n - 2, 1.0, x - b[n - 1]);
+        return (n - 2, b[n - 1], true);
     }
     let mut i = cursor.get() as usize;
     while i > 0 && x < b[i] {
@@ -1573,16 +1648,66 @@ fn locate(b: &[f64], inv_widths: &[f64], x: f64, cursor: &Cell<u32>) -> (usize, 
         i += 1;
     }
     cursor.set(i as u32);
-    (i, (x - b[i]) * inv_widths[i], 0.0)
+    (i, x, false)
+}
+
+/// Six lanes of `c` from `at`.
+#[inline(always)]
+fn lanes(c: &[f64], at: usize) -> &[f64; 6] {
+    c[at..at + 6].try_into().expect("six lanes")
+}
+
+/// a + x b, lane by lane.
+#[inline(always)]
+fn lin(x: f64, a: &[f64; 6], b: &[f64; 6]) -> [f64; 6] {
+    [
+        x.mul_add(b[0], a[0]),
+        x.mul_add(b[1], a[1]),
+        x.mul_add(b[2], a[2]),
+        x.mul_add(b[3], a[3]),
+        x.mul_add(b[4], a[4]),
+        x.mul_add(b[5], a[5]),
+    ]
+}
+
+/// The input of an axis (`input` as [`RuntimeAxis::input`]), chosen among scalars: an array
+/// indexed at run time would go through memory, and its assembly from four scalar stores into
+/// one vector load stalls store forwarding at every force evaluation.
+#[inline(always)]
+fn pick(input: usize, inputs: &Inputs) -> f64 {
+    match input {
+        0 => inputs.alpha_rad,
+        1 => inputs.beta_rad,
+        2 => inputs.distance_m,
+        _ => inputs.lateral_m,
+    }
+}
+
+/// What the run-time tables are looked up at.
+#[derive(Debug, Clone, Copy)]
+pub struct Inputs {
+    /// Local angle of attack \[rad\].
+    pub alpha_rad: f64,
+    /// Local sideslip \[rad\].
+    pub beta_rad: f64,
+    /// Distance of the CG from carriage \[m\].
+    pub distance_m: f64,
+    /// Lateral offset of the CG from carriage (launch-frame y) \[m\].
+    pub lateral_m: f64,
+}
+
+/// (c0 + c1 x) + y (c2 + c3 x) with the four coefficient lanes from `at`.
+#[inline(always)]
+fn bilinear(c: &[f64], at: usize, x: f64, y: f64) -> [f64; 6] {
+    let p = lin(x, lanes(c, at), lanes(c, at + 6));
+    let q = lin(x, lanes(c, at + 12), lanes(c, at + 18));
+    lin(y, &p, &q)
 }
 
 /// One propagation's table scratch: interval cursors and excursion counts (fixed size).
 #[derive(Debug, Default)]
 pub struct TableState {
-    cursor: [Cell<u32>; MAX_AXES],
-    index: [Cell<u32>; MAX_AXES],
-    weight: [Cell<f64>; MAX_AXES],
-    excursion: [Cell<f64>; MAX_AXES],
+    cursor: [[Cell<u32>; 3]; MAX_GROUPS],
     evaluations: Cell<u64>,
     count: [Cell<u64>; MAX_TABLES],
     worst: [[Cell<f64>; 5]; MAX_TABLES],
@@ -1675,6 +1800,15 @@ impl fmt::Display for TableExcursion {
 mod tests {
     use super::*;
 
+    fn at(alpha_rad: f64, beta_rad: f64) -> Inputs {
+        Inputs {
+            alpha_rad,
+            beta_rad,
+            distance_m: 0.0,
+            lateral_m: 0.0,
+        }
+    }
+
     fn axis(variable: Variable, b: &[f64]) -> Axis {
         Axis {
             variable,
@@ -1700,11 +1834,11 @@ mod tests {
         p.add_runtime(id, Target::Static(2), axes, values);
         let state = TableState::default();
         state.count_evaluation();
-        let (s, _) = p.evaluate(&state, [5f64.to_radians(), 0.0, 0.0, 0.0]);
+        let (s, _) = p.evaluate(&state, &at(5f64.to_radians(), 0.0));
         assert!((s[2] - 6.5).abs() < 1e-12, "{}", s[2]);
         // Beyond alpha: held at the alpha = 10 deg edge and recorded.
         state.count_evaluation();
-        let (s, _) = p.evaluate(&state, [12f64.to_radians(), 5.0f64.to_radians(), 0.0, 0.0]);
+        let (s, _) = p.evaluate(&state, &at(12f64.to_radians(), 5.0f64.to_radians()));
         assert!((s[2] - 8.0).abs() < 1e-12, "{}", s[2]);
         let r = p.report(&state.excursions());
         assert_eq!(r.len(), 1);

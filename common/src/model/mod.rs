@@ -36,7 +36,7 @@ use crate::elementary::atan2_asin;
 use crate::extension::{TermError, TermInput, TermSet};
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
-use crate::table::{AeroAtMach, PreparedTables, TableState};
+use crate::table::{AeroAtMach, Inputs, PreparedTables, TableState};
 
 pub use aero::{Coefficients, Flow};
 pub use ejector::EjectorCurve;
@@ -672,15 +672,22 @@ fn add_table_terms(
 ) -> Coefficients {
     let (s, d) = tables.evaluate(
         state,
-        [flow.alpha_rad, flow.beta_rad, flow.distance_m, lateral_m],
+        &Inputs {
+            alpha_rad: flow.alpha_rad,
+            beta_rad: flow.beta_rad,
+            distance_m: flow.distance_m,
+            lateral_m,
+        },
     );
     let m = &run.interference_multipliers;
+    let c = tables.constants();
+    // The static tables' values (late: they wait for alpha and beta) added last.
     k.cx = m[0].mul_add(d[0], k.cx - s[0]);
-    k.cy = m[1].mul_add(d[1], k.cy + s[1]);
-    k.cz = m[2].mul_add(d[2], k.cz + s[2]);
-    k.cl = m[3].mul_add(d[3], k.cl + s[3]);
-    k.cm = m[4].mul_add(d[4], k.cm + s[4]);
-    k.cn = m[5].mul_add(d[5], k.cn + s[5]);
+    k.cy = m[1].mul_add(d[1], k.cy + (s[1] + c[1]));
+    k.cz = m[2].mul_add(d[2], k.cz + (s[2] + c[2]));
+    k.cl = m[3].mul_add(d[3], k.cl + (s[3] + c[3]));
+    k.cm = m[4].mul_add(d[4], k.cm + (s[4] + c[4]));
+    k.cn = m[5].mul_add(d[5], k.cn + (s[5] + c[5]));
     k
 }
 
