@@ -59,7 +59,7 @@ pub enum Variable {
 }
 
 impl Variable {
-    /// Every variable, in their fixed nesting order.
+    /// Every variable (each [`Kind`] has its own nesting order, [`Kind::allowed`]).
     pub const ALL: [Variable; 5] = [
         Variable::Mach,
         Variable::Alpha,
@@ -235,7 +235,8 @@ impl Table {
                     kind.allowed_list(", ")
                 ));
             }
-            if previous.is_some_and(|p| p >= a.variable) {
+            let rank = |v: Variable| kind.allowed().iter().position(|&w| w == v);
+            if previous.is_some_and(|p| rank(p) >= rank(a.variable)) {
                 return Err(format!(
                     "axes must nest in the order {}",
                     kind.allowed_list(", ")
@@ -483,7 +484,8 @@ enum Nested {
 
 impl RawTable {
     fn into_coefficient(self, kind: Kind) -> Result<Coefficient, String> {
-        let axes: Vec<Axis> = [
+        // In the kind's nesting order (a variable it may not span goes last, to be refused).
+        let mut axes: Vec<Axis> = [
             (Variable::Mach, self.mach),
             (Variable::Alpha, self.alpha_deg),
             (Variable::Beta, self.beta_deg),
@@ -498,6 +500,12 @@ impl RawTable {
             })
         })
         .collect();
+        axes.sort_by_key(|a| {
+            kind.allowed()
+                .iter()
+                .position(|&v| v == a.variable)
+                .unwrap_or(usize::MAX)
+        });
         if let Some(csv) = self.csv {
             if !axes.is_empty() || self.values.is_some() {
                 return Err(
@@ -836,8 +844,9 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
             if columns.iter().any(|c| matches!(c, Column::Value(..))) {
                 return Err(at("axis columns come before the value columns".into()));
             }
+            let rank = |v: &Variable| kind.allowed().iter().position(|w| w == v);
             if let Some(Column::Axis(p, _)) = columns.last()
-                && *p >= *v
+                && rank(p) >= rank(v)
             {
                 return Err(at(format!(
                     "axis columns must come in the order {} (first axis slowest)",
