@@ -334,11 +334,6 @@ fn a_store_whose_drag_and_pitch_stiffness_change_with_mach_needs_its_tables() {
     ]);
     let without = pooled_fit(d, &constant, &releases, "constants");
     let (jp_c, ja_c) = best_goals(&without);
-    eprintln!(
-        "DEBUG tables {jp} {ja} constants {jp_c} {ja_c} evals {} {}",
-        with["methods"]["ga+lm"]["best"]["evaluations"],
-        without["methods"]["ga+lm"]["best"]["evaluations"]
-    );
     assert!(
         jp_c > 2.0 * 0.003 || ja_c > 2.0 * 0.1,
         "with constants: {jp_c} m, {ja_c} deg"
