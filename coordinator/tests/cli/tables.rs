@@ -61,6 +61,31 @@ fn scenario_tables_writes_a_starting_point_that_simulates_as_the_default() {
     }
 }
 
+#[test]
+fn the_example_store_simulates_inside_its_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let example =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/tabulated-store/scenario.toml");
+    let example = example.to_str().unwrap();
+    ok(&sepval(
+        &[
+            "simulate",
+            "--scenario",
+            example,
+            "--strict-tables",
+            "--out",
+            "store.csv",
+        ],
+        dir.path(),
+    ));
+    assert_eq!(
+        Trajectory::read(&dir.path().join("store.csv"))
+            .unwrap()
+            .len(),
+        201
+    );
+}
+
 /// A directory holding the default scenario with `cz` as the table file `cz.csv` (`csv`).
 fn with_cz_table(dir: &Path, csv: &str) {
     let text = sepval_common::scenario::DEFAULT_SCENARIO_TOML.replace(
