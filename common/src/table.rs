@@ -1189,28 +1189,45 @@ impl Group {
         inputs: &Inputs,
         outside: &mut bool,
     ) -> [f64; 6] {
-        let g = self;
-        let mut cell = 0usize;
-        let mut x = [0.0f64; 3];
-        for (k, a) in g.axes.iter().enumerate() {
-            let (i, x_k, out_k) = locate(a, pick(a.input, inputs), &cursors[k]);
-            cell += i * g.cell_strides[k];
-            x[k] = x_k;
-            *outside |= out_k;
+        let c = &self.cells;
+        // The cell's polynomial, nested: (c0 + c1 x) + y (c2 + c3 x), and so on, one arm per
+        // axis count (unrolled). Helper functions, not closures, do the arithmetic: a closure
+        // is not always inlined into the FMA-compiled propagator.
+        match self.axes.len() {
+            0 => *lanes(c, 0),
+            1 => {
+                let (at, x) = self.axis(0, cursors, inputs, outside);
+                lin(x, lanes(c, at), lanes(c, at + 6))
+            }
+            2 => {
+                let (a0, x) = self.axis(0, cursors, inputs, outside);
+                let (a1, y) = self.axis(1, cursors, inputs, outside);
+                bilinear(c, a0 + a1, x, y)
+            }
+            _ => {
+                let (a0, x) = self.axis(0, cursors, inputs, outside);
+                let (a1, y) = self.axis(1, cursors, inputs, outside);
+                let (a2, z) = self.axis(2, cursors, inputs, outside);
+                let at = a0 + a1 + a2;
+                lin(z, &bilinear(c, at, x, y), &bilinear(c, at + 24, x, y))
+            }
         }
-        let c = &g.cells;
-        // The cell's polynomial, nested: (c0 + c1 x) + y (c2 + c3 x), and so on. (Helper
-        // functions, not closures: closures are not inlined into the FMA-compiled propagator.)
-        match g.axes.len() {
-            0 => *lanes(c, cell),
-            1 => lin(x[0], lanes(c, cell), lanes(c, cell + 6)),
-            2 => bilinear(c, cell, x[0], x[1]),
-            _ => lin(
-                x[2],
-                &bilinear(c, cell, x[0], x[1]),
-                &bilinear(c, cell + 24, x[0], x[1]),
-            ),
-        }
+    }
+
+    /// Axis `k` at `inputs`: the offset of its interval's cells and its input held at the
+    /// edges (`outside` set when held).
+    #[inline(always)]
+    fn axis(
+        &self,
+        k: usize,
+        cursors: &[Cell<u32>; 3],
+        inputs: &Inputs,
+        outside: &mut bool,
+    ) -> (usize, f64) {
+        let a = &self.axes[k];
+        let (i, x, out) = locate(a, pick(a.input, inputs), &cursors[k]);
+        *outside |= out;
+        (i * self.cell_strides[k], x)
     }
 
     /// Expands the grid values into each cell's polynomial (docs/model.md section 3): on
@@ -1276,6 +1293,8 @@ pub struct PreparedTables {
     static_groups: usize,
     /// Constant static coefficients (CY, CZ, Cl, Cm, Cn given as numbers; CA is never here).
     constants: [f64; 6],
+    /// Whether the force evaluation has anything to add (groups, or a constant not 0).
+    runtime: bool,
 }
 
 impl PreparedTables {
@@ -1286,6 +1305,7 @@ impl PreparedTables {
         groups: Vec::new(),
         static_groups: 0,
         constants: [0.0; 6],
+        runtime: false,
     };
 
     /// Whether the scenario has any table.
@@ -1297,7 +1317,7 @@ impl PreparedTables {
     /// Whether the force evaluation has tables to interpolate.
     #[inline(always)]
     pub fn runtime(&self) -> bool {
-        !self.groups.is_empty() || self.constants.iter().any(|&c| c != 0.0)
+        self.runtime
     }
 
     /// Registers a table (name for reports) and interpolates its Mach axis at `mach`: the
@@ -1409,6 +1429,7 @@ impl PreparedTables {
                 &mut self.groups[at]
             }
         };
+        self.runtime = true;
         g.ids.push(id);
         for (p, v) in values.iter().enumerate() {
             // Two tables of one coefficient in one group add (a static table and a constant
@@ -1585,7 +1606,10 @@ pub fn prepare(scenario: &crate::scenario::Scenario) -> (AeroAtMach, [f64; 6], P
         match c.map(|c| &c.value) {
             None => {}
             Some(Coefficient::Constant(v)) if k == 0 => consts.ca0 = *v,
-            Some(Coefficient::Constant(v)) => p.constants[k] = *v,
+            Some(Coefficient::Constant(v)) => {
+                p.constants[k] = *v;
+                p.runtime |= *v != 0.0;
+            }
             Some(Coefficient::Table(t)) => {
                 let (id, axes, values) = p.slice_mach(name, t, mach);
                 if k == 0 && axes.is_empty() {

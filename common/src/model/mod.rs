@@ -682,12 +682,13 @@ fn add_table_terms(
     let m = &run.interference_multipliers;
     let c = tables.constants();
     // The static tables' values (late: they wait for alpha and beta) added last.
-    k.cx = m[0].mul_add(d[0], k.cx - s[0]);
-    k.cy = m[1].mul_add(d[1], k.cy + (s[1] + c[1]));
-    k.cz = m[2].mul_add(d[2], k.cz + (s[2] + c[2]));
-    k.cl = m[3].mul_add(d[3], k.cl + (s[3] + c[3]));
-    k.cm = m[4].mul_add(d[4], k.cm + (s[4] + c[4]));
-    k.cn = m[5].mul_add(d[5], k.cn + (s[5] + c[5]));
+    // The static tables' values (late: they wait for alpha and beta) are added last.
+    k.cx = m[0].mul_add(d[0], k.cx) - s[0];
+    k.cy = m[1].mul_add(d[1], k.cy + c[1]) + s[1];
+    k.cz = m[2].mul_add(d[2], k.cz + c[2]) + s[2];
+    k.cl = m[3].mul_add(d[3], k.cl + c[3]) + s[3];
+    k.cm = m[4].mul_add(d[4], k.cm + c[4]) + s[4];
+    k.cn = m[5].mul_add(d[5], k.cn + c[5]) + s[5];
     k
 }
 
