@@ -360,8 +360,8 @@ pub enum ScenarioError {
         origin: String,
         /// The field, as a TOML path.
         field: String,
-        /// The cause.
-        source: TableError,
+        /// The cause (boxed: it is large and rare).
+        source: Box<TableError>,
     },
     /// A value is out of its physical range.
     #[error("scenario {origin}: `{field}` {reason}")]
@@ -413,7 +413,7 @@ impl Scenario {
         let wrap = |field: &str, source: TableError| ScenarioError::Table {
             origin: origin.to_string(),
             field: field.to_string(),
-            source,
+            source: Box::new(source),
         };
         for (field, mut c) in self.aero.fields_mut() {
             c.resolve(dir).map_err(|e| wrap(field, e))?;
