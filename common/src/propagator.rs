@@ -219,7 +219,7 @@ fn propagate_inline<S: SampleSink>(
             sink.record(index, &observe(run, &off_grid.x), &off_grid.x);
         }
     }
-    if model.tables.any() {
+    if model.tables.in_evaluation() {
         engine.log.tables = table_state.excursions();
     }
     Ok(engine.log)

@@ -27,7 +27,11 @@
 //!   precomputed per scenario ([`PreparedTables`]); a propagation keeps its interval cursors and
 //!   excursion counts in a [`TableState`] of fixed size: no allocation per force evaluation.
 //! - Interval search starts from the previous evaluation's interval (a hunt: the store moves
-//!   little between two stages), so it costs a comparison or two.
+//!   little between two stages), so it costs a comparison or two. Each grid cell holds its
+//!   interpolant as a polynomial in the inputs ((c0 + c1 x) + y (c2 + c3 x), ...), evaluated
+//!   with fused multiply-adds: the same value as the formula above to rounding, and shorter on
+//!   the path from the flow angles to the forces. Tables over the same axes are grouped and
+//!   interpolated six lanes at a time.
 
 use std::cell::Cell;
 use std::fmt;
@@ -1312,6 +1316,14 @@ impl PreparedTables {
     #[inline(always)]
     pub fn any(&self) -> bool {
         !self.info.is_empty()
+    }
+
+    /// Whether force evaluations must see the tables: to interpolate them, or to count the
+    /// evaluations of a run whose Mach lies outside a Mach axis. A scenario whose only tables
+    /// are Mach tables containing its Mach (folded into constants) runs the contract's path.
+    #[inline(always)]
+    pub fn in_evaluation(&self) -> bool {
+        self.runtime || self.mach_excursion.iter().any(|&e| e > 0.0)
     }
 
     /// Whether the force evaluation has tables to interpolate.

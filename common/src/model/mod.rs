@@ -520,7 +520,10 @@ impl<'a> EquationsOfMotion<'a> {
     /// excursion counts in `state`.
     pub fn with_tables(run: &'a RunSetup, model: &'a Model, state: &'a TableState) -> Self {
         EquationsOfMotion {
-            tables: model.tables.any().then_some((&model.tables, state)),
+            tables: model
+                .tables
+                .in_evaluation()
+                .then_some((&model.tables, state)),
             ..EquationsOfMotion::new(run, &model.curve)
         }
     }
