@@ -12,6 +12,7 @@
 //! - [`goals`]: section 5;
 //! - [`telemetry`]: section 6;
 //! - [`effects`]: section 7, the effect catalogue;
+//! - [`table`], [`table_form`]: sections 1 and 3, tabulated coefficients and interference;
 //! - [`noise`]: the measurement noise of the synthetic flight test (section 4);
 //! - [`elementary`], [`lanes`]: section 9, sepval's own elementary functions (no C library),
 //!   written once for one double and for four lanes.
@@ -38,6 +39,8 @@ pub mod propagator;
 pub mod scenario;
 pub mod simulation;
 pub mod synthetic;
+pub mod table;
+pub mod table_form;
 pub mod telemetry;
 pub mod toml_error;
 pub mod units;

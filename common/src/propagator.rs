@@ -30,6 +30,7 @@ use nalgebra::Vector3;
 
 use crate::frames::{dcm_from_quaternion, euler_321_deg, wrap_deg};
 use crate::model::{EquationsOfMotion, Model, RunSetup, StateVector};
+use crate::table::TableState;
 
 /// Tolerance to which switch times are located \[s\] (docs/model.md section 3a).
 pub const SWITCH_TOLERANCE_S: f64 = 1e-12;
@@ -94,6 +95,8 @@ pub struct RunLog {
     pub foot_off_s: [Option<f64>; 2],
     /// Full and part RK4 steps taken on the main trajectory.
     pub steps: u64,
+    /// How often the force evaluations left the scenario's tables (all zero without tables).
+    pub tables: crate::table::TableExcursions,
 }
 
 /// The integrator state between grid points.
@@ -160,9 +163,10 @@ fn propagate_inline<S: SampleSink>(
     times_s: &[f64],
     sink: &mut S,
 ) -> Result<RunLog, Diverged> {
+    let table_state = TableState::default();
     let mut engine = Engine {
         run,
-        equations: EquationsOfMotion::new(run, &model.curve),
+        equations: EquationsOfMotion::with_tables(run, model, &table_state),
         dt_s: model.dt_s,
         log: RunLog::default(),
     };
@@ -214,6 +218,9 @@ fn propagate_inline<S: SampleSink>(
             let off_grid = engine.advance(cursor, t, false)?;
             sink.record(index, &observe(run, &off_grid.x), &off_grid.x);
         }
+    }
+    if model.tables.in_evaluation() {
+        engine.log.tables = table_state.excursions();
     }
     Ok(engine.log)
 }

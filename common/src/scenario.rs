@@ -22,6 +22,9 @@ use sha2::{Digest, Sha256};
 
 use crate::atmosphere::TROPOPAUSE_M;
 use crate::factors::{Factor, FactorSpec, FactorTable};
+use crate::table::{
+    Coefficient, DerivativeCoefficient, InterferenceCoefficient, StaticCoefficient, TableError,
+};
 
 /// The embedded default scenario text (docs/model.md section 1).
 pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../scenarios/eglin_default.toml");
@@ -57,39 +60,171 @@ pub struct Ejector {
     pub curve: Vec<[f64; 2]>,
 }
 
-/// Freestream aerodynamic database, body axes (docs/model.md section 1).
+/// Freestream aerodynamic database, body axes (docs/model.md section 1). Each field is a
+/// constant or a table ([`crate::table`]): static coefficients over Mach, local alpha and local
+/// beta, derivatives over Mach.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[allow(missing_docs)]
 pub struct Aero {
-    pub ca0: f64,
-    pub cz_alpha_per_rad: f64,
-    pub cy_beta_per_rad: f64,
-    pub cm_alpha_per_rad: f64,
-    pub cn_beta_per_rad: f64,
+    /// Axial force coefficient CA (CX = -CA): a constant CA0 or a table CA(M, alpha, beta).
+    pub ca0: StaticCoefficient,
+    /// CZ_alpha [1/rad]; may be left out when `cz` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cz_alpha_per_rad: Option<DerivativeCoefficient>,
+    /// CY_beta [1/rad]; may be left out when `cy` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cy_beta_per_rad: Option<DerivativeCoefficient>,
+    /// Cm_alpha [1/rad]; may be left out when `cm` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cm_alpha_per_rad: Option<DerivativeCoefficient>,
+    /// Cn_beta [1/rad]; may be left out when `cn` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cn_beta_per_rad: Option<DerivativeCoefficient>,
     /// Roll damping, per rad of p d / 2V.
-    pub cl_p_per_rad: f64,
+    pub cl_p_per_rad: DerivativeCoefficient,
     /// Pitch damping, per rad of q d / 2V.
-    pub cm_q_per_rad: f64,
+    pub cm_q_per_rad: DerivativeCoefficient,
     /// Yaw damping, per rad of r d / 2V.
-    pub cn_r_per_rad: f64,
+    pub cn_r_per_rad: DerivativeCoefficient,
+    /// Static side-force coefficient CY(M, alpha, beta), added to CY_beta beta (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cy: Option<StaticCoefficient>,
+    /// Static normal-force coefficient CZ(M, alpha, beta), added to CZ_alpha alpha (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cz: Option<StaticCoefficient>,
+    /// Static rolling-moment coefficient Cl(M, alpha, beta) (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cl: Option<StaticCoefficient>,
+    /// Static pitching-moment coefficient Cm(M, alpha, beta), added to Cm_alpha alpha (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cm: Option<StaticCoefficient>,
+    /// Static yawing-moment coefficient Cn(M, alpha, beta), added to Cn_beta beta (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cn: Option<StaticCoefficient>,
 }
 
-/// Aircraft interference increments at carriage and their decay (docs/model.md section 1).
+/// Aircraft interference increments and their decay (docs/model.md section 1). Each increment
+/// is a constant at carriage, decaying as f(s), or a table over distance (and local alpha and
+/// lateral offset), used as it is.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct Interference {
-    pub dcx0: f64,
-    pub dcy0: f64,
-    pub dcz0: f64,
-    pub dcl0: f64,
-    pub dcm0: f64,
-    pub dcn0: f64,
-    /// Decay length lambda \[m\].
+    pub dcx0: InterferenceCoefficient,
+    pub dcy0: InterferenceCoefficient,
+    pub dcz0: InterferenceCoefficient,
+    pub dcl0: InterferenceCoefficient,
+    pub dcm0: InterferenceCoefficient,
+    pub dcn0: InterferenceCoefficient,
+    /// Decay length lambda \[m\] (of the constant increments).
     pub lambda_m: f64,
-    /// Distance beyond which the interference is zero \[m\].
+    /// Distance beyond which the constant increments' interference is zero \[m\].
     pub s_end_m: f64,
+}
+
+impl Aero {
+    /// Every field that can be a table, with its TOML path (fields left out are omitted).
+    pub fn fields(&self) -> Vec<(&'static str, &Coefficient)> {
+        let mut v = vec![("aero.ca0", &self.ca0.value)];
+        for (name, c) in [
+            ("aero.cz_alpha_per_rad", self.cz_alpha_per_rad.as_ref()),
+            ("aero.cy_beta_per_rad", self.cy_beta_per_rad.as_ref()),
+            ("aero.cm_alpha_per_rad", self.cm_alpha_per_rad.as_ref()),
+            ("aero.cn_beta_per_rad", self.cn_beta_per_rad.as_ref()),
+            ("aero.cl_p_per_rad", Some(&self.cl_p_per_rad)),
+            ("aero.cm_q_per_rad", Some(&self.cm_q_per_rad)),
+            ("aero.cn_r_per_rad", Some(&self.cn_r_per_rad)),
+        ] {
+            if let Some(c) = c {
+                v.push((name, &c.value));
+            }
+        }
+        for (name, c) in [
+            ("aero.cy", self.cy.as_ref()),
+            ("aero.cz", self.cz.as_ref()),
+            ("aero.cl", self.cl.as_ref()),
+            ("aero.cm", self.cm.as_ref()),
+            ("aero.cn", self.cn.as_ref()),
+        ] {
+            if let Some(c) = c {
+                v.push((name, &c.value));
+            }
+        }
+        v
+    }
+
+    /// Every field that can be a table, with its TOML path (fields left out are omitted).
+    pub fn fields_mut(&mut self) -> Vec<(&'static str, TabulatedMut<'_>)> {
+        let mut v: Vec<(&'static str, TabulatedMut<'_>)> =
+            vec![("aero.ca0", TabulatedMut::Static(&mut self.ca0))];
+        for (name, c) in [
+            ("aero.cz_alpha_per_rad", self.cz_alpha_per_rad.as_mut()),
+            ("aero.cy_beta_per_rad", self.cy_beta_per_rad.as_mut()),
+            ("aero.cm_alpha_per_rad", self.cm_alpha_per_rad.as_mut()),
+            ("aero.cn_beta_per_rad", self.cn_beta_per_rad.as_mut()),
+            ("aero.cl_p_per_rad", Some(&mut self.cl_p_per_rad)),
+            ("aero.cm_q_per_rad", Some(&mut self.cm_q_per_rad)),
+            ("aero.cn_r_per_rad", Some(&mut self.cn_r_per_rad)),
+        ] {
+            if let Some(c) = c {
+                v.push((name, TabulatedMut::Derivative(c)));
+            }
+        }
+        for (name, c) in [
+            ("aero.cy", self.cy.as_mut()),
+            ("aero.cz", self.cz.as_mut()),
+            ("aero.cl", self.cl.as_mut()),
+            ("aero.cm", self.cm.as_mut()),
+            ("aero.cn", self.cn.as_mut()),
+        ] {
+            if let Some(c) = c {
+                v.push((name, TabulatedMut::Static(c)));
+            }
+        }
+        v
+    }
+}
+
+impl Interference {
+    /// The six increments (dCX, dCY, dCZ, dCl, dCm, dCn) with their TOML paths.
+    pub fn increments(&self) -> [(&'static str, &InterferenceCoefficient); 6] {
+        [
+            ("interference.dcx0", &self.dcx0),
+            ("interference.dcy0", &self.dcy0),
+            ("interference.dcz0", &self.dcz0),
+            ("interference.dcl0", &self.dcl0),
+            ("interference.dcm0", &self.dcm0),
+            ("interference.dcn0", &self.dcn0),
+        ]
+    }
+
+    /// [`Interference::increments`], mutable.
+    pub fn increments_mut(&mut self) -> [(&'static str, &mut InterferenceCoefficient); 6] {
+        [
+            ("interference.dcx0", &mut self.dcx0),
+            ("interference.dcy0", &mut self.dcy0),
+            ("interference.dcz0", &mut self.dcz0),
+            ("interference.dcl0", &mut self.dcl0),
+            ("interference.dcm0", &mut self.dcm0),
+            ("interference.dcn0", &mut self.dcn0),
+        ]
+    }
+}
+
+/// A mutable aerodynamic field of either kind.
+#[allow(missing_docs)]
+pub enum TabulatedMut<'a> {
+    Static(&'a mut StaticCoefficient),
+    Derivative(&'a mut DerivativeCoefficient),
+}
+
+impl TabulatedMut<'_> {
+    fn resolve(&mut self, dir: &Path) -> Result<(), crate::table::TableError> {
+        match self {
+            TabulatedMut::Static(c) => c.resolve(dir),
+            TabulatedMut::Derivative(c) => c.resolve(dir),
+        }
+    }
 }
 
 /// Flight condition of the aircraft at release (docs/model.md sections 1 and 2).
@@ -218,6 +353,16 @@ pub enum ScenarioError {
         /// The parser's message (it names line and column).
         message: String,
     },
+    /// A table file that cannot be used (the error names its file, line and column).
+    #[error("scenario {origin}: `{field}`: {source}")]
+    Table {
+        /// The scenario file.
+        origin: String,
+        /// The field, as a TOML path.
+        field: String,
+        /// The cause (boxed: it is large and rare).
+        source: Box<TableError>,
+    },
     /// A value is out of its physical range.
     #[error("scenario {origin}: `{field}` {reason}")]
     Invalid {
@@ -237,23 +382,69 @@ impl Scenario {
             .expect("the embedded default scenario is valid (checked by tests)")
     }
 
-    /// Parses and validates scenario TOML; `origin` names the source in errors.
+    /// Parses and validates scenario TOML; `origin` names the source in errors. Tables must be
+    /// inline (a table file needs [`Scenario::load`], which reads it relative to the scenario).
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Scenario, ScenarioError> {
-        let scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+        Scenario::from_toml_str_in(text, origin, None)
+    }
+
+    /// Parses scenario TOML, reads its table files relative to `dir` (when given) into inline
+    /// tables, and validates it.
+    pub fn from_toml_str_in(
+        text: &str,
+        origin: &str,
+        dir: Option<&Path>,
+    ) -> Result<Scenario, ScenarioError> {
+        let mut scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             origin: origin.to_string(),
             message: crate::toml_error::one_line(text, &e),
         })?;
+        if let Some(dir) = dir {
+            scenario.resolve_tables(dir, origin)?;
+        }
         scenario.validate(origin)?;
         Ok(scenario)
     }
 
-    /// Loads and validates a scenario file.
+    /// Reads every table file the scenario references (relative to `dir`) into inline tables,
+    /// so that the scenario carries its tables' contents (the content hash covers them, and a
+    /// worker never needs the files).
+    pub fn resolve_tables(&mut self, dir: &Path, origin: &str) -> Result<(), ScenarioError> {
+        let wrap = |field: &str, source: TableError| ScenarioError::Table {
+            origin: origin.to_string(),
+            field: field.to_string(),
+            source: Box::new(source),
+        };
+        for (field, mut c) in self.aero.fields_mut() {
+            c.resolve(dir).map_err(|e| wrap(field, e))?;
+        }
+        for (field, c) in self.interference.increments_mut() {
+            c.resolve(dir).map_err(|e| wrap(field, e))?;
+        }
+        Ok(())
+    }
+
+    /// Whether any coefficient is a table.
+    pub fn has_tables(&self) -> bool {
+        self.aero
+            .fields()
+            .iter()
+            .any(|(_, c)| !matches!(c, Coefficient::Constant(_)))
+            || self
+                .interference
+                .increments()
+                .iter()
+                .any(|(_, c)| !matches!(c.value, Coefficient::Constant(_)))
+    }
+
+    /// Loads and validates a scenario file (its table files are read relative to it).
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
         let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        Scenario::from_toml_str(&text, &path.display().to_string())
+        let dir = path.parent().unwrap_or(Path::new(""));
+        Scenario::from_toml_str_in(&text, &path.display().to_string(), Some(dir))
     }
 
     /// The scenario as TOML (values round-trip exactly).
@@ -298,6 +489,18 @@ impl Scenario {
             } else {
                 Err(bad(field, format!("= {v}: expected a finite value")))
             }
+        };
+        let check_coefficient = |field: &str, c: &Coefficient| match c {
+            Coefficient::Constant(v) => finite(field, *v),
+            // Tables are checked when they are made (crate::table::Table::new).
+            Coefficient::Table(_) => Ok(()),
+            Coefficient::File(f) => Err(bad(
+                field,
+                format!(
+                    "refers to the table file {}, which was not read: a scenario with table files is loaded from its file (they are relative to it)",
+                    f.csv.display()
+                ),
+            )),
         };
         let s = &self.store;
         positive("store.mass_kg", s.mass_kg)?;
@@ -347,30 +550,47 @@ impl Scenario {
             ));
         }
 
+        for (field, c) in self.aero.fields() {
+            check_coefficient(field, c)?;
+        }
+        for (field, c) in self.interference.increments() {
+            check_coefficient(field, &c.value)?;
+        }
         let a = &self.aero;
-        for (field, v) in [
-            ("aero.ca0", a.ca0),
-            ("aero.cz_alpha_per_rad", a.cz_alpha_per_rad),
-            ("aero.cy_beta_per_rad", a.cy_beta_per_rad),
-            ("aero.cm_alpha_per_rad", a.cm_alpha_per_rad),
-            ("aero.cn_beta_per_rad", a.cn_beta_per_rad),
-            ("aero.cl_p_per_rad", a.cl_p_per_rad),
-            ("aero.cm_q_per_rad", a.cm_q_per_rad),
-            ("aero.cn_r_per_rad", a.cn_r_per_rad),
+        for (slope, table, has_slope, has_table) in [
+            (
+                "aero.cz_alpha_per_rad",
+                "aero.cz",
+                a.cz_alpha_per_rad.is_some(),
+                a.cz.is_some(),
+            ),
+            (
+                "aero.cy_beta_per_rad",
+                "aero.cy",
+                a.cy_beta_per_rad.is_some(),
+                a.cy.is_some(),
+            ),
+            (
+                "aero.cm_alpha_per_rad",
+                "aero.cm",
+                a.cm_alpha_per_rad.is_some(),
+                a.cm.is_some(),
+            ),
+            (
+                "aero.cn_beta_per_rad",
+                "aero.cn",
+                a.cn_beta_per_rad.is_some(),
+                a.cn.is_some(),
+            ),
         ] {
-            finite(field, v)?;
+            if !has_slope && !has_table {
+                return Err(bad(
+                    slope,
+                    format!("is missing: give it, or the static coefficient `{table}` as a table"),
+                ));
+            }
         }
         let i = &self.interference;
-        for (field, v) in [
-            ("interference.dcx0", i.dcx0),
-            ("interference.dcy0", i.dcy0),
-            ("interference.dcz0", i.dcz0),
-            ("interference.dcl0", i.dcl0),
-            ("interference.dcm0", i.dcm0),
-            ("interference.dcn0", i.dcn0),
-        ] {
-            finite(field, v)?;
-        }
         positive("interference.lambda_m", i.lambda_m)?;
         positive("interference.s_end_m", i.s_end_m)?;
 

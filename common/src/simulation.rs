@@ -105,6 +105,12 @@ impl Simulator {
         Ok((traj, log))
     }
 
+    /// The tables a run left (docs/model.md section 3: held at the edge and recorded), named,
+    /// from its log; empty for a scenario without tables or a run that stayed inside them.
+    pub fn table_excursions(&self, log: &RunLog) -> Vec<crate::table::TableExcursion> {
+        self.model.tables.report(&log.tables)
+    }
+
     /// Simulates at `times_s` (strictly increasing).
     pub fn simulate(
         &self,

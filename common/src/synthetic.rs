@@ -4,6 +4,7 @@
 use crate::effects::EffectSet;
 use crate::factors::Factors;
 use crate::noise::{SIGMA_ATT_DEG, SIGMA_POS_M, add_noise};
+use crate::propagator::RunLog;
 use crate::simulation::{SimError, Simulator};
 use crate::telemetry::Trajectory;
 
@@ -20,7 +21,18 @@ pub fn synthetic_flight_test(
     times_s: &[f64],
     noise_seed: Option<u64>,
 ) -> Result<Trajectory, SimError> {
-    let mut traj = sim.simulate(factors, effects, times_s)?;
+    synthetic_flight_test_logged(sim, factors, effects, times_s, noise_seed).map(|(t, _)| t)
+}
+
+/// [`synthetic_flight_test`] with the run's log (switch times, tables left).
+pub fn synthetic_flight_test_logged(
+    sim: &Simulator,
+    factors: &Factors,
+    effects: &EffectSet,
+    times_s: &[f64],
+    noise_seed: Option<u64>,
+) -> Result<(Trajectory, RunLog), SimError> {
+    let (mut traj, log) = sim.simulate_logged(factors, effects, times_s)?;
     let sc = sim.scenario();
     traj.push_metadata("scenario", &sc.name);
     traj.push_metadata("scenario_sha256", &sc.content_hash());
@@ -39,7 +51,7 @@ pub fn synthetic_flight_test(
         }
         None => traj.push_metadata("noise", "none"),
     }
-    Ok(traj)
+    Ok((traj, log))
 }
 
 /// The embedded default synthetic flight test: the truth factors of docs/model.md section 4 on the

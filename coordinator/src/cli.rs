@@ -123,6 +123,10 @@ pub struct FitArgs {
     /// Skip the figures.
     #[arg(long)]
     pub no_figures: bool,
+    /// Fail (exit 2, after writing result.json) when the best fit leaves one of the scenario's
+    /// tables (by default the value is held at the edge and the excursion reported).
+    #[arg(long)]
+    pub strict_tables: bool,
     /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).
     #[arg(long)]
     pub overwrite: bool,
@@ -310,6 +314,10 @@ pub struct SimulateArgs {
     /// Telemetry rate [Hz] (default: the scenario's).
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
+    /// Refuse a run that leaves one of the scenario's tables (by default the value is held at
+    /// the table's edge and the excursion reported).
+    #[arg(long)]
+    pub strict_tables: bool,
     /// Output CSV file (written atomically).
     #[arg(long, value_name = "FILE.csv")]
     pub out: PathBuf,
@@ -330,8 +338,13 @@ pub struct ScenarioArgs {
     /// Scenario to rewrite (validated); the embedded default when absent.
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
-    /// Output TOML file (written atomically).
-    #[arg(long, value_name = "FILE.toml")]
+    /// Write the scenario's aerodynamics and interference as tables (docs/model.md section 1):
+    /// --out is then a directory that receives scenario.toml and tables/*.csv, a starting point
+    /// for your own tabulated data.
+    #[arg(long)]
+    pub tables: bool,
+    /// Output TOML file (written atomically); with --tables, an output directory.
+    #[arg(long, value_name = "FILE.toml|DIR")]
     pub out: PathBuf,
 }
 

@@ -108,6 +108,10 @@ pub struct EventInfo {
     pub name: String,
     /// Its number of samples.
     pub samples: usize,
+    /// The scenario tables the best fit's run of this event left (held at the edge; docs/model.md
+    /// section 3); absent when it left none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tables_left: Vec<sepval_common::table::TableExcursion>,
 }
 
 /// How the run was executed.

@@ -12,7 +12,7 @@
 //! ```
 
 use crate::factors::{Factor, Factors};
-use crate::scenario::Aero;
+use crate::table::AeroAtMach;
 
 /// The flow seen by the store at one force evaluation; effects' coefficient terms read it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,8 +83,8 @@ pub struct AeroConstants {
 }
 
 impl AeroConstants {
-    /// Folds the offsets of `factors` into the database.
-    pub fn new(aero: &Aero, factors: &Factors) -> Self {
+    /// Folds the offsets of `factors` into the database (at the flight Mach).
+    pub fn new(aero: &AeroAtMach, factors: &Factors) -> Self {
         AeroConstants {
             cx0: -(aero.ca0 + factors.get(Factor::Caoff)),
             cy_beta: aero.cy_beta_per_rad,

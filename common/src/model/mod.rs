@@ -36,6 +36,7 @@ use crate::elementary::{atan2_asin, cos, sin};
 use crate::extension::{TermError, TermInput, TermSet};
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
+use crate::table::{AeroAtMach, Inputs, PreparedTables, TableState};
 
 pub use aero::{Coefficients, Flow};
 pub use ejector::EjectorCurve;
@@ -108,6 +109,12 @@ pub struct Model {
     pub initial_velocity_m_s: Vector3<f64>,
     /// Initial body rates [rad/s].
     pub initial_rates_rad_s: Vector3<f64>,
+    /// The freestream database's constants at the flight Mach (docs/model.md section 3).
+    pub aero_at_mach: AeroAtMach,
+    /// The constant interference increments at carriage (dCX0, ..., dCn0; 0 where tabulated).
+    pub interference_at_carriage: [f64; 6],
+    /// The scenario's tables, ready for the force evaluation (docs/model.md section 3).
+    pub tables: PreparedTables,
 }
 
 impl Model {
@@ -119,6 +126,7 @@ impl Model {
         let v_inf = f.mach * air.speed_of_sound_m_s;
         let (a, b) = (f.alpha_deg.to_radians(), f.beta_deg.to_radians());
         let theta_a = (f.alpha_deg + f.gamma_deg).to_radians();
+        let (aero_at_mach, interference_at_carriage, tables) = crate::table::prepare(scenario);
         Model {
             scenario: scenario.clone(),
             mass_kg: s.mass_kg,
@@ -141,6 +149,9 @@ impl Model {
             dt_s: scenario.integrator.dt_s,
             initial_velocity_m_s: Vector3::from(scenario.initial.velocity_m_s),
             initial_rates_rad_s: Vector3::from(scenario.initial.rates_deg_s.map(f64::to_radians)),
+            aero_at_mach,
+            interference_at_carriage,
+            tables,
         }
     }
 
@@ -198,6 +209,8 @@ pub struct RunSetup {
     pub aero: aero::AeroConstants,
     /// Interference increments times their multipliers: (dCX, dCY, dCZ, dCl, dCm, dCn).
     pub interference_increments: [f64; 6],
+    /// The interference multipliers (caintfac, ..., cnintfac), for tabulated increments.
+    pub interference_multipliers: [f64; 6],
     /// Interference decay f(s).
     pub decay: InterferenceDecay,
     /// Forward and aft feet.
@@ -278,7 +291,7 @@ impl RunSetup {
             ia[1] * fx(Factor::Yinerfac),
             ia[2] * fx(Factor::Zinerfac),
         ));
-        let i = &sc.interference;
+        let i = &model.interference_at_carriage;
         let mut run = RunSetup {
             inv_mass_per_kg: 1.0 / model.mass_kg,
             inertia_kg_m2: inertia,
@@ -292,16 +305,24 @@ impl RunSetup {
             half_diameter_m: 0.5 * model.diameter_m,
             v_aircraft_air_l_m_s: model.v_aircraft_air_l_m_s,
             gravity_l_m_s2: model.gravity_l_m_s2,
-            aero: aero::AeroConstants::new(&sc.aero, factors),
+            aero: aero::AeroConstants::new(&model.aero_at_mach, factors),
             interference_increments: [
-                fx(Factor::Caintfac) * i.dcx0,
-                fx(Factor::Cyintfac) * i.dcy0,
-                fx(Factor::Czintfac) * i.dcz0,
-                fx(Factor::Clintfac) * i.dcl0,
-                fx(Factor::Cmintfac) * i.dcm0,
-                fx(Factor::Cnintfac) * i.dcn0,
+                fx(Factor::Caintfac) * i[0],
+                fx(Factor::Cyintfac) * i[1],
+                fx(Factor::Czintfac) * i[2],
+                fx(Factor::Clintfac) * i[3],
+                fx(Factor::Cmintfac) * i[4],
+                fx(Factor::Cnintfac) * i[5],
             ],
-            decay: InterferenceDecay::new(i.lambda_m, i.s_end_m),
+            interference_multipliers: [
+                fx(Factor::Caintfac),
+                fx(Factor::Cyintfac),
+                fx(Factor::Czintfac),
+                fx(Factor::Clintfac),
+                fx(Factor::Cmintfac),
+                fx(Factor::Cnintfac),
+            ],
+            decay: InterferenceDecay::new(sc.interference.lambda_m, sc.interference.s_end_m),
             feet: [
                 Foot {
                     x_m: model.feet_x_m[0],
@@ -470,6 +491,8 @@ impl RunSetup {
 pub struct EquationsOfMotion<'a> {
     run: &'a RunSetup,
     curve: &'a EjectorCurve,
+    /// The scenario's tables and this propagation's table scratch (none without tables).
+    tables: Option<(&'a PreparedTables, &'a TableState)>,
     /// 0.5 rho S / m [1/m]: times V^2 and a force coefficient, an acceleration.
     accel_per_speed2: f64,
     /// 0.5 rho S d \[kg\]: times V^2 and a moment coefficient, a moment.
@@ -479,14 +502,29 @@ pub struct EquationsOfMotion<'a> {
 }
 
 impl<'a> EquationsOfMotion<'a> {
-    /// The equations of `run` with the ejector force curve `curve`.
+    /// The equations of `run` with the ejector force curve `curve`, for a scenario without
+    /// tables (the flow alone does not depend on them; for the forces of a scenario with
+    /// tables, use [`EquationsOfMotion::with_tables`]).
     pub fn new(run: &'a RunSetup, curve: &'a EjectorCurve) -> Self {
         EquationsOfMotion {
             run,
             curve,
+            tables: None,
             accel_per_speed2: run.half_rho_area * run.inv_mass_per_kg,
             moment_per_speed2: run.half_rho_area * run.diameter_m,
             reference_arm: run.aero_reference_x_m / run.diameter_m,
+        }
+    }
+
+    /// The equations of `run` for `model` (its ejector curve and tables), keeping cursors and
+    /// excursion counts in `state`.
+    pub fn with_tables(run: &'a RunSetup, model: &'a Model, state: &'a TableState) -> Self {
+        EquationsOfMotion {
+            tables: model
+                .tables
+                .in_evaluation()
+                .then_some((&model.tables, state)),
+            ..EquationsOfMotion::new(run, &model.curve)
         }
     }
 
@@ -561,6 +599,12 @@ impl<'a> EquationsOfMotion<'a> {
         // Section 3: the six coefficients, then the catalogue's extra terms (section 7) and
         // the extension's (section 11).
         let mut k = run.aero.coefficients(&flow, &run.interference_increments);
+        if let Some((tables, state)) = self.tables {
+            state.count_evaluation();
+            if tables.runtime() {
+                k = add_table_terms(run, tables, state, &flow, x[1], k);
+            }
+        }
         if run.coefficient_term_count > 0 {
             k = run.add_coefficient_terms(flow, k);
         }
@@ -615,6 +659,40 @@ impl<'a> EquationsOfMotion<'a> {
         let [dp, dq, dr] = run.angular_acceleration([mx, my, mz], [p, q, r]);
         [vx, vy, vz, ax, ay, az, dq0, dq1, dq2, dq3, dp, dq, dr]
     }
+}
+
+/// Adds the tables' terms (docs/model.md section 3, "Tabulated coefficients"): the static
+/// coefficients (CX = -CA) and the tabulated interference increments times their multipliers,
+/// at the stage's local alpha and beta, distance from carriage and lateral offset `lateral_m`.
+#[inline(always)]
+fn add_table_terms(
+    run: &RunSetup,
+    tables: &PreparedTables,
+    state: &TableState,
+    flow: &Flow,
+    lateral_m: f64,
+    mut k: Coefficients,
+) -> Coefficients {
+    let (s, d) = tables.evaluate(
+        state,
+        &Inputs {
+            alpha_rad: flow.alpha_rad,
+            beta_rad: flow.beta_rad,
+            distance_m: flow.distance_m,
+            lateral_m,
+        },
+    );
+    let m = &run.interference_multipliers;
+    let c = tables.constants();
+    // The static tables' values (late: they wait for alpha and beta) added last.
+    // The static tables' values (late: they wait for alpha and beta) are added last.
+    k.cx = m[0].mul_add(d[0], k.cx) - s[0];
+    k.cy = m[1].mul_add(d[1], k.cy + c[1]) + s[1];
+    k.cz = m[2].mul_add(d[2], k.cz + c[2]) + s[2];
+    k.cl = m[3].mul_add(d[3], k.cl + c[3]) + s[3];
+    k.cm = m[4].mul_add(d[4], k.cm + c[4]) + s[4];
+    k.cn = m[5].mul_add(d[5], k.cn + c[5]) + s[5];
+    k
 }
 
 /// a . b with fused multiply-adds.

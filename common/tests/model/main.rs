@@ -8,4 +8,5 @@ mod conformance;
 mod effects;
 mod elementary;
 mod fuzz;
+mod tables;
 mod verification;

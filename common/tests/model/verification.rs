@@ -185,7 +185,8 @@ fn off_grid_samples_lie_on_the_trajectory() {
 fn divergence_is_reported_with_its_time() {
     // A wildly unstable store: huge pitch instability with a tiny pitch inertia.
     let mut scenario = Scenario::embedded_default();
-    scenario.aero.cm_alpha_per_rad = 500.0;
+    scenario.aero.cm_alpha_per_rad =
+        Some(sepval_common::table::DerivativeCoefficient::constant(500.0));
     scenario.store.iyy_kg_m2 = 0.5;
     let sim = Simulator::new(&scenario);
     let err = sim

@@ -225,6 +225,40 @@ mod tests {
         assert_eq!(back.scenario_sha256(), j.scenario_sha256());
     }
 
+    /// A scenario's tables travel with it, inline: a worker needs no table file, and what it
+    /// decodes has the same content hash and simulates the same trajectory.
+    #[test]
+    fn tables_travel_inline_in_the_setup() {
+        let dir = tempfile::tempdir().unwrap();
+        let form =
+            sepval_common::table_form::table_form(&Scenario::embedded_default(), true).unwrap();
+        for (p, text) in &form.files {
+            std::fs::create_dir_all(dir.path().join(p).parent().unwrap()).unwrap();
+            std::fs::write(dir.path().join(p), text).unwrap();
+        }
+        let path = dir.path().join("scenario.toml");
+        std::fs::write(&path, form.scenario.to_toml_string()).unwrap();
+        let scenario = Scenario::load(&path).unwrap();
+        let j = Job::single(
+            "tables",
+            &scenario,
+            sepval_common::synthetic::default_flight_test(),
+        );
+        let (h, bytes) = encode_setup(&j);
+        drop(dir); // the files are gone: the setup must not need them
+        let back = decode_setup(&h, &bytes).unwrap();
+        assert_eq!(back.scenario_sha256(), j.scenario_sha256());
+        let sim = &back.events()[0].simulator;
+        assert_eq!(sim.scenario(), &scenario);
+        let f = sepval_common::factors::Factors::TRUTH;
+        let none = sepval_common::effects::EffectSet::NONE;
+        let times = sim.default_times();
+        assert_eq!(
+            sim.simulate(&f, &none, &times).unwrap(),
+            j.events()[0].simulator.simulate(&f, &none, &times).unwrap()
+        );
+    }
+
     /// A count of events is refused at the first event that does not decode, with nothing
     /// allocated for the others (found by `fuzz_tests::setup_mutations`: 4096 events of 24
     /// bytes each allocated 4.8 MB up front, 48 times the bytes present).

@@ -166,6 +166,26 @@ pub fn run(args: FitArgs) -> Result<()> {
     }
     println!("results in {}", args.out.join("result.json").display());
     drop(run_dir);
+    // Tables left by the best fit: reported, or an error with --strict-tables.
+    let left: Vec<String> = output
+        .result
+        .events
+        .iter()
+        .flat_map(|e| {
+            e.tables_left
+                .iter()
+                .map(move |x| format!("{}: {x}", e.name))
+        })
+        .collect();
+    if args.strict_tables && !left.is_empty() {
+        anyhow::bail!(
+            "--strict-tables: the best fit {} (result.json records it)",
+            left.join("; and ")
+        );
+    }
+    for l in &left {
+        eprintln!("warning: {l}");
+    }
     Ok(())
 }
 

@@ -1,18 +1,64 @@
-//! `sepval scenario`: a scenario written as TOML (the embedded default to start your own).
+//! `sepval scenario`: a scenario written as TOML (the embedded default to start your own), or
+//! with `--tables` as a directory of TOML and CSV tables (docs/model.md section 1, "Tables").
 
-use anyhow::Result;
+use anyhow::{Context, Result, bail};
+use sepval_common::atomic_file::write_atomically;
+use sepval_common::scenario::Scenario;
 
 use super::inputs;
 use crate::cli::ScenarioArgs;
 
+const HEADER: &str = "# sepval scenario (SI units, angles in degrees); docs/model.md section 1 describes each field.\n";
+
 /// Runs `sepval scenario`.
 pub fn run(args: ScenarioArgs) -> Result<()> {
     let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
+    if !args.tables {
+        let text = format!("{HEADER}{}", scenario.to_toml_string());
+        write_atomically(&args.out, text.as_bytes())?;
+        eprintln!("wrote {}", args.out.display());
+        return Ok(());
+    }
+    let form = sepval_common::table_form::table_form(&scenario, true)
+        .map_err(anyhow::Error::msg)
+        .context("--tables")?;
+    let dir = &args.out;
+    let toml_path = dir.join("scenario.toml");
+    if dir.exists() && !dir.is_dir() {
+        bail!(
+            "--out {} with --tables: expected a directory",
+            dir.display()
+        );
+    }
+    for p in std::iter::once(toml_path.clone()).chain(form.files.iter().map(|(p, _)| dir.join(p))) {
+        if p.exists() {
+            bail!(
+                "--out {}: {} exists; choose a new directory (nothing was written)",
+                dir.display(),
+                p.display()
+            );
+        }
+    }
+    for (p, text) in &form.files {
+        let path = dir.join(p);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create {}", parent.display()))?;
+        }
+        write_atomically(&path, text.as_bytes())?;
+    }
     let text = format!(
-        "# sepval scenario (SI units, angles in degrees); docs/model.md section 1 describes each field.\n{}",
-        scenario.to_toml_string()
+        "{HEADER}# Tables: docs/model.md section 1 (\"Tables\"); CSV files are relative to this file.\n{}",
+        form.scenario.to_toml_string()
     );
-    sepval_common::atomic_file::write_atomically(&args.out, text.as_bytes())?;
-    eprintln!("wrote {}", args.out.display());
+    write_atomically(&toml_path, text.as_bytes())?;
+    // What was written reads back.
+    Scenario::load(&toml_path).context("the scenario written as tables does not read back")?;
+    eprintln!(
+        "wrote {} and {} table files in {}",
+        toml_path.display(),
+        form.files.len(),
+        dir.join("tables").display()
+    );
     Ok(())
 }

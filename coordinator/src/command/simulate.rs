@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use sepval_common::limits::{check_sampling, check_steps};
 use sepval_common::simulation::{Simulator, sample_times};
-use sepval_common::synthetic::synthetic_flight_test;
+use sepval_common::synthetic::synthetic_flight_test_logged;
 
 use super::{inputs, positive};
 use crate::cli::SimulateArgs;
@@ -22,8 +22,18 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     check_sampling(t_end, rate).with_context(|| format!("--t-end {t_end} with --rate {rate}"))?;
     let sim = Simulator::new(&scenario);
     let times = sample_times(t_end, rate);
-    let mut traj = synthetic_flight_test(&sim, &factors, &effects, &times, args.noise_seed)
-        .context("simulation failed")?;
+    let (mut traj, log) =
+        synthetic_flight_test_logged(&sim, &factors, &effects, &times, args.noise_seed)
+            .context("simulation failed")?;
+    // Tables left: held at the edge and reported, or refused (docs/model.md section 3).
+    let left = sim.table_excursions(&log);
+    if args.strict_tables && !left.is_empty() {
+        let lines: Vec<String> = left.iter().map(|e| e.to_string()).collect();
+        anyhow::bail!(
+            "--strict-tables: the run {} (nothing written)",
+            lines.join("; and ")
+        );
+    }
     traj.comments
         .insert(0, format!("sepval simulate --factors {}", args.factors));
     traj.write(&args.out)?;
@@ -33,5 +43,8 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         traj.len(),
         traj.times_s.last().copied().unwrap_or(0.0)
     );
+    for e in &left {
+        eprintln!("warning: {e}");
+    }
     Ok(())
 }

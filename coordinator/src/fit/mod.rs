@@ -517,6 +517,14 @@ pub fn run_fit(
             .map(|e| EventInfo {
                 name: e.name.clone(),
                 samples: e.data.len(),
+                tables_left: match best {
+                    Some((f, _)) if e.simulator.model().tables.any() => e
+                        .simulator
+                        .simulate_logged(&f, &EffectSet::NONE, &e.data.times_s)
+                        .map(|(_, log)| e.simulator.table_excursions(&log))
+                        .unwrap_or_default(),
+                    _ => Vec::new(),
+                },
             })
             .collect(),
         data_sha256: job.data_sha256().to_string(),

@@ -246,7 +246,9 @@ fn a_roll_damping_change_is_discovered_as_a_rate_term() {
     let mut model = default_scenario();
     model.initial.rates_deg_s = [120.0, 0.0, 0.0];
     let mut truth = model.clone();
-    truth.aero.cl_p_per_rad *= 2.0;
+    truth.aero.cl_p_per_rad = sepval_common::table::DerivativeCoefficient::constant(
+        2.0 * model.aero.cl_p_per_rad.as_constant().unwrap(),
+    );
     let r = release(&truth, None, 13);
     let d = diagnose(dir.path(), &[r], 1, Some(&model));
     let first = found_first(&d, dir.path(), "Cl", "rate");

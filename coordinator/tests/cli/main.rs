@@ -13,3 +13,4 @@ mod fit;
 mod fuzz;
 mod hardening;
 mod refine;
+mod tables;

@@ -1,0 +1,203 @@
+//! A constant-form scenario written as tables: the starting point `sepval scenario --tables`
+//! writes for users who bring their own tabulated data.
+//!
+//! Source: `docs/model.md` section 1 ("Tables"). The linear terms of section 3 become static
+//! tables over Mach, alpha and beta (CA = CA0, CY = CY_beta beta, CZ = CZ_alpha alpha, Cl = 0,
+//! Cm = Cm_alpha alpha, Cn = Cn_beta beta), constant in Mach; the damping derivatives become
+//! tables over Mach; and (optionally) each interference increment becomes a table over distance
+//! sampled from dC0 f(s).
+//!
+//! Choices made here:
+//! - alpha and beta from -45 to 45 deg every 5 deg: a linear function is interpolated exactly
+//!   (to rounding) on any grid, so the aerodynamic tables reproduce the constant form to
+//!   rounding; the grid is there to be edited.
+//! - Mach breakpoints 0.4, 0.8, 1.2 and 1.6, widened to contain the flight Mach.
+//! - The interference grid is graded: every 0.01 m to 1 m, every 0.05 m to 3 m, every 0.25 m to
+//!   s_end, then s_end (where f = 0) and 100 m (still 0), so that the event never leaves it. The
+//!   linear interpolation of f(s) between breakpoints 0.01 m apart near carriage differs from
+//!   the exponential by at most 0.01^2 / (8 lambda^2) = 3.5e-5 of dC0 there (the trajectory
+//!   difference this makes is measured by the test `default_as_tables_*`).
+
+use std::path::PathBuf;
+
+use crate::model::InterferenceDecay;
+use crate::scenario::Scenario;
+use crate::table::{Axis, Coefficient, DerivativeCoefficient, TableFile, Variable, write_csv};
+
+/// A scenario in table form: the TOML's scenario (referring to its files) and the files, each
+/// with its path relative to the scenario file.
+#[derive(Debug, Clone)]
+pub struct TableForm {
+    /// The scenario, its tables as file references.
+    pub scenario: Scenario,
+    /// (relative path, CSV text) of each table file.
+    pub files: Vec<(PathBuf, String)>,
+}
+
+fn file<K>(path: &str, column: &str) -> crate::table::Tabulated<K>
+where
+    K: crate::table::TableKind,
+{
+    let mut c = crate::table::Tabulated::<K>::constant(0.0);
+    c.value = Coefficient::File(TableFile {
+        csv: PathBuf::from(path),
+        column: Some(column.to_string()),
+    });
+    c
+}
+
+fn grid(from: f64, to: f64, step: f64) -> Vec<f64> {
+    let n = ((to - from) / step).round() as usize;
+    (0..=n).map(|k| from + k as f64 * step).collect()
+}
+
+/// Writes the constant coefficients of `scenario` (without tables) as tables; the interference
+/// too when `interference` is set. Refuses a scenario that already has tables.
+pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, String> {
+    if scenario.has_tables() {
+        return Err(
+            "the scenario already has tables: only a constant form is written as tables".into(),
+        );
+    }
+    let constant = |c: &Coefficient| match c {
+        Coefficient::Constant(v) => *v,
+        _ => unreachable!("checked: no tables"),
+    };
+    let a = &scenario.aero;
+    let slope = |c: &Option<DerivativeCoefficient>| c.as_ref().map_or(0.0, |c| constant(&c.value));
+    let mach_flight = scenario.flight.mach;
+    let mut mach = vec![0.4, 0.8, 1.2, 1.6];
+    if mach_flight < mach[0] {
+        mach.insert(0, mach_flight);
+    }
+    if mach_flight > mach[mach.len() - 1] {
+        mach.push(mach_flight);
+    }
+    let angles = grid(-45.0, 45.0, 5.0);
+    let axes = vec![
+        Axis {
+            variable: Variable::Mach,
+            breakpoints: mach.clone(),
+        },
+        Axis {
+            variable: Variable::Alpha,
+            breakpoints: angles.clone(),
+        },
+        Axis {
+            variable: Variable::Beta,
+            breakpoints: angles.clone(),
+        },
+    ];
+    let (ca0, cy_b, cz_a, cm_a, cn_b) = (
+        constant(&a.ca0.value),
+        slope(&a.cy_beta_per_rad),
+        slope(&a.cz_alpha_per_rad),
+        slope(&a.cm_alpha_per_rad),
+        slope(&a.cn_beta_per_rad),
+    );
+    let mut columns: [Vec<f64>; 6] = Default::default();
+    for _ in &mach {
+        for al in &angles {
+            for be in &angles {
+                let (al, be) = (al.to_radians(), be.to_radians());
+                for (c, v) in [ca0, cy_b * be, cz_a * al, 0.0, cm_a * al, cn_b * be]
+                    .into_iter()
+                    .enumerate()
+                {
+                    columns[c].push(v);
+                }
+            }
+        }
+    }
+    let static_csv = write_csv(
+        &axes,
+        &[
+            ("ca", "-", &columns[0]),
+            ("cy", "-", &columns[1]),
+            ("cz", "-", &columns[2]),
+            ("cl", "-", &columns[3]),
+            ("cm", "-", &columns[4]),
+            ("cn", "-", &columns[5]),
+        ],
+    );
+    let mach_axis = [Axis {
+        variable: Variable::Mach,
+        breakpoints: mach.clone(),
+    }];
+    let damping: Vec<Vec<f64>> = [&a.cl_p_per_rad, &a.cm_q_per_rad, &a.cn_r_per_rad]
+        .iter()
+        .map(|c| vec![constant(&c.value); mach.len()])
+        .collect();
+    let derivatives_csv = write_csv(
+        &mach_axis,
+        &[
+            ("cl_p", "1/rad", &damping[0]),
+            ("cm_q", "1/rad", &damping[1]),
+            ("cn_r", "1/rad", &damping[2]),
+        ],
+    );
+
+    let mut s = scenario.clone();
+    s.description = format!(
+        "{} (written as tables by `sepval scenario --tables`)",
+        scenario.description
+    );
+    s.aero.ca0 = file::<crate::table::StaticKind>("tables/aero_static.csv", "ca");
+    s.aero.cy = Some(file("tables/aero_static.csv", "cy"));
+    s.aero.cz = Some(file("tables/aero_static.csv", "cz"));
+    s.aero.cl = Some(file("tables/aero_static.csv", "cl"));
+    s.aero.cm = Some(file("tables/aero_static.csv", "cm"));
+    s.aero.cn = Some(file("tables/aero_static.csv", "cn"));
+    s.aero.cy_beta_per_rad = None;
+    s.aero.cz_alpha_per_rad = None;
+    s.aero.cm_alpha_per_rad = None;
+    s.aero.cn_beta_per_rad = None;
+    s.aero.cl_p_per_rad = file("tables/aero_damping.csv", "cl_p");
+    s.aero.cm_q_per_rad = file("tables/aero_damping.csv", "cm_q");
+    s.aero.cn_r_per_rad = file("tables/aero_damping.csv", "cn_r");
+    let mut files = vec![
+        (PathBuf::from("tables/aero_static.csv"), static_csv),
+        (PathBuf::from("tables/aero_damping.csv"), derivatives_csv),
+    ];
+    if interference {
+        let i = &scenario.interference;
+        let decay = InterferenceDecay::new(i.lambda_m, i.s_end_m);
+        let mut d = grid(0.0, 1.0, 0.01);
+        d.extend(grid(1.0, 3.0, 0.05).into_iter().skip(1));
+        d.extend(
+            grid(3.0, i.s_end_m, 0.25)
+                .into_iter()
+                .skip(1)
+                .filter(|&x| x < i.s_end_m),
+        );
+        d.extend([i.s_end_m, (i.s_end_m + 1.0).max(100.0)]);
+        let names = ["dcx", "dcy", "dcz", "dcl", "dcm", "dcn"];
+        let values: Vec<Vec<f64>> = i
+            .increments()
+            .iter()
+            .map(|(_, c)| {
+                let c0 = constant(&c.value);
+                d.iter().map(|&s| c0 * decay.factor(s)).collect()
+            })
+            .collect();
+        let cols: Vec<(&str, &str, &[f64])> = names
+            .iter()
+            .zip(&values)
+            .map(|(n, v)| (*n, "-", v.as_slice()))
+            .collect();
+        files.push((
+            PathBuf::from("tables/interference.csv"),
+            write_csv(
+                &[Axis {
+                    variable: Variable::Distance,
+                    breakpoints: d,
+                }],
+                &cols,
+            ),
+        ));
+        for ((_, c), n) in s.interference.increments_mut().into_iter().zip(names) {
+            *c = file::<crate::table::InterferenceKind>("tables/interference.csv", n);
+        }
+    }
+    Ok(TableForm { scenario: s, files })
+}
