@@ -57,16 +57,17 @@ fn variable(r: Regressor) -> &'static str {
 }
 
 /// The modelled carriage increment on `axis`, signed as a term on that axis adds (a term on
-/// `CA` subtracts from CX, docs/model.md section 11.2); `None` for the ejector.
+/// `CA` subtracts from CX, docs/model.md section 11.2); `None` for the ejector and for a
+/// tabulated increment (it has no single sign).
 pub fn carriage_increment(interference: &Interference, axis: Axis) -> Option<f64> {
     let i = interference;
     match axis {
-        Axis::CA => Some(-i.dcx0),
-        Axis::CY => Some(i.dcy0),
-        Axis::CZ => Some(i.dcz0),
-        Axis::Cl => Some(i.dcl0),
-        Axis::Cm => Some(i.dcm0),
-        Axis::Cn => Some(i.dcn0),
+        Axis::CA => i.dcx0.as_constant().map(|v| -v),
+        Axis::CY => i.dcy0.as_constant(),
+        Axis::CZ => i.dcz0.as_constant(),
+        Axis::Cl => i.dcl0.as_constant(),
+        Axis::Cm => i.dcm0.as_constant(),
+        Axis::Cn => i.dcn0.as_constant(),
         Axis::Ejector => None,
     }
 }
@@ -181,13 +182,14 @@ mod tests {
     }
 
     fn carriage() -> Interference {
+        use sepval_common::table::Tabulated;
         Interference {
-            dcx0: 0.1,
-            dcy0: 0.0,
-            dcz0: -0.2,
-            dcl0: 0.0,
-            dcm0: -0.05,
-            dcn0: 0.02,
+            dcx0: Tabulated::constant(0.1),
+            dcy0: Tabulated::constant(0.0),
+            dcz0: Tabulated::constant(-0.2),
+            dcl0: Tabulated::constant(0.0),
+            dcm0: Tabulated::constant(-0.05),
+            dcn0: Tabulated::constant(0.02),
             lambda_m: 0.6,
             s_end_m: 3.0,
         }
