@@ -1,0 +1,364 @@
+//! Table CSV files (docs/model.md section 1, "Tables"): a header naming each column and its
+//! unit, one row per grid point; the reader refuses a bad file with its line and column.
+
+use super::*;
+
+/// Splits a CSV line into trimmed fields (double quotes around a whole field are removed).
+fn fields(line: &str) -> Vec<String> {
+    line.split(',')
+        .map(|f| {
+            let f = f.trim();
+            f.strip_prefix('"')
+                .and_then(|g| g.strip_suffix('"'))
+                .unwrap_or(f)
+                .trim()
+                .to_string()
+        })
+        .collect()
+}
+
+/// One column of a table file.
+enum Column {
+    Axis(Variable, Conversion),
+    Value(String, Conversion),
+}
+
+/// Reads the table of `kind` in a CSV file: a header row `name [unit]` per column, the axis
+/// columns first (in nesting order), then one or more value columns, then one row per grid
+/// point in row-major order (first axis slowest). `column` picks the value column (needed when
+/// there are several). Lines starting with `#` and blank lines are skipped.
+pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, TableError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| TableError::Io {
+        file: file.clone(),
+        message: e.to_string(),
+    })?;
+    let mut lines = text
+        .trim_start_matches('\u{feff}')
+        .lines()
+        .enumerate()
+        .map(|(k, l)| (k + 1, l))
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let Some((header_line, header)) = lines.next() else {
+        return Err(TableError::Empty { file });
+    };
+    let names = fields(header);
+    let mut columns = Vec::with_capacity(names.len());
+    for (k, h) in names.iter().enumerate() {
+        let at = |reason: String| TableError::Header {
+            file: file.clone(),
+            line: header_line,
+            column: k + 1,
+            header: h.clone(),
+            reason,
+        };
+        let (name, unit) = match h.find('[') {
+            Some(open) if h.ends_with(']') => (h[..open].trim(), h[open + 1..h.len() - 1].trim()),
+            _ => {
+                let variable = Variable::ALL.iter().find(|v| v.csv_name() == h);
+                return Err(TableError::MissingUnit {
+                    file: file.clone(),
+                    line: header_line,
+                    column: k + 1,
+                    header: h.clone(),
+                    example: variable
+                        .map(|v| v.csv_units()[0].0)
+                        .unwrap_or(kind.value_units()[0].0)
+                        .to_string(),
+                });
+            }
+        };
+        let unknown = |accepted: &[(&str, Conversion)]| TableError::UnknownUnit {
+            file: file.clone(),
+            line: header_line,
+            column: k + 1,
+            header: h.clone(),
+            expected: accepted
+                .iter()
+                .map(|(u, _)| format!("`{name} [{u}]`"))
+                .collect::<Vec<_>>()
+                .join(" or "),
+        };
+        let c = if let Some(v) = Variable::ALL.iter().find(|v| v.csv_name() == name) {
+            if !kind.allowed().contains(v) {
+                return Err(at(format!(
+                    "{} may be tabulated over {} only, not over {name}",
+                    kind.what(),
+                    kind.allowed_list(", ")
+                )));
+            }
+            let conv = v
+                .csv_units()
+                .iter()
+                .find(|(u, _)| *u == unit)
+                .ok_or_else(|| unknown(v.csv_units()))?
+                .1;
+            if columns.iter().any(|c| matches!(c, Column::Value(..))) {
+                return Err(at("axis columns come before the value columns".into()));
+            }
+            let rank = |v: &Variable| kind.allowed().iter().position(|w| w == v);
+            if let Some(Column::Axis(p, _)) = columns.last()
+                && rank(p) >= rank(v)
+            {
+                return Err(at(format!(
+                    "axis columns must come in the order {} (first axis slowest)",
+                    kind.allowed_list(", ")
+                )));
+            }
+            Column::Axis(*v, conv)
+        } else {
+            if name.is_empty() {
+                return Err(at("a column needs a name".into()));
+            }
+            let conv = kind
+                .value_units()
+                .iter()
+                .find(|(u, _)| *u == unit)
+                .ok_or_else(|| unknown(kind.value_units()))?
+                .1;
+            if columns
+                .iter()
+                .any(|c| matches!(c, Column::Value(n, _) if n == name))
+            {
+                return Err(at(format!("repeats the column `{name}`")));
+            }
+            Column::Value(name.to_string(), conv)
+        };
+        columns.push(c);
+    }
+    let n_axes = columns
+        .iter()
+        .filter(|c| matches!(c, Column::Axis(..)))
+        .count();
+    let value_names: Vec<&str> = columns
+        .iter()
+        .filter_map(|c| match c {
+            Column::Value(n, _) => Some(n.as_str()),
+            _ => None,
+        })
+        .collect();
+    let header_error = |column: usize, reason: String| TableError::Header {
+        file: file.clone(),
+        line: header_line,
+        column,
+        header: names
+            .get(column.saturating_sub(1))
+            .cloned()
+            .unwrap_or_default(),
+        reason,
+    };
+    if n_axes == 0 {
+        return Err(header_error(
+            1,
+            format!(
+                "no axis column: {} is tabulated over {}",
+                kind.what(),
+                kind.allowed_list(", ")
+            ),
+        ));
+    }
+    if let Some(r) = kind.required()
+        && !columns
+            .iter()
+            .any(|c| matches!(c, Column::Axis(v, _) if *v == r))
+    {
+        return Err(header_error(
+            1,
+            format!("no {} column: {} needs one", r.csv_name(), kind.what()),
+        ));
+    }
+    let chosen = match column {
+        Some(want) => columns
+            .iter()
+            .position(|c| matches!(c, Column::Value(n, _) if n == want))
+            .ok_or_else(|| {
+                header_error(
+                    n_axes + 1,
+                    format!(
+                        "no value column `{want}` (the file has: {})",
+                        value_names.join(", ")
+                    ),
+                )
+            })?,
+        None if value_names.len() == 1 => n_axes,
+        None => {
+            return Err(header_error(
+                n_axes + 1,
+                format!(
+                    "{} value columns ({}): name one with `column = \"...\"` in the scenario",
+                    value_names.len(),
+                    value_names.join(", ")
+                ),
+            ));
+        }
+    };
+
+    // Rows: every field a finite number, converted to the scenario's units.
+    let mut rows: Vec<(usize, Vec<f64>)> = Vec::new();
+    for (line, text) in lines {
+        let f = fields(text);
+        if f.len() != columns.len() {
+            return Err(TableError::Ragged {
+                file,
+                line,
+                expected: columns.len(),
+                found: f.len(),
+            });
+        }
+        let mut row = Vec::with_capacity(f.len());
+        for (k, (s, c)) in f.iter().zip(&columns).enumerate() {
+            let v: f64 = match s.parse::<f64>() {
+                Ok(v) if v.is_finite() => v,
+                _ => {
+                    return Err(TableError::NotFinite {
+                        file,
+                        line,
+                        column: k + 1,
+                        header: names[k].clone(),
+                        value: s.clone(),
+                    });
+                }
+            };
+            let conv = match c {
+                Column::Axis(_, conv) | Column::Value(_, conv) => *conv,
+            };
+            row.push(conv.apply(v));
+        }
+        if rows.len() >= MAX_TABLE_VALUES {
+            return Err(TableError::Grid {
+                file,
+                line,
+                column: 1,
+                header: names[0].clone(),
+                reason: format!("more rows than the limit of {MAX_TABLE_VALUES} grid points"),
+            });
+        }
+        rows.push((line, row));
+    }
+    if rows.is_empty() {
+        return Err(header_error(1, "no rows after the header".into()));
+    }
+
+    // The grid: the breakpoints of axis j are its values at rows 0, stride_j, 2 stride_j, ...
+    // while the slower axes keep row 0's values (stride_j: the product of the faster axes'
+    // sizes, found from the last axis backwards).
+    let grid_error = |r: usize, j: usize, reason: String| TableError::Grid {
+        file: file.clone(),
+        line: rows[r].0,
+        column: j + 1,
+        header: names[j].clone(),
+        reason,
+    };
+    let mut sizes = vec![0usize; n_axes];
+    let mut breakpoints: Vec<Vec<f64>> = vec![Vec::new(); n_axes];
+    let mut stride = 1usize;
+    for j in (0..n_axes).rev() {
+        let mut r = 0;
+        while r < rows.len() && (0..j).all(|i| rows[r].1[i].to_bits() == rows[0].1[i].to_bits()) {
+            let x = rows[r].1[j];
+            if let Some(&prev) = breakpoints[j].last()
+                && x <= prev
+            {
+                return Err(grid_error(
+                    r,
+                    j,
+                    format!(
+                        "breakpoints are not strictly increasing: {x} after {prev} (rows are in row-major order, the first axis slowest)"
+                    ),
+                ));
+            }
+            breakpoints[j].push(x);
+            r += stride;
+        }
+        sizes[j] = breakpoints[j].len();
+        if sizes[j] < 2 {
+            return Err(grid_error(
+                0,
+                j,
+                format!(
+                    "axis {} has 1 breakpoint: expected at least 2 (give a constant instead of a table)",
+                    names[j]
+                ),
+            ));
+        }
+        stride *= sizes[j];
+    }
+    if rows.len() != stride {
+        let last = rows.len().min(stride) - 1;
+        return Err(grid_error(
+            last,
+            0,
+            format!(
+                "the rows do not form a complete grid: {} rows for {} breakpoints ({stride} rows expected)",
+                rows.len(),
+                sizes
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect::<Vec<_>>()
+                    .join(" x ")
+            ),
+        ));
+    }
+    let mut values = Vec::with_capacity(rows.len());
+    for (r, (_, row)) in rows.iter().enumerate() {
+        let mut rem = r;
+        for j in (0..n_axes).rev() {
+            let expected = breakpoints[j][rem % sizes[j]];
+            rem /= sizes[j];
+            if row[j].to_bits() != expected.to_bits() {
+                return Err(grid_error(
+                    r,
+                    j,
+                    format!(
+                        "expected {expected} here: rows list every grid point in row-major order (the first axis slowest)"
+                    ),
+                ));
+            }
+        }
+        values.push(row[chosen]);
+    }
+    let axes = columns
+        .iter()
+        .zip(breakpoints)
+        .filter_map(|(c, breakpoints)| match c {
+            Column::Axis(variable, _) => Some(Axis {
+                variable: *variable,
+                breakpoints,
+            }),
+            Column::Value(..) => None,
+        })
+        .collect();
+    Table::new(axes, values, kind).map_err(|reason| header_error(1, reason))
+}
+
+/// Writes a table as CSV (header `name [unit]`, one row per grid point, numbers in the shortest
+/// form that reads back as the same double): one or more value columns on one grid.
+pub fn write_csv(axes: &[Axis], columns: &[(&str, &str, &[f64])]) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let head: Vec<String> = axes
+        .iter()
+        .map(|a| format!("{} [{}]", a.variable.csv_name(), a.variable.unit()))
+        .chain(columns.iter().map(|(n, u, _)| format!("{n} [{u}]")))
+        .collect();
+    s.push_str(&head.join(","));
+    s.push('\n');
+    let sizes: Vec<usize> = axes.iter().map(|a| a.breakpoints.len()).collect();
+    let n: usize = sizes.iter().product();
+    for r in 0..n {
+        let mut rem = r;
+        let mut idx = vec![0; axes.len()];
+        for j in (0..axes.len()).rev() {
+            idx[j] = rem % sizes[j];
+            rem /= sizes[j];
+        }
+        let fields: Vec<String> = axes
+            .iter()
+            .zip(&idx)
+            .map(|(a, &i)| format!("{:?}", a.breakpoints[i]))
+            .chain(columns.iter().map(|(_, _, v)| format!("{:?}", v[r])))
+            .collect();
+        let _ = writeln!(s, "{}", fields.join(","));
+    }
+    s
+}

@@ -1,0 +1,658 @@
+//! Tabulated aerodynamics and interference: the table form of a scenario's coefficients, its
+//! files, and the multilinear interpolation the force evaluation uses.
+//!
+//! Source: `docs/model.md` section 1 ("Tables") and section 3 ("Tabulated coefficients"). A
+//! coefficient is a constant (the contract's form) or a table on a rectilinear grid of one to
+//! three variables, interpolated multilinearly:
+//!
+//! ```text
+//! 1 axis:   v(x)       = v_i + t (v_{i+1} - v_i),          t = (x - x_i) / (x_{i+1} - x_i)
+//! 2 axes:   v(x, y)    = 1-axis interpolation in y on rows i and i+1, then in x between them
+//! 3 axes:   v(x, y, z) = 2-axis interpolation in (y, z) on planes i and i+1, then in x
+//! ```
+//!
+//! (the last axis first; Press et al., *Numerical Recipes*, 3rd ed., section 3.6, "bilinear
+//! interpolation", extended one axis at a time). Outside a table the value is held at the edge
+//! (t clamped to [0, 1]) and the excursion is recorded, never extrapolated.
+//!
+//! Choices made here (docs/model.md section 1 records them):
+//! - The variables a table may span depend on what it tabulates ([`Kind`]): a static coefficient
+//!   (CA, CY, CZ, Cl, Cm, Cn) over Mach, local alpha and local beta; a derivative (CZ_alpha,
+//!   CY_beta, Cm_alpha, Cn_beta, Cl_p, Cm_q, Cn_r) over Mach only; an interference increment over
+//!   distance from carriage (required), local alpha and lateral offset. The grid's axes nest in
+//!   that fixed order (first axis slowest).
+//! - Mach is the flight condition's (free-stream) Mach, fixed for the event, so every Mach axis
+//!   is interpolated once when the run is set up: a derivative table becomes a constant, and a
+//!   static table a table over (alpha, beta). Everything the force evaluation needs is
+//!   precomputed per scenario ([`PreparedTables`]); a propagation keeps its interval cursors and
+//!   excursion counts in a [`TableState`] of fixed size: no allocation per force evaluation.
+//! - Interval search starts from the previous evaluation's interval (a hunt: the store moves
+//!   little between two stages), so it costs a comparison or two. Each grid cell holds its
+//!   interpolant as a polynomial in the inputs ((c0 + c1 x) + y (c2 + c3 x), ...), evaluated
+//!   with fused multiply-adds: the same value as the formula above to rounding, and shorter on
+//!   the path from the flow angles to the forces. Tables over the same axes are grouped and
+//!   interpolated six lanes at a time.
+
+use std::cell::Cell;
+use std::fmt;
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+
+use serde::de::{self, MapAccess, Visitor};
+use serde::ser::SerializeMap;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::units::{M_PER_FT, M_PER_IN};
+
+/// Most values one table may hold.
+pub const MAX_TABLE_VALUES: usize = 1_000_000;
+
+/// A variable a table may be tabulated over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Variable {
+    /// The flight condition's Mach number \[-\].
+    Mach,
+    /// The store's local angle of attack atan2(w, u) \[deg in files\].
+    Alpha,
+    /// The store's local sideslip asin(v / V) \[deg in files\].
+    Beta,
+    /// Distance of the CG from its carriage position |r| \[m\].
+    Distance,
+    /// Lateral offset of the CG from carriage: the launch-frame y (crossrange) \[m\].
+    Lateral,
+}
+
+impl Variable {
+    /// Every variable (each [`Kind`] has its own nesting order, [`Kind::allowed`]).
+    pub const ALL: [Variable; 5] = [
+        Variable::Mach,
+        Variable::Alpha,
+        Variable::Beta,
+        Variable::Distance,
+        Variable::Lateral,
+    ];
+
+    /// Its key in an inline TOML table (with the unit of its breakpoints).
+    pub fn key(self) -> &'static str {
+        match self {
+            Variable::Mach => "mach",
+            Variable::Alpha => "alpha_deg",
+            Variable::Beta => "beta_deg",
+            Variable::Distance => "distance_m",
+            Variable::Lateral => "lateral_m",
+        }
+    }
+
+    /// Its name in a CSV header (`name [unit]`).
+    pub fn csv_name(self) -> &'static str {
+        match self {
+            Variable::Mach => "mach",
+            Variable::Alpha => "alpha",
+            Variable::Beta => "beta",
+            Variable::Distance => "distance",
+            Variable::Lateral => "lateral",
+        }
+    }
+
+    /// The unit breakpoints are kept in (scenario files, reports).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Variable::Mach => "-",
+            Variable::Alpha | Variable::Beta => "deg",
+            Variable::Distance | Variable::Lateral => "m",
+        }
+    }
+
+    /// Units a CSV header may give, and the conversion to [`Variable::unit`].
+    fn csv_units(self) -> &'static [(&'static str, Conversion)] {
+        match self {
+            Variable::Mach => &[("-", Conversion::Scale(1.0))],
+            Variable::Alpha | Variable::Beta => &[
+                ("deg", Conversion::Scale(1.0)),
+                ("rad", Conversion::RadToDeg),
+            ],
+            Variable::Distance | Variable::Lateral => &[
+                ("m", Conversion::Scale(1.0)),
+                ("ft", Conversion::Scale(M_PER_FT)),
+                ("in", Conversion::Scale(M_PER_IN)),
+            ],
+        }
+    }
+
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// How a file's unit converts to the scenario's.
+#[derive(Debug, Clone, Copy)]
+enum Conversion {
+    /// Multiply by this exact factor.
+    Scale(f64),
+    /// Radians to degrees (`f64::to_degrees`); for a value per degree, per radian.
+    RadToDeg,
+}
+
+impl Conversion {
+    fn apply(self, x: f64) -> f64 {
+        match self {
+            Conversion::Scale(s) => x * s,
+            Conversion::RadToDeg => x.to_degrees(),
+        }
+    }
+}
+
+/// What a table tabulates, which decides the variables it may span and the unit of its values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A static coefficient (CA, CY, CZ, Cl, Cm, Cn): over Mach, alpha and beta.
+    Static,
+    /// A derivative (per rad of a flow angle or of a non-dimensional rate): over Mach.
+    Derivative,
+    /// An interference increment: over distance (required), alpha and lateral offset.
+    Interference,
+}
+
+impl Kind {
+    /// The variables it may span, in nesting order.
+    pub fn allowed(self) -> &'static [Variable] {
+        match self {
+            Kind::Static => &[Variable::Mach, Variable::Alpha, Variable::Beta],
+            Kind::Derivative => &[Variable::Mach],
+            Kind::Interference => &[Variable::Distance, Variable::Alpha, Variable::Lateral],
+        }
+    }
+
+    /// A variable every table of this kind spans.
+    fn required(self) -> Option<Variable> {
+        match self {
+            Kind::Interference => Some(Variable::Distance),
+            _ => None,
+        }
+    }
+
+    /// Units a CSV value column may give, and the conversion to the scenario's.
+    fn value_units(self) -> &'static [(&'static str, Conversion)] {
+        match self {
+            Kind::Static | Kind::Interference => &[("-", Conversion::Scale(1.0))],
+            Kind::Derivative => &[
+                ("1/rad", Conversion::Scale(1.0)),
+                ("1/deg", Conversion::RadToDeg),
+            ],
+        }
+    }
+
+    fn what(self) -> &'static str {
+        match self {
+            Kind::Static => "a static coefficient",
+            Kind::Derivative => "a derivative",
+            Kind::Interference => "an interference increment",
+        }
+    }
+
+    fn allowed_list(self, sep: &str) -> String {
+        self.allowed()
+            .iter()
+            .map(|v| v.csv_name())
+            .collect::<Vec<_>>()
+            .join(sep)
+    }
+}
+
+/// One axis of a table: a variable and its breakpoints (strictly increasing, in the
+/// variable's [`Variable::unit`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// The variable.
+    pub variable: Variable,
+    /// Its breakpoints.
+    pub breakpoints: Vec<f64>,
+}
+
+/// A table on a rectilinear grid of one to three axes; values row-major (last axis fastest),
+/// in the unit of the coefficient (derivatives per rad).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    axes: Vec<Axis>,
+    values: Vec<f64>,
+}
+
+impl Table {
+    /// A checked table of `kind`: one to three axes, each allowed for the kind and in nesting
+    /// order, at least two finite strictly increasing breakpoints each, one finite value per
+    /// grid point. The message says what is wrong (the caller says where).
+    pub fn new(axes: Vec<Axis>, values: Vec<f64>, kind: Kind) -> Result<Table, String> {
+        if axes.is_empty() || axes.len() > 3 {
+            return Err(format!(
+                "has {} axes: expected one to three of {}",
+                axes.len(),
+                kind.allowed_list(", ")
+            ));
+        }
+        let mut previous: Option<Variable> = None;
+        for a in &axes {
+            if !kind.allowed().contains(&a.variable) {
+                return Err(format!(
+                    "is a table over {}: {} may be tabulated over {} only",
+                    a.variable.csv_name(),
+                    kind.what(),
+                    kind.allowed_list(", ")
+                ));
+            }
+            let rank = |v: Variable| kind.allowed().iter().position(|&w| w == v);
+            if previous.is_some_and(|p| rank(p) >= rank(a.variable)) {
+                return Err(format!(
+                    "axes must nest in the order {}",
+                    kind.allowed_list(", ")
+                ));
+            }
+            previous = Some(a.variable);
+            check_breakpoints(a.variable, &a.breakpoints)?;
+        }
+        if let Some(r) = kind.required()
+            && !axes.iter().any(|a| a.variable == r)
+        {
+            return Err(format!(
+                "has no {} axis: {} is tabulated over {} at least",
+                r.csv_name(),
+                kind.what(),
+                r.csv_name()
+            ));
+        }
+        let points: usize = axes.iter().map(|a| a.breakpoints.len()).product();
+        if points > MAX_TABLE_VALUES {
+            return Err(format!(
+                "has {points} grid points, more than the limit of {MAX_TABLE_VALUES}"
+            ));
+        }
+        if values.len() != points {
+            return Err(format!(
+                "has {} values for a grid of {points} points",
+                values.len()
+            ));
+        }
+        if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+            return Err(format!(
+                "value {k} is {}: expected finite values",
+                values[k]
+            ));
+        }
+        Ok(Table { axes, values })
+    }
+
+    /// Its axes, in nesting order.
+    pub fn axes(&self) -> &[Axis] {
+        &self.axes
+    }
+
+    /// Its values, row-major (last axis fastest).
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Number of breakpoints of each axis.
+    fn shape(&self) -> Vec<usize> {
+        self.axes.iter().map(|a| a.breakpoints.len()).collect()
+    }
+}
+
+fn check_breakpoints(v: Variable, b: &[f64]) -> Result<(), String> {
+    if b.len() < 2 {
+        return Err(format!(
+            "axis {} has {} breakpoint(s): expected at least 2 (give a constant instead of a table)",
+            v.csv_name(),
+            b.len()
+        ));
+    }
+    for (k, x) in b.iter().enumerate() {
+        if !x.is_finite() {
+            return Err(format!(
+                "axis {} breakpoint {k} is {x}: expected finite values",
+                v.csv_name()
+            ));
+        }
+        if k > 0 && *x <= b[k - 1] {
+            return Err(format!(
+                "axis {} breakpoints are not strictly increasing: {x} after {}",
+                v.csv_name(),
+                b[k - 1]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A reference to a CSV table file, relative to the scenario file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableFile {
+    /// The file, relative to the scenario file's directory.
+    pub csv: PathBuf,
+    /// The value column to use (its name without the unit); needed when the file holds several.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub column: Option<String>,
+}
+
+/// A coefficient as a scenario gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Coefficient {
+    /// A constant (the contract's form).
+    Constant(f64),
+    /// A table, inline or read from its file.
+    Table(Table),
+    /// A table file not read yet (only between parsing and [`Tabulated::resolve`]).
+    File(TableFile),
+}
+
+/// The marker of what a [`Tabulated`] coefficient is (its [`Kind`]).
+pub trait TableKind {
+    /// The kind.
+    const KIND: Kind;
+}
+
+/// Marker: a static coefficient.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StaticKind;
+/// Marker: a derivative.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DerivativeKind;
+/// Marker: an interference increment.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InterferenceKind;
+
+impl TableKind for StaticKind {
+    const KIND: Kind = Kind::Static;
+}
+impl TableKind for DerivativeKind {
+    const KIND: Kind = Kind::Derivative;
+}
+impl TableKind for InterferenceKind {
+    const KIND: Kind = Kind::Interference;
+}
+
+/// A coefficient of a known kind: in TOML a number, an inline table
+/// (`{ mach = [..], alpha_deg = [..], values = [[..], ..] }`) or a file
+/// (`{ csv = "tables/cz.csv", column = "cz" }`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tabulated<K> {
+    /// The coefficient.
+    pub value: Coefficient,
+    kind: PhantomData<K>,
+}
+
+/// A static coefficient (CA, CY, CZ, Cl, Cm, Cn).
+pub type StaticCoefficient = Tabulated<StaticKind>;
+/// A derivative (CZ_alpha, CY_beta, Cm_alpha, Cn_beta, Cl_p, Cm_q, Cn_r).
+pub type DerivativeCoefficient = Tabulated<DerivativeKind>;
+/// An interference increment.
+pub type InterferenceCoefficient = Tabulated<InterferenceKind>;
+
+impl<K: TableKind> Tabulated<K> {
+    /// A constant.
+    pub fn constant(v: f64) -> Self {
+        Tabulated {
+            value: Coefficient::Constant(v),
+            kind: PhantomData,
+        }
+    }
+
+    /// A table, checked for this kind.
+    pub fn table(t: Table) -> Result<Self, String> {
+        Table::new(t.axes, t.values, K::KIND).map(|t| Tabulated {
+            value: Coefficient::Table(t),
+            kind: PhantomData,
+        })
+    }
+
+    /// The constant, if it is one.
+    pub fn as_constant(&self) -> Option<f64> {
+        match self.value {
+            Coefficient::Constant(v) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// The table, if it is one.
+    pub fn as_table(&self) -> Option<&Table> {
+        match &self.value {
+            Coefficient::Table(t) => Some(t),
+            _ => None,
+        }
+    }
+
+    /// Reads a file reference (relative to `dir`) into its table; constants and tables stay.
+    pub fn resolve(&mut self, dir: &Path) -> Result<(), TableError> {
+        if let Coefficient::File(f) = &self.value {
+            let path = dir.join(&f.csv);
+            let table = read_csv(&path, f.column.as_deref(), K::KIND)?;
+            self.value = Coefficient::Table(table);
+        }
+        Ok(())
+    }
+}
+
+impl<K> Serialize for Tabulated<K> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match &self.value {
+            Coefficient::Constant(v) => s.serialize_f64(*v),
+            Coefficient::File(f) => f.serialize(s),
+            Coefficient::Table(t) => {
+                let mut m = s.serialize_map(Some(t.axes.len() + 1))?;
+                for a in &t.axes {
+                    m.serialize_entry(a.variable.key(), &a.breakpoints)?;
+                }
+                let shape = t.shape();
+                match shape.len() {
+                    1 => m.serialize_entry("values", &t.values)?,
+                    2 => {
+                        let rows: Vec<&[f64]> = t.values.chunks(shape[1]).collect();
+                        m.serialize_entry("values", &rows)?
+                    }
+                    _ => {
+                        let planes: Vec<Vec<&[f64]>> = t
+                            .values
+                            .chunks(shape[1] * shape[2])
+                            .map(|p| p.chunks(shape[2]).collect())
+                            .collect();
+                        m.serialize_entry("values", &planes)?
+                    }
+                }
+                m.end()
+            }
+        }
+    }
+}
+
+/// The fields an inline table or file reference may have.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTable {
+    csv: Option<PathBuf>,
+    column: Option<String>,
+    mach: Option<Vec<f64>>,
+    alpha_deg: Option<Vec<f64>>,
+    beta_deg: Option<Vec<f64>>,
+    distance_m: Option<Vec<f64>>,
+    lateral_m: Option<Vec<f64>>,
+    values: Option<Nested>,
+}
+
+/// `values` nested one array per axis.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Nested {
+    D1(Vec<f64>),
+    D2(Vec<Vec<f64>>),
+    D3(Vec<Vec<Vec<f64>>>),
+}
+
+impl RawTable {
+    fn into_coefficient(self, kind: Kind) -> Result<Coefficient, String> {
+        // In the kind's nesting order (a variable it may not span goes last, to be refused).
+        let mut axes: Vec<Axis> = [
+            (Variable::Mach, self.mach),
+            (Variable::Alpha, self.alpha_deg),
+            (Variable::Beta, self.beta_deg),
+            (Variable::Distance, self.distance_m),
+            (Variable::Lateral, self.lateral_m),
+        ]
+        .into_iter()
+        .filter_map(|(variable, b)| {
+            b.map(|breakpoints| Axis {
+                variable,
+                breakpoints,
+            })
+        })
+        .collect();
+        axes.sort_by_key(|a| {
+            kind.allowed()
+                .iter()
+                .position(|&v| v == a.variable)
+                .unwrap_or(usize::MAX)
+        });
+        if let Some(csv) = self.csv {
+            if !axes.is_empty() || self.values.is_some() {
+                return Err(
+                    "a table is either a file (`csv`) or inline (axes and `values`), not both"
+                        .into(),
+                );
+            }
+            return Ok(Coefficient::File(TableFile {
+                csv,
+                column: self.column,
+            }));
+        }
+        if self.column.is_some() {
+            return Err("`column` names a column of a `csv` file; there is none".into());
+        }
+        let Some(values) = self.values else {
+            return Err(format!(
+                "an inline table needs its breakpoints ({}) and `values`",
+                kind.allowed()
+                    .iter()
+                    .map(|v| format!("`{}`", v.key()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        };
+        // Every axis is checked first, so that a ragged `values` is reported against a good
+        // grid.
+        let shape: Vec<usize> = axes.iter().map(|a| a.breakpoints.len()).collect();
+        let t = Table {
+            axes,
+            values: Vec::new(),
+        };
+        Table::new(t.axes.clone(), vec![0.0; shape.iter().product()], kind)?;
+        let ragged = |what: &str, k: usize, found: usize, expected: usize| {
+            Err(format!(
+                "`values`{what} {k} has {found} values, expected {expected} (one per breakpoint of the {} axis)",
+                t.axes[shape.len() - 1].variable.csv_name()
+            ))
+        };
+        let flat = match (values, shape.as_slice()) {
+            (Nested::D1(v), [n]) => {
+                if v.len() != *n {
+                    return Err(format!(
+                        "`values` has {} values, expected {n} (one per breakpoint)",
+                        v.len()
+                    ));
+                }
+                v
+            }
+            (Nested::D2(rows), [n0, n1]) => {
+                if rows.len() != *n0 {
+                    return Err(format!("`values` has {} rows, expected {n0}", rows.len()));
+                }
+                let mut flat = Vec::with_capacity(n0 * n1);
+                for (k, r) in rows.into_iter().enumerate() {
+                    if r.len() != *n1 {
+                        return ragged(" row", k, r.len(), *n1);
+                    }
+                    flat.extend(r);
+                }
+                flat
+            }
+            (Nested::D3(planes), [n0, n1, n2]) => {
+                if planes.len() != *n0 {
+                    return Err(format!(
+                        "`values` has {} planes, expected {n0}",
+                        planes.len()
+                    ));
+                }
+                let mut flat = Vec::with_capacity(n0 * n1 * n2);
+                for (k, p) in planes.into_iter().enumerate() {
+                    if p.len() != *n1 {
+                        return Err(format!(
+                            "`values` plane {k} has {} rows, expected {n1}",
+                            p.len()
+                        ));
+                    }
+                    for r in p {
+                        if r.len() != *n2 {
+                            return ragged(&format!(" plane {k} row"), 0, r.len(), *n2);
+                        }
+                        flat.extend(r);
+                    }
+                }
+                flat
+            }
+            (v, s) => {
+                let depth = match v {
+                    Nested::D1(_) => 1,
+                    Nested::D2(_) => 2,
+                    Nested::D3(_) => 3,
+                };
+                return Err(format!(
+                    "`values` is nested {depth} deep for a table of {} axes: nest one array per axis",
+                    s.len()
+                ));
+            }
+        };
+        Table::new(t.axes, flat, kind).map(Coefficient::Table)
+    }
+}
+
+impl<'de, K: TableKind> Deserialize<'de> for Tabulated<K> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<K>(PhantomData<K>);
+        impl<'de, K: TableKind> Visitor<'de> for V<K> {
+            type Value = Tabulated<K>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                write!(
+                    f,
+                    "a number, an inline table over {} or {{ csv = \"FILE.csv\" }}",
+                    K::KIND.allowed_list(", ")
+                )
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Self::Value, E> {
+                Ok(Tabulated::constant(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Self::Value, E> {
+                Ok(Tabulated::constant(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Self::Value, E> {
+                Ok(Tabulated::constant(v as f64))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+                let raw = RawTable::deserialize(de::value::MapAccessDeserializer::new(map))?;
+                let value = raw.into_coefficient(K::KIND).map_err(de::Error::custom)?;
+                Ok(Tabulated {
+                    value,
+                    kind: PhantomData,
+                })
+            }
+        }
+        d.deserialize_any(V(PhantomData))
+    }
+}
+
+mod csv;
+mod error;
+mod prepared;
+pub use csv::*;
+pub use error::*;
+pub use prepared::*;
+
+#[cfg(test)]
+#[allow(clippy::float_cmp)] // exact values on purpose: interpolation of representable data
+mod tests;

@@ -1,0 +1,103 @@
+use super::*;
+
+fn at(alpha_rad: f64, beta_rad: f64) -> Inputs {
+    Inputs {
+        alpha_rad,
+        beta_rad,
+        distance_m: 0.0,
+        lateral_m: 0.0,
+    }
+}
+
+fn axis(variable: Variable, b: &[f64]) -> Axis {
+    Axis {
+        variable,
+        breakpoints: b.to_vec(),
+    }
+}
+
+#[test]
+fn bilinear_interpolation_and_edge_hold() {
+    let mut p = PreparedTables::default();
+    let t = Table::new(
+        vec![
+            axis(Variable::Mach, &[0.5, 1.0]),
+            axis(Variable::Alpha, &[0.0, 10.0]),
+            axis(Variable::Beta, &[-5.0, 5.0]),
+        ],
+        vec![0.0, 1.0, 2.0, 3.0, 10.0, 11.0, 12.0, 13.0],
+        Kind::Static,
+    )
+    .unwrap();
+    let (id, axes, values) = p.slice_mach("aero.cz", &t, 0.75);
+    assert_eq!(values, vec![5.0, 6.0, 7.0, 8.0]);
+    p.add_runtime(id, Target::Static(2), axes, values);
+    let state = TableState::default();
+    state.count_evaluation();
+    let (s, _) = p.evaluate(&state, &at(5f64.to_radians(), 0.0));
+    assert!((s[2] - 6.5).abs() < 1e-12, "{}", s[2]);
+    // Beyond alpha: held at the alpha = 10 deg edge and recorded.
+    state.count_evaluation();
+    let (s, _) = p.evaluate(&state, &at(12f64.to_radians(), 5.0f64.to_radians()));
+    assert!((s[2] - 8.0).abs() < 1e-12, "{}", s[2]);
+    let r = p.report(&state.excursions());
+    assert_eq!(r.len(), 1);
+    assert_eq!(r[0].evaluations_outside, 1);
+    assert_eq!(r[0].evaluations, 2);
+    assert!((r[0].axes[0].worst_excursion - 2.0).abs() < 1e-9, "{r:?}");
+}
+
+#[test]
+fn mach_beyond_the_table_is_held_and_counts_every_evaluation() {
+    let mut p = PreparedTables::default();
+    let t = Table::new(
+        vec![axis(Variable::Mach, &[0.5, 0.9])],
+        vec![1.0, 2.0],
+        Kind::Derivative,
+    )
+    .unwrap();
+    let (_, axes, values) = p.slice_mach("aero.cm_q_per_rad", &t, 0.95);
+    assert!(axes.is_empty());
+    assert_eq!(values, vec![2.0]);
+    let ex = TableExcursions {
+        evaluations: 40,
+        ..TableExcursions::default()
+    };
+    let r = p.report(&ex);
+    assert_eq!(r[0].evaluations_outside, 40);
+    assert!((r[0].axes[0].worst_excursion - 0.05).abs() < 1e-12);
+}
+
+#[test]
+fn tables_are_checked() {
+    let e = Table::new(
+        vec![axis(Variable::Alpha, &[0.0, 1.0])],
+        vec![0.0, 1.0],
+        Kind::Derivative,
+    )
+    .unwrap_err();
+    assert_eq!(
+        e,
+        "is a table over alpha: a derivative may be tabulated over mach only"
+    );
+    let e = Table::new(
+        vec![axis(Variable::Mach, &[0.9, 0.6])],
+        vec![0.0, 1.0],
+        Kind::Static,
+    )
+    .unwrap_err();
+    assert_eq!(
+        e,
+        "axis mach breakpoints are not strictly increasing: 0.6 after 0.9"
+    );
+    let e = Table::new(
+        vec![axis(Variable::Alpha, &[0.0, 1.0])],
+        vec![0.0, 1.0],
+        Kind::Interference,
+    )
+    .unwrap_err();
+    assert_eq!(
+        e,
+        "has no distance axis: an interference increment is tabulated over distance at least"
+    );
+}
