@@ -7,8 +7,8 @@
 //! accumulating the goals against a 201-sample measured trajectory as a fit does.
 //!
 //! `simulate_default_event_tables`: the same with the default written as tables
-//! (`sepval scenario --tables`: static coefficients over Mach, alpha and beta, damping over Mach,
-//! interference over distance); issue 15 asks for at most 20 % more time than the constant form.
+//! (`sepval scenario --tables --interference-tables`: static coefficients over Mach, alpha and
+//! beta, damping over Mach, interference over distance); issue 15 asks for at most 20 % more time than the constant form.
 
 use std::hint::black_box;
 

@@ -338,11 +338,16 @@ pub struct ScenarioArgs {
     /// Scenario to rewrite (validated); the embedded default when absent.
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
-    /// Write the scenario's aerodynamics and interference as tables (docs/model.md section 1):
-    /// --out is then a directory that receives scenario.toml and tables/*.csv, a starting point
-    /// for your own tabulated data.
+    /// Write the scenario's aerodynamics as tables (docs/model.md section 1): --out is then a
+    /// directory that receives scenario.toml and tables/*.csv, a starting point for your own
+    /// tabulated data that simulates as the constant form to rounding.
     #[arg(long)]
     pub tables: bool,
+    /// With --tables, the interference increments too, as tables over distance sampled from
+    /// their exponential decay (linear between breakpoints: within about 1e-4 m and 0.01 deg of
+    /// the exponential form's trajectory, not to rounding).
+    #[arg(long, requires = "tables")]
+    pub interference_tables: bool,
     /// Output TOML file (written atomically); with --tables, an output directory.
     #[arg(long, value_name = "FILE.toml|DIR")]
     pub out: PathBuf,

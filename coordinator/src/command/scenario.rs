@@ -19,7 +19,7 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
         eprintln!("wrote {}", args.out.display());
         return Ok(());
     }
-    let form = sepval_common::table_form::table_form(&scenario, true)
+    let form = sepval_common::table_form::table_form(&scenario, args.interference_tables)
         .map_err(anyhow::Error::msg)
         .context("--tables")?;
     let dir = &args.out;

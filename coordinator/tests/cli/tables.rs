@@ -29,34 +29,54 @@ fn scenario_tables_writes_a_starting_point_that_simulates_as_the_default() {
         "mine/scenario.toml",
         "mine/tables/aero_static.csv",
         "mine/tables/aero_damping.csv",
-        "mine/tables/interference.csv",
     ] {
         assert!(d.join(f).exists(), "{f}");
     }
+    assert!(!d.join("mine/tables/interference.csv").exists());
     // Written again into the same directory: refused, nothing overwritten.
     refused(
         &sepval(&["scenario", "--tables", "--out", "mine"], d),
         "exists; choose a new directory (nothing was written)",
     );
-    // Simulated from another directory: the CSV files are found relative to the scenario.
     ok(&sepval(
         &[
-            "simulate",
-            "--scenario",
-            "mine/scenario.toml",
-            "--strict-tables",
+            "scenario",
+            "--tables",
+            "--interference-tables",
             "--out",
-            "tables.csv",
+            "all",
         ],
         d,
     ));
+    assert!(d.join("all/tables/interference.csv").exists());
     ok(&sepval(&["simulate", "--out", "constant.csv"], d));
-    let a = Trajectory::read(&d.join("tables.csv")).unwrap();
     let b = Trajectory::read(&d.join("constant.csv")).unwrap();
-    for k in 0..a.len() {
-        for j in 0..3 {
-            assert!((a.pos_m[k][j] - b.pos_m[k][j]).abs() < 1e-4);
-            assert!((a.att_deg[k][j] - b.att_deg[k][j]).abs() < 1e-2);
+    // Simulated from another directory: the CSV files are found relative to the scenario. The
+    // aerodynamics as tables reproduce the default to rounding; the sampled interference to its
+    // interpolation error.
+    for (name, pos_m, att_deg) in [("mine", 1e-9, 1e-9), ("all", 1e-4, 1e-2)] {
+        let scenario = format!("{name}/scenario.toml");
+        let out = format!("{name}.csv");
+        ok(&sepval(
+            &[
+                "simulate",
+                "--scenario",
+                &scenario,
+                "--strict-tables",
+                "--out",
+                &out,
+            ],
+            d,
+        ));
+        let a = Trajectory::read(&d.join(&out)).unwrap();
+        for k in 0..a.len() {
+            for j in 0..3 {
+                assert!((a.pos_m[k][j] - b.pos_m[k][j]).abs() <= pos_m, "{name}");
+                assert!(
+                    (a.att_deg[k][j] - b.att_deg[k][j]).abs() <= att_deg,
+                    "{name}"
+                );
+            }
         }
     }
 }
