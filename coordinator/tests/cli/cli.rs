@@ -1,18 +1,7 @@
 //! The `sepval` command line, run as a user runs it.
 
-use std::process::Output;
-
 use sepval_common::telemetry::Trajectory;
-use sepval_tests::{ok, sepval};
-
-fn refused(out: &Output, expected: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
-    assert!(
-        stderr.contains(expected),
-        "expected `{expected}` in: {stderr}"
-    );
-}
+use sepval_tests::{ok, refused, sepval};
 
 #[test]
 fn simulate_truth_reproduces_the_conformance_table() {

@@ -15,7 +15,7 @@ use sepval_common::propagator::{Observation, propagate};
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
-use sepval_tests::{ok, sepval};
+use sepval_tests::{Gauss, ok, sepval};
 use serde_json::Value;
 
 /// Factors of the base model (not the default truth).
@@ -26,23 +26,6 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
 
 /// A hidden coefficient function and its parameters.
 type Hidden = (CoefficientFn, [f64; MAX_EFFECT_PARAMS]);
-
-/// Gaussian noise from a seeded xorshift generator (Box-Muller), independent of sepval's.
-struct Gauss(u64);
-
-impl Gauss {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn next(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
 
 /// One release: `scenario` (its flight condition written as metadata) simulated with the base
 /// factors and the hidden term, 1 s at 200 Hz, noisy.
@@ -61,11 +44,11 @@ fn release(scenario: &Scenario, hidden: Option<Hidden>, seed: u64) -> Trajectory
         times_s: times,
         pos_m: obs
             .iter()
-            .map(|o| o.pos_m.map(|v| v + SIGMA_POS_M * g.next()))
+            .map(|o| o.pos_m.map(|v| v + SIGMA_POS_M * g.normal()))
             .collect(),
         att_deg: obs
             .iter()
-            .map(|o| o.att_deg.map(|v| v + SIGMA_ATT_DEG * g.next()))
+            .map(|o| o.att_deg.map(|v| v + SIGMA_ATT_DEG * g.normal()))
             .collect(),
         ..Trajectory::default()
     };

@@ -4,23 +4,12 @@
 //! where; nothing is left behind.
 
 use std::path::Path;
-use std::process::Output;
 use std::time::Duration;
 
 use sepval_tests::{
-    assert_run_gone, ok, processes_of_run, run_id, sepval, signal, spawn_sepval, wait_exit,
-    wait_for,
+    assert_run_gone, ok, processes_of_run, refused, run_id, sepval, signal, spawn_sepval,
+    wait_exit, wait_for,
 };
-
-fn refused(out: &Output, expected: &str) -> String {
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
-    assert!(
-        stderr.contains(expected),
-        "expected `{expected}` in: {stderr}"
-    );
-    stderr
-}
 
 const HEADER: &str = "t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n";
 

@@ -4,21 +4,11 @@
 //! describe (reduced searches: small fits, few generations).
 
 use std::path::Path;
-use std::process::Output;
 
 use sepval_common::scenario::Scenario;
 use sepval_common::telemetry::Trajectory;
-use sepval_tests::{ok, sepval};
+use sepval_tests::{Gauss, ok, refused, sepval};
 use serde_json::Value;
-
-fn refused(out: &Output, expected: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
-    assert!(
-        stderr.contains(expected),
-        "expected `{expected}` in: {stderr}"
-    );
-}
 
 #[test]
 fn scenario_tables_writes_a_starting_point_that_simulates_as_the_default() {
@@ -224,23 +214,6 @@ fn leaving_a_table_is_reported_or_refused() {
 // ---------------------------------------------------------------------------------------------
 // Pooled fits.
 
-/// Gaussian noise from a seeded xorshift generator (Box-Muller), independent of sepval's.
-struct Gauss(u64);
-
-impl Gauss {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn next(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
-
 /// The truth factors of these fits (not the default truth).
 const TRUTH: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerfac": 1.03,
  "zinerfac": 0.97, "caoff": -0.02, "cyoff": 0.04, "czoff": -0.06, "cmoff": 0.1, "cnoff": -0.08,
@@ -264,12 +237,12 @@ fn release(scenario: &Scenario, mach: f64, alpha_deg: f64, seed: u64) -> Traject
         pos_m: clean
             .pos_m
             .iter()
-            .map(|p| p.map(|v| v + 0.003 * g.next()))
+            .map(|p| p.map(|v| v + 0.003 * g.normal()))
             .collect(),
         att_deg: clean
             .att_deg
             .iter()
-            .map(|a| a.map(|v| v + 0.1 * g.next()))
+            .map(|a| a.map(|v| v + 0.1 * g.normal()))
             .collect(),
         times_s: times,
         ..Trajectory::default()
