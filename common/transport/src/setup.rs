@@ -277,7 +277,7 @@ mod tests {
         let (result, cost) = sepval_tests::fuzz::measure(|| decode_setup(&header, &bytes));
         let e = crate::error_chain(&result.unwrap_err());
         assert!(
-            e.starts_with("setup event ``: scenario : TOML parse error"),
+            e.starts_with("setup event ``: scenario : line 1, column 1: "),
             "{e}"
         );
         // The test binary counts allocations (crate::fuzz_tests).
