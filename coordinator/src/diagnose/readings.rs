@@ -60,16 +60,10 @@ fn variable(r: Regressor) -> &'static str {
 /// `CA` subtracts from CX, docs/model.md section 11.2); `None` for the ejector and for a
 /// tabulated increment (it has no single sign).
 pub fn carriage_increment(interference: &Interference, axis: Axis) -> Option<f64> {
-    let i = interference;
-    match axis {
-        Axis::CA => i.dcx0.as_constant().map(|v| -v),
-        Axis::CY => i.dcy0.as_constant(),
-        Axis::CZ => i.dcz0.as_constant(),
-        Axis::Cl => i.dcl0.as_constant(),
-        Axis::Cm => i.dcm0.as_constant(),
-        Axis::Cn => i.dcn0.as_constant(),
-        Axis::Ejector => None,
-    }
+    // The aerodynamic axes are in the order of the increments (dCX0, dCY0, ... dCn0).
+    let (_, c) = *interference.increments().get(axis.index())?;
+    let v = c.as_constant()?;
+    Some(if axis == Axis::CA { -v } else { v })
 }
 
 /// The reading of `term` (its coefficient signed as fitted; for an oscillation, either of its
