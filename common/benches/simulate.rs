@@ -15,12 +15,13 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use sepval_common::{EffectSet, Factors, Simulator};
 
-fn simulate_default_event(c: &mut Criterion) {
-    let sim = Simulator::embedded_default();
+/// Times one fit evaluation of `sim`: the run set up at the truth factors and propagated,
+/// goals accumulated against its own nominal run.
+fn bench_goals(c: &mut Criterion, name: &str, sim: &Simulator) {
     let measured = sim
         .simulate(&Factors::NOMINAL, &EffectSet::NONE, &sim.default_times())
         .expect("nominal run");
-    c.bench_function("simulate_default_event", |b| {
+    c.bench_function(name, |b| {
         b.iter(|| {
             let run = sim
                 .run_setup(black_box(&Factors::TRUTH), &EffectSet::NONE)
@@ -29,6 +30,10 @@ fn simulate_default_event(c: &mut Criterion) {
                 .expect("finite run")
         })
     });
+}
+
+fn simulate_default_event(c: &mut Criterion) {
+    bench_goals(c, "simulate_default_event", &Simulator::embedded_default());
 }
 
 fn simulate_default_event_tables(c: &mut Criterion) {
@@ -44,18 +49,7 @@ fn simulate_default_event_tables(c: &mut Criterion) {
     let path = dir.path().join("scenario.toml");
     std::fs::write(&path, form.scenario.to_toml_string()).expect("the scenario");
     let sim = Simulator::new(&sepval_common::Scenario::load(&path).expect("it reads back"));
-    let measured = sim
-        .simulate(&Factors::NOMINAL, &EffectSet::NONE, &sim.default_times())
-        .expect("nominal run");
-    c.bench_function("simulate_default_event_tables", |b| {
-        b.iter(|| {
-            let run = sim
-                .run_setup(black_box(&Factors::TRUTH), &EffectSet::NONE)
-                .expect("valid factors");
-            sim.goal_sums(&run, black_box(&measured))
-                .expect("finite run")
-        })
-    });
+    bench_goals(c, "simulate_default_event_tables", &sim);
 }
 
 criterion_group!(
