@@ -158,7 +158,7 @@ fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
             ));
         }
     }
-    if let Some((_, caution)) = d.verdict.split_once("; caution: ") {
+    if let Some(caution) = &d.caution {
         s.push_str(&format!("caution:   {caution}\n"));
     }
     if d.extension.as_ref().is_some_and(|x| x.answer) {

@@ -132,8 +132,12 @@ pub struct Diagnosis {
     /// extension's own verdict is `extension.explained`; the terminal summary shows the
     /// answer's.
     pub explained: bool,
-    /// The verdict in one sentence.
+    /// The verdict in one sentence (ending with the caution when there is one).
     pub verdict: String,
+    /// Why the answer may not name the cause: an alternative predicts the `--validate` events
+    /// clearly better.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub caution: Option<String>,
     /// Terms found beyond the catalogue, most important first, when they are the answer.
     pub discovered: Vec<DiscoveredTerm>,
     /// Models that explain part of the data but not as well as the answer (mimics).

@@ -410,8 +410,9 @@ pub fn diagnose(
         }
         None => Vec::new(),
     };
-    if let Some(note) = prediction_caveat(&validation, noise) {
-        verdict.push_str(&note);
+    let caution = prediction_caveat(&validation, noise);
+    if let Some(c) = &caution {
+        verdict.push_str(&format!("; caution: {c}"));
     }
 
     let mut residuals = BTreeMap::new();
@@ -422,6 +423,7 @@ pub fn diagnose(
         causes,
         explained,
         verdict,
+        caution,
         discovered,
         alternatives,
         extension,

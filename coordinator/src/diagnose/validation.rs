@@ -128,7 +128,7 @@ pub(super) fn prediction_caveat(validation: &[ValidationReport], noise: Noise) -
     }
     let kind = model.split(':').next().unwrap_or("an");
     Some(format!(
-        "; caution: on the events not fitted the {kind} alternative predicts better (RMS over events J_pos {:.4} m, J_att {:.3} deg): the answer may fit these data without naming their cause",
+        "on the events not fitted the {kind} alternative predicts better (RMS over events J_pos {:.4} m, J_att {:.3} deg): the answer may fit these data without naming their cause",
         (p2 / n).sqrt(),
         (a2 / n).sqrt()
     ))
