@@ -223,22 +223,43 @@ impl ChannelRms {
     }
 }
 
+/// Sums of the squared residuals of each channel, sample by sample (pooled over events in the
+/// order the samples come): (dx, dy, dz \[m\], droll, dpitch, dyaw \[deg\]), angle
+/// differences wrapped.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ChannelSums {
+    sums: [f64; 6],
+    n: usize,
+}
+
+impl ChannelSums {
+    /// Adds the residuals of the simulated sample `sim` against a measured one.
+    #[inline]
+    pub fn add(&mut self, sim: &Observation, pos_m: &[f64; 3], att_deg: &[f64; 3]) {
+        let (p, a) = residual(sim, pos_m, att_deg);
+        for (s, r) in self.sums.iter_mut().zip(p.iter().chain(&a)) {
+            *s += r * r;
+        }
+        self.n += 1;
+    }
+
+    /// The RMS of each channel.
+    pub fn rms(&self) -> ChannelRms {
+        rms_of(self.sums, self.n)
+    }
+}
+
 /// RMS of each channel of the residuals of simulated samples against the job's data, pooled
 /// over events: (dx, dy, dz \[m\], droll, dpitch, dyaw \[deg\]), angle differences wrapped.
 /// Streams the samples: a long record's residuals are never held at once.
 pub fn residual_rms(job: &Job, samples: &[Vec<Observation>]) -> ChannelRms {
-    let mut sums = [0.0; 6];
-    let mut n = 0usize;
+    let mut sums = ChannelSums::default();
     for (e, sim) in job.events().iter().zip(samples) {
         for (k, o) in sim.iter().enumerate() {
-            let (p, a) = residual(o, &e.data.pos_m[k], &e.data.att_deg[k]);
-            for (s, r) in sums.iter_mut().zip(p.iter().chain(&a)) {
-                *s += r * r;
-            }
-            n += 1;
+            sums.add(o, &e.data.pos_m[k], &e.data.att_deg[k]);
         }
     }
-    rms_of(sums, n)
+    sums.rms()
 }
 
 /// RMS of each channel of residuals pooled over events.

@@ -119,8 +119,9 @@ pub const FLOOR_FACTOR: f64 = 1.1;
 pub struct FitOutput {
     /// DIR/result.json.
     pub result: FitResult,
-    /// Per method, the simulated samples of its best member (per event).
-    pub best_samples: BTreeMap<String, Vec<Vec<Observation>>>,
+    /// Per method, the simulated samples of its best member that the figures draw: the first
+    /// event's, every k-th of a long record (the whole trajectories are not kept).
+    pub best_plotted: BTreeMap<String, Vec<Observation>>,
     /// The best refined fit (`+lm` methods), with its residuals and Jacobian.
     pub refined: Option<LmResult>,
 }
@@ -241,7 +242,8 @@ impl Context<'_> {
 struct Stage {
     name: String,
     result: crate::results::MethodResult,
-    samples: Vec<Vec<Observation>>,
+    /// The best member's samples the figures draw.
+    plotted: Vec<Observation>,
     refined: Option<LmResult>,
 }
 
@@ -309,7 +311,7 @@ fn hill_stage(
             Some(lm),
         )
     } else {
-        let (rms, samples) = best_samples_of(evaluator, &r.best)?;
+        let (rms, samples) = best_samples_of(&cx.job, &r.best)?;
         (r.best.clone(), rms, samples, None, r.evaluations, None)
     };
     let mut m = method_result(
@@ -327,7 +329,7 @@ fn hill_stage(
     Ok(Stage {
         name: name.to_string(),
         result: m,
-        samples,
+        plotted: samples,
         refined,
     })
 }
@@ -418,7 +420,7 @@ fn ga_stage(
             refined_member(evaluator, &lm, &best, probes.clone());
         (member, rms, samples, Some(refinement), total, Some(lm))
     } else {
-        let (rms, samples) = best_samples_of(evaluator, &best)?;
+        let (rms, samples) = best_samples_of(&cx.job, &best)?;
         (best.clone(), rms, samples, None, state.evaluations, None)
     };
     let mut m = method_result(
@@ -436,7 +438,7 @@ fn ga_stage(
     Ok(Stage {
         name: name.to_string(),
         result: m,
-        samples,
+        plotted: samples,
         refined,
     })
 }
@@ -478,10 +480,10 @@ pub fn run_fit(
         stages.push(ga_stage(&cx, evaluator, progress)?);
     }
     let mut methods = BTreeMap::new();
-    let mut best_samples = BTreeMap::new();
+    let mut best_plotted = BTreeMap::new();
     let mut refined: Vec<LmResult> = Vec::new();
     for s in stages {
-        best_samples.insert(s.name.clone(), s.samples);
+        best_plotted.insert(s.name.clone(), s.plotted);
         refined.extend(s.refined);
         methods.insert(s.name, s.result);
     }
@@ -501,11 +503,11 @@ pub fn run_fit(
     });
     // What one grid step of each factor does at the best fit.
     let best = methods
-        .iter()
-        .min_by(|a, b| a.1.best.weighted.total_cmp(&b.1.best.weighted))
-        .map(|(name, m)| (m.best.factors, &best_samples[name]));
+        .values()
+        .min_by(|a, b| a.best.weighted.total_cmp(&b.best.weighted))
+        .map(|m| m.best.factors);
     let resolution = match best {
-        Some((f, base)) => resolution_advice(evaluator, job.factor_table(), &f, base, noise)?,
+        Some(f) => resolution_advice(evaluator, job.factor_table(), &f, noise)?,
         None => Vec::new(),
     };
 
@@ -518,7 +520,7 @@ pub fn run_fit(
                 name: e.name.clone(),
                 samples: e.data.len(),
                 tables_left: match best {
-                    Some((f, _)) if e.simulator.model().tables.any() => e
+                    Some(f) if e.simulator.model().tables.any() => e
                         .simulator
                         .simulate_logged(&f, &EffectSet::NONE, &e.data.times_s)
                         .map(|(_, log)| e.simulator.table_excursions(&log))
@@ -546,7 +548,7 @@ pub fn run_fit(
     write_result(&options.out, &result)?;
     Ok(FitOutput {
         result,
-        best_samples,
+        best_plotted,
         refined: best_refined,
     })
 }

@@ -3,21 +3,22 @@
 //! figures.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use sepval_common::atomic_file::write_atomically;
 use sepval_common::evaluation::{Candidate, Evaluator, Job, Outcome};
 use sepval_common::factors::{FACTOR_COUNT, Factors};
-use sepval_common::goals::residual;
-use sepval_common::propagator::Observation;
+use sepval_common::goals::GoalSums;
+use sepval_common::model::StateVector;
+use sepval_common::propagator::{Observation, SampleSink, propagate};
 
 use super::{FitError, FitOutput};
 use crate::problem::factors_of;
 use crate::refine::{LmResult, Noise};
 use crate::results::{
-    Best, ChannelRms, FitResult, FrontPoint, HistoryPoint, MethodResult, Probe, Refinement,
-    ResolutionRow, residual_rms,
+    Best, ChannelRms, ChannelSums, FitResult, FrontPoint, HistoryPoint, MethodResult, Probe,
+    Refinement, ResolutionRow, residual_rms,
 };
-use crate::run::{Evaluate, Problem};
 use crate::search::ga::Member;
 
 /// Simulations at which the history first has both goals at the floor.
@@ -42,13 +43,13 @@ pub(super) fn lm_first_at_floor(
         .map(|(n, _)| before + n)
 }
 
-/// The refined member, its channel summary and samples, and the refinement record.
+/// The refined member, its channel summary and plotted samples, and the refinement record.
 pub(super) fn refined_member(
     evaluator: &mut dyn Evaluator,
     lm: &LmResult,
     start: &Member,
     probes: Vec<Probe>,
-) -> (Member, ChannelRms, Vec<Vec<Observation>>, Refinement) {
+) -> (Member, ChannelRms, Vec<Observation>, Refinement) {
     let values = lm.x[..FACTOR_COUNT].to_vec();
     let member = Member {
         chromosome: sepval_common::encoding::Chromosome::encode_values(
@@ -69,23 +70,76 @@ pub(super) fn refined_member(
         stop: lm.stop.clone(),
         probes,
     };
-    (member, rms, lm.samples.clone(), refinement)
+    let stride = plot_stride(evaluator.job());
+    let plotted = lm.samples[0].iter().step_by(stride).copied().collect();
+    (member, rms, plotted, refinement)
+}
+
+/// Simulates `c` on every event of `job` in this process, handing each sample to
+/// `record(event, index, observation)` as it is made (no trajectory is stored unless `record`
+/// stores it); the reason when a run does not finish.
+///
+/// The same runs as [`Job::evaluate`] (an evaluation is a pure function of the job and the
+/// candidate, whichever evaluator makes it): the outputs after a search compare long
+/// trajectories sample by sample here, where the data already is, instead of bringing each one
+/// back whole from a worker (two copies of a long record in each process, issue 13).
+fn simulate_locally(
+    job: &Job,
+    c: &Candidate,
+    mut record: impl FnMut(usize, usize, &Observation),
+) -> Result<(), String> {
+    struct Each<'a, F>(&'a mut F, usize);
+    impl<F: FnMut(usize, usize, &Observation)> SampleSink for Each<'_, F> {
+        #[inline]
+        fn record(&mut self, index: usize, obs: &Observation, _x: &StateVector) {
+            (self.0)(self.1, index, obs);
+        }
+    }
+    for (k, event) in job.events().iter().enumerate() {
+        let run = event
+            .simulator
+            .run_setup_with(&c.factors, &c.effects, &c.terms)
+            .map_err(|e| e.to_string())?;
+        propagate(
+            event.simulator.model(),
+            &run,
+            &event.data.times_s,
+            &mut Each(&mut record, k),
+        )
+        .map_err(|d| format!("diverged at t = {} s (event {k})", d.t_s))?;
+    }
+    Ok(())
 }
 
 /// One grid step of each factor at `factors` (inward at a bound): the change of the goals and
 /// of the simulated trajectory, coarse when the trajectory moves by more than the noise.
 ///
-/// `base` is the simulated samples of `factors` (the best method's, already at hand: a second
-/// copy of a long record is not made).
+/// The trajectory of `factors` is simulated here and held once; each step is simulated here
+/// and compared with it (and with the data) sample by sample, so no stepped trajectory is
+/// stored or transferred. The base goals come from `evaluator`. Every number is the one an
+/// evaluation with samples gives (the step goals pooled over events as such an evaluation
+/// pools them).
 pub fn resolution_advice(
     evaluator: &mut dyn Evaluator,
     table: &sepval_common::factors::FactorTable,
     factors: &Factors,
-    base: &[Vec<Observation>],
     noise: Noise,
 ) -> Result<Vec<ResolutionRow>, FitError> {
     use sepval_common::factors::Factor;
-    let mut batch = vec![Candidate::baseline(*factors)];
+    let g0 = evaluator.evaluate(&[Candidate::baseline(*factors)], false)?[0]
+        .outcome
+        .objectives();
+    let job = Arc::clone(evaluator.job());
+    let mut base: Vec<Vec<Observation>> = job
+        .events()
+        .iter()
+        .map(|e| Vec::with_capacity(e.data.len()))
+        .collect();
+    simulate_locally(&job, &Candidate::baseline(*factors), |k, _, o| {
+        base[k].push(*o)
+    })
+    .map_err(|e| FitError::Failed(format!("the best member did not finish: {e}")))?;
+    let mut rows = Vec::with_capacity(table.0.len());
     for (i, spec) in table.0.iter().enumerate() {
         let mut f = *factors;
         let step = spec.step();
@@ -94,71 +148,80 @@ pub fn resolution_advice(
         } else {
             f.0[i] - step
         };
-        batch.push(Candidate::baseline(f));
-    }
-    // The base goals, then the steps in parts (each part's samples are dropped once its rows
-    // are made, so that long records stay within memory).
-    let g0 = evaluator.evaluate(&batch[..1], false)?[0]
-        .outcome
-        .objectives();
-    let per = evaluator.job().sample_count().max(1);
-    let part = (crate::run::SAMPLE_BUDGET / per).max(1);
-    let mut rows = Vec::new();
-    let mut i = 0;
-    for chunk in batch[1..].chunks(part) {
-        for e in Evaluate(evaluator).evaluate(chunk, true)? {
-            let name = Factor::NAMES[i].to_string();
-            let step = table.0[i].step();
-            i += 1;
-            let Some(s) = &e.samples else {
-                rows.push(ResolutionRow {
-                    factor: name,
-                    step,
-                    d_j_pos_m: None,
-                    d_j_att_deg: None,
-                    traj_rms_pos_m: None,
-                    traj_rms_att_deg: None,
-                    coarse: true,
-                });
-                continue;
-            };
-            let (mut dp, mut da, mut n) = (0.0, 0.0, 0usize);
-            for (ev_a, ev_b) in s.iter().zip(base) {
-                for (a, b) in ev_a.iter().zip(ev_b) {
-                    let (p, q) = residual(a, &b.pos_m, &b.att_deg);
-                    dp += p.iter().map(|v| v * v).sum::<f64>();
-                    da += q.iter().map(|v| v * v).sum::<f64>();
-                    n += 1;
-                }
-            }
-            let n3 = 3.0 * n.max(1) as f64;
-            let (rp, ra) = ((dp / n3).sqrt(), (da / n3).sqrt());
-            let g = e.outcome.objectives();
+        // Against the data (the step's goals) and against the base trajectory.
+        let (mut to_data, mut to_base) = (GoalSums::default(), GoalSums::default());
+        let ran = simulate_locally(&job, &Candidate::baseline(f), |k, j, o| {
+            let d = &job.events()[k].data;
+            to_data.add(o, &d.pos_m[j], &d.att_deg[j]);
+            let b = &base[k][j];
+            to_base.add(o, &b.pos_m, &b.att_deg);
+        });
+        let g = to_data.goals();
+        let name = Factor::NAMES[i].to_string();
+        if ran.is_err() || !(g.j_pos_m.is_finite() && g.j_att_deg.is_finite()) {
+            // A step that does not finish (or whose goals are beyond f64, a failed run).
             rows.push(ResolutionRow {
                 factor: name,
                 step,
-                d_j_pos_m: Some(g[0] - g0[0]),
-                d_j_att_deg: Some(g[1] - g0[1]),
-                traj_rms_pos_m: Some(rp),
-                traj_rms_att_deg: Some(ra),
-                coarse: rp > noise.pos_m || ra > noise.att_deg,
+                d_j_pos_m: None,
+                d_j_att_deg: None,
+                traj_rms_pos_m: None,
+                traj_rms_att_deg: None,
+                coarse: true,
             });
+            continue;
         }
+        let t = to_base.goals();
+        let (rp, ra) = (t.j_pos_m, t.j_att_deg);
+        rows.push(ResolutionRow {
+            factor: name,
+            step,
+            d_j_pos_m: Some(g.j_pos_m - g0[0]),
+            d_j_att_deg: Some(g.j_att_deg - g0[1]),
+            traj_rms_pos_m: Some(rp),
+            traj_rms_att_deg: Some(ra),
+            coarse: rp > noise.pos_m || ra > noise.att_deg,
+        });
     }
     Ok(rows)
 }
 
-/// Re-evaluates a best member with its samples: its per-channel residual RMS and trajectory.
+/// Every how many samples a trajectory figure draws the first event (a figure has about a
+/// thousand pixels across: a long record is thinned to at most [`MAX_PLOTTED_SAMPLES`]).
+fn plot_stride(job: &Job) -> usize {
+    job.events()[0]
+        .data
+        .len()
+        .div_ceil(MAX_PLOTTED_SAMPLES)
+        .max(1)
+}
+
+/// Simulates a best member here: its per-channel residual RMS and the samples the figures
+/// draw (the first event's, thinned), without holding its whole trajectory.
 pub(super) fn best_samples_of(
-    evaluator: &mut dyn Evaluator,
+    job: &Job,
     best: &Member,
-) -> Result<(ChannelRms, Vec<Vec<Observation>>), FitError> {
-    let batch = [Candidate::baseline(factors_of(&best.values))];
-    let e = evaluator.evaluate(&batch, true)?.remove(0);
-    let samples = e.samples.ok_or_else(|| {
-        FitError::Failed("the best member did not finish when re-evaluated".into())
+) -> Result<(ChannelRms, Vec<Observation>), FitError> {
+    let stride = plot_stride(job);
+    let mut plotted = Vec::with_capacity(job.events()[0].data.len().div_ceil(stride));
+    let mut rms = ChannelSums::default();
+    simulate_locally(
+        job,
+        &Candidate::baseline(factors_of(&best.values)),
+        |k, j, o| {
+            let d = &job.events()[k].data;
+            rms.add(o, &d.pos_m[j], &d.att_deg[j]);
+            if k == 0 && j % stride == 0 {
+                plotted.push(*o);
+            }
+        },
+    )
+    .map_err(|e| {
+        FitError::Failed(format!(
+            "the best member did not finish when re-evaluated: {e}"
+        ))
     })?;
-    Ok((residual_rms(evaluator.job(), &samples), samples))
+    Ok((rms.rms(), plotted))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -239,7 +302,7 @@ pub fn write_fit_figures(
     let first = &job.events()[0];
     // A long record is drawn from every k-th sample (a figure has about a thousand pixels
     // across; the plotted copies stay small).
-    let stride = first.data.len().div_ceil(MAX_PLOTTED_SAMPLES).max(1);
+    let stride = plot_stride(job);
     let pick = |n: usize| (0..n).step_by(stride);
     let data = sepval_common::telemetry::Trajectory {
         times_s: pick(first.data.len())
@@ -254,14 +317,13 @@ pub fn write_fit_figures(
         ..Default::default()
     };
     let fits: Vec<(String, sepval_common::telemetry::Trajectory)> = output
-        .best_samples
+        .best_plotted
         .iter()
-        .map(|(m, samples)| {
-            let obs = &samples[0];
+        .map(|(m, plotted)| {
             let traj = sepval_common::telemetry::Trajectory {
                 times_s: data.times_s.clone(),
-                pos_m: pick(obs.len()).map(|k| obs[k].pos_m).collect(),
-                att_deg: pick(obs.len()).map(|k| obs[k].att_deg).collect(),
+                pos_m: plotted.iter().map(|o| o.pos_m).collect(),
+                att_deg: plotted.iter().map(|o| o.att_deg).collect(),
                 ..Default::default()
             };
             (label(m), traj)
