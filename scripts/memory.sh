@@ -2,14 +2,19 @@
 # Peak memory of a fit on a long record: coordinator and worker processes together, as PSS
 # (proportional set size: shared memory counted once across the processes that map it).
 #
-#   scripts/memory.sh [ROWS]      (default 2 000 000 rows, the limit issue 13 set: under 500 MB)
+#   scripts/memory.sh [ROWS [METHOD]]   (default 2 000 000 rows, the limit issue 13 set: under
+#                                        500 MB; METHOD: ga (default), hill, both, ga+lm, hill+lm)
 #
-# Simulates ROWS telemetry rows at 10 kHz (200 s for 2 million: a long record that stays within the plausible-position bound) with noise, fits them with a one-generation GA of four
-# candidates on one worker, samples /proc/PID/smaps_rollup of `sepval` and `sepval-worker`
-# every 0.1 s, and prints the peak of their sum. Build first: cargo build --release.
+# Simulates ROWS telemetry rows at 10 kHz (200 s for 2 million: a long record that stays within
+# the plausible-position bound) with noise, fits them with METHOD on one worker, each search as
+# short as it goes (a one-generation GA of four candidates, a hill climb of 4 simulations, a
+# refinement of 30: its start and one Jacobian), samples /proc/PID/smaps_rollup of `sepval`
+# and `sepval-worker` every 0.1 s, and prints the peak of their sum. Build first:
+# cargo build --release.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 rows=${1:-2000000}
+method=${2:-ga}
 bin=./target/release
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
@@ -19,8 +24,8 @@ t_end=$(python3 -c "print(($rows - 1) / $rate)")
 "$bin/sepval" simulate --t-end "$t_end" --rate "$rate" --noise-seed 1 --out "$dir/long.csv" >/dev/null
 echo "telemetry: $(($(grep -vc '^#' "$dir/long.csv") - 1)) rows, $(du -m "$dir/long.csv" | cut -f1) MB"
 
-"$bin/sepval" fit --data "$dir/long.csv" --method ga --generations 1 --population 4 \
-    --workers 1 --out "$dir/run" >"$dir/fit.log" 2>&1 &
+"$bin/sepval" fit --data "$dir/long.csv" --method "$method" --generations 1 --population 4 \
+    --hill-budget 4 --lm-budget 30 --workers 1 --out "$dir/run" >"$dir/fit.log" 2>&1 &
 fit=$!
 peak=0 peak_coordinator=0 peak_worker=0
 while kill -0 "$fit" 2>/dev/null; do
@@ -41,5 +46,5 @@ while kill -0 "$fit" 2>/dev/null; do
     sleep 0.1
 done
 wait "$fit" || { cat "$dir/fit.log"; exit 1; }
-echo "peak PSS, coordinator + worker: $((peak / 1024)) MB" \
+echo "$method: peak PSS, coordinator + worker: $((peak / 1024)) MB" \
     "(coordinator alone $((peak_coordinator / 1024)) MB, worker alone $((peak_worker / 1024)) MB)"
