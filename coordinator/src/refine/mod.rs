@@ -136,8 +136,16 @@ fn solve_bounded(a: DMatrix<f64>, b: DVector<f64>) -> DVector<f64> {
 enum Stage {
     /// The start point.
     Start,
-    /// Derivative probes (then the final Jacobian is complete when `last`).
-    Jacobian { steps: Vec<f64>, last: bool },
+    /// Derivative probes (then the final Jacobian is complete when `last`), asked in parts of
+    /// at most `part` parameters so that a long record's probe trajectories are not all held
+    /// at once: `jac` has the columns before `next`.
+    Jacobian {
+        steps: Vec<f64>,
+        last: bool,
+        next: usize,
+        part: usize,
+        jac: DMatrix<f64>,
+    },
     /// Probes along each damped step for its curvature.
     Curvature {
         deltas: Vec<Vec<f64>>,
@@ -216,7 +224,9 @@ impl LmRun {
     pub fn request(&self) -> Result<Option<Vec<Candidate>>> {
         let points: Vec<Vec<f64>> = match &self.stage {
             Stage::Start => vec![self.x.clone()],
-            Stage::Jacobian { steps, .. } => (0..self.space.len())
+            Stage::Jacobian {
+                steps, next, part, ..
+            } => (*next..(*next + *part).min(self.space.len()))
                 .map(|i| {
                     let mut p = self.x.clone();
                     p[i] += steps[i];
@@ -250,10 +260,14 @@ impl LmRun {
                     .push((self.evaluations, goals_of(&self.r, self.noise)));
                 self.begin_jacobian(false);
             }
-            Stage::Jacobian { steps, last } => {
-                let n = self.space.len();
-                let mut jac = DMatrix::zeros(self.r.len(), n);
-                for (i, s) in out.into_iter().enumerate() {
+            Stage::Jacobian {
+                steps,
+                last,
+                next,
+                part,
+                mut jac,
+            } => {
+                for (i, s) in (next..).zip(out) {
                     let s = s.ok_or_else(|| {
                         search_error(format!(
                             "the derivative probe of {} did not simulate",
@@ -264,6 +278,17 @@ impl LmRun {
                     for (k, v) in ri.iter().enumerate() {
                         jac[(k, i)] = (v - self.r[k]) / steps[i];
                     }
+                }
+                let next = (next + part).min(self.space.len());
+                if next < self.space.len() {
+                    self.stage = Stage::Jacobian {
+                        steps,
+                        last,
+                        next,
+                        part,
+                        jac,
+                    };
+                    return Ok(());
                 }
                 self.jac = jac;
                 if !last {
@@ -323,9 +348,17 @@ impl LmRun {
     }
 
     fn begin_jacobian(&mut self, last: bool) {
+        // The previous Jacobian is not used again: it goes before the new one is made (6 x
+        // samples x parameters doubles each, 1.6 GB at 2 million samples and 17 parameters).
+        self.jac = DMatrix::zeros(0, 0);
+        let n = self.space.len();
+        let per = self.job.sample_count().max(1);
         self.stage = Stage::Jacobian {
             steps: fd_steps(&self.space, &self.x, self.settings.fd_step),
             last,
+            next: 0,
+            part: (crate::run::SAMPLE_BUDGET / per).clamp(1, n.max(1)),
+            jac: DMatrix::zeros(self.r.len(), n),
         };
     }
 
