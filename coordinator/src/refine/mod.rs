@@ -136,31 +136,39 @@ fn solve_bounded(a: DMatrix<f64>, b: DVector<f64>) -> DVector<f64> {
 enum Stage {
     /// The start point.
     Start,
-    /// Derivative probes (then the final Jacobian is complete when `last`), asked in parts of
-    /// at most `part` parameters so that a long record's probe trajectories are not all held
-    /// at once: `jac` has the columns before `next`.
+    /// Derivative probes (then the final Jacobian is complete when `last`): `jac` has the
+    /// columns before `next`.
     Jacobian {
         steps: Vec<f64>,
         last: bool,
         next: usize,
-        part: usize,
         jac: DMatrix<f64>,
     },
-    /// Probes along each damped step for its curvature.
+    /// Probes along each damped step for its curvature: `points` has the trials of the steps
+    /// before `next`.
     Curvature {
         deltas: Vec<Vec<f64>>,
         probes: Vec<Vec<f64>>,
         mus: [f64; 4],
         free: Vec<usize>,
+        jtj: DMatrix<f64>,
+        next: usize,
+        points: Vec<Vec<f64>>,
     },
-    /// Damped (and accelerated) Gauss-Newton trials at four damping values.
+    /// Damped (and accelerated) Gauss-Newton trials at four damping values: `best` is the
+    /// lowest cost of the trials before `next` (index, cost, residuals, samples).
     Trials {
         points: Vec<Vec<f64>>,
         mus: [f64; 4],
+        next: usize,
+        best: Option<Best>,
     },
     /// Finished.
     Done,
 }
+
+/// The best trial so far: its index, cost, residuals and samples.
+type Best = (usize, f64, Vec<f64>, Vec<Vec<Observation>>);
 
 /// One refinement as a sequence of batches: [`LmRun::request`] gives the next parameter
 /// vectors to simulate, [`LmRun::absorb`] takes their samples. Several refinements can so share
@@ -183,6 +191,10 @@ pub struct LmRun {
     stop: String,
     /// Consecutive accepted steps that lowered the cost by less than the tolerance.
     small_gains: usize,
+    /// Most points asked at once: a stage's points go in parts within
+    /// [`crate::run::SAMPLE_BUDGET`] samples, each part's trajectories reduced and dropped
+    /// before the next part is asked (a long record's are 96 MB each at 2 million samples).
+    part: usize,
 }
 
 impl LmRun {
@@ -195,6 +207,7 @@ impl LmRun {
         settings: LmSettings,
     ) -> Self {
         let x = space.clamp(x0);
+        let part = (crate::run::SAMPLE_BUDGET / job.sample_count().max(1)).max(1);
         LmRun {
             space,
             job,
@@ -212,6 +225,7 @@ impl LmRun {
             stage: Stage::Start,
             stop: String::new(),
             small_gains: 0,
+            part,
         }
     }
 
@@ -224,17 +238,19 @@ impl LmRun {
     pub fn request(&self) -> Result<Option<Vec<Candidate>>> {
         let points: Vec<Vec<f64>> = match &self.stage {
             Stage::Start => vec![self.x.clone()],
-            Stage::Jacobian {
-                steps, next, part, ..
-            } => (*next..(*next + *part).min(self.space.len()))
+            Stage::Jacobian { steps, next, .. } => (*next..self.part_end(*next, self.space.len()))
                 .map(|i| {
                     let mut p = self.x.clone();
                     p[i] += steps[i];
                     p
                 })
                 .collect(),
-            Stage::Curvature { probes, .. } => probes.clone(),
-            Stage::Trials { points, .. } => points.clone(),
+            Stage::Curvature { probes, next, .. } => {
+                probes[*next..self.part_end(*next, probes.len())].to_vec()
+            }
+            Stage::Trials { points, next, .. } => {
+                points[*next..self.part_end(*next, points.len())].to_vec()
+            }
             Stage::Done => return Ok(None),
         };
         Ok(Some(
@@ -243,6 +259,11 @@ impl LmRun {
                 .map(|x| self.space.candidate(x))
                 .collect::<Result<_>>()?,
         ))
+    }
+
+    /// The end of the part that starts at `next` of `len` points.
+    fn part_end(&self, next: usize, len: usize) -> usize {
+        next.saturating_add(self.part).min(len)
     }
 
     /// Takes the samples of the last request (`None` for runs that did not finish).
@@ -264,7 +285,6 @@ impl LmRun {
                 steps,
                 last,
                 next,
-                part,
                 mut jac,
             } => {
                 for (i, s) in (next..).zip(out) {
@@ -279,13 +299,12 @@ impl LmRun {
                         jac[(k, i)] = (v - self.r[k]) / steps[i];
                     }
                 }
-                let next = (next + part).min(self.space.len());
+                let next = self.part_end(next, self.space.len());
                 if next < self.space.len() {
                     self.stage = Stage::Jacobian {
                         steps,
                         last,
                         next,
-                        part,
                         jac,
                     };
                     return Ok(());
@@ -296,27 +315,69 @@ impl LmRun {
                 }
             }
             Stage::Curvature {
-                deltas, mus, free, ..
-            } => self.plan_accelerated(deltas, out, mus, free),
-            Stage::Trials { points, mus } => {
-                let mut best: Option<(usize, f64, Vec<f64>)> = None;
-                let mut kept: Vec<Option<Vec<Vec<Observation>>>> = out;
-                for (k, s) in kept.iter().enumerate() {
+                deltas,
+                probes,
+                mus,
+                free,
+                jtj,
+                next,
+                mut points,
+            } => {
+                for (k, s) in (next..).zip(out) {
+                    points.push(self.accelerated(&deltas[k], s.as_deref(), mus[k], &free, &jtj));
+                }
+                let next = self.part_end(next, deltas.len());
+                self.stage = if next < deltas.len() {
+                    Stage::Curvature {
+                        deltas,
+                        probes,
+                        mus,
+                        free,
+                        jtj,
+                        next,
+                        points,
+                    }
+                } else {
+                    Stage::Trials {
+                        points,
+                        mus,
+                        next: 0,
+                        best: None,
+                    }
+                };
+            }
+            Stage::Trials {
+                points,
+                mus,
+                next,
+                mut best,
+            } => {
+                for (k, s) in (next..).zip(out) {
                     if let Some(s) = s {
-                        let rk = residual_vector(&self.job, s, self.noise);
+                        let rk = residual_vector(&self.job, &s, self.noise);
                         let ck: f64 = rk.iter().map(|v| v * v).sum();
                         if best.as_ref().is_none_or(|b| ck < b.1) {
-                            best = Some((k, ck, rk));
+                            best = Some((k, ck, rk, s));
                         }
                     }
                 }
+                let next = self.part_end(next, points.len());
+                if next < points.len() {
+                    self.stage = Stage::Trials {
+                        points,
+                        mus,
+                        next,
+                        best,
+                    };
+                    return Ok(());
+                }
                 match best {
-                    Some((k, ck, rk)) if ck < self.cost => {
+                    Some((k, ck, rk, sk)) if ck < self.cost => {
                         let gain = (self.cost - ck) / self.cost;
                         self.x = points[k].clone();
                         self.cost = ck;
                         self.r = rk;
-                        self.samples = kept[k].take().expect("finished trial");
+                        self.samples = sk;
                         self.mu = mus[k].max(1e-12);
                         self.history
                             .push((self.evaluations, goals_of(&self.r, self.noise)));
@@ -351,14 +412,11 @@ impl LmRun {
         // The previous Jacobian is not used again: it goes before the new one is made (6 x
         // samples x parameters doubles each, 1.6 GB at 2 million samples and 17 parameters).
         self.jac = DMatrix::zeros(0, 0);
-        let n = self.space.len();
-        let per = self.job.sample_count().max(1);
         self.stage = Stage::Jacobian {
             steps: fd_steps(&self.space, &self.x, self.settings.fd_step),
             last,
             next: 0,
-            part: (crate::run::SAMPLE_BUDGET / per).clamp(1, n.max(1)),
-            jac: DMatrix::zeros(self.r.len(), n),
+            jac: DMatrix::zeros(self.r.len(), self.space.len()),
         };
     }
 
@@ -402,6 +460,9 @@ impl LmRun {
             probes,
             mus,
             free,
+            jtj,
+            next: 0,
+            points: Vec::with_capacity(4),
         };
     }
 
@@ -410,49 +471,46 @@ impl LmRun {
     /// second directional derivative of the residuals along each step, from one probe at
     /// h = 0.1 of the step, gives a curvature correction a; the trial is x + delta + a / 2 when
     /// 2 |a| <= 0.75 |delta| (range-scaled norms), else x + delta.
-    fn plan_accelerated(
-        &mut self,
-        deltas: Vec<Vec<f64>>,
-        probes: Vec<Option<Vec<Vec<Observation>>>>,
-        mus: [f64; 4],
-        free: Vec<usize>,
-    ) {
+    ///
+    /// The trial of one step `delta` (damping `mu`) from its probe's samples (`None`: the
+    /// probe did not finish, and the trial is the plain step); `jtj` is J^T J.
+    fn accelerated(
+        &self,
+        delta: &[f64],
+        probe: Option<&[Vec<Observation>]>,
+        mu: f64,
+        free: &[usize],
+        jtj: &DMatrix<f64>,
+    ) -> Vec<f64> {
         let n = self.space.len();
-        let jtj = self.jac.tr_mul(&self.jac);
         let scaled = |v: &[f64]| -> f64 {
             (0..n)
                 .map(|i| (v[i] / self.space.range(i)).powi(2))
                 .sum::<f64>()
                 .sqrt()
         };
-        let mut points = Vec::with_capacity(4);
-        for (k, delta) in deltas.iter().enumerate() {
-            let mut step = delta.clone();
-            if let Some(s) = &probes[k] {
-                let rh = residual_vector(&self.job, s, self.noise);
-                let jd = &self.jac * DVector::from_column_slice(delta);
-                let rpp: Vec<f64> = (0..rh.len())
-                    .map(|j| 2.0 / CURVATURE_H * ((rh[j] - self.r[j]) / CURVATURE_H - jd[j]))
-                    .collect();
-                let rhs: Vec<f64> = self
-                    .jac
-                    .tr_mul(&DVector::from_column_slice(&rpp))
-                    .iter()
-                    .map(|v| -v)
-                    .collect();
-                let acc = solve_damped(&jtj, &free, mus[k], &rhs);
-                if 2.0 * scaled(&acc) <= 0.75 * scaled(delta) {
-                    for i in 0..n {
-                        step[i] += 0.5 * acc[i];
-                    }
+        let mut step = delta.to_vec();
+        if let Some(s) = probe {
+            let rh = residual_vector(&self.job, s, self.noise);
+            let jd = &self.jac * DVector::from_column_slice(delta);
+            let rpp: Vec<f64> = (0..rh.len())
+                .map(|j| 2.0 / CURVATURE_H * ((rh[j] - self.r[j]) / CURVATURE_H - jd[j]))
+                .collect();
+            let rhs: Vec<f64> = self
+                .jac
+                .tr_mul(&DVector::from_column_slice(&rpp))
+                .iter()
+                .map(|v| -v)
+                .collect();
+            let acc = solve_damped(jtj, free, mu, &rhs);
+            if 2.0 * scaled(&acc) <= 0.75 * scaled(delta) {
+                for i in 0..n {
+                    step[i] += 0.5 * acc[i];
                 }
             }
-            points.push(
-                self.space
-                    .clamp(&(0..n).map(|i| self.x[i] + step[i]).collect::<Vec<_>>()),
-            );
         }
-        self.stage = Stage::Trials { points, mus };
+        self.space
+            .clamp(&(0..n).map(|i| self.x[i] + step[i]).collect::<Vec<_>>())
     }
 
     /// The result (after [`LmRun::request`] returned `None`).
