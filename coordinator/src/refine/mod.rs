@@ -491,17 +491,18 @@ impl LmRun {
         };
         let mut step = delta.to_vec();
         if let Some(s) = probe {
-            let rh = residual_vector(&self.job, s, self.noise);
-            let jd = &self.jac * DVector::from_column_slice(delta);
-            let rpp: Vec<f64> = (0..rh.len())
-                .map(|j| 2.0 / CURVATURE_H * ((rh[j] - self.r[j]) / CURVATURE_H - jd[j]))
-                .collect();
-            let rhs: Vec<f64> = self
-                .jac
-                .tr_mul(&DVector::from_column_slice(&rpp))
-                .iter()
-                .map(|v| -v)
-                .collect();
+            // Made as a vector of its own at once (a long record's residual vectors are
+            // 96 MB each at 2 million samples: no second copy of it).
+            let rpp = {
+                let rh = residual_vector(&self.job, s, self.noise);
+                let jd = &self.jac * DVector::from_column_slice(delta);
+                DVector::from_iterator(
+                    rh.len(),
+                    (0..rh.len())
+                        .map(|j| 2.0 / CURVATURE_H * ((rh[j] - self.r[j]) / CURVATURE_H - jd[j])),
+                )
+            };
+            let rhs: Vec<f64> = self.jac.tr_mul(&rpp).iter().map(|v| -v).collect();
             let acc = solve_damped(jtj, free, mu, &rhs);
             if 2.0 * scaled(&acc) <= 0.75 * scaled(delta) {
                 for i in 0..n {
