@@ -10,7 +10,8 @@
 # short as it goes (a one-generation GA of four candidates, a hill climb of 4 simulations, a
 # refinement of 30: its start and one Jacobian), samples /proc/PID/smaps_rollup of `sepval`
 # and `sepval-worker` every 0.1 s, and prints the peak of their sum. Build first:
-# cargo build --release.
+# cargo build --release. The hill climber starts from the nominal factors, whose run diverges
+# at t = 58 s: hill, both and hill+lm need ROWS <= 570 000 (e.g. scripts/memory.sh 500000 both).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 rows=${1:-2000000}
