@@ -31,7 +31,9 @@ fit=$!
 peak=0 peak_coordinator=0 peak_worker=0
 while kill -0 "$fit" 2>/dev/null; do
     total=0 coordinator=0 worker=0
-    for pid in $(pgrep -f "$bin/sepval" || true); do
+    # This fit and the workers it started (its children), not other sepval processes on the
+    # host (a pattern on the command line would also match another checkout's binaries).
+    for pid in "$fit" $(pgrep -P "$fit" || true); do
         kb=$(awk '/^Pss:/ {print $2}' "/proc/$pid/smaps_rollup" 2>/dev/null || echo 0)
         kb=${kb:-0}
         total=$((total + kb))
