@@ -170,7 +170,8 @@ impl Job {
 
     /// Evaluates one candidate (goals pooled over all events).
     pub fn evaluate(&self, c: &Candidate) -> Evaluation {
-        self.evaluate_batch(std::slice::from_ref(c), false).remove(0)
+        self.evaluate_batch(std::slice::from_ref(c), false)
+            .remove(0)
     }
 
     /// Evaluates one candidate and keeps the simulated samples of every event.
@@ -206,8 +207,10 @@ impl Job {
             for group in live.chunks(LANES) {
                 let runs: Vec<RunSetup> = group.iter().map(|(_, run)| *run).collect();
                 let results = if keep {
-                    let mut sinks: Vec<Vec<Observation>> =
-                        runs.iter().map(|_| Vec::with_capacity(data.len())).collect();
+                    let mut sinks: Vec<Vec<Observation>> = runs
+                        .iter()
+                        .map(|_| Vec::with_capacity(data.len()))
+                        .collect();
                     let results = propagate_lanes(model, &runs, &data.times_s, &mut sinks);
                     for ((&(i, _), r), obs) in group.iter().zip(&results).zip(sinks) {
                         if r.is_ok() {

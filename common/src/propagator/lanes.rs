@@ -19,8 +19,10 @@
 //!
 //! Choices: a scenario with tables (section 3) runs each lane through the scalar path
 //! ([`super::propagate`]): the tables' look-ups are scalar and their excursion counts are per run;
-//! so does a batch of one run, and a host without AVX2 and FMA units, where four lanes are four
-//! scalar operations each and the scalar path is the faster.
+//! so does a batch of one run, and an x86-64 host without AVX2 and FMA units (there a fused
+//! multiply-add is a call to the C library in either path, and four lanes are four scalar
+//! operations each, so the scalar path is the faster). AArch64 hosts run the lanes as two
+//! 2-lane NEON instructions per operation (FMA is part of the base instruction set).
 
 use crate::lanes::{F64x4, Real, gather, lane};
 use crate::model::{LaneEquations, Model, RunSetup, STATE_LEN, StateVector};
@@ -39,8 +41,9 @@ pub const LANES: usize = 4;
 ///
 /// Result `i` and the samples `sinks[i]` receives are bit for bit those of
 /// [`propagate`]`(model, &runs[i], times_s, &mut sinks[i])`. On x86-64 hosts with AVX2 and FMA
-/// units the runs advance in lockstep, one per lane; elsewhere, and for a scenario with tables,
-/// one after another (see the module documentation).
+/// units (chosen at run time) and on AArch64 (NEON, two lanes per instruction) the runs advance
+/// in lockstep, one per lane; elsewhere, and for a scenario with tables, one after another (see
+/// the module documentation).
 ///
 /// # Panics
 /// If `runs` is empty or longer than [`LANES`], or `sinks` is not as long as `runs`.
@@ -59,6 +62,12 @@ pub fn propagate_lanes<S: SampleSink>(
     {
         // SAFETY: the CPU supports the features `lanes_fma` is compiled for.
         return unsafe { lanes_fma(model, runs, times_s, sinks) };
+    }
+    // AArch64 has NEON and fused multiply-adds in its base instruction set: each F64x4
+    // operation is two 2-lane instructions.
+    #[cfg(target_arch = "aarch64")]
+    if runs.len() > 1 && !model.tables.in_evaluation() {
+        return lanes_inline(model, runs, times_s, sinks);
     }
     runs.iter()
         .zip(sinks)

@@ -384,7 +384,10 @@ mod tests {
             assert!(plan.iter().all(|c| !c.is_empty() && c.len() <= 16));
             // Every chunk but the last fills whole lane batches.
             let whole = plan.len().saturating_sub(1);
-            assert!(plan.iter().take(whole).all(|c| c.len() % LANES == 0), "{n} {w}");
+            assert!(
+                plan.iter().take(whole).all(|c| c.len() % LANES == 0),
+                "{n} {w}"
+            );
         }
     }
 }
