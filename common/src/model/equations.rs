@@ -205,7 +205,7 @@ impl<'a> EquationsOfMotion<'a> {
     ///
     /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
     /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
-    /// allocation. Each block of [`derivative`] cites the docs/model.md line it implements.
+    /// allocation. Each block of the generic `derivative` behind it cites the docs/model.md line it implements.
     ///
     /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
     /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).

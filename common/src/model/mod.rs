@@ -1,12 +1,13 @@
 //! The store-separation model: one scenario set up once ([`Model`]), one run's constants
 //! ([`RunSetup`]: factors and effects applied), and the equations of motion
-//! ([`RunSetup::derivative`]).
+//! ([`EquationsOfMotion`], in `equations.rs`: once for one run and for one run per SIMD lane).
 //!
 //! Source: `docs/model.md` sections 1 to 3. The tree mirrors the physics:
 //! [`ejector`] (force-versus-displacement table), [`interference`] (decay with distance),
 //! [`aero`] (coefficients and the flow state the catalogue's terms see).
 //!
-//! Equations of motion (docs/model.md section 2), implemented in [`RunSetup::derivative`]:
+//! Equations of motion (docs/model.md section 2), implemented in
+//! [`EquationsOfMotion::derivative`] (and [`RunSetup::derivative`] for one state):
 //!
 //! ```text
 //! dr/dt     = v

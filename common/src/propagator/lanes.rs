@@ -168,7 +168,10 @@ fn set_state(x: &mut [F64x4; STATE_LEN], i: usize, s: &StateVector) {
 fn diverged(y: &[F64x4; STATE_LEN]) -> [bool; LANES] {
     let mut nan = F64x4::splat(0.0);
     for &v in y {
-        nan = nan + (v - v);
+        // v - v: 0 for a finite v, NaN for an infinite or NaN one.
+        #[allow(clippy::eq_op)]
+        let zero_if_finite = v - v;
+        nan = nan + zero_if_finite;
     }
     let rate2 = y[10] * y[10] + y[11] * y[11] + y[12] * y[12];
     let bad = nan.is_nan() | rate2.gt(F64x4::splat(MAX_RATE_RAD_S * MAX_RATE_RAD_S));
