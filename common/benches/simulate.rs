@@ -6,6 +6,11 @@
 //! default 1.0 s event (2 000 RK4 steps, 8 000 force evaluations plus the located stroke ends),
 //! accumulating the goals against a 201-sample measured trajectory as a fit does.
 //!
+//! `simulate_lanes`: the amortised time of one run in a batch of 100 default-event candidates
+//! around the truth (each factor moved by up to 2 % of its range), propagated four at a time
+//! through the lane propagator, goals accumulated as `simulate_default_event` does (issue 16: at
+//! most 0.12 ms per run on one core).
+//!
 //! `simulate_default_event_tables`: the same with the default written as tables
 //! (`sepval scenario --tables --interference-tables`: static coefficients over Mach, alpha and
 //! beta, damping over Mach, interference over distance); issue 15 asks for at most 20 % more time than the constant form.
@@ -36,6 +41,52 @@ fn simulate_default_event(c: &mut Criterion) {
     bench_goals(c, "simulate_default_event", &Simulator::embedded_default());
 }
 
+fn simulate_lanes(c: &mut Criterion) {
+    use sepval_common::goals::GoalAccumulator;
+    use sepval_common::propagator::{LANES, propagate_lanes};
+    let sim = Simulator::embedded_default();
+    let measured = sim
+        .simulate(&Factors::NOMINAL, &EffectSet::NONE, &sim.default_times())
+        .expect("nominal run");
+    let table = &sim.scenario().factors;
+    // 100 candidates around the truth: factor j of candidate k moved by a fixed fraction of its
+    // range (a deterministic spread, no generator needed).
+    let runs: Vec<_> = (0..100)
+        .map(|k| {
+            let mut f = Factors::TRUTH;
+            for (j, v) in f.0.iter_mut().enumerate() {
+                let row = &table.0[j];
+                let u = ((k * 17 + j * 31) % 101) as f64 / 100.0 - 0.5;
+                *v = (*v + 0.04 * u * (row.max - row.min)).clamp(row.min, row.max);
+            }
+            sim.run_setup(&f, &EffectSet::NONE).expect("valid factors")
+        })
+        .collect();
+    c.bench_function("simulate_lanes", |b| {
+        b.iter_custom(|iters| {
+            let start = std::time::Instant::now();
+            for _ in 0..iters {
+                for batch in runs.chunks(LANES) {
+                    let mut sinks: Vec<_> = batch
+                        .iter()
+                        .map(|_| GoalAccumulator::new(&measured))
+                        .collect();
+                    black_box(propagate_lanes(
+                        sim.model(),
+                        batch,
+                        &measured.times_s,
+                        &mut sinks,
+                    ));
+                    for s in &sinks {
+                        black_box(s.sums.goals());
+                    }
+                }
+            }
+            start.elapsed() / runs.len() as u32
+        })
+    });
+}
+
 fn simulate_default_event_tables(c: &mut Criterion) {
     let dir = tempfile::tempdir().expect("a temporary directory");
     let form =
@@ -55,6 +106,7 @@ fn simulate_default_event_tables(c: &mut Criterion) {
 criterion_group!(
     benches,
     simulate_default_event,
+    simulate_lanes,
     simulate_default_event_tables
 );
 criterion_main!(benches);

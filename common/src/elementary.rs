@@ -734,6 +734,7 @@ pub fn atan2_asin<R: Real>(w: R, u: R, a: R, a2_num: R, a2_den: R) -> (R, R) {
         & z_atan.le(c(ATAN_T_MAX * ATAN_T_MAX))
         & z_asin.le(c(ASIN_A_MAX * ASIN_A_MAX));
     if !packed.all() {
+        cold();
         return atan2_asin_mixed(packed, w, u, a, t, z_asin);
     }
     atan2_asin_packed(t, z_atan, a, z_asin)
@@ -763,8 +764,10 @@ fn atan2_asin_packed<R: Real>(t: R, z_atan: R, a: R, z_asin: R) -> (R, R) {
 }
 
 /// [`atan2_asin`] when some lane is outside the store's range: there [`atan2`] and [`asin`].
-#[cold]
-#[inline(never)]
+/// Inlined (and so compiled with the caller's target features: out of line, in a build without
+/// FMA, each `mul_add` would be a library call; a fit's wilder candidates take this path at
+/// every stage), its branch marked cold.
+#[inline(always)]
 fn atan2_asin_mixed<R: Real>(packed: R::Mask, w: R, u: R, a: R, t: R, z_asin: R) -> (R, R) {
     let (alpha, beta) = atan2_asin_packed(t, t * t, a, z_asin);
     (
@@ -772,6 +775,11 @@ fn atan2_asin_mixed<R: Real>(packed: R::Mask, w: R, u: R, a: R, t: R, z_asin: R)
         R::select(packed, beta, asin(a)),
     )
 }
+
+/// Marks the branch that calls it as rarely taken (code layout only).
+#[cold]
+#[inline(never)]
+fn cold() {}
 
 /// `[f(0), f(1)]`: two lanes of arithmetic written so the compiler may pack them.
 #[inline(always)]

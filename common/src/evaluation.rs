@@ -20,7 +20,8 @@ use crate::effects::EffectSet;
 use crate::extension::TermSet;
 use crate::factors::{FactorTable, Factors};
 use crate::goals::{GoalAccumulator, GoalSums, Goals};
-use crate::propagator::{Observation, propagate};
+use crate::model::RunSetup;
+use crate::propagator::{LANES, Observation, propagate_lanes};
 use crate::scenario::{Scenario, hex_sha256};
 use crate::simulation::Simulator;
 use crate::telemetry::Trajectory;
@@ -169,65 +170,108 @@ impl Job {
 
     /// Evaluates one candidate (goals pooled over all events).
     pub fn evaluate(&self, c: &Candidate) -> Evaluation {
-        self.run(c, false)
+        self.evaluate_batch(std::slice::from_ref(c), false)
+            .remove(0)
     }
 
     /// Evaluates one candidate and keeps the simulated samples of every event.
     pub fn evaluate_with_samples(&self, c: &Candidate) -> Evaluation {
-        self.run(c, true)
+        self.evaluate_batch(std::slice::from_ref(c), true).remove(0)
     }
 
-    fn run(&self, c: &Candidate, keep: bool) -> Evaluation {
-        let mut sums = GoalSums::default();
-        let mut samples = Vec::new();
+    /// Evaluates `batch` (goals pooled over all events; with `keep`, the simulated samples of
+    /// every event too), one evaluation per candidate, in order. Candidates run [`LANES`] at a
+    /// time through the lane propagator ([`propagate_lanes`]), event after event (a candidate
+    /// that fails or diverges in one event runs no further), so evaluation `i` has the bits of
+    /// the evaluation of `batch[i]` alone.
+    pub fn evaluate_batch(&self, batch: &[Candidate], keep: bool) -> Vec<Evaluation> {
+        let mut sums = vec![GoalSums::default(); batch.len()];
+        let mut samples: Vec<Vec<Vec<Observation>>> = vec![Vec::new(); batch.len()];
+        let mut ended: Vec<Option<Evaluation>> = vec![None; batch.len()];
         for (k, event) in self.events.iter().enumerate() {
-            let run = match event
-                .simulator
-                .run_setup_with(&c.factors, &c.effects, &c.terms)
-            {
-                Ok(run) => run,
-                Err(e) => return Evaluation::from(Outcome::failed(e.to_string())),
-            };
-            let model = event.simulator.model();
-            let result = if keep {
-                let mut obs: Vec<Observation> = Vec::with_capacity(event.data.len());
-                let r = propagate(model, &run, &event.data.times_s, &mut obs);
-                if r.is_ok() {
-                    for (i, o) in obs.iter().enumerate() {
-                        sums.add(o, &event.data.pos_m[i], &event.data.att_deg[i]);
-                    }
-                    samples.push(obs);
+            let mut live: Vec<(usize, RunSetup)> = Vec::with_capacity(batch.len());
+            for (i, c) in batch.iter().enumerate() {
+                if ended[i].is_some() {
+                    continue;
                 }
-                r
-            } else {
-                let mut acc = GoalAccumulator::new(&event.data);
-                let r = propagate(model, &run, &event.data.times_s, &mut acc);
-                sums.merge(&acc.sums);
-                r
-            };
-            if let Err(d) = result {
-                return Evaluation::from(Outcome::Diverged {
-                    t_s: d.t_s,
-                    event: k,
-                });
+                match event
+                    .simulator
+                    .run_setup_with(&c.factors, &c.effects, &c.terms)
+                {
+                    Ok(run) => live.push((i, run)),
+                    Err(e) => ended[i] = Some(Outcome::failed(e.to_string()).into()),
+                }
+            }
+            let model = event.simulator.model();
+            let data = &event.data;
+            for group in live.chunks(LANES) {
+                let runs: Vec<RunSetup> = group.iter().map(|(_, run)| *run).collect();
+                let results = if keep {
+                    let mut sinks: Vec<Vec<Observation>> = runs
+                        .iter()
+                        .map(|_| Vec::with_capacity(data.len()))
+                        .collect();
+                    let results = propagate_lanes(model, &runs, &data.times_s, &mut sinks);
+                    for ((&(i, _), r), obs) in group.iter().zip(&results).zip(sinks) {
+                        if r.is_ok() {
+                            for (j, o) in obs.iter().enumerate() {
+                                sums[i].add(o, &data.pos_m[j], &data.att_deg[j]);
+                            }
+                            samples[i].push(obs);
+                        }
+                    }
+                    results
+                } else {
+                    let mut sinks: Vec<GoalAccumulator> =
+                        runs.iter().map(|_| GoalAccumulator::new(data)).collect();
+                    let results = propagate_lanes(model, &runs, &data.times_s, &mut sinks);
+                    for (&(i, _), acc) in group.iter().zip(&sinks) {
+                        sums[i].merge(&acc.sums);
+                    }
+                    results
+                };
+                for (&(i, _), r) in group.iter().zip(results) {
+                    if let Err(d) = r {
+                        ended[i] = Some(
+                            Outcome::Diverged {
+                                t_s: d.t_s,
+                                event: k,
+                            }
+                            .into(),
+                        );
+                    }
+                }
             }
         }
-        let g = sums.goals();
-        if !(g.j_pos_m.is_finite() && g.j_att_deg.is_finite()) {
-            // Residuals beyond f64 (a run far outside the data): a failed run, never a
-            // number that files would write as null.
-            return Evaluation::from(Outcome::failed(format!(
-                "the goals are not finite numbers (J_pos = {} m, J_att = {} deg)",
-                g.j_pos_m, g.j_att_deg
-            )));
-        }
-        Evaluation {
-            outcome: Outcome::Goals {
-                j_pos_m: g.j_pos_m,
-                j_att_deg: g.j_att_deg,
-            },
-            samples: keep.then_some(samples),
-        }
+        ended
+            .into_iter()
+            .zip(sums)
+            .zip(samples)
+            .map(|((ended, sums), samples)| {
+                ended.unwrap_or_else(|| finished(&sums, keep.then_some(samples)))
+            })
+            .collect()
+    }
+}
+
+/// The evaluation of a candidate that ran through every event: its pooled goals, or a failure
+/// if they are not finite.
+fn finished(sums: &GoalSums, samples: Option<Vec<Vec<Observation>>>) -> Evaluation {
+    let g = sums.goals();
+    if !(g.j_pos_m.is_finite() && g.j_att_deg.is_finite()) {
+        // Residuals beyond f64 (a run far outside the data): a failed run, never a
+        // number that files would write as null.
+        return Evaluation::from(Outcome::failed(format!(
+            "the goals are not finite numbers (J_pos = {} m, J_att = {} deg)",
+            g.j_pos_m, g.j_att_deg
+        )));
+    }
+    Evaluation {
+        outcome: Outcome::Goals {
+            j_pos_m: g.j_pos_m,
+            j_att_deg: g.j_att_deg,
+        },
+        samples,
     }
 }
 
@@ -401,37 +445,32 @@ impl Evaluator for InProcess {
         with_samples: bool,
     ) -> Result<Vec<Evaluation>, EvalError> {
         let job = &*self.job;
-        let eval = |c: &Candidate| {
-            if with_samples {
-                job.evaluate_with_samples(c)
-            } else {
-                job.evaluate(c)
-            }
-        };
-        let threads = self.threads.min(batch.len());
+        // Chunks of LANES consecutive candidates, each run as one lane batch.
+        let chunks: Vec<&[Candidate]> = batch.chunks(LANES).collect();
+        let threads = self.threads.min(chunks.len());
         if threads <= 1 {
             let mut out = Vec::with_capacity(batch.len());
-            for c in batch {
+            for chunk in chunks {
                 crate::cancel::check().map_err(|_| EvalError::Interrupted)?;
-                out.push(eval(c));
+                out.extend(job.evaluate_batch(chunk, with_samples));
             }
             return Ok(out);
         }
-        // Threads take the next index until the batch is done; each result goes to its own
-        // slot, so the order (and every bit) is independent of the thread count.
+        // Threads take the next chunk until the batch is done; each chunk's results go to its
+        // own slot, so the order (and every bit) is independent of the thread count.
         let next = AtomicUsize::new(0);
-        let mut slots: Vec<Option<Evaluation>> = vec![None; batch.len()];
-        let results: Vec<Vec<(usize, Evaluation)>> = std::thread::scope(|s| {
+        let mut slots: Vec<Option<Vec<Evaluation>>> = vec![None; chunks.len()];
+        let results: Vec<Vec<(usize, Vec<Evaluation>)>> = std::thread::scope(|s| {
             let handles: Vec<_> = (0..threads)
                 .map(|_| {
                     s.spawn(|| {
                         let mut mine = Vec::new();
                         loop {
                             let i = next.fetch_add(1, Ordering::Relaxed);
-                            if i >= batch.len() || crate::cancel::requested() {
+                            if i >= chunks.len() || crate::cancel::requested() {
                                 break mine;
                             }
-                            mine.push((i, eval(&batch[i])));
+                            mine.push((i, job.evaluate_batch(chunks[i], with_samples)));
                         }
                     })
                 })
@@ -447,7 +486,7 @@ impl Evaluator for InProcess {
         }
         Ok(slots
             .into_iter()
-            .map(|e| e.expect("every index was evaluated"))
+            .flat_map(|e| e.expect("every chunk was evaluated"))
             .collect())
     }
 

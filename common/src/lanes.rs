@@ -125,6 +125,36 @@ pub trait Real:
     fn map(self, f: impl FnMut(f64) -> f64) -> Self;
 }
 
+/// The lanes `f(0), f(1), ...` (one per lane of `R`).
+#[inline(always)]
+pub fn gather<R: Real>(mut f: impl FnMut(usize) -> f64) -> R {
+    let mut a = R::splat(0.0).to_array();
+    for (i, v) in a.as_mut().iter_mut().enumerate() {
+        *v = f(i);
+    }
+    R::from_array(a)
+}
+
+/// Lane `i` of `v`.
+#[inline(always)]
+pub fn lane<R: Real>(v: R, i: usize) -> f64 {
+    v.to_array().as_ref()[i]
+}
+
+/// `v` with lane `i` replaced by `value`.
+#[inline(always)]
+pub fn with_lane<R: Real>(v: R, i: usize, value: f64) -> R {
+    let mut a = v.to_array();
+    a.as_mut()[i] = value;
+    R::from_array(a)
+}
+
+/// The mask set in the lanes `i` where `f(i)` holds.
+#[inline(always)]
+pub fn mask<R: Real>(mut f: impl FnMut(usize) -> bool) -> R::Mask {
+    gather::<R>(|i| if f(i) { 1.0 } else { 0.0 }).gt(R::splat(0.0))
+}
+
 impl Mask for bool {
     #[inline(always)]
     fn all(self) -> bool {

@@ -45,6 +45,12 @@ pub mod telemetry;
 pub mod toml_error;
 pub mod units;
 
+/// The version of the simulation's arithmetic, raised whenever a change moves any bit of a
+/// result (recorded in checkpoints, so that one that no longer reproduces can say why):
+/// 1, the host's C library for the elementary functions (wire protocol 3 and earlier); 2,
+/// sepval's own (`elementary`, docs/model.md section 9; protocol 4).
+pub const ARITHMETIC_VERSION: u32 = 2;
+
 pub use effects::EffectSet;
 pub use factors::{Factor, FactorTable, Factors};
 pub use goals::Goals;

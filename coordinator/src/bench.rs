@@ -1,6 +1,8 @@
 //! `sepval bench`: simulations per second against worker count, per transport.
 //!
-//! Transports: `single` (one thread, in-process), `pool` (in-process thread pool), `ipc`
+//! Transports: `scalar` (one thread, in-process, one candidate at a time through the scalar
+//! propagator: the reference for the lane propagator), `single` (one thread, in-process, four
+//! candidates at a time through the lane propagator, as every other transport runs them), `pool` (in-process thread pool), `ipc`
 //! (iceoryx2 worker processes), `uds` (the same requests as postcard frames over Unix domain
 //! sockets) and, when built with the `zenoh` feature, `zenoh` (workers joining over TCP on the
 //! loopback interface). Each measurement is one batch of `evals` distinct candidates after a warm-up batch;
@@ -29,6 +31,8 @@ use crate::figures::FigureError;
 /// A transport `sepval bench` can measure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Transport {
+    /// One thread of this process, one candidate at a time (the scalar propagator).
+    Scalar,
     /// One thread of this process.
     Single,
     /// A thread pool in this process.
@@ -45,6 +49,7 @@ impl Transport {
     /// Its name in tables and files.
     pub fn name(self) -> &'static str {
         match self {
+            Transport::Scalar => "scalar",
             Transport::Single => "single",
             Transport::Pool => "pool",
             Transport::Ipc => "ipc",
@@ -190,6 +195,7 @@ fn start(
     options: &BenchOptions,
 ) -> Result<Box<dyn Evaluator>, TransportError> {
     let spec = match transport {
+        Transport::Scalar => return Ok(Box::new(OneAtATime(Arc::clone(job)))),
         Transport::Single => EvaluatorSpec::InProcess { threads: 1 },
         Transport::Pool => EvaluatorSpec::InProcess { threads: workers },
         Transport::Ipc => EvaluatorSpec::Ipc {
@@ -230,6 +236,38 @@ fn start(
     spec.start(Arc::clone(job), quiet())
 }
 
+/// The `scalar` row's evaluator: one candidate after the other in this thread, each a batch of
+/// one (which [`Job::evaluate_batch`] runs through the scalar propagator).
+struct OneAtATime(Arc<Job>);
+
+impl Evaluator for OneAtATime {
+    fn evaluate(
+        &mut self,
+        batch: &[Candidate],
+        with_samples: bool,
+    ) -> Result<Vec<sepval_common::evaluation::Evaluation>, EvalError> {
+        let job = &self.0;
+        Ok(batch
+            .iter()
+            .map(|c| {
+                if with_samples {
+                    job.evaluate_with_samples(c)
+                } else {
+                    job.evaluate(c)
+                }
+            })
+            .collect())
+    }
+
+    fn job(&self) -> &Arc<Job> {
+        &self.0
+    }
+
+    fn describe(&self) -> String {
+        "inproc, 1 thread, one candidate at a time (scalar)".into()
+    }
+}
+
 fn median(v: &[f64]) -> f64 {
     let mut v = v.to_vec();
     v.sort_by(f64::total_cmp);
@@ -265,7 +303,7 @@ pub fn run_bench(
         .transports
         .iter()
         .flat_map(|&t| {
-            let counts = if t == Transport::Single {
+            let counts = if matches!(t, Transport::Single | Transport::Scalar) {
                 vec![1]
             } else {
                 options.workers.clone()

@@ -197,10 +197,10 @@ pub enum SelftestCommand {
 
 /// Transports `sepval bench` measures by default.
 #[cfg(feature = "zenoh")]
-pub const DEFAULT_TRANSPORTS: &str = "single,pool,ipc,uds,zenoh";
+pub const DEFAULT_TRANSPORTS: &str = "scalar,single,pool,ipc,uds,zenoh";
 /// Transports `sepval bench` measures by default.
 #[cfg(not(feature = "zenoh"))]
-pub const DEFAULT_TRANSPORTS: &str = "single,pool,ipc,uds";
+pub const DEFAULT_TRANSPORTS: &str = "scalar,single,pool,ipc,uds";
 
 #[derive(clap::Args)]
 pub struct BenchArgs {
@@ -384,6 +384,9 @@ pub enum EvaluatorKind {
 /// `--transports`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum TransportArg {
+    /// One thread of this process, one candidate at a time through the scalar propagator (the
+    /// reference for the lane propagator's gain).
+    Scalar,
     /// One thread of this process.
     Single,
     /// A thread pool of this process.

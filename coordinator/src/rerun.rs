@@ -113,6 +113,8 @@ pub struct Report {
     pub mismatches: Vec<Mismatch>,
     /// The replay.
     pub replay: Replay,
+    /// The arithmetic version of the build that wrote the checkpoint, if recorded.
+    pub arithmetic: Option<u32>,
 }
 
 impl Report {
@@ -145,6 +147,7 @@ impl Report {
                     ""
                 }
             ));
+            parts.extend(arithmetic_hint(self.arithmetic));
         }
         if let Replay::Differs(origin, differ) = &self.replay {
             parts.push(format!(
@@ -171,6 +174,25 @@ impl Report {
             self.generation, self.population, self.archive
         )
     }
+}
+
+/// Why members may not reproduce, from the checkpoint's arithmetic version (nothing when it is
+/// this build's).
+fn arithmetic_hint(written: Option<u32>) -> Option<String> {
+    let ours = sepval_common::ARITHMETIC_VERSION;
+    Some(match written {
+        Some(v) if v == ours => return None,
+        Some(v) => format!(
+            "it was written by a build whose simulation arithmetic is version {v}, this one's is \
+             {ours}: results differ in their last bits, so run the fit again with this build"
+        ),
+        None => format!(
+            "it does not record the build's arithmetic version: if a sepval older than version \
+             {ours} of the arithmetic (wire protocol 3 or earlier, before sepval's own elementary \
+             functions) wrote it, results differ in their last bits, so run the fit again with \
+             this build"
+        ),
+    })
 }
 
 /// Errors of a rerun.
@@ -294,6 +316,7 @@ pub fn check(
         Err(why) => Replay::Skipped(why),
     };
     Ok(Report {
+        arithmetic: checkpoint.arithmetic,
         generation: state.generation,
         population: state.population.len(),
         archive: state.archive.len(),
@@ -374,5 +397,57 @@ pub fn same_bits(a: &Outcome, b: &Outcome) -> bool {
         }
         (Outcome::Failed { reason: r1 }, Outcome::Failed { reason: r2 }) => r1 == r2,
         _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(arithmetic: Option<u32>) -> Report {
+        let goals = |j: f64| Outcome::Goals {
+            j_pos_m: j,
+            j_att_deg: 1.0,
+        };
+        Report {
+            generation: 3,
+            population: 4,
+            archive: 2,
+            mismatches: vec![Mismatch {
+                set: Set::Population,
+                member: 1,
+                saved: goals(0.1),
+                rerun: goals(0.1 + 1e-17),
+            }],
+            replay: Replay::Skipped("no previous checkpoint".into()),
+            arithmetic,
+        }
+    }
+
+    #[test]
+    fn a_checkpoint_of_other_arithmetic_says_why_it_does_not_reproduce() {
+        let ours = sepval_common::ARITHMETIC_VERSION;
+        let same = report(Some(ours)).failures();
+        assert!(same.contains("population member 1"), "{same}");
+        assert!(!same.contains("arithmetic"), "{same}");
+        let older = report(Some(ours - 1)).failures();
+        assert!(
+            older.contains(&format!(
+                "arithmetic is version {}, this one's is {ours}",
+                ours - 1
+            )),
+            "{older}"
+        );
+        let unrecorded = report(None).failures();
+        assert!(
+            unrecorded.contains("does not record the build's arithmetic version"),
+            "{unrecorded}"
+        );
+        // Nothing to explain when everything reproduces.
+        let fine = Report {
+            mismatches: Vec::new(),
+            ..report(None)
+        };
+        assert!(fine.failures().is_empty());
     }
 }

@@ -12,74 +12,76 @@
 //! ```
 
 use crate::factors::{Factor, Factors};
+use crate::lanes::Real;
 use crate::table::AeroAtMach;
 
 /// The flow seen by the store at one force evaluation; effects' coefficient terms read it.
+/// (`R`: one run's doubles, or one lane per run; see [`crate::lanes`].)
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Flow {
+pub struct Flow<R = f64> {
     /// Angle of attack atan2(w, u) \[rad\].
-    pub alpha_rad: f64,
+    pub alpha_rad: R,
     /// Sideslip asin(v / V) \[rad\].
-    pub beta_rad: f64,
+    pub beta_rad: R,
     /// Non-dimensional roll rate p d / 2V.
-    pub p_hat: f64,
+    pub p_hat: R,
     /// Non-dimensional pitch rate q d / 2V.
-    pub q_hat: f64,
+    pub q_hat: R,
     /// Non-dimensional yaw rate r d / 2V.
-    pub r_hat: f64,
+    pub r_hat: R,
     /// Air-relative speed V [m/s].
-    pub speed_m_s: f64,
+    pub speed_m_s: R,
     /// Interference decay factor f(s) in [0, 1].
-    pub interference_factor: f64,
+    pub interference_factor: R,
     /// Time of the evaluation (the RK4 stage's) \[s\].
-    pub t_s: f64,
+    pub t_s: R,
     /// Distance of the CG from carriage \[m\].
-    pub distance_m: f64,
+    pub distance_m: R,
     /// The store's Mach number V / a.
-    pub mach: f64,
+    pub mach: R,
 }
 
 /// Body-axis force and moment coefficients.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[allow(missing_docs)]
-pub struct Coefficients {
-    pub cx: f64,
-    pub cy: f64,
-    pub cz: f64,
-    pub cl: f64,
-    pub cm: f64,
-    pub cn: f64,
+pub struct Coefficients<R = f64> {
+    pub cx: R,
+    pub cy: R,
+    pub cz: R,
+    pub cl: R,
+    pub cm: R,
+    pub cn: R,
 }
 
 /// The freestream database with the factor offsets folded in, for one run.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AeroConstants {
+pub struct AeroConstants<R = f64> {
     /// -(CA0 + caoff).
-    pub cx0: f64,
+    pub cx0: R,
     /// CY_beta [1/rad].
-    pub cy_beta: f64,
+    pub cy_beta: R,
     /// cyoff.
-    pub cy0: f64,
+    pub cy0: R,
     /// CZ_alpha [1/rad].
-    pub cz_alpha: f64,
+    pub cz_alpha: R,
     /// czoff.
-    pub cz0: f64,
+    pub cz0: R,
     /// Cl_p [1/rad].
-    pub cl_p: f64,
+    pub cl_p: R,
     /// cloff.
-    pub cl0: f64,
+    pub cl0: R,
     /// Cm_alpha [1/rad].
-    pub cm_alpha: f64,
+    pub cm_alpha: R,
     /// Cm_q [1/rad].
-    pub cm_q: f64,
+    pub cm_q: R,
     /// cmoff.
-    pub cm0: f64,
+    pub cm0: R,
     /// Cn_beta [1/rad].
-    pub cn_beta: f64,
+    pub cn_beta: R,
     /// Cn_r [1/rad].
-    pub cn_r: f64,
+    pub cn_r: R,
     /// cnoff.
-    pub cn0: f64,
+    pub cn0: R,
 }
 
 impl AeroConstants {
@@ -101,15 +103,37 @@ impl AeroConstants {
             cn0: factors.get(Factor::Cnoff),
         }
     }
+}
+
+impl<R: Real> AeroConstants<R> {
+    /// The constants of one run per lane (`runs(i)`: lane `i`'s).
+    pub(crate) fn gather<'a>(runs: impl Fn(usize) -> &'a AeroConstants) -> Self {
+        let g = |f: fn(&AeroConstants) -> f64| crate::lanes::gather::<R>(|i| f(runs(i)));
+        AeroConstants {
+            cx0: g(|a| a.cx0),
+            cy_beta: g(|a| a.cy_beta),
+            cy0: g(|a| a.cy0),
+            cz_alpha: g(|a| a.cz_alpha),
+            cz0: g(|a| a.cz0),
+            cl_p: g(|a| a.cl_p),
+            cl0: g(|a| a.cl0),
+            cm_alpha: g(|a| a.cm_alpha),
+            cm_q: g(|a| a.cm_q),
+            cm0: g(|a| a.cm0),
+            cn_beta: g(|a| a.cn_beta),
+            cn_r: g(|a| a.cn_r),
+            cn0: g(|a| a.cn0),
+        }
+    }
 
     /// The coefficients of docs/model.md section 3 (without the catalogue's terms).
     /// `increments` are the interference increments times their multipliers,
     /// (dCX, dCY, dCZ, dCl, dCm, dCn).
     #[inline(always)]
-    pub fn coefficients(&self, flow: &Flow, increments: &[f64; 6]) -> Coefficients {
+    pub fn coefficients(&self, flow: &Flow<R>, increments: &[R; 6]) -> Coefficients<R> {
         let f = flow.interference_factor;
         // Each sum as fused multiply-adds, interference term innermost.
-        let lin = |slope: f64, x: f64, rest: f64| slope.mul_add(x, rest);
+        let lin = |slope: R, x: R, rest: R| slope.mul_add(x, rest);
         Coefficients {
             cx: increments[0].mul_add(f, self.cx0),
             cy: lin(

@@ -3,25 +3,26 @@
 //! length, kept as |q|^2 C_LB and 1/|q|^2).
 
 use super::dot;
+use crate::lanes::Real;
 
 /// The direction-cosine matrix C_LB of one stage's quaternion q scaled to unit length (see
 /// [`crate::frames`]), kept as `m` = |q|^2 C_LB (row-major, `m[i][j]` = |q|^2 C_LB(i, j)),
 /// the products of q without a division, and the scale 1 / |q|^2.
 #[derive(Debug, Clone, Copy)]
-pub struct Dcm {
+pub struct Dcm<R = f64> {
     /// |q|^2 C_LB.
-    pub m: [[f64; 3]; 3],
+    pub m: [[R; 3]; 3],
     /// |q|^2.
-    pub n2: f64,
+    pub n2: R,
     /// 1 / |q|^2.
-    pub inv_n2: f64,
+    pub inv_n2: R,
 }
 
-impl Dcm {
+impl<R: Real> Dcm<R> {
     /// |q|^2 C_LB of the quaternion (q0, q1, q2, q3): the diagonal as q0^2 + qi^2 - qj^2 - qk^2,
     /// the rest as 2 (qi qj -+ q0 qk).
     #[inline(always)]
-    pub fn from_quaternion(q0: f64, q1: f64, q2: f64, q3: f64) -> Dcm {
+    pub fn from_quaternion(q0: R, q1: R, q2: R, q3: R) -> Dcm<R> {
         let (s00, s11, s22, s33) = (q0 * q0, q1 * q1, q2 * q2, q3 * q3);
         let (a, b) = (s00 + s11, s22 + s33);
         let (c, d) = (s00 - s11, s22 - s33);
@@ -36,13 +37,13 @@ impl Dcm {
                 [(-t02).mul_add(q2, p13), t01.mul_add(q1, p23), c - d],
             ],
             n2,
-            inv_n2: 1.0 / n2,
+            inv_n2: R::splat(1.0) / n2,
         }
     }
 
     /// |q|^2 C_BL a: a launch-frame vector in body axes, times |q|^2.
     #[inline(always)]
-    pub fn to_body_scaled(&self, a: [f64; 3]) -> [f64; 3] {
+    pub fn to_body_scaled(&self, a: [R; 3]) -> [R; 3] {
         let m = &self.m;
         [
             dot([m[0][0], m[1][0], m[2][0]], a),
@@ -55,7 +56,7 @@ impl Dcm {
     /// The sum runs from b\[0\] to b\[2\], so that b\[2\] (in the force evaluation the normal force,
     /// the last to be known) waits for one multiply-add only.
     #[inline(always)]
-    pub fn to_launch_scaled(&self, b: [f64; 3], base: [f64; 3]) -> [f64; 3] {
+    pub fn to_launch_scaled(&self, b: [R; 3], base: [R; 3]) -> [R; 3] {
         let m = &self.m;
         let row =
             |i: usize| m[i][2].mul_add(b[2], m[i][1].mul_add(b[1], m[i][0].mul_add(b[0], base[i])));

@@ -10,6 +10,7 @@
 //! Both exponentials are sepval's [`exp`] (docs/model.md section 9).
 
 use crate::elementary::exp;
+use crate::lanes::Real;
 
 /// Precomputed constants of f(s) for one lambda and s_end.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,9 +19,9 @@ pub struct InterferenceDecay {
     pub lambda_m: f64,
     /// Cut-off distance \[m\].
     pub s_end_m: f64,
-    inv_lambda_per_m: f64,
-    exp_end: f64,
-    inv_denominator: f64,
+    pub(crate) inv_lambda_per_m: f64,
+    pub(crate) exp_end: f64,
+    pub(crate) inv_denominator: f64,
 }
 
 impl InterferenceDecay {
@@ -39,11 +40,37 @@ impl InterferenceDecay {
     /// f(s) for the CG distance `s_m` from carriage.
     #[inline(always)]
     pub fn factor(&self, s_m: f64) -> f64 {
-        if s_m < self.s_end_m {
-            (exp(-s_m * self.inv_lambda_per_m) - self.exp_end) * self.inv_denominator
-        } else {
-            0.0
+        DecayLanes::gather(|_| self).factor(s_m)
+    }
+}
+
+/// The constants of f(s) of one run per lane (see [`crate::lanes`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct DecayLanes<R> {
+    s_end_m: R,
+    inv_lambda_per_m: R,
+    exp_end: R,
+    inv_denominator: R,
+}
+
+impl<R: Real> DecayLanes<R> {
+    /// The decays of one run per lane (`runs(i)`: lane `i`'s).
+    #[inline(always)]
+    pub(crate) fn gather<'a>(runs: impl Fn(usize) -> &'a InterferenceDecay) -> Self {
+        let g = |f: fn(&InterferenceDecay) -> f64| crate::lanes::gather::<R>(|i| f(runs(i)));
+        DecayLanes {
+            s_end_m: g(|d| d.s_end_m),
+            inv_lambda_per_m: g(|d| d.inv_lambda_per_m),
+            exp_end: g(|d| d.exp_end),
+            inv_denominator: g(|d| d.inv_denominator),
         }
+    }
+
+    /// f(s) for the CG distance `s_m` from carriage (0 from s_end on).
+    #[inline(always)]
+    pub(crate) fn factor(&self, s_m: R) -> R {
+        let inside = (exp(-s_m * self.inv_lambda_per_m) - self.exp_end) * self.inv_denominator;
+        R::select(s_m.lt(self.s_end_m), inside, R::splat(0.0))
     }
 }
 

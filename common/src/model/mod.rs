@@ -1,12 +1,13 @@
 //! The store-separation model: one scenario set up once ([`Model`]), one run's constants
 //! ([`RunSetup`]: factors and effects applied), and the equations of motion
-//! ([`RunSetup::derivative`]).
+//! ([`EquationsOfMotion`], in `equations.rs`: once for one run and for one run per SIMD lane).
 //!
 //! Source: `docs/model.md` sections 1 to 3. The tree mirrors the physics:
 //! [`ejector`] (force-versus-displacement table), [`interference`] (decay with distance),
 //! [`aero`] (coefficients and the flow state the catalogue's terms see).
 //!
-//! Equations of motion (docs/model.md section 2), implemented in [`RunSetup::derivative`]:
+//! Equations of motion (docs/model.md section 2), implemented in
+//! [`EquationsOfMotion::derivative`] (and [`RunSetup::derivative`] for one state):
 //!
 //! ```text
 //! dr/dt     = v
@@ -24,19 +25,22 @@
 pub mod aero;
 mod dcm;
 pub mod ejector;
+mod equations;
 pub mod interference;
 
 pub use dcm::Dcm;
+pub use equations::EquationsOfMotion;
+pub(crate) use equations::{LaneEquations, dot};
 
 use nalgebra::{Matrix3, Vector3};
 
 use crate::atmosphere::isa_troposphere;
 use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
-use crate::elementary::{atan2_asin, cos, sin};
+use crate::elementary::{cos, sin};
 use crate::extension::{TermError, TermInput, TermSet};
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
-use crate::table::{AeroAtMach, Inputs, PreparedTables, TableState};
+use crate::table::{AeroAtMach, PreparedTables};
 
 pub use aero::{Coefficients, Flow};
 pub use ejector::EjectorCurve;
@@ -454,266 +458,6 @@ impl RunSetup {
         let sigma = s_i.clamp(0.0, self.stroke_m) / self.stroke_m;
         self.terms.ejector_factor(t_s, sigma)
     }
-
-    /// I^-1 (M - omega x (I omega)) (docs/model.md section 2), with a short path for the diagonal
-    /// tensor of the contract.
-    #[inline(always)]
-    fn angular_acceleration(&self, m: [f64; 3], w: [f64; 3]) -> [f64; 3] {
-        let [p, q, r] = w;
-        if self.inertia_diagonal {
-            let [dyz, dzx, dxy] = self.inertia_principal_differences;
-            let [jx, jy, jz] = self.inertia_principal_inv;
-            // omega x (I omega) for diagonal I: ((Izz - Iyy) q r, (Ixx - Izz) r p,
-            // (Iyy - Ixx) p q).
-            return [
-                (-dyz * q).mul_add(r, m[0]) * jx,
-                (-dzx * r).mul_add(p, m[1]) * jy,
-                (-dxy * p).mul_add(q, m[2]) * jz,
-            ];
-        }
-        let i = &self.inertia_kg_m2;
-        let row = |k: usize| [i[(k, 0)], i[(k, 1)], i[(k, 2)]];
-        let h = [dot(row(0), w), dot(row(1), w), dot(row(2), w)];
-        let t = [
-            m[0] - q.mul_add(h[2], -r * h[1]),
-            m[1] - r.mul_add(h[0], -p * h[2]),
-            m[2] - p.mul_add(h[1], -q * h[0]),
-        ];
-        let j = &self.inertia_inv;
-        let row = |k: usize| [j[(k, 0)], j[(k, 1)], j[(k, 2)]];
-        [dot(row(0), t), dot(row(1), t), dot(row(2), t)]
-    }
-}
-
-/// The equations of motion of one run (docs/model.md sections 2 and 3), with the products of the
-/// run's constants that the force evaluation needs formed once, when a propagation starts.
-#[derive(Clone, Copy)]
-pub struct EquationsOfMotion<'a> {
-    run: &'a RunSetup,
-    curve: &'a EjectorCurve,
-    /// The scenario's tables and this propagation's table scratch (none without tables).
-    tables: Option<(&'a PreparedTables, &'a TableState)>,
-    /// 0.5 rho S / m [1/m]: times V^2 and a force coefficient, an acceleration.
-    accel_per_speed2: f64,
-    /// 0.5 rho S d \[kg\]: times V^2 and a moment coefficient, a moment.
-    moment_per_speed2: f64,
-    /// x_ref / d: moving the moments to the CG is Cm -= CZ x_ref / d, Cn += CY x_ref / d.
-    reference_arm: f64,
-}
-
-impl<'a> EquationsOfMotion<'a> {
-    /// The equations of `run` with the ejector force curve `curve`, for a scenario without
-    /// tables (the flow alone does not depend on them; for the forces of a scenario with
-    /// tables, use [`EquationsOfMotion::with_tables`]).
-    pub fn new(run: &'a RunSetup, curve: &'a EjectorCurve) -> Self {
-        EquationsOfMotion {
-            run,
-            curve,
-            tables: None,
-            accel_per_speed2: run.half_rho_area * run.inv_mass_per_kg,
-            moment_per_speed2: run.half_rho_area * run.diameter_m,
-            reference_arm: run.aero_reference_x_m / run.diameter_m,
-        }
-    }
-
-    /// The equations of `run` for `model` (its ejector curve and tables), keeping cursors and
-    /// excursion counts in `state`.
-    pub fn with_tables(run: &'a RunSetup, model: &'a Model, state: &'a TableState) -> Self {
-        EquationsOfMotion {
-            tables: model
-                .tables
-                .in_evaluation()
-                .then_some((&model.tables, state)),
-            ..EquationsOfMotion::new(run, &model.curve)
-        }
-    }
-
-    /// The flow of a stage (section 3) with its direction cosines and V^2: the first half of
-    /// [`EquationsOfMotion::derivative`], inlined there.
-    #[inline(always)]
-    fn flow_frame(&self, x: &StateVector, t_s: f64) -> (Flow, Dcm, f64) {
-        let run = self.run;
-        let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
-        // Section 1: interference decay with s = |r|. First: its input is ready long before
-        // the stage's velocity and attitude, so the exponential overlaps the rest.
-        let distance_m = dot([rx, ry, rz], [rx, ry, rz]).sqrt();
-        let f_s = run.decay.factor(distance_m);
-        // Section 2: C_LB of the stage's quaternion scaled to unit length, kept as
-        // |q|^2 C_LB and 1 / |q|^2 (the scale is applied where it is needed, off the chain
-        // from the stage's state to the flow angles).
-        let c = Dcm::from_quaternion(q0, q1, q2, q3);
-
-        // Section 2: v_air = v + V_inf (cos a cos b, sin b, sin a cos b) in L;
-        // (u, v, w) = C_BL v_air, here |q|^2 (u, v, w).
-        let va = &run.v_aircraft_air_l_m_s;
-        let air = [vx + va.x, vy + va.y, vz + va.z];
-        let [u_s, v_s, w_s] = c.to_body_scaled(air);
-        // Section 3: V = |v_air| (rotation-invariant, so taken in L), qbar = 0.5 rho V^2,
-        // alpha = atan2(w, u) (the scale |q|^2 cancels), beta = asin(v / V) with
-        // (v / V)^2 = (|q|^2 v)^2 / (|q|^4 V^2), p^ = p d / 2V (likewise q^, r^).
-        let speed2 = dot(air, air);
-        let inv_speed = 1.0 / speed2.sqrt();
-        let (alpha, beta) = atan2_asin(
-            w_s,
-            u_s,
-            v_s * (c.inv_n2 * inv_speed),
-            v_s * v_s,
-            speed2 * (c.n2 * c.n2),
-        );
-        let rate_scale = run.half_diameter_m * inv_speed;
-        let flow = Flow {
-            alpha_rad: alpha,
-            beta_rad: beta,
-            p_hat: p * rate_scale,
-            q_hat: q * rate_scale,
-            r_hat: r * rate_scale,
-            speed_m_s: speed2 * inv_speed,
-            interference_factor: f_s,
-            t_s,
-            distance_m,
-            mach: (speed2 * inv_speed) * run.inv_speed_of_sound_s_m,
-        };
-        (flow, c, speed2)
-    }
-
-    /// The flow the store sees in state `x` at time `t_s` (docs/model.md section 3): what the
-    /// catalogue's and the extension's terms read, for reports and diagnoses.
-    pub fn flow(&self, x: &StateVector, t_s: f64) -> Flow {
-        self.flow_frame(x, t_s).0
-    }
-
-    /// The state derivative with the ejector feet in the given modes (`on[i]`: foot i
-    /// pushes).
-    ///
-    /// This is the hot path (four calls per RK4 step): straight-line scalar arithmetic on the
-    /// stage's own state, one direction-cosine matrix, inlined elementary functions, no
-    /// allocation. Each block cites the docs/model.md line it implements.
-    ///
-    /// Products are summed with fused multiply-adds (`mul_add`, one rounding): the same bits
-    /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
-    #[inline(always)]
-    pub fn derivative(&self, x: &StateVector, t_s: f64, on: [bool; 2]) -> StateVector {
-        let run = self.run;
-        let (flow, c, speed2) = self.flow_frame(x, t_s);
-        let [_, _, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
-        // Section 3: the six coefficients, then the catalogue's extra terms (section 7) and
-        // the extension's (section 11).
-        let mut k = run.aero.coefficients(&flow, &run.interference_increments);
-        if let Some((tables, state)) = self.tables {
-            state.count_evaluation();
-            if tables.runtime() {
-                k = add_table_terms(run, tables, state, &flow, x[1], k);
-            }
-        }
-        if run.coefficient_term_count > 0 {
-            k = run.add_coefficient_terms(flow, k);
-        }
-        if !run.terms.is_empty() {
-            k = run.add_extension_terms(&flow, k);
-        }
-        // Section 3: M_aero_B = qbar S d (Cl, Cm, Cn), moved from the moment reference point
-        // (x_ref, 0, 0) to the CG: M += (x_ref, 0, 0) x F_aero_B.
-        let moment_scale = self.moment_per_speed2 * speed2;
-        let arm = self.reference_arm;
-        let mx = moment_scale * k.cl;
-        let mut my = moment_scale * (-arm).mul_add(k.cz, k.cm);
-        let mut mz = moment_scale * arm.mul_add(k.cy, k.cn);
-        // Sections 2 and 3: dv/dt = g_L + (C_LB F_aero_B + F_ej_L) / m, F_aero_B = qbar S
-        // (CX, CY, CZ), with 1 / (m |q|^2) folded into the body force.
-        let body_scale = (self.accel_per_speed2 * speed2) * c.inv_n2;
-        let g = &run.gravity_l_m_s2;
-        let [mut ax, mut ay, mut az] = c.to_launch_scaled(
-            [body_scale * k.cx, body_scale * k.cy, body_scale * k.cz],
-            [g.x, g.y, g.z],
-        );
-
-        // Section 3: each foot pushes along its L direction d with
-        // F_i = fac_i F_ej(clamp(s_i, 0, stroke)), s_i = (r + C_LB (x_i, 0, 0))_z; its moment
-        // about the CG is (x_i, 0, 0) x (C_BL F_i d) = F_i x_i (0, -(C_BL d)_z, (C_BL d)_y).
-        if on[0] || on[1] {
-            let c20 = c.m[2][0] * c.inv_n2;
-            let (mut force_n, mut arm_force_n_m) = (0.0, 0.0);
-            for (foot, _) in run.feet.iter().zip(on).filter(|(_, on)| *on) {
-                let s_i = c20.mul_add(foot.x_m, rz);
-                let mut f_i = foot.fac * self.curve.force_n(s_i.clamp(0.0, run.stroke_m));
-                if !run.terms.is_empty() {
-                    f_i *= run.ejector_factor(t_s, s_i);
-                }
-                force_n += f_i;
-                arm_force_n_m = foot.x_m.mul_add(f_i, arm_force_n_m);
-            }
-            let d = &run.ejector_direction_l;
-            let accel = force_n * run.inv_mass_per_kg;
-            ax = accel.mul_add(d.x, ax);
-            ay = accel.mul_add(d.y, ay);
-            az = accel.mul_add(d.z, az);
-            let [_, by, bz] = c.to_body_scaled([d.x, d.y, d.z]);
-            let arm_force = arm_force_n_m * c.inv_n2;
-            my = (-arm_force).mul_add(bz, my);
-            mz = arm_force.mul_add(by, mz);
-        }
-
-        // Section 2: dq/dt = 0.5 q (x) (0, omega).
-        let [dq0, dq1, dq2, dq3] = quaternion_rate([q0, q1, q2, q3], p, q, r);
-        // Section 2: domega/dt = I^-1 (M_B - omega x (I omega)).
-        let [dp, dq, dr] = run.angular_acceleration([mx, my, mz], [p, q, r]);
-        [vx, vy, vz, ax, ay, az, dq0, dq1, dq2, dq3, dp, dq, dr]
-    }
-}
-
-/// Adds the tables' terms (docs/model.md section 3, "Tabulated coefficients"): the static
-/// coefficients (CX = -CA) and the tabulated interference increments times their multipliers,
-/// at the stage's local alpha and beta, distance from carriage and lateral offset `lateral_m`.
-#[inline(always)]
-fn add_table_terms(
-    run: &RunSetup,
-    tables: &PreparedTables,
-    state: &TableState,
-    flow: &Flow,
-    lateral_m: f64,
-    mut k: Coefficients,
-) -> Coefficients {
-    let (s, d) = tables.evaluate(
-        state,
-        &Inputs {
-            alpha_rad: flow.alpha_rad,
-            beta_rad: flow.beta_rad,
-            distance_m: flow.distance_m,
-            lateral_m,
-        },
-    );
-    let m = &run.interference_multipliers;
-    let c = tables.constants();
-    // The static tables' values (late: they wait for alpha and beta) added last.
-    // The static tables' values (late: they wait for alpha and beta) are added last.
-    k.cx = m[0].mul_add(d[0], k.cx) - s[0];
-    k.cy = m[1].mul_add(d[1], k.cy + c[1]) + s[1];
-    k.cz = m[2].mul_add(d[2], k.cz + c[2]) + s[2];
-    k.cl = m[3].mul_add(d[3], k.cl + c[3]) + s[3];
-    k.cm = m[4].mul_add(d[4], k.cm + c[4]) + s[4];
-    k.cn = m[5].mul_add(d[5], k.cn + c[5]) + s[5];
-    k
-}
-
-/// a . b with fused multiply-adds.
-#[inline(always)]
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0].mul_add(b[0], a[1].mul_add(b[1], a[2] * b[2]))
-}
-
-/// Quaternion kinematics `dq/dt = 0.5 q (x) (0, omega)` (docs/model.md section 2), as
-/// [`crate::frames::quaternion_rate`] with fused multiply-adds.
-#[inline(always)]
-fn quaternion_rate(q: [f64; 4], p: f64, qq: f64, r: f64) -> [f64; 4] {
-    let [q0, q1, q2, q3] = q;
-    // Halving is exact: 0.5 (a p + b q + c r) = a (p/2) + b (q/2) + c (r/2).
-    let (hp, hq, hr) = (0.5 * p, 0.5 * qq, 0.5 * r);
-    [
-        -q1.mul_add(hp, q2.mul_add(hq, q3 * hr)),
-        q0.mul_add(hp, q2.mul_add(hr, -q3 * hq)),
-        q0.mul_add(hq, q3.mul_add(hp, -q1 * hr)),
-        q0.mul_add(hr, q1.mul_add(hq, -q2 * hp)),
-    ]
 }
 
 /// Inverse of a symmetric inertia tensor, refusing one that is not positive definite.

@@ -8,5 +8,6 @@ mod conformance;
 mod effects;
 mod elementary;
 mod fuzz;
+mod lanes;
 mod tables;
 mod verification;

@@ -15,6 +15,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use sepval_common::evaluation::{Candidate, EvalError, Evaluation, Evaluator, Job};
+use sepval_common::propagator::LANES;
 
 use crate::TransportError;
 use crate::link::{Link, LinkEvent, Notice, Notices, WorkerId};
@@ -24,11 +25,15 @@ use crate::wire::Chunk;
 const TICK: Duration = Duration::from_millis(50);
 
 /// Splits a batch of `n` candidates into chunks of consecutive indices for `workers` workers:
-/// about four chunks per worker, so the last chunks balance the load, and at most 16 candidates
+/// about four chunks per worker, so the last chunks balance the load, a multiple of the lane
+/// count ([`LANES`]: a worker runs a chunk four candidates at a time), and at most 16 candidates
 /// per chunk, so a lost worker costs little. The same plan for every transport, so `sepval
 /// bench` compares transports, not chunkings.
 pub fn chunk_plan(n: usize, workers: usize) -> VecDeque<Vec<usize>> {
-    let chunk = n.div_ceil(workers.max(1) * 4).clamp(1, 16);
+    let chunk = n
+        .div_ceil(workers.max(1) * 4)
+        .next_multiple_of(LANES)
+        .clamp(LANES, 16);
     (0..n)
         .collect::<Vec<_>>()
         .chunks(chunk)
@@ -377,6 +382,12 @@ mod tests {
             let flat: Vec<usize> = plan.iter().flatten().copied().collect();
             assert_eq!(flat, (0..n).collect::<Vec<_>>());
             assert!(plan.iter().all(|c| !c.is_empty() && c.len() <= 16));
+            // Every chunk but the last fills whole lane batches.
+            let whole = plan.len().saturating_sub(1);
+            assert!(
+                plan.iter().take(whole).all(|c| c.len() % LANES == 0),
+                "{n} {w}"
+            );
         }
     }
 }

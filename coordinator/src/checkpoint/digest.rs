@@ -25,7 +25,7 @@ pub struct Digest {
     /// without its `digest` field.
     pub sha256: String,
     /// The first 16 hex digits of the SHA-256 of each part's compact JSON, by the part's name:
-    /// each field of the checkpoint (`format`, `method`, `settings`, `hill`, `sigma`,
+    /// each field of the checkpoint (`format`, `arithmetic` when present, `method`, `settings`, `hill`, `sigma`,
     /// `data_sha256`, `scenario_sha256`, `inputs`, `probes`), each field of its state
     /// (`state.generation`, `state.evaluations`, `state.rng`, `state.history`), and each member
     /// of the population and of the archive (`state.population[i]`, `state.archive[i]`).
@@ -60,6 +60,7 @@ impl Checkpoint {
         let Checkpoint {
             format,
             digest: _,
+            arithmetic,
             method,
             settings,
             hill,
@@ -78,8 +79,12 @@ impl Checkpoint {
             rng,
             history,
         } = state;
-        let mut parts = vec![
-            part("format", format),
+        let mut parts = vec![part("format", format)];
+        // Absent from checkpoints written before it was recorded, whose parts it must not change.
+        if let Some(a) = arithmetic {
+            parts.push(part("arithmetic", a));
+        }
+        parts.extend([
             part("method", method),
             part("settings", settings),
             part("hill", hill),
@@ -89,7 +94,7 @@ impl Checkpoint {
             part("inputs", inputs),
             part("state.generation", generation),
             part("state.evaluations", evaluations),
-        ];
+        ]);
         for (i, m) in population.iter().enumerate() {
             parts.push(part(&format!("state.population[{i}]"), m));
         }

@@ -167,6 +167,10 @@ pub struct Checkpoint {
     /// computes it (whatever is here is ignored); [`Checkpoint::load`] checks it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub digest: Option<Digest>,
+    /// [`sepval_common::ARITHMETIC_VERSION`] of the build that wrote it (absent in checkpoints
+    /// written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arithmetic: Option<u32>,
     /// Method being run (`ga`, `both`, ...).
     pub method: String,
     /// GA settings.

@@ -66,6 +66,7 @@ fn checkpoint(job: &Arc<Job>, generations: usize, finish: bool) -> Checkpoint {
     Checkpoint {
         format: CHECKPOINT_FORMAT.into(),
         digest: None,
+        arithmetic: Some(sepval_common::ARITHMETIC_VERSION),
         method: "ga".into(),
         settings,
         hill: HillSettings::default(),

@@ -24,6 +24,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .transports
         .iter()
         .map(|t| match t {
+            TransportArg::Scalar => Transport::Scalar,
             TransportArg::Single => Transport::Single,
             TransportArg::Pool => Transport::Pool,
             TransportArg::Ipc => Transport::Ipc,

@@ -210,6 +210,7 @@ impl Observer<GaStage> for Checkpointer {
         let checkpoint = Checkpoint {
             format: CHECKPOINT_FORMAT.to_string(),
             digest: None,
+            arithmetic: Some(sepval_common::ARITHMETIC_VERSION),
             method: self.method.clone(),
             settings: self.settings.clone(),
             hill: self.hill.clone(),

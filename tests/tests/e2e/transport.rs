@@ -341,7 +341,7 @@ fn bench_writes_its_table_csv_and_figure() {
             "--evals",
             "16",
             "--transports",
-            "single,pool,ipc,uds",
+            "scalar,single,pool,ipc,uds",
             "--repeat",
             "2",
             "--out",
@@ -349,7 +349,7 @@ fn bench_writes_its_table_csv_and_figure() {
         ],
         dir.path(),
     ));
-    for t in ["single", "pool", "ipc", "uds"] {
+    for t in ["scalar", "single", "pool", "ipc", "uds"] {
         assert!(out.contains(t), "{out}");
     }
     // Every row has a measured overhead (a number; single's is 0 by definition).
@@ -363,8 +363,8 @@ fn bench_writes_its_table_csv_and_figure() {
         lines.next(),
         Some("transport,workers,evals,wall_s,evals_per_s")
     );
-    // single once, pool/ipc/uds for 1 and 2 workers.
-    assert_eq!(lines.count(), 7);
+    // scalar and single once, pool/ipc/uds for 1 and 2 workers.
+    assert_eq!(lines.count(), 8);
     let png = std::fs::read(dir.path().join("b/bench.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
     let bad = sepval(&["bench", "--workers", "0", "--out", "c"], dir.path());

@@ -499,20 +499,12 @@ pub fn serve_chunks<E>(
         .collect())
 }
 
-/// Evaluates a chunk in this process, one candidate after the other.
+/// Evaluates a chunk in this process, its candidates [`sepval_common::propagator::LANES`] at a
+/// time through the lane propagator ([`Job::evaluate_batch`]).
 pub fn serve_locally(job: &Job, chunk: &Chunk) -> Answer {
     let result: Result<Vec<Answer>, std::convert::Infallible> =
         serve_chunks(job, std::slice::from_ref(chunk), |batch, s| {
-            Ok(batch
-                .iter()
-                .map(|c| {
-                    if s {
-                        job.evaluate_with_samples(c)
-                    } else {
-                        job.evaluate(c)
-                    }
-                })
-                .collect())
+            Ok(job.evaluate_batch(batch, s))
         });
     match result {
         Ok(mut a) => a.remove(0),

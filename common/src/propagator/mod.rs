@@ -26,10 +26,15 @@
 //! - A telemetry time before release (t < 0, or t + dt_tm < 0 with a time offset) shows the
 //!   carriage state.
 
+mod lanes;
+
+pub use lanes::{LANES, propagate_lanes, propagate_lanes_portable};
+
 use nalgebra::Vector3;
 
 use crate::frames::{dcm_from_quaternion, euler_321_deg, wrap_deg};
-use crate::model::{EquationsOfMotion, Model, RunSetup, StateVector};
+use crate::lanes::{F64x4, Real};
+use crate::model::{EquationsOfMotion, LaneEquations, Model, RunSetup, STATE_LEN, StateVector};
 use crate::table::TableState;
 
 /// Tolerance to which switch times are located \[s\] (docs/model.md section 3a).
@@ -164,26 +169,9 @@ fn propagate_inline<S: SampleSink>(
     sink: &mut S,
 ) -> Result<RunLog, Diverged> {
     let table_state = TableState::default();
-    let mut engine = Engine {
-        run,
-        equations: EquationsOfMotion::with_tables(run, model, &table_state),
-        dt_s: model.dt_s,
-        log: RunLog::default(),
-    };
-    let start_mode = if run.ejector_start_s > 0.0 {
-        FootMode::Waiting
-    } else {
-        FootMode::On
-    };
+    let mut engine = Engine::new(model, run, &table_state);
     let initial = run.initial_state();
-    let mut cursor = Cursor {
-        t_s: 0.0,
-        x: initial,
-        modes: [start_mode; 2],
-    };
-    if start_mode == FootMode::On {
-        engine.log.foot_on_s = [Some(0.0); 2];
-    }
+    let mut cursor = engine.start();
     let mut k: u64 = 0;
     for (index, &t_label) in times_s.iter().enumerate() {
         let t = t_label + run.time_offset_s;
@@ -191,13 +179,7 @@ fn propagate_inline<S: SampleSink>(
             sink.record(index, &observe(run, &initial), &initial);
             continue;
         }
-        let nearest = (t / engine.dt_s).round().max(0.0);
-        let on_grid = (t - nearest * engine.dt_s).abs() <= GRID_MATCH_TOLERANCE_S;
-        let target_k = if on_grid {
-            nearest as u64
-        } else {
-            (t / engine.dt_s).floor().max(0.0) as u64
-        };
+        let (target_k, on_grid) = grid_target(t, engine.dt_s);
         while k < target_k {
             if cursor.modes == [FootMode::Off; 2] {
                 // After the stroke ends no switch is due: plain steps, as `advance` takes them
@@ -223,6 +205,21 @@ fn propagate_inline<S: SampleSink>(
         engine.log.tables = table_state.excursions();
     }
     Ok(engine.log)
+}
+
+/// The grid point `k` a sample at time `t` (> -1e-9 s) is taken from, and whether `t` is that
+/// grid time (within 1e-9 s; otherwise `t` lies in (t_k, t_k+1) and the sample is one step off
+/// the grid from t_k).
+#[inline(always)]
+fn grid_target(t: f64, dt_s: f64) -> (u64, bool) {
+    let nearest = (t / dt_s).round().max(0.0);
+    let on_grid = (t - nearest * dt_s).abs() <= GRID_MATCH_TOLERANCE_S;
+    let target_k = if on_grid {
+        nearest as u64
+    } else {
+        (t / dt_s).floor().max(0.0) as u64
+    };
+    (target_k, on_grid)
 }
 
 /// The observation of a state, with the measurement knobs applied (tracked point, attitude
@@ -252,29 +249,71 @@ struct Engine<'a> {
     log: RunLog,
 }
 
-impl Engine<'_> {
+impl<'a> Engine<'a> {
+    /// The engine of `run` (its table scratch in `table_state`).
+    #[inline(always)]
+    fn new(model: &'a Model, run: &'a RunSetup, table_state: &'a TableState) -> Self {
+        Engine {
+            run,
+            equations: EquationsOfMotion::with_tables(run, model, table_state),
+            dt_s: model.dt_s,
+            log: RunLog::default(),
+        }
+    }
+
+    /// The cursor at release (t = 0): the initial state, the feet pushing at once or waiting
+    /// for the ejector start time (logged).
+    fn start(&mut self) -> Cursor {
+        let start_mode = if self.run.ejector_start_s > 0.0 {
+            FootMode::Waiting
+        } else {
+            FootMode::On
+        };
+        if start_mode == FootMode::On {
+            self.log.foot_on_s = [Some(0.0); 2];
+        }
+        Cursor {
+            t_s: 0.0,
+            x: self.run.initial_state(),
+            modes: [start_mode; 2],
+        }
+    }
+
     /// One classic RK4 step of length `h` from `x` at time `t` with the modes held, q
     /// renormalised (each stage at its own time: t, t + h/2, t + h/2, t + h).
     #[inline(always)]
     fn rk4(&self, x: &StateVector, t: f64, h: f64, modes: [FootMode; 2]) -> StateVector {
-        let on = [modes[0] == FootMode::On, modes[1] == FootMode::On];
-        let f = |y: &StateVector, t: f64| self.equations.derivative(y, t, on);
-        let half = 0.5 * h;
-        let sixth = h / 6.0;
-        let k1 = f(x, t);
-        let k2 = f(&axpy(x, half, &k1), t + half);
-        let k3 = f(&axpy(x, half, &k2), t + half);
-        let k4 = f(&axpy(x, h, &k3), t + h);
-        let mut y = *x;
-        for j in 0..y.len() {
-            y[j] = sixth.mul_add(2.0f64.mul_add(k2[j] + k3[j], k1[j]) + k4[j], x[j]);
-        }
-        let n2 = y[6].mul_add(y[6], y[7].mul_add(y[7], y[8].mul_add(y[8], y[9] * y[9])));
-        let inv_norm = 1.0 / n2.sqrt();
-        for v in &mut y[6..10] {
-            *v *= inv_norm;
-        }
-        y
+        rk4(
+            &Held {
+                equations: &self.equations,
+                on: pushing(modes),
+            },
+            x,
+            t,
+            h,
+        )
+    }
+
+    /// Whether a step from `c` of length `h` may not be taken whole with the modes held: a mode
+    /// is due to switch at its start, or the ejector start time falls inside it (what
+    /// [`Engine::advance`] checks before its trial step).
+    #[inline(always)]
+    fn event_at_start(&self, c: &Cursor, h: f64) -> bool {
+        let tau = self.run.ejector_start_s;
+        (0..2).any(|i| match c.modes[i] {
+            FootMode::Waiting => {
+                c.t_s >= tau - SWITCH_TOLERANCE_S || tau - c.t_s < h - SWITCH_TOLERANCE_S
+            }
+            FootMode::On => self.stroke_excess(&c.x, i) > 0.0,
+            FootMode::Off => false,
+        })
+    }
+
+    /// Whether a foot pushing during the step from `c` is past the stroke at its end `trial`
+    /// (a stroke end inside the step, which [`Engine::advance`] locates).
+    #[inline(always)]
+    fn stroke_ends_in(&self, c: &Cursor, trial: &StateVector) -> bool {
+        (0..2).any(|i| c.modes[i] == FootMode::On && self.stroke_excess(trial, i) > 0.0)
     }
 
     /// Grid steps from `t_s` = t_k to t_end (k < end), with both feet off: what
@@ -443,11 +482,76 @@ impl Engine<'_> {
     }
 }
 
+/// Which feet push in `modes`.
+#[inline(always)]
+fn pushing(modes: [FootMode; 2]) -> [bool; 2] {
+    [modes[0] == FootMode::On, modes[1] == FootMode::On]
+}
+
+/// A state derivative with the feet's modes held (one run, or one run per lane of `R`), for
+/// [`rk4`]. (A trait with an `#[inline(always)]` method rather than a closure: a closure may be
+/// compiled out of line, without the FMA build's target features, and its fused multiply-adds
+/// would then be calls to the C library.)
+trait Derivative<R> {
+    /// dx/dt at `x` and time `t`.
+    fn at(&self, x: &[R; STATE_LEN], t: R) -> [R; STATE_LEN];
+}
+
+/// One run's equations with the feet's modes held.
+struct Held<'e, 'a> {
+    equations: &'e EquationsOfMotion<'a>,
+    on: [bool; 2],
+}
+
+impl Derivative<f64> for Held<'_, '_> {
+    #[inline(always)]
+    fn at(&self, x: &StateVector, t: f64) -> StateVector {
+        self.equations.derivative(x, t, self.on)
+    }
+}
+
+/// Four runs' equations, one per lane, each with its feet's modes held.
+struct LanesHeld<'e, 'a> {
+    equations: &'e LaneEquations<'a>,
+    on: [[bool; 2]; 4],
+}
+
+impl Derivative<F64x4> for LanesHeld<'_, '_> {
+    #[inline(always)]
+    fn at(&self, x: &[F64x4; STATE_LEN], t: F64x4) -> [F64x4; STATE_LEN] {
+        self.equations.derivative(x, t, &self.on)
+    }
+}
+
+/// One classic RK4 step of length `h` from `x` at time `t` of the derivative `f` (one run or
+/// one run per lane of `R`), q renormalised (each stage at its own time: t, t + h/2, t + h/2,
+/// t + h).
+#[inline(always)]
+fn rk4<R: Real>(f: &impl Derivative<R>, x: &[R; STATE_LEN], t: R, h: R) -> [R; STATE_LEN] {
+    let half = R::splat(0.5) * h;
+    let sixth = h / R::splat(6.0);
+    let k1 = f.at(x, t);
+    let k2 = f.at(&axpy(x, half, &k1), t + half);
+    let k3 = f.at(&axpy(x, half, &k2), t + half);
+    let k4 = f.at(&axpy(x, h, &k3), t + h);
+    let two = R::splat(2.0);
+    let mut y = *x;
+    for j in 0..STATE_LEN {
+        y[j] = sixth.mul_add(two.mul_add(k2[j] + k3[j], k1[j]) + k4[j], x[j]);
+    }
+    let n2 = y[6].mul_add(y[6], y[7].mul_add(y[7], y[8].mul_add(y[8], y[9] * y[9])));
+    let inv_norm = R::splat(1.0) / n2.sqrt();
+    for v in &mut y[6..10] {
+        *v = *v * inv_norm;
+    }
+    y
+}
+
 /// x + a k, component by component (fused).
 #[inline(always)]
-fn axpy(x: &StateVector, a: f64, k: &StateVector) -> StateVector {
+fn axpy<R: Real>(x: &[R; STATE_LEN], a: R, k: &[R; STATE_LEN]) -> [R; STATE_LEN] {
     let mut y = *x;
-    for j in 0..y.len() {
+    for j in 0..STATE_LEN {
         y[j] = a.mul_add(k[j], x[j]);
     }
     y
