@@ -26,7 +26,13 @@ pub fn throughput_figure(
             p
         })
         .collect();
-    let base = series.first().and_then(|(_, s)| {
+    // Ideal scaling from the one-thread lane evaluator (`single`) when measured (the `scalar`
+    // row is a reference, not what workers run), else from the first series.
+    let reference = series
+        .iter()
+        .position(|(name, _)| *name == "single")
+        .unwrap_or(0);
+    let base = series.get(reference).and_then(|(_, s)| {
         s.iter()
             .find(|&&(w, r)| w == 1 && plottable(r) && r > 0.0)
             .map(|&(_, r)| r)
@@ -52,7 +58,7 @@ pub fn throughput_figure(
             fmt_count_tick,
             fmt_tick,
         )?;
-        if let (Some(points), Some((first, _))) = (ideal, series.first()) {
+        if let (Some(points), Some((first, _))) = (ideal, series.get(reference)) {
             let label = format!("Ideal scaling (from {first} at 1 worker)");
             draw_dashed(&mut chart, points, FLOOR_GREY.stroke_width(2), Some(&label))?;
         }
