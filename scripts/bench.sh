@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Throughput per worker count for each transport (single, pool, ipc, uds, zenoh), and the criterion
-# benchmark of one simulation. Writes bench-out/bench.csv and bench-out/bench.png.
+# Throughput per worker count for each transport (scalar, single, pool, ipc, uds, zenoh), and the
+# criterion benchmarks of one simulation (scalar) and of one run in a lane batch (simulate_lanes). Writes bench-out/bench.csv and bench-out/bench.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --workspace --features zenoh
