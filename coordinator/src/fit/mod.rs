@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use sepval_common::atomic_file::WriteError;
 use sepval_common::effects::EffectSet;
-use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
+use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job, Outcome};
 use sepval_common::factors::Factors;
 use sepval_common::propagator::Observation;
 
@@ -275,6 +275,20 @@ fn hill_stage(
     progress.finish();
     r?;
     let r = climb.inner.finish();
+    if r.stop == HillStop::StartFailed {
+        let why = match &r.best.outcome {
+            Outcome::Diverged { t_s, event } => format!(
+                "it diverges at t = {t_s} s in event `{}`",
+                cx.job.events()[*event].name
+            ),
+            Outcome::Failed { reason } => reason.clone(),
+            Outcome::Goals { .. } => "it was not evaluated".into(),
+        };
+        return Err(FitError::Failed(format!(
+            "the hill climber's start, the nominal factors (clamped to their bounds), does not \
+             simulate: {why}; --method ga or ga+lm start from a random population instead"
+        )));
+    }
     let front = update_archive(&[], &r.visited);
     let history: Vec<HistoryPoint> = r
         .history

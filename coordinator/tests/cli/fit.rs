@@ -258,3 +258,42 @@ fn bad_fit_settings_are_refused() {
         assert!(err.contains(expected), "{err}");
     }
 }
+
+#[test]
+fn a_hill_start_that_does_not_simulate_is_named_as_such() {
+    // A wildly unstable store (roll damping of the wrong sign and a tiny roll inertia): the
+    // nominal factors, where the hill climber starts, diverge.
+    let dir = tempfile::tempdir().unwrap();
+    ok(&sepval(&["scenario", "--out", "s.toml"], dir.path()));
+    ok(&sepval(&["simulate", "--out", "d.csv"], dir.path()));
+    let s = std::fs::read_to_string(dir.path().join("s.toml")).unwrap();
+    let wild = s
+        .replace("cl_p_per_rad = -40.0", "cl_p_per_rad = 400.0")
+        .replace("ixx_kg_m2 = 27.116358966628006", "ixx_kg_m2 = 0.1");
+    assert_ne!(wild, s);
+    std::fs::write(dir.path().join("wild.toml"), wild).unwrap();
+    let out = sepval(
+        &[
+            "fit",
+            "--scenario",
+            "wild.toml",
+            "--data",
+            "d.csv",
+            "--method",
+            "hill",
+            "--no-figures",
+            "--evaluator",
+            "inproc",
+            "--out",
+            "run",
+        ],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("the hill climber's start, the nominal factors (clamped to their bounds), does not simulate: it diverges at t = "),
+        "{err}"
+    );
+    assert!(err.contains("--method ga or ga+lm"), "{err}");
+}
