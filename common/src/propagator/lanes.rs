@@ -69,10 +69,9 @@ pub fn propagate_lanes<S: SampleSink>(
     if runs.len() > 1 && !model.tables.in_evaluation() {
         return lanes_inline(model, runs, times_s, sinks);
     }
-    runs.iter()
-        .zip(sinks)
-        .map(|(run, sink)| propagate(model, run, times_s, sink))
-        .collect()
+    run_by_run(runs, sinks, |run, sink| {
+        propagate(model, run, times_s, sink)
+    })
 }
 
 /// [`propagate_lanes`] without run-time dispatch, in lockstep on any host (four scalar
@@ -89,13 +88,23 @@ pub fn propagate_lanes_portable<S: SampleSink>(
 ) -> Vec<Result<RunLog, Diverged>> {
     check_batch(runs, sinks);
     if model.tables.in_evaluation() {
-        return runs
-            .iter()
-            .zip(sinks)
-            .map(|(run, sink)| propagate_portable(model, run, times_s, sink))
-            .collect();
+        return run_by_run(runs, sinks, |run, sink| {
+            propagate_portable(model, run, times_s, sink)
+        });
     }
     lanes_inline(model, runs, times_s, sinks)
+}
+
+/// Each run through the scalar propagator `one`, one after another.
+fn run_by_run<S>(
+    runs: &[RunSetup],
+    sinks: &mut [S],
+    mut one: impl FnMut(&RunSetup, &mut S) -> Result<RunLog, Diverged>,
+) -> Vec<Result<RunLog, Diverged>> {
+    runs.iter()
+        .zip(sinks)
+        .map(|(run, sink)| one(run, sink))
+        .collect()
 }
 
 fn check_batch<S>(runs: &[RunSetup], sinks: &[S]) {
