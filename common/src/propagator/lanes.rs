@@ -15,13 +15,16 @@
 //!   lane records the samples it takes there, and takes an off-grid sample with the scalar
 //!   one-step [`Engine::advance`] from the grid state, as [`super::propagate`] does;
 //! - a lane that diverges or has recorded its last sample is done: it keeps stepping with the
-//!   others (its values unused) until every lane is done.
+//!   others (its values unused) until every lane is done;
+//! - with tables (section 3), each lane looks its tables up with its own scratch (interval
+//!   cursors and excursion counts); a lane that takes a step again through the scalar integrator
+//!   first puts its scratch back to t_k, so that its cursors have the history of the scalar run
+//!   (the interval chosen for an input on a breakpoint depends on it) and its counts are those
+//!   of one pass.
 //!
-//! Choices: a scenario with tables (section 3) runs each lane through the scalar path
-//! ([`super::propagate`]): the tables' look-ups are scalar and their excursion counts are per run;
-//! so does a batch of one run, and an x86-64 host without AVX2 and FMA units (there a fused
-//! multiply-add is a call to the C library in either path, and four lanes are four scalar
-//! operations each, so the scalar path is the faster). AArch64 hosts run the lanes as two
+//! Choices: a batch of one run takes the scalar path, and so does an x86-64 host without AVX2
+//! and FMA units (there a fused multiply-add is a call to the C library in either path, and four
+//! lanes are four scalar operations each, so the scalar path is the faster). AArch64 hosts run the lanes as two
 //! 2-lane NEON instructions per operation (FMA is part of the base instruction set).
 
 use crate::lanes::{F64x4, Real, gather, lane};
@@ -30,7 +33,7 @@ use crate::table::TableState;
 
 use super::{
     Cursor, Diverged, Engine, FootMode, GRID_MATCH_TOLERANCE_S, LanesHeld, MAX_RATE_RAD_S, RunLog,
-    SampleSink, grid_target, observe, propagate, propagate_portable, pushing, rk4,
+    SampleSink, grid_target, observe, propagate, pushing, rk4,
 };
 
 /// Runs per lane batch: the lanes of an [`F64x4`] (four doubles in an AVX2 register).
@@ -56,7 +59,6 @@ pub fn propagate_lanes<S: SampleSink>(
     check_batch(runs, sinks);
     #[cfg(target_arch = "x86_64")]
     if runs.len() > 1
-        && !model.tables.in_evaluation()
         && std::arch::is_x86_feature_detected!("fma")
         && std::arch::is_x86_feature_detected!("avx2")
     {
@@ -66,7 +68,7 @@ pub fn propagate_lanes<S: SampleSink>(
     // AArch64 has NEON and fused multiply-adds in its base instruction set: each F64x4
     // operation is two 2-lane instructions.
     #[cfg(target_arch = "aarch64")]
-    if runs.len() > 1 && !model.tables.in_evaluation() {
+    if runs.len() > 1 {
         return lanes_inline(model, runs, times_s, sinks);
     }
     run_by_run(runs, sinks, |run, sink| {
@@ -76,7 +78,7 @@ pub fn propagate_lanes<S: SampleSink>(
 
 /// [`propagate_lanes`] without run-time dispatch, in lockstep on any host (four scalar
 /// operations per lane operation where the build has no vector units): the same results bit for
-/// bit. A scenario with tables runs each lane through [`propagate_portable`].
+/// bit.
 ///
 /// # Panics
 /// As [`propagate_lanes`].
@@ -87,11 +89,6 @@ pub fn propagate_lanes_portable<S: SampleSink>(
     sinks: &mut [S],
 ) -> Vec<Result<RunLog, Diverged>> {
     check_batch(runs, sinks);
-    if model.tables.in_evaluation() {
-        return run_by_run(runs, sinks, |run, sink| {
-            propagate_portable(model, run, times_s, sink)
-        });
-    }
     lanes_inline(model, runs, times_s, sinks)
 }
 
@@ -198,9 +195,13 @@ fn lanes_inline<S: SampleSink>(
     let n = runs.len();
     // Lanes beyond the batch repeat its last run and record nothing (done from the start).
     let run_of = |i: usize| &runs[i.min(n - 1)];
-    let table_state = TableState::default();
+    // Each lane's table scratch; `saved` holds a lane's as it was before a step that the lane
+    // may take again through the scalar integrator.
+    let tables = model.tables.in_evaluation();
+    let table_states: [TableState; LANES] = Default::default();
+    let mut saved: [Option<TableState>; LANES] = Default::default();
     let mut engines: [Engine; LANES] =
-        std::array::from_fn(|i| Engine::new(model, run_of(i), &table_state));
+        std::array::from_fn(|i| Engine::new(model, run_of(i), &table_states[i]));
     let equations = LaneEquations::new(std::array::from_fn(|i| engines[i].equations.parts()));
     let mut lanes: [Lane; LANES] = std::array::from_fn(|i| {
         let cursor = engines[i].start();
@@ -226,7 +227,12 @@ fn lanes_inline<S: SampleSink>(
             lane.cursor.x = state_of(&x, i);
             match record_due(&mut engines[i], lane, k, times_s, &mut sinks[i]) {
                 Ok(Some(next_k)) => lane.next_k = next_k,
-                Ok(None) => lane.result = Some(Ok(engines[i].log)),
+                Ok(None) => {
+                    if tables {
+                        engines[i].log.tables = table_states[i].excursions();
+                    }
+                    lane.result = Some(Ok(engines[i].log));
+                }
                 Err(d) => lane.result = Some(Err(d)),
             }
         }
@@ -248,6 +254,9 @@ fn lanes_inline<S: SampleSink>(
                 Step::Coast
             } else {
                 lane.cursor.x = state_of(&x, i);
+                if tables {
+                    saved[i] = Some(table_states[i].clone());
+                }
                 if engines[i].event_at_start(&lane.cursor, h) {
                     Step::Scalar
                 } else {
@@ -270,6 +279,7 @@ fn lanes_inline<S: SampleSink>(
             let lane = &mut lanes[i];
             let engine = &mut engines[i];
             let mut step = steps[i];
+            let before = saved[i].take();
             if step == Step::Trial && engine.stroke_ends_in(&lane.cursor, &state_of(&y, i)) {
                 step = Step::Scalar;
             }
@@ -282,13 +292,19 @@ fn lanes_inline<S: SampleSink>(
                         lane.result = Some(Err(Diverged { t_s: t_next }));
                     }
                 }
-                Step::Scalar => match engine.advance(lane.cursor, t_next, true) {
-                    Ok(c) => {
-                        lane.cursor = c;
-                        set_state(&mut y, i, &c.x);
+                Step::Scalar => {
+                    // From the table scratch of t_k, as if the lockstep step had not been.
+                    if let Some(before) = before {
+                        table_states[i].restore(&before);
                     }
-                    Err(d) => lane.result = Some(Err(d)),
-                },
+                    match engine.advance(lane.cursor, t_next, true) {
+                        Ok(c) => {
+                            lane.cursor = c;
+                            set_state(&mut y, i, &c.x);
+                        }
+                        Err(d) => lane.result = Some(Err(d)),
+                    }
+                }
             }
         }
         x = y;

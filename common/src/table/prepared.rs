@@ -636,7 +636,7 @@ fn bilinear(c: &[f64], at: usize, x: f64, y: f64) -> [f64; 6] {
 }
 
 /// One propagation's table scratch: interval cursors and excursion counts (fixed size).
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub struct TableState {
     cursor: [[Cell<u32>; 3]; MAX_GROUPS],
     evaluations: Cell<u64>,
@@ -649,6 +649,26 @@ impl TableState {
     #[inline(always)]
     pub fn count_evaluation(&self) {
         self.evaluations.set(self.evaluations.get() + 1);
+    }
+
+    /// Puts this state back to `saved` (cursors and counts): for a step taken again from where
+    /// `saved` was taken, so that the cursors' history, which decides the interval of an input
+    /// on a breakpoint, is the one of a single pass.
+    pub fn restore(&self, saved: &TableState) {
+        for (group, from) in self.cursor.iter().zip(&saved.cursor) {
+            for (c, f) in group.iter().zip(from) {
+                c.set(f.get());
+            }
+        }
+        self.evaluations.set(saved.evaluations.get());
+        for (c, f) in self.count.iter().zip(&saved.count) {
+            c.set(f.get());
+        }
+        for (w, f) in self.worst.iter().zip(&saved.worst) {
+            for (c, f) in w.iter().zip(f) {
+                c.set(f.get());
+            }
+        }
     }
 
     /// The counts so far.

@@ -6,6 +6,7 @@ use sepval_common::model::{RunSetup, StateVector};
 use sepval_common::propagator::{
     LANES, Observation, propagate, propagate_lanes, propagate_lanes_portable,
 };
+use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
 use sepval_common::{Factors, Simulator};
 
 /// A base that is not the default truth.
@@ -38,6 +39,10 @@ fn bits(
             for t in log.foot_on_s.iter().chain(&log.foot_off_s) {
                 out.push(t.map_or(u64::MAX, f64::to_bits));
             }
+            let t = &log.tables;
+            out.push(t.evaluations);
+            out.extend(t.count);
+            out.extend(t.worst.iter().flatten().map(|v| v.to_bits()));
         }
         Err(d) => out.extend([u64::MAX - 1, d.t_s.to_bits()]),
     }
@@ -79,10 +84,9 @@ fn mixed_runs(sim: &Simulator) -> Vec<RunSetup> {
     (0..n).map(|j| runs[(j * stride) % n]).collect()
 }
 
-fn check_lanes_against_scalar(times: &[f64]) {
-    let sim = Simulator::embedded_default();
+fn check_lanes_against_scalar(sim: &Simulator, times: &[f64]) {
     let model = sim.model();
-    let runs = mixed_runs(&sim);
+    let runs = mixed_runs(sim);
     let mut diverged = 0;
     // Batches of LANES, then a last batch of one to three (padded lanes).
     for batch in runs.chunks(LANES).chain([&runs[..1], &runs[1..3]]) {
@@ -120,13 +124,38 @@ fn check_lanes_against_scalar(times: &[f64]) {
 #[test]
 fn lanes_equal_scalar_runs_bit_for_bit_on_the_grid() {
     let sim = Simulator::embedded_default();
-    check_lanes_against_scalar(&sim.default_times());
+    check_lanes_against_scalar(&sim, &sim.default_times());
+}
+
+#[test]
+fn lanes_equal_scalar_runs_bit_for_bit_with_tables() {
+    // CZ over alpha within +-1 deg, a breakpoint at 0 (where every run starts: the interval an
+    // input on a breakpoint takes depends on the cursors' history) and excursions beyond.
+    let from = "cz_alpha_per_rad = -6.0";
+    assert!(DEFAULT_SCENARIO_TOML.contains(from));
+    let narrow = Scenario::from_toml_str(
+        &DEFAULT_SCENARIO_TOML.replace(
+            from,
+            "cz = { alpha_deg = [-1.0, 0.0, 1.0], values = [0.10471975511965977, 0.0, \
+             -0.10471975511965977] }",
+        ),
+        "narrow",
+    )
+    .unwrap();
+    let sim = Simulator::new(&narrow);
+    check_lanes_against_scalar(&sim, &sim.default_times());
+    // The default's aerodynamics and interference written as tables.
+    let dir = tempfile::tempdir().unwrap();
+    let sim = Simulator::new(&crate::tables::write_and_load(dir.path(), true));
+    let times: Vec<f64> = (0..300).map(|j| -0.01 + j as f64 / 333.0).collect();
+    check_lanes_against_scalar(&sim, &times);
 }
 
 #[test]
 fn lanes_equal_scalar_runs_bit_for_bit_off_the_grid_and_before_release() {
     // 333 Hz from t = -10 ms: samples before release, between grid points, and (with the
     // time-offset effect) moved differently in each lane.
+    let sim = Simulator::embedded_default();
     let times: Vec<f64> = (0..300).map(|j| -0.01 + j as f64 / 333.0).collect();
-    check_lanes_against_scalar(&times);
+    check_lanes_against_scalar(&sim, &times);
 }

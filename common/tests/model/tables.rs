@@ -14,7 +14,7 @@ use sepval_common::table_form::table_form;
 use sepval_common::telemetry::Trajectory;
 
 /// Writes `form` into `dir` and loads it as a user would.
-fn write_and_load(dir: &Path, interference: bool) -> Scenario {
+pub(crate) fn write_and_load(dir: &Path, interference: bool) -> Scenario {
     let form = table_form(&Scenario::embedded_default(), interference).unwrap();
     for (p, text) in &form.files {
         std::fs::create_dir_all(dir.join(p).parent().unwrap()).unwrap();
