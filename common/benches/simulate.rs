@@ -11,6 +11,8 @@
 //! through the lane propagator, goals accumulated as `simulate_default_event` does (issue 16: at
 //! most 0.12 ms per run on one core).
 //!
+//! `simulate_lanes_tables`: `simulate_lanes` with the default written as tables.
+//!
 //! `simulate_default_event_tables`: the same with the default written as tables
 //! (`sepval scenario --tables --interference-tables`: static coefficients over Mach, alpha and
 //! beta, damping over Mach, interference over distance); issue 15 asks for at most 20 % more time than the constant form.
@@ -42,15 +44,20 @@ fn simulate_default_event(c: &mut Criterion) {
 }
 
 fn simulate_lanes(c: &mut Criterion) {
+    bench_lanes(c, "simulate_lanes", &Simulator::embedded_default());
+}
+
+/// Times one run of `sim` in a batch of 100 candidates around the truth (factor j of candidate
+/// k moved by a fixed fraction of its range: a deterministic spread, no generator needed), four
+/// at a time through the lane propagator, goals accumulated against the nominal run; reports
+/// the time per run.
+fn bench_lanes(c: &mut Criterion, name: &str, sim: &Simulator) {
     use sepval_common::goals::GoalAccumulator;
     use sepval_common::propagator::{LANES, propagate_lanes};
-    let sim = Simulator::embedded_default();
     let measured = sim
         .simulate(&Factors::NOMINAL, &EffectSet::NONE, &sim.default_times())
         .expect("nominal run");
     let table = &sim.scenario().factors;
-    // 100 candidates around the truth: factor j of candidate k moved by a fixed fraction of its
-    // range (a deterministic spread, no generator needed).
     let runs: Vec<_> = (0..100)
         .map(|k| {
             let mut f = Factors::TRUTH;
@@ -62,7 +69,7 @@ fn simulate_lanes(c: &mut Criterion) {
             sim.run_setup(&f, &EffectSet::NONE).expect("valid factors")
         })
         .collect();
-    c.bench_function("simulate_lanes", |b| {
+    c.bench_function(name, |b| {
         b.iter_custom(|iters| {
             let start = std::time::Instant::now();
             for _ in 0..iters {
@@ -87,7 +94,9 @@ fn simulate_lanes(c: &mut Criterion) {
     });
 }
 
-fn simulate_default_event_tables(c: &mut Criterion) {
+/// The default written as tables (`sepval scenario --tables --interference-tables`), loaded
+/// from a temporary directory as a user's would be.
+fn tables_simulator() -> Simulator {
     let dir = tempfile::tempdir().expect("a temporary directory");
     let form =
         sepval_common::table_form::table_form(&sepval_common::Scenario::embedded_default(), true)
@@ -99,14 +108,22 @@ fn simulate_default_event_tables(c: &mut Criterion) {
     }
     let path = dir.path().join("scenario.toml");
     std::fs::write(&path, form.scenario.to_toml_string()).expect("the scenario");
-    let sim = Simulator::new(&sepval_common::Scenario::load(&path).expect("it reads back"));
-    bench_goals(c, "simulate_default_event_tables", &sim);
+    Simulator::new(&sepval_common::Scenario::load(&path).expect("it reads back"))
+}
+
+fn simulate_default_event_tables(c: &mut Criterion) {
+    bench_goals(c, "simulate_default_event_tables", &tables_simulator());
+}
+
+fn simulate_lanes_tables(c: &mut Criterion) {
+    bench_lanes(c, "simulate_lanes_tables", &tables_simulator());
 }
 
 criterion_group!(
     benches,
     simulate_default_event,
     simulate_lanes,
-    simulate_default_event_tables
+    simulate_default_event_tables,
+    simulate_lanes_tables
 );
 criterion_main!(benches);

@@ -141,14 +141,6 @@ pub fn lane<R: Real>(v: R, i: usize) -> f64 {
     v.to_array().as_ref()[i]
 }
 
-/// `v` with lane `i` replaced by `value`.
-#[inline(always)]
-pub fn with_lane<R: Real>(v: R, i: usize, value: f64) -> R {
-    let mut a = v.to_array();
-    a.as_mut()[i] = value;
-    R::from_array(a)
-}
-
 /// The mask set in the lanes `i` where `f(i)` holds.
 #[inline(always)]
 pub fn mask<R: Real>(mut f: impl FnMut(usize) -> bool) -> R::Mask {

@@ -19,7 +19,7 @@
 //! keep the rule.
 
 use crate::elementary::atan2_asin;
-use crate::lanes::{F64x4, Real, gather, lane, mask, with_lane};
+use crate::lanes::{F64x4, Real, gather, lane, mask};
 use crate::table::{Inputs, PreparedTables, TableState};
 
 use super::aero::{AeroConstants, Coefficients, Flow};
@@ -339,14 +339,15 @@ fn derivative<R: Real>(
     }
     if any_pushing {
         let c20 = dcm.m[2][0] * dcm.inv_n2;
-        let (mut force_n, mut arm_force_n_m) = (R::splat(0.0), R::splat(0.0));
+        let (mut force_n, mut arm_force_n_m) = (R::splat(0.0).to_array(), R::splat(0.0).to_array());
         for (i, (part, &on)) in parts.iter().zip(on).enumerate() {
             if on[0] || on[1] {
                 let (f, a) = part.ejector(lane(c20, i), lane(rz, i), lane(t_s, i), on);
-                force_n = with_lane(force_n, i, f);
-                arm_force_n_m = with_lane(arm_force_n_m, i, a);
+                force_n.as_mut()[i] = f;
+                arm_force_n_m.as_mut()[i] = a;
             }
         }
+        let (force_n, arm_force_n_m) = (R::from_array(force_n), R::from_array(arm_force_n_m));
         let pushing = mask::<R>(|i| on[i][0] || on[i][1]);
         let d = c.ejector_direction_l;
         let accel = force_n * c.inv_mass_per_kg;
@@ -376,43 +377,66 @@ fn lane_by_lane_terms<R: Real>(
     lateral_m: R,
     k: Coefficients<R>,
 ) -> Coefficients<R> {
-    let mut out = k;
+    // Through arrays, each lane read and written once (a lane written into a register's
+    // memory and read back whole stalls the load).
+    let f = [
+        flow.alpha_rad,
+        flow.beta_rad,
+        flow.p_hat,
+        flow.q_hat,
+        flow.r_hat,
+        flow.speed_m_s,
+        flow.interference_factor,
+        flow.t_s,
+        flow.distance_m,
+        flow.mach,
+        lateral_m,
+    ]
+    .map(R::to_array);
+    let mut c = [k.cx, k.cy, k.cz, k.cl, k.cm, k.cn].map(R::to_array);
     for (i, part) in parts.iter().enumerate() {
         if !part.has_extra_terms() {
             continue;
         }
-        let l = |v: R| lane(v, i);
+        let l = |j: usize| f[j].as_ref()[i];
         let flow_i = Flow {
-            alpha_rad: l(flow.alpha_rad),
-            beta_rad: l(flow.beta_rad),
-            p_hat: l(flow.p_hat),
-            q_hat: l(flow.q_hat),
-            r_hat: l(flow.r_hat),
-            speed_m_s: l(flow.speed_m_s),
-            interference_factor: l(flow.interference_factor),
-            t_s: l(flow.t_s),
-            distance_m: l(flow.distance_m),
-            mach: l(flow.mach),
+            alpha_rad: l(0),
+            beta_rad: l(1),
+            p_hat: l(2),
+            q_hat: l(3),
+            r_hat: l(4),
+            speed_m_s: l(5),
+            interference_factor: l(6),
+            t_s: l(7),
+            distance_m: l(8),
+            mach: l(9),
         };
+        let at = |j: usize| c[j].as_ref()[i];
         let k_i = Coefficients {
-            cx: l(k.cx),
-            cy: l(k.cy),
-            cz: l(k.cz),
-            cl: l(k.cl),
-            cm: l(k.cm),
-            cn: l(k.cn),
+            cx: at(0),
+            cy: at(1),
+            cz: at(2),
+            cl: at(3),
+            cm: at(4),
+            cn: at(5),
         };
-        let k_i = part.extra_terms(&flow_i, l(lateral_m), k_i);
-        out = Coefficients {
-            cx: with_lane(out.cx, i, k_i.cx),
-            cy: with_lane(out.cy, i, k_i.cy),
-            cz: with_lane(out.cz, i, k_i.cz),
-            cl: with_lane(out.cl, i, k_i.cl),
-            cm: with_lane(out.cm, i, k_i.cm),
-            cn: with_lane(out.cn, i, k_i.cn),
-        };
+        let k_i = part.extra_terms(&flow_i, l(10), k_i);
+        for (j, v) in [k_i.cx, k_i.cy, k_i.cz, k_i.cl, k_i.cm, k_i.cn]
+            .into_iter()
+            .enumerate()
+        {
+            c[j].as_mut()[i] = v;
+        }
     }
-    out
+    let [cx, cy, cz, cl, cm, cn] = c.map(R::from_array);
+    Coefficients {
+        cx,
+        cy,
+        cz,
+        cl,
+        cm,
+        cn,
+    }
 }
 
 /// I^-1 (M - omega x (I omega)) (docs/model.md section 2), with a short path for the diagonal

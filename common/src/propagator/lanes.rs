@@ -279,7 +279,6 @@ fn lanes_inline<S: SampleSink>(
             let lane = &mut lanes[i];
             let engine = &mut engines[i];
             let mut step = steps[i];
-            let before = saved[i].take();
             if step == Step::Trial && engine.stroke_ends_in(&lane.cursor, &state_of(&y, i)) {
                 step = Step::Scalar;
             }
@@ -293,8 +292,9 @@ fn lanes_inline<S: SampleSink>(
                     }
                 }
                 Step::Scalar => {
-                    // From the table scratch of t_k, as if the lockstep step had not been.
-                    if let Some(before) = before {
+                    // From the table scratch of t_k, as if the lockstep step had not been (saved
+                    // when this step was planned).
+                    if let Some(before) = saved[i].take() {
                         table_states[i].restore(&before);
                     }
                     match engine.advance(lane.cursor, t_next, true) {
