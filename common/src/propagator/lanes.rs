@@ -24,8 +24,9 @@
 //!
 //! Choices: a batch of one run takes the scalar path, and so does an x86-64 host without AVX2
 //! and FMA units (there a fused multiply-add is a call to the C library in either path, and four
-//! lanes are four scalar operations each, so the scalar path is the faster). AArch64 hosts run the lanes as two
-//! 2-lane NEON instructions per operation (FMA is part of the base instruction set).
+//! lanes are four scalar operations each, so the scalar path is the faster). AArch64 hosts run
+//! the lanes as two 2-lane NEON instructions per operation (FMA is part of the base instruction
+//! set).
 
 use crate::lanes::{F64x4, Real, gather, lane};
 use crate::model::{LaneEquations, Model, RunSetup, STATE_LEN, StateVector};
@@ -45,8 +46,8 @@ pub const LANES: usize = 4;
 /// Result `i` and the samples `sinks[i]` receives are bit for bit those of
 /// [`propagate`]`(model, &runs[i], times_s, &mut sinks[i])`. On x86-64 hosts with AVX2 and FMA
 /// units (chosen at run time) and on AArch64 (NEON, two lanes per instruction) the runs advance
-/// in lockstep, one per lane; elsewhere, and for a scenario with tables, one after another (see
-/// the module documentation).
+/// in lockstep, one per lane; elsewhere, and for a batch of one, one after another (see the
+/// module documentation).
 ///
 /// # Panics
 /// If `runs` is empty or longer than [`LANES`], or `sinks` is not as long as `runs`.
@@ -131,7 +132,6 @@ unsafe fn lanes_fma<S: SampleSink>(
 /// One lane's run: where it is, which sample it takes next, and how it ended.
 struct Lane {
     cursor: Cursor,
-    initial: StateVector,
     /// Index of the next sample to record.
     next: usize,
     /// The grid point at which the next sample is taken (checked again there).
@@ -207,7 +207,6 @@ fn lanes_inline<S: SampleSink>(
         let cursor = engines[i].start();
         Lane {
             cursor,
-            initial: cursor.x,
             next: 0,
             next_k: 0,
             result: (i >= n).then_some(Ok(RunLog::default())),
@@ -334,7 +333,8 @@ fn record_due<S: SampleSink>(
         let index = lane.next;
         let t = t_label + run.time_offset_s;
         if t < -GRID_MATCH_TOLERANCE_S {
-            sink.record(index, &observe(run, &lane.initial), &lane.initial);
+            let initial = run.initial_state();
+            sink.record(index, &observe(run, &initial), &initial);
             lane.next += 1;
             continue;
         }

@@ -299,14 +299,26 @@ impl<'a> Engine<'a> {
     /// [`Engine::advance`] checks before its trial step).
     #[inline(always)]
     fn event_at_start(&self, c: &Cursor, h: f64) -> bool {
-        let tau = self.run.ejector_start_s;
-        (0..2).any(|i| match c.modes[i] {
-            FootMode::Waiting => {
-                c.t_s >= tau - SWITCH_TOLERANCE_S || tau - c.t_s < h - SWITCH_TOLERANCE_S
-            }
+        (0..2).any(|i| self.switch_due(c, i))
+            || (c.modes.contains(&FootMode::Waiting) && self.ejector_starts_within(c.t_s, h))
+    }
+
+    /// Whether foot `i`'s mode is due to switch at the cursor's time: waiting at the ejector
+    /// start time, or on and already past the stroke.
+    #[inline(always)]
+    fn switch_due(&self, c: &Cursor, i: usize) -> bool {
+        match c.modes[i] {
+            FootMode::Waiting => c.t_s >= self.run.ejector_start_s - SWITCH_TOLERANCE_S,
             FootMode::On => self.stroke_excess(&c.x, i) > 0.0,
             FootMode::Off => false,
-        })
+        }
+    }
+
+    /// Whether the ejector start time falls inside a step of length `h` from `t_s` (more than
+    /// 1e-12 s before its end; within that of the end it is taken at the end).
+    #[inline(always)]
+    fn ejector_starts_within(&self, t_s: f64, h: f64) -> bool {
+        self.run.ejector_start_s - t_s < h - SWITCH_TOLERANCE_S
     }
 
     /// Whether a foot pushing during the step from `c` is past the stroke at its end `trial`
@@ -358,10 +370,10 @@ impl<'a> Engine<'a> {
                 return Ok(c);
             }
             let tau = self.run.ejector_start_s;
-            let waiting = c.modes.contains(&FootMode::Waiting);
             // The ejector start time falls inside this step: end the step there. (Within
             // 1e-12 s after the target it is taken at the target, by the next call.)
-            let to_tau = waiting && tau - c.t_s < h - SWITCH_TOLERANCE_S;
+            let to_tau =
+                c.modes.contains(&FootMode::Waiting) && self.ejector_starts_within(c.t_s, h);
             if to_tau {
                 h = tau - c.t_s;
             }
@@ -408,9 +420,8 @@ impl<'a> Engine<'a> {
     /// Switches the modes that are due at the cursor's time: waiting feet at the ejector start
     /// time, "on" feet already past the stroke.
     fn switch_due_modes(&mut self, c: &mut Cursor, main: bool) {
-        let tau = self.run.ejector_start_s;
         for i in 0..2 {
-            if c.modes[i] == FootMode::Waiting && c.t_s >= tau - SWITCH_TOLERANCE_S {
+            if c.modes[i] == FootMode::Waiting && self.switch_due(c, i) {
                 // docs/model.md 3a: at t = tau each foot whose s_i <= stroke turns on.
                 c.modes[i] = if self.stroke_excess(&c.x, i) <= 0.0 {
                     if main {
@@ -421,7 +432,7 @@ impl<'a> Engine<'a> {
                     FootMode::Off
                 };
             }
-            if c.modes[i] == FootMode::On && self.stroke_excess(&c.x, i) > 0.0 {
+            if c.modes[i] == FootMode::On && self.switch_due(c, i) {
                 c.modes[i] = FootMode::Off;
                 if main {
                     self.log.foot_off_s[i] = Some(c.t_s);
