@@ -189,7 +189,9 @@ impl Job {
         let mut samples: Vec<Vec<Vec<Observation>>> = vec![Vec::new(); batch.len()];
         let mut ended: Vec<Option<Evaluation>> = vec![None; batch.len()];
         for (k, event) in self.events.iter().enumerate() {
-            let mut live: Vec<(usize, RunSetup)> = Vec::with_capacity(batch.len());
+            // The candidates still running, and their runs of this event.
+            let mut live: Vec<usize> = Vec::with_capacity(batch.len());
+            let mut live_runs: Vec<RunSetup> = Vec::with_capacity(batch.len());
             for (i, c) in batch.iter().enumerate() {
                 if ended[i].is_some() {
                     continue;
@@ -198,21 +200,23 @@ impl Job {
                     .simulator
                     .run_setup_with(&c.factors, &c.effects, &c.terms)
                 {
-                    Ok(run) => live.push((i, run)),
+                    Ok(run) => {
+                        live.push(i);
+                        live_runs.push(run);
+                    }
                     Err(e) => ended[i] = Some(Outcome::failed(e.to_string()).into()),
                 }
             }
             let model = event.simulator.model();
             let data = &event.data;
-            for group in live.chunks(LANES) {
-                let runs: Vec<RunSetup> = group.iter().map(|(_, run)| *run).collect();
+            for (group, runs) in live.chunks(LANES).zip(live_runs.chunks(LANES)) {
                 let results = if keep {
                     let mut sinks: Vec<Vec<Observation>> = runs
                         .iter()
                         .map(|_| Vec::with_capacity(data.len()))
                         .collect();
-                    let results = propagate_lanes(model, &runs, &data.times_s, &mut sinks);
-                    for ((&(i, _), r), obs) in group.iter().zip(&results).zip(sinks) {
+                    let results = propagate_lanes(model, runs, &data.times_s, &mut sinks);
+                    for ((&i, r), obs) in group.iter().zip(&results).zip(sinks) {
                         if r.is_ok() {
                             for (j, o) in obs.iter().enumerate() {
                                 sums[i].add(o, &data.pos_m[j], &data.att_deg[j]);
@@ -224,13 +228,13 @@ impl Job {
                 } else {
                     let mut sinks: Vec<GoalAccumulator> =
                         runs.iter().map(|_| GoalAccumulator::new(data)).collect();
-                    let results = propagate_lanes(model, &runs, &data.times_s, &mut sinks);
-                    for (&(i, _), acc) in group.iter().zip(&sinks) {
+                    let results = propagate_lanes(model, runs, &data.times_s, &mut sinks);
+                    for (&i, acc) in group.iter().zip(&sinks) {
                         sums[i].merge(&acc.sums);
                     }
                     results
                 };
-                for (&(i, _), r) in group.iter().zip(results) {
+                for (&i, r) in group.iter().zip(results) {
                     if let Err(d) = r {
                         ended[i] = Some(
                             Outcome::Diverged {
