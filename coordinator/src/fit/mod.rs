@@ -275,20 +275,6 @@ fn hill_stage(
     progress.finish();
     r?;
     let r = climb.inner.finish();
-    if r.stop == HillStop::StartFailed {
-        let why = match &r.best.outcome {
-            Outcome::Diverged { t_s, event } => format!(
-                "it diverges at t = {t_s} s in event `{}`",
-                cx.job.events()[*event].name
-            ),
-            Outcome::Failed { reason } => reason.clone(),
-            Outcome::Goals { .. } => "it was not evaluated".into(),
-        };
-        return Err(FitError::Failed(format!(
-            "the hill climber's start, the nominal factors (clamped to their bounds), does not \
-             simulate: {why}; --method ga or ga+lm start from a random population instead"
-        )));
-    }
     let front = update_archive(&[], &r.visited);
     let history: Vec<HistoryPoint> = r
         .history
@@ -306,7 +292,20 @@ fn hill_stage(
     let stop = match r.stop {
         HillStop::Budget => "budget spent",
         HillStop::LocalOptimum => "local optimum (no downhill step above the minimum)",
-        HillStop::StartFailed => "the start did not simulate",
+        HillStop::StartFailed => {
+            let why = match &r.best.outcome {
+                Outcome::Diverged { t_s, event } => format!(
+                    "it diverges at t = {t_s} s in event `{}`",
+                    cx.job.events()[*event].name
+                ),
+                Outcome::Failed { reason } => reason.clone(),
+                Outcome::Goals { .. } => "it was not evaluated".into(),
+            };
+            return Err(FitError::Failed(format!(
+                "the hill climber's start, the nominal factors (clamped to their bounds), does \
+                 not simulate: {why}; --method ga or ga+lm start from a random population instead"
+            )));
+        }
     };
     let (best, rms, samples, refinement, evaluations, refined) = if o.method.refines() {
         let lm = cx.refine(evaluator, &r.best.values, progress, name)?;
