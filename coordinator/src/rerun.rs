@@ -180,19 +180,19 @@ impl Report {
 /// this build's).
 fn arithmetic_hint(written: Option<u32>) -> Option<String> {
     let ours = sepval_common::ARITHMETIC_VERSION;
-    Some(match written {
-        Some(v) if v == ours => return None,
-        Some(v) => format!(
+    match written {
+        Some(v) if v == ours => None,
+        Some(v) => Some(format!(
             "it was written by a build whose simulation arithmetic is version {v}, this one's is \
              {ours}: results differ in their last bits, so run the fit again with this build"
-        ),
-        None => format!(
+        )),
+        None => Some(format!(
             "it does not record the build's arithmetic version: if a sepval older than version \
              {ours} of the arithmetic (wire protocol 3 or earlier, before sepval's own elementary \
              functions) wrote it, results differ in their last bits, so run the fit again with \
              this build"
-        ),
-    })
+        )),
+    }
 }
 
 /// Errors of a rerun.
