@@ -343,6 +343,28 @@ pub enum Outcome {
 pub const MAX_REASON_BYTES: usize = 240;
 
 impl Outcome {
+    /// Whether two outcomes are identical to the last bit (what a replay must reproduce).
+    pub fn same_bits(&self, other: &Outcome) -> bool {
+        match (self, other) {
+            (
+                Outcome::Goals {
+                    j_pos_m: p1,
+                    j_att_deg: a1,
+                },
+                Outcome::Goals {
+                    j_pos_m: p2,
+                    j_att_deg: a2,
+                },
+            ) => p1.to_bits() == p2.to_bits() && a1.to_bits() == a2.to_bits(),
+            (
+                Outcome::Diverged { t_s: t1, event: e1 },
+                Outcome::Diverged { t_s: t2, event: e2 },
+            ) => t1.to_bits() == t2.to_bits() && e1 == e2,
+            (Outcome::Failed { reason: r1 }, Outcome::Failed { reason: r2 }) => r1 == r2,
+            _ => false,
+        }
+    }
+
     /// A failed outcome whose reason is cut to [`MAX_REASON_BYTES`] at a character boundary.
     pub fn failed(reason: impl Into<String>) -> Outcome {
         let mut reason = reason.into();

@@ -35,6 +35,7 @@ pub mod lanes;
 pub mod limits;
 pub mod model;
 pub mod noise;
+pub mod nonfinite;
 pub mod propagator;
 pub mod scenario;
 pub mod simulation;

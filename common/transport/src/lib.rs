@@ -12,13 +12,15 @@
 //! - the transports, each only a link: [`ipc`] (iceoryx2 shared memory, one host), [`uds`] (Unix
 //!   sockets, the benchmark's conventional baseline), `zenoh` (other hosts, feature `zenoh`,
 //!   with the gateway that serves a zenoh run with a host's iceoryx2 workers);
-//! - [`spec`]: which evaluator to start, as a validated configuration.
+//! - [`spec`]: which evaluator to start, as a validated configuration;
+//! - [`bench`]: simulations per second against worker count, per transport (`sepval bench`).
 //!
 //! Nothing here prints: what the user should hear goes out as [`link::Notice`]s.
 
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod bench;
 pub mod codec;
 pub mod dispatch;
 pub mod ipc;

@@ -1,0 +1,240 @@
+//! The catalogue stage of a diagnosis: every effect of the catalogue (`docs/model.md` section
+//! 7) extends the model in turn and is refitted from the baseline optimum, all candidate refits
+//! sharing each batch sent to the workers; each is judged by nested least squares (chi-square
+//! drop, the F test of its extra parameters, Bonferroni-corrected over the round, and the BIC
+//! change, G. Schwarz 1978); the significant one of lowest BIC is chosen, and further effects
+//! are added while each addition is itself significant (forward selection).
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS};
+use sepval_common::evaluation::{Evaluator, Job};
+use sepval_common::factors::FACTOR_COUNT;
+
+use super::residuals::{physical_residuals, rms_channels};
+use super::{ALPHA, CandidateReport, DiagnoseError, Fitted, ParamValue, Result, bic};
+use sepval_fit::refine::{ModelLm, refine_together};
+use sepval_fit::space::{Noise, ParamSpace};
+use sepval_solve::identifiability::identifiability;
+use sepval_solve::lm::LmSettings;
+use sepval_solve::stats::f_test;
+
+/// Refines a model again from its optimum until it converges (a reference model must be
+/// converged for the drops of its extensions to measure them); keeps the better of the two.
+pub(super) fn converge(
+    evaluator: &mut dyn Evaluator,
+    job: &Arc<Job>,
+    fitted: Fitted,
+    noise: Noise,
+    settings: &LmSettings,
+    evaluations: &mut u64,
+) -> Result<Fitted> {
+    let mut run = [ModelLm::new(
+        fitted.space(job),
+        Arc::clone(job),
+        &fitted.lm.x,
+        noise,
+        settings.clone(),
+    )];
+    refine_together(evaluator, &mut run)?;
+    let [run] = run;
+    let lm = run.finish();
+    *evaluations += lm.evaluations;
+    Ok(if lm.cost < fitted.lm.cost {
+        Fitted { lm, ..fitted }
+    } else {
+        fitted
+    })
+}
+
+/// The extensions of `base` by each effect of `ids`, refitted together from `base`'s optimum.
+fn try_extensions(
+    evaluator: &mut dyn Evaluator,
+    job: &Arc<Job>,
+    base: &Fitted,
+    ids: &[usize],
+    noise: Noise,
+    settings: &LmSettings,
+) -> Result<Vec<(usize, Fitted)>> {
+    let table = *job.factor_table();
+    let mut runs = Vec::new();
+    let mut sets = Vec::new();
+    for &index in ids {
+        let mut set = base.effects;
+        let neutral: Vec<f64> = CATALOGUE[index]
+            .params()
+            .iter()
+            .map(|p| p.neutral)
+            .collect();
+        set.push(index, &neutral)
+            .map_err(|e| DiagnoseError::Model(e.to_string()))?;
+        let space = ParamSpace::new(&table, &set);
+        let mut x0 = base.lm.x.clone();
+        x0.extend(neutral);
+        runs.push(ModelLm::new(
+            space,
+            Arc::clone(job),
+            &x0,
+            noise,
+            settings.clone(),
+        ));
+        sets.push((index, set));
+    }
+    refine_together(evaluator, &mut runs)?;
+    Ok(sets
+        .into_iter()
+        .zip(runs)
+        .map(|((index, effects), run)| {
+            (
+                index,
+                Fitted {
+                    effects,
+                    terms: Vec::new(),
+                    lm: run.finish(),
+                },
+            )
+        })
+        .collect())
+}
+
+/// The estimates of parameters `from..` of a fitted model, with their standard errors
+/// (corrected for coloured residuals).
+pub(super) fn param_values(
+    space: &ParamSpace,
+    fitted: &Fitted,
+    events: &[usize],
+    from: usize,
+) -> Vec<ParamValue> {
+    let id = identifiability(
+        &space.params,
+        &fitted.lm.x,
+        &fitted.lm.residuals,
+        &fitted.lm.jacobian,
+        events,
+    );
+    id.parameters[from..]
+        .iter()
+        .map(|p| ParamValue {
+            name: p.name.clone(),
+            unit: p.unit.clone(),
+            value: p.value,
+            std_error: p.std_error,
+        })
+        .collect()
+}
+
+/// What the catalogue stage found.
+pub(super) struct CatalogueOutcome {
+    /// The model with the chosen effects (the baseline when none).
+    pub fitted: Fitted,
+    /// The chosen effects' catalogue indices, in the order chosen.
+    pub chosen: Vec<usize>,
+    /// Every candidate tried, every round.
+    pub candidates: Vec<CandidateReport>,
+}
+
+/// Forward selection over the catalogue from the converged `baseline`.
+pub(super) fn select(
+    evaluator: &mut dyn Evaluator,
+    job: &Arc<Job>,
+    baseline: &Fitted,
+    noise: Noise,
+    settings: &LmSettings,
+    evaluations: &mut u64,
+) -> Result<CatalogueOutcome> {
+    let events: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
+    let m = 6 * job.sample_count();
+    let mut current = Fitted {
+        effects: EffectSet::NONE,
+        terms: Vec::new(),
+        lm: baseline.lm.clone(),
+    };
+    let mut chosen: Vec<usize> = Vec::new();
+    let mut candidates = Vec::new();
+    for round in 1..=MAX_ACTIVE_EFFECTS {
+        let remaining: Vec<usize> = (0..CATALOGUE.len())
+            .filter(|i| !chosen.contains(i))
+            .collect();
+        if remaining.is_empty() {
+            break;
+        }
+        let threshold = ALPHA / remaining.len() as f64;
+        let tried = try_extensions(evaluator, job, &current, &remaining, noise, settings)?;
+        let mut best: Option<(usize, f64)> = None;
+        let mut fitted_by_index = BTreeMap::new();
+        for (index, fitted) in tried {
+            *evaluations += fitted.lm.evaluations;
+            let effect = CATALOGUE[index];
+            let q = effect.params().len();
+            let p1 = FACTOR_COUNT + fitted.effects.param_count();
+            let (f, p) = f_test(current.lm.cost, fitted.lm.cost, q, m, p1);
+            let delta_bic = bic(fitted.lm.cost, p1, m) - bic(current.lm.cost, p1 - q, m);
+            let space = fitted.space(job);
+            let from = space.len() - q;
+            let parameters = param_values(&space, &fitted, &events, from);
+            let significant = p < threshold && delta_bic < 0.0;
+            let note = if significant {
+                String::new()
+            } else {
+                format!(
+                    "not significant (p = {p:.2e}, threshold {threshold:.1e}; BIC change {delta_bic:+.1}); the data bound it to {}",
+                    parameters
+                        .iter()
+                        .map(|v| match v.std_error {
+                            Some(se) => format!(
+                                "|{}| <~ {:.3e} {} (2 SE)",
+                                v.name,
+                                v.value.abs() + 2.0 * se,
+                                v.unit
+                            ),
+                            None => format!("{}: undetermined", v.name),
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            };
+            if significant && best.is_none_or(|(_, b)| delta_bic < b) {
+                best = Some((index, delta_bic));
+            }
+            candidates.push(CandidateReport {
+                id: effect.id().to_string(),
+                adds: effect.adds().to_string(),
+                round,
+                parameters,
+                chi2: fitted.lm.cost,
+                chi2_drop: current.lm.cost - fitted.lm.cost,
+                f,
+                p_value: p,
+                p_threshold: threshold,
+                delta_bic,
+                significant,
+                goals: fitted.lm.goals.as_array(),
+                channel_rms: rms_channels(&physical_residuals(
+                    &fitted.lm.residuals,
+                    noise,
+                    &events,
+                )),
+                note,
+                refinement: format!(
+                    "{} after {} iterations",
+                    fitted.lm.stop, fitted.lm.iterations
+                ),
+            });
+            fitted_by_index.insert(index, fitted);
+        }
+        let Some((index, _)) = best else {
+            break;
+        };
+        chosen.push(index);
+        let Some(picked) = fitted_by_index.remove(&index) else {
+            break;
+        };
+        current = converge(evaluator, job, picked, noise, settings, evaluations)?;
+    }
+    Ok(CatalogueOutcome {
+        fitted: current,
+        chosen,
+        candidates,
+    })
+}

@@ -1,0 +1,175 @@
+//! The diagnosis as files hold it (DIR/diagnosis.json, format [`super::DIAGNOSIS_FORMAT`]):
+//! every record the analysis produces, documented field by field in docs/model.md section 11.7.
+
+use std::collections::BTreeMap;
+
+use sepval_common::factors::Factors;
+use serde::{Deserialize, Serialize};
+
+use super::{
+    DiscoveredTerm, DiscoveryStep, Gain, Reconstruction, ResidualReport, ValidationReport,
+};
+use sepval_fit::results::ChannelRms;
+
+/// One parameter's estimate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamValue {
+    /// Parameter name.
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Estimate.
+    pub value: f64,
+    /// Standard error (null when the data do not determine it).
+    pub std_error: Option<f64>,
+}
+
+/// Summary of one model's fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelSummary {
+    /// Its effects (empty: the baseline).
+    pub effects: Vec<String>,
+    /// Its extension terms (`axis: formula`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub terms: Vec<String>,
+    /// Free parameters.
+    pub parameters: usize,
+    /// RMS position error \[m\].
+    pub j_pos_m: f64,
+    /// RMS attitude error \[deg\].
+    pub j_att_deg: f64,
+    /// Sum of squared normalised residuals.
+    pub chi2: f64,
+    /// RMS residual per channel.
+    pub channel_rms: ChannelRms,
+    /// The 17 factors as fitted with it (absent in files written before they were recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factors: Option<Factors>,
+}
+
+/// One candidate extension, tried against the model of its round.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateReport {
+    /// Effect id.
+    pub id: String,
+    /// What it adds.
+    pub adds: String,
+    /// Forward-selection round (1: against the baseline).
+    pub round: usize,
+    /// Its parameters' estimates.
+    pub parameters: Vec<ParamValue>,
+    /// Chi-square of the extended fit.
+    pub chi2: f64,
+    /// Chi-square drop from the round's model.
+    pub chi2_drop: f64,
+    /// F statistic of the extra parameters.
+    pub f: f64,
+    /// Its p-value.
+    pub p_value: f64,
+    /// The Bonferroni-corrected threshold of the round.
+    pub p_threshold: f64,
+    /// BIC change (negative: better even after charging the parameters).
+    pub delta_bic: f64,
+    /// Whether the extension is significant.
+    pub significant: bool,
+    /// Goals after the extension: J_pos \[m\], J_att \[deg\].
+    pub goals: [f64; 2],
+    /// RMS residual per channel after the extension.
+    pub channel_rms: ChannelRms,
+    /// A remark (for example a weak effect's bound).
+    pub note: String,
+    /// Why its refinement stopped, and after how many iterations.
+    pub refinement: String,
+}
+
+/// The discovered extension: the model with the discovered terms, refitted, and its gain.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExtensionReport {
+    /// Whether it is the answer (else the catalogue's effects are, and it is an alternative).
+    pub answer: bool,
+    /// The extension file written (relative to DIR), when it is the answer.
+    pub file: Option<String>,
+    /// The extended model's fit.
+    pub model: ModelSummary,
+    /// Its gain over the baseline (chi-square drop, F test, BIC).
+    pub gain: Gain,
+    /// Whether every channel's residuals are white.
+    pub white: bool,
+    /// Whether both goals are within 1.1 sigma.
+    pub at_noise_floor: bool,
+    /// Whether it explains the data to the noise (white and at the floor).
+    pub explained: bool,
+    /// Why its refinement stopped.
+    pub refinement: String,
+}
+
+/// A model that explains part of the data but is not the answer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Alternative {
+    /// `catalogue` (effects) or `discovered` (terms).
+    pub kind: String,
+    /// Its effects or terms.
+    pub names: Vec<String>,
+    /// Its fit.
+    pub model: ModelSummary,
+    /// Its BIC minus the answer's (positive: worse).
+    pub delta_bic_vs_answer: f64,
+    /// Why it is not the answer.
+    pub note: String,
+}
+
+/// DIR/diagnosis.json.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Diagnosis {
+    /// [`DIAGNOSIS_FORMAT`](super::DIAGNOSIS_FORMAT).
+    pub format: String,
+    /// The catalogue effects named as causes, in the order chosen (empty when the baseline
+    /// explains the data, or when a discovered extension explains it better).
+    pub causes: Vec<String>,
+    /// Whether the catalogue's answer leaves nothing but noise: the model with the effects it
+    /// chose (the baseline when it chose none), even when those effects are not the answer
+    /// (`causes` is then empty because a discovered extension explains better). A discovered
+    /// extension's own verdict is `extension.explained`; the terminal summary shows the
+    /// answer's.
+    pub explained: bool,
+    /// The verdict in one sentence (ending with the caution when there is one).
+    pub verdict: String,
+    /// Why the answer may not name the cause: an alternative predicts the `--validate` events
+    /// clearly better.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub caution: Option<String>,
+    /// Terms found beyond the catalogue, most important first, when they are the answer.
+    pub discovered: Vec<DiscoveredTerm>,
+    /// Models that explain part of the data but not as well as the answer (mimics).
+    pub alternatives: Vec<Alternative>,
+    /// The discovered extension and its gain, when discovery verified one.
+    pub extension: Option<ExtensionReport>,
+    /// What discovery did beyond its findings (why nothing was named, terms dropped).
+    pub discovery_notes: Vec<String>,
+    /// Each step of discovery's selection: the entries ranked, the refits, what entered.
+    pub discovery_steps: Vec<DiscoveryStep>,
+    /// Position noise \[m\].
+    pub sigma_pos_m: f64,
+    /// Attitude noise \[deg\].
+    pub sigma_att_deg: f64,
+    /// Where the sigmas came from.
+    pub sigma_source: String,
+    /// The baseline fit.
+    pub baseline: ModelSummary,
+    /// The answer's model; the baseline when nothing is named.
+    pub extended: ModelSummary,
+    /// Each named effect's parameters with standard errors.
+    pub parameters: BTreeMap<String, Vec<ParamValue>>,
+    /// Every candidate tried, every round.
+    pub candidates: Vec<CandidateReport>,
+    /// Residual analysis before and after.
+    pub residuals: BTreeMap<String, ResidualReport>,
+    /// Per event, the reconstructed coefficient increments with their bands.
+    pub reconstruction: Vec<Reconstruction>,
+    /// Prediction of the `--validate` events.
+    pub validation: Vec<ValidationReport>,
+    /// Simulations run (baseline fit included).
+    pub evaluations: u64,
+    /// Wall time \[s\].
+    pub wall_s: f64,
+}

@@ -1,0 +1,387 @@
+//! The consistency checks of a checkpoint's content (listed in the documentation of
+//! [`crate::checkpoint`]). Each returns what disagrees, naming the member, field or count.
+
+use sepval_common::evaluation::{Job, MAX_REASON_BYTES, Outcome};
+use sepval_common::factors::{Factor, FactorSpec};
+
+use super::Checkpoint;
+use crate::method::Method;
+use sepval_solve::ga::{Member, best_weighted};
+use sepval_solve::pareto::dominates;
+use sepval_solve::rng::{RngState, seeded};
+
+impl Checkpoint {
+    /// Everything that can be checked without the job.
+    pub(super) fn check_content(&self) -> Result<(), String> {
+        self.check_header()?;
+        self.check_counts()?;
+        self.check_rng()?;
+        for (set, members) in [
+            ("population", &self.state.population),
+            ("archive", &self.state.archive),
+        ] {
+            for (i, m) in members.iter().enumerate() {
+                check_outcome(&m.outcome).map_err(|e| format!("{set} member {i}: {e}"))?;
+            }
+        }
+        self.check_archive()?;
+        self.check_history()?;
+        self.check_probes()
+    }
+
+    /// The method, settings, noise levels and hashes.
+    fn check_header(&self) -> Result<(), String> {
+        match Method::from_name(&self.method) {
+            Some(Method::Ga | Method::Both | Method::GaLm) => {}
+            _ => {
+                return Err(format!(
+                    "method `{}`: a checkpoint is written by ga, both or ga+lm",
+                    self.method
+                ));
+            }
+        }
+        self.settings.validate().map_err(|e| e.to_string())?;
+        let s = &self.sigma;
+        if !(s.pos_m.is_finite() && s.pos_m > 0.0 && s.att_deg.is_finite() && s.att_deg > 0.0) {
+            return Err(format!(
+                "noise levels sigma_pos {} m, sigma_att {} deg: expected positive numbers",
+                s.pos_m, s.att_deg
+            ));
+        }
+        let h = &self.hill;
+        for (name, v) in [
+            ("fd_step", h.fd_step),
+            ("initial_step", h.initial_step),
+            ("min_step", h.min_step),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!(
+                    "hill-climber setting {name} = {v}: expected a positive number"
+                ));
+            }
+        }
+        for (name, hash) in [
+            ("data_sha256", &self.data_sha256),
+            ("scenario_sha256", &self.scenario_sha256),
+        ] {
+            let hex = hash.len() == 64
+                && hash
+                    .bytes()
+                    .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b));
+            if !hex {
+                return Err(format!(
+                    "{name} `{hash}` is not a SHA-256 (64 lower-case hex digits)"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The generation and simulation counts against the settings.
+    fn check_counts(&self) -> Result<(), String> {
+        let (s, st) = (&self.settings, &self.state);
+        if st.generation < 1 || st.generation > s.generations {
+            return Err(format!(
+                "generation {}: expected 1 to the settings' {} generations",
+                st.generation, s.generations
+            ));
+        }
+        if st.population.len() != s.population {
+            return Err(format!(
+                "population of {} members, settings say {}",
+                st.population.len(),
+                s.population
+            ));
+        }
+        // Exact: a generation near usize::MAX must not wrap to a count that matches.
+        let expected = st.generation as u128 * s.population as u128;
+        if u128::from(st.evaluations) != expected {
+            return Err(format!(
+                "{} simulations recorded, but {} generations of {} make {expected}",
+                st.evaluations, st.generation, s.population
+            ));
+        }
+        Ok(())
+    }
+
+    /// The generator: restores, is written as this sepval writes it, and is the settings'
+    /// seed's (a search never changes its key or stream, only its position).
+    fn check_rng(&self) -> Result<(), String> {
+        let rng = &self.state.rng;
+        let restored = rng
+            .restore()
+            .map_err(|e| format!("generator state (state.rng): {e}"))?;
+        if RngState::of(&restored) != *rng {
+            return Err(format!(
+                "generator state (state.rng) is not written as sepval writes it: {rng:?}"
+            ));
+        }
+        let start = RngState::of(&seeded(self.settings.seed));
+        if rng.seed_hex != start.seed_hex || rng.stream != start.stream {
+            return Err(format!(
+                "generator state (state.rng): its key and stream are not those of the \
+                 settings' seed {}",
+                self.settings.seed
+            ));
+        }
+        Ok(())
+    }
+
+    /// The archive alone, then the population against it.
+    fn check_archive(&self) -> Result<(), String> {
+        let archive = &self.state.archive;
+        for (i, a) in archive.iter().enumerate() {
+            if a.outcome.goals().is_none() {
+                return Err(format!(
+                    "archive member {i} did not finish: the archive holds finished runs only"
+                ));
+            }
+            if let Some(j) = archive[..i]
+                .iter()
+                .position(|b| b.chromosome == a.chromosome)
+            {
+                return Err(format!(
+                    "archive members {j} and {i} have the same chromosome"
+                ));
+            }
+            if i > 0 {
+                let (p, q) = (archive[i - 1].objectives(), a.objectives());
+                if p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])).is_gt() {
+                    return Err(format!(
+                        "archive members {} and {i} are not in order of J_pos, then J_att",
+                        i - 1
+                    ));
+                }
+            }
+            if let Some(j) = archive
+                .iter()
+                .position(|b| dominates(&b.objectives(), &a.objectives()))
+            {
+                return Err(format!(
+                    "archive member {i} is dominated by archive member {j}: the archive holds \
+                     non-dominated runs only"
+                ));
+            }
+        }
+        for (i, m) in self.state.population.iter().enumerate() {
+            if let Some(j) = archive.iter().position(|a| a.chromosome == m.chromosome) {
+                if !m.outcome.same_bits(&archive[j].outcome) {
+                    return Err(format!(
+                        "population member {i} and archive member {j} have the same \
+                         chromosome but different outcomes ({:?}, {:?})",
+                        m.outcome, archive[j].outcome
+                    ));
+                }
+            } else if m.outcome.goals().is_some()
+                && !archive
+                    .iter()
+                    .any(|a| dominates(&a.objectives(), &m.objectives()))
+            {
+                return Err(format!(
+                    "population member {i} ({:?}) is neither in the archive nor dominated by \
+                     an archive member",
+                    m.outcome
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// One history entry per generation, with its counts; the last one is what the population
+    /// gives (the earlier populations are gone: their entries can only be counted).
+    fn check_history(&self) -> Result<(), String> {
+        let (st, pop) = (&self.state, self.settings.population as u64);
+        if st.history.len() != st.generation {
+            return Err(format!(
+                "history of {} generations (state.history), the state is at generation {}",
+                st.history.len(),
+                st.generation
+            ));
+        }
+        for (i, h) in st.history.iter().enumerate() {
+            let g = i + 1;
+            if h.generation != g || h.evaluations != g as u64 * pop {
+                return Err(format!(
+                    "history entry {i} (state.history): generation {} after {} simulations, \
+                     expected generation {g} after {}",
+                    h.generation,
+                    h.evaluations,
+                    g as u64 * pop
+                ));
+            }
+            for (name, v) in [
+                ("best_j_pos_m", h.best_j_pos_m),
+                ("best_j_att_deg", h.best_j_att_deg),
+                ("best_weighted", h.best_weighted),
+            ] {
+                if v.is_nan() || v < 0.0 {
+                    return Err(format!(
+                        "history of generation {g} (state.history): {name} = {v}: expected a \
+                         non-negative number or \"inf\""
+                    ));
+                }
+            }
+        }
+        // As GaSearch computes it: the smallest objectives of the population and the smallest
+        // weighted sum of a finished member (infinite when none finished).
+        let w = self.sigma.weights();
+        let min = |j: usize| {
+            st.population
+                .iter()
+                .map(|m| m.objectives()[j])
+                .fold(f64::INFINITY, f64::min)
+        };
+        let weighted = |m: &Member| {
+            let o = m.objectives();
+            w[0] * o[0] + w[1] * o[1]
+        };
+        let last = st.history.last().expect("at least one generation");
+        for (name, recorded, population) in [
+            ("best_j_pos_m", last.best_j_pos_m, min(0)),
+            ("best_j_att_deg", last.best_j_att_deg, min(1)),
+            (
+                "best_weighted",
+                last.best_weighted,
+                best_weighted(&st.population, w).map_or(f64::INFINITY, weighted),
+            ),
+        ] {
+            if recorded.to_bits() != population.to_bits() {
+                return Err(format!(
+                    "history of generation {} (state.history): {name} = {recorded}, but the \
+                     population's is {population}",
+                    st.generation
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Probes only for ga+lm, after generations already done, with the simulations before
+    /// each one being the generations' and the earlier probes'.
+    fn check_probes(&self) -> Result<(), String> {
+        if self.probes.is_empty() {
+            return Ok(());
+        }
+        if self.method != Method::GaLm.name() {
+            return Err(format!(
+                "{} refinement attempt(s) (probes), but method `{}` makes none",
+                self.probes.len(),
+                self.method
+            ));
+        }
+        // Exact sums: an attempt of nearly 2^64 simulations must not wrap the count of the
+        // next one's back to a value that matches.
+        let pop = self.settings.population as u128;
+        let mut probed = 0u128;
+        let mut generation = 0;
+        for (i, p) in self.probes.iter().enumerate() {
+            if p.generation < generation || p.generation > self.state.generation {
+                return Err(format!(
+                    "probe {i} after generation {}: expected generation {generation} to {}",
+                    p.generation, self.state.generation
+                ));
+            }
+            let before = p.generation as u128 * pop + probed;
+            if u128::from(p.evaluations_before) != before {
+                return Err(format!(
+                    "probe {i}: {} simulations before it recorded, the generations and earlier \
+                     probes make {before}",
+                    p.evaluations_before
+                ));
+            }
+            if !p.goals.iter().all(|g| g.is_finite() && *g >= 0.0) {
+                return Err(format!(
+                    "probe {i}: goals {:?}: expected finite non-negative numbers",
+                    p.goals
+                ));
+            }
+            probed += u128::from(p.evaluations);
+            generation = p.generation;
+        }
+        Ok(())
+    }
+
+    /// What needs the job: every member's chromosome fits the factor table and decodes to its
+    /// recorded values; divergences name an event of the job.
+    pub(super) fn check_members(&self, job: &Job) -> Result<(), String> {
+        let genes: &[FactorSpec] = &job.factor_table().0;
+        let events = job.events().len();
+        for (set, members) in [
+            ("population", &self.state.population),
+            ("archive", &self.state.archive),
+        ] {
+            for (i, m) in members.iter().enumerate() {
+                check_decoding(m, genes).map_err(|e| format!("{set} member {i}: {e}"))?;
+                if let Outcome::Diverged { event, .. } = m.outcome {
+                    if event >= events {
+                        return Err(format!(
+                            "{set} member {i}: diverged in event {event}, the job has {events}"
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// An outcome a simulation can give.
+fn check_outcome(o: &Outcome) -> Result<(), String> {
+    let valid = |v: f64| v.is_finite() && v >= 0.0;
+    match o {
+        Outcome::Goals { j_pos_m, j_att_deg } => {
+            if !(valid(*j_pos_m) && valid(*j_att_deg)) {
+                return Err(format!(
+                    "goals J_pos {j_pos_m} m, J_att {j_att_deg} deg: expected finite \
+                     non-negative numbers"
+                ));
+            }
+        }
+        Outcome::Diverged { t_s, .. } => {
+            if !valid(*t_s) {
+                return Err(format!(
+                    "diverged at t = {t_s} s: expected a finite non-negative time"
+                ));
+            }
+        }
+        Outcome::Failed { reason } => {
+            if reason.len() > MAX_REASON_BYTES {
+                return Err(format!(
+                    "failure reason of {} bytes, longer than the {MAX_REASON_BYTES} a failure \
+                     carries",
+                    reason.len()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The member's chromosome has the genes' length and decodes to exactly its values.
+fn check_decoding(m: &Member, genes: &[FactorSpec]) -> Result<(), String> {
+    let bits: usize = genes.iter().map(|g| g.bits as usize).sum();
+    if m.chromosome.len() != bits {
+        return Err(format!(
+            "chromosome of {} bits, the factor table's genes make {bits}",
+            m.chromosome.len()
+        ));
+    }
+    if m.values.len() != genes.len() {
+        return Err(format!(
+            "{} values recorded, the factor table has {} factors",
+            m.values.len(),
+            genes.len()
+        ));
+    }
+    let decoded = m.chromosome.decode_values(genes);
+    if let Some(k) = (0..genes.len()).find(|&k| decoded[k].to_bits() != m.values[k].to_bits()) {
+        let name = Factor::ALL
+            .get(k)
+            .map_or_else(|| format!("gene {k}"), |f| format!("factor {}", f.name()));
+        return Err(format!(
+            "its chromosome decodes to {name} = {:?}, its recorded value is {:?}",
+            decoded[k], m.values[k]
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,8 @@
+//! What sepval writes for people: figures as PNG files ([`figures`]), drawn from plain
+//! data. Fits, diagnoses and the commands to come describe what
+//! to show; this crate knows nothing of how it was computed.
+
+#![warn(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod figures;

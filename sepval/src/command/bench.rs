@@ -1,0 +1,80 @@
+//! `sepval bench`: simulations per second against worker count, per transport.
+
+use std::sync::Arc;
+
+use anyhow::{Result, bail};
+use sepval_report::figures::throughput_figure;
+use sepval_transport::bench::{BenchOptions, Transport, run_bench, series, table, write_csv};
+use sepval_transport::ipc::MAX_WORKERS;
+
+use super::{inputs, worker_executable};
+use crate::cli::{BenchArgs, TransportArg};
+
+/// Runs `sepval bench`.
+pub fn run(args: BenchArgs) -> Result<()> {
+    if let Some(w) = args.workers.iter().find(|w| **w == 0 || **w > MAX_WORKERS) {
+        bail!("--workers {w}: expected 1 to {MAX_WORKERS}");
+    }
+    if args.evals == 0 {
+        bail!("--evals 0: expected at least 1");
+    }
+    if args.repeat == 0 {
+        bail!("--repeat 0: expected at least 1");
+    }
+    let transports: Vec<Transport> = args
+        .transports
+        .iter()
+        .map(|t| match t {
+            TransportArg::Scalar => Transport::Scalar,
+            TransportArg::Single => Transport::Single,
+            TransportArg::Pool => Transport::Pool,
+            TransportArg::Ipc => Transport::Ipc,
+            TransportArg::Uds => Transport::Uds,
+            TransportArg::Zenoh => Transport::Zenoh,
+        })
+        .collect();
+    if cfg!(not(feature = "zenoh")) && transports.contains(&Transport::Zenoh) {
+        bail!(
+            "--transports zenoh: this sepval was built without the zenoh feature \
+             (cargo build --release --features zenoh)"
+        );
+    }
+    let options = BenchOptions {
+        workers: args.workers.clone(),
+        evals: args.evals,
+        transports,
+        worker_executable: worker_executable()?,
+        repeat: args.repeat,
+    };
+    let (job, _) = inputs::job(&[], None, None)?;
+    eprintln!(
+        "benchmarking {} simulations of the default event per measurement, median of {} \
+         interleaved rounds, on {} core(s)",
+        args.evals,
+        args.repeat,
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    );
+    let rows = run_bench(Arc::new(job), &options, &mut |r| {
+        eprintln!(
+            "  {:<6} {} worker(s): {:.0} simulations/s, {:.0} refused requests/s",
+            r.transport,
+            r.workers,
+            r.evals_per_s(),
+            r.evals as f64 / r.probe_wall_s
+        );
+    })?;
+    print!("{}", table(&rows));
+    write_csv(&args.out, &rows)?;
+    let data = series(&rows);
+    let lines: Vec<(&str, &[(usize, f64)])> = data
+        .iter()
+        .map(|(n, v)| (n.as_str(), v.as_slice()))
+        .collect();
+    throughput_figure(&args.out.join("bench.png"), &lines)?;
+    println!(
+        "wrote {} and {}",
+        args.out.join("bench.csv").display(),
+        args.out.join("bench.png").display()
+    );
+    Ok(())
+}

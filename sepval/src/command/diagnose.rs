@@ -1,0 +1,176 @@
+//! `sepval diagnose`: what the simulation still gets wrong after a fit, and why.
+
+use std::sync::Arc;
+
+use anyhow::{Context, Result};
+use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
+use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_fit::sigma::Sigma;
+use sepval_fit::{FitOptions, Method};
+use sepval_solve::ga::GaSettings;
+use sepval_solve::hill::HillSettings;
+use sepval_solve::lm::LmSettings;
+
+use super::{Bar, evaluator_spec, inputs, notices};
+use crate::cli::DiagnoseArgs;
+
+/// Runs `sepval diagnose`.
+pub fn run(args: DiagnoseArgs) -> Result<()> {
+    let spec = evaluator_spec(&args.eval)?;
+    // The output directory, before anything runs (no worker is started for a refused --out).
+    let claim = if args.overwrite {
+        Claim::Overwrite
+    } else {
+        Claim::Fresh
+    };
+    let run_dir = RunDir::claim(&args.out, claim, "diagnose").with_context(|| {
+        format!(
+            "--out {} (--overwrite clears an earlier run)",
+            args.out.display()
+        )
+    })?;
+    let ga = GaSettings {
+        population: args.population,
+        generations: args.generations,
+        seed: args.seed,
+        ..GaSettings::default()
+    };
+    ga.validate()?;
+    let (job, inputs) = inputs::job(
+        &args.data,
+        args.scenario.as_deref(),
+        args.extension.as_deref(),
+    )?;
+    let validation = inputs::validation_job(
+        &args.validate,
+        &args.data,
+        args.scenario.as_deref(),
+        args.extension.as_deref(),
+    )?;
+    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
+        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
+    let lm = LmSettings {
+        budget: args.lm_budget,
+        ..LmSettings::default()
+    };
+    let fit = FitOptions {
+        method: Method::GaLm,
+        ga,
+        hill: HillSettings::default(),
+        sigma,
+        truth: None,
+        out: args.out.join("baseline"),
+        resume: None,
+        inputs,
+        lm: lm.clone(),
+        lm_probe: LmSettings {
+            budget: args.lm_budget.min(800),
+            ..LmSettings::default()
+        },
+    };
+    let options = DiagnoseOptions {
+        fit,
+        out: args.out.clone(),
+        candidate_lm: LmSettings {
+            max_iterations: 400,
+            budget: 10_000,
+            ..lm
+        },
+        validation,
+    };
+    let mut evaluator = spec.start(Arc::new(job), notices())?;
+    let d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
+    print!("{}", summary_lines(&d, &args.out));
+    drop(run_dir);
+    Ok(())
+}
+
+/// The terminal summary: a few short lines.
+fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
+    let mut s = String::new();
+    let answer = if !d.discovered.is_empty() {
+        "terms found beyond the catalogue"
+    } else if !d.causes.is_empty() {
+        "catalogue effects"
+    } else {
+        "nothing named"
+    };
+    s.push_str(&format!("answer:    {answer}\n"));
+    for c in &d.causes {
+        let values: Vec<String> = d
+            .parameters
+            .get(c)
+            .map(|v| {
+                v.iter()
+                    .map(|p| match p.std_error {
+                        Some(se) => format!("{} = {:.4} ± {:.2}", p.name, p.value, se),
+                        None => format!("{} = {:.4}", p.name, p.value),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        s.push_str(&format!("cause:     {c} ({})\n", values.join(", ")));
+    }
+    for t in &d.discovered {
+        s.push_str(&format!("found:     {}\n", fmt_discovered(t)));
+        s.push_str(&format!("           {}\n", t.reading));
+    }
+    s.push_str(&format!(
+        "fit:       J_pos {:.4} -> {:.4} m, J_att {:.3} -> {:.3} deg (noise {:.4} m, {:.3} deg)\n",
+        d.baseline.j_pos_m,
+        d.extended.j_pos_m,
+        d.baseline.j_att_deg,
+        d.extended.j_att_deg,
+        d.sigma_pos_m,
+        d.sigma_att_deg
+    ));
+    let explained = match &d.extension {
+        Some(x) if x.answer => x.explained,
+        _ => d.explained,
+    };
+    s.push_str(&format!(
+        "explained: {} ({} simulations, {:.1} s)\n",
+        if explained {
+            "yes, to the noise"
+        } else {
+            "no, structure remains"
+        },
+        d.evaluations,
+        d.wall_s
+    ));
+    for v in &d.validation {
+        let f = |v: Option<f64>, p: usize| {
+            v.map_or("-".to_string(), |v| format!("{v:.prec$}", prec = p))
+        };
+        s.push_str(&format!(
+            "predicts:  {}: J_pos {} -> {} m, J_att {} -> {} deg\n",
+            v.event,
+            f(v.baseline_j_pos_m, 4),
+            f(v.extended_j_pos_m, 4),
+            f(v.baseline_j_att_deg, 3),
+            f(v.extended_j_att_deg, 3)
+        ));
+        for a in &v.alternatives {
+            let kind = a.model.split(':').next().unwrap_or("alternative");
+            s.push_str(&format!(
+                "           the {kind} alternative would give J_pos {:.4} m, J_att {:.3} deg\n",
+                a.j_pos_m, a.j_att_deg
+            ));
+        }
+    }
+    if let Some(caution) = &d.caution {
+        s.push_str(&format!("caution:   {caution}\n"));
+    }
+    if d.extension.as_ref().is_some_and(|x| x.answer) {
+        s.push_str(&format!(
+            "extension: {} with factors {}\n",
+            out.join("extension.toml").display(),
+            out.join("factors.json").display()
+        ));
+    }
+    s.push_str(&format!(
+        "report:    {}\n",
+        out.join("report.html").display()
+    ));
+    s
+}

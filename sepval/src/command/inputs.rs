@@ -1,0 +1,186 @@
+//! Reading the inputs the flags name (scenario, factors, effects, data files) into validated
+//! values, with errors that name the file and the problem.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use sepval_common::effects::EffectSet;
+use sepval_common::factors::{FactorTable, Factors};
+use sepval_common::scenario::Scenario;
+use sepval_common::synthetic::default_flight_test;
+use sepval_common::telemetry::Trajectory;
+
+/// The scenario of `--scenario FILE`, or the embedded default, extended by the terms of
+/// `--extension FILE` (docs/model.md section 11).
+pub fn scenario(path: Option<&Path>, extension: Option<&Path>) -> Result<Scenario> {
+    let mut s = match path {
+        Some(p) => Scenario::load(p)?,
+        None => Scenario::embedded_default(),
+    };
+    if let Some(e) = extension {
+        let terms = sepval_common::extension::load_extension(e)?;
+        s.extension
+            .extend(terms.iter().map(sepval_common::extension::TermRecord::of));
+        s.validate(&format!("{} extended by {}", s.name, e.display()))?;
+    }
+    Ok(s)
+}
+
+/// The factors of `--factors truth|nominal|FILE.json`, checked against `table`.
+pub fn factors(spec: &str, table: &FactorTable) -> Result<Factors> {
+    let factors = match spec {
+        "truth" => Factors::TRUTH,
+        "nominal" => Factors::NOMINAL,
+        path => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read factors file {path}"))?;
+            return Factors::from_json_str(&text, table)
+                .with_context(|| format!("factors file {path}"));
+        }
+    };
+    table
+        .check(&factors)
+        .with_context(|| format!("the {spec} factors do not fit this scenario's factor table"))?;
+    Ok(factors)
+}
+
+/// The effects of repeated `--effect ID=V1,V2,...` flags.
+pub fn effects(specs: &[String]) -> Result<EffectSet> {
+    let mut set = EffectSet::NONE;
+    for spec in specs {
+        set.push_spec(spec)
+            .with_context(|| format!("--effect {spec}"))?;
+    }
+    Ok(set)
+}
+
+/// The measured data of `--data FILE` (several allowed), or the embedded default synthetic
+/// flight test when none is given.
+pub fn data(paths: &[std::path::PathBuf]) -> Result<Vec<Trajectory>> {
+    if paths.is_empty() {
+        return Ok(vec![default_flight_test()]);
+    }
+    paths
+        .iter()
+        .map(|p| Trajectory::read(p).map_err(anyhow::Error::from))
+        .collect()
+}
+
+/// The job of a fit: each data file (or the embedded default flight test) with the scenario,
+/// and the record of where they came from.
+pub fn job(
+    data_paths: &[std::path::PathBuf],
+    scenario_path: Option<&Path>,
+    extension_path: Option<&Path>,
+) -> Result<(
+    sepval_common::evaluation::Job,
+    sepval_fit::checkpoint::InputsRecord,
+)> {
+    use sepval_common::evaluation::{Event, Job};
+    use sepval_common::simulation::Simulator;
+    // Each release once: the same file given twice would count its samples twice.
+    let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    for (i, p) in data_paths.iter().enumerate() {
+        if let Some(q) = data_paths[..i].iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--data {} is the same file as --data {}: give each release once",
+                p.display(),
+                q.display()
+            );
+        }
+    }
+    let scen = scenario(scenario_path, extension_path)?;
+    let data = data(data_paths)?;
+    let names: Vec<String> = if data_paths.is_empty() {
+        vec!["embedded default synthetic flight test".to_string()]
+    } else {
+        data_paths.iter().map(|p| p.display().to_string()).collect()
+    };
+    let mut events = Vec::with_capacity(data.len());
+    for (name, data) in names.into_iter().zip(data) {
+        let scenario = event_scenario(&scen, &data, &name)?;
+        events.push(Event {
+            name,
+            simulator: Simulator::new(&scenario),
+            data,
+        });
+    }
+    let record = sepval_fit::checkpoint::InputsRecord {
+        data: data_paths.iter().map(|p| absolute(p)).collect(),
+        scenario: scenario_path.map(absolute),
+        extension: extension_path.map(absolute),
+    };
+    Ok((Job::new(events)?, record))
+}
+
+/// The scenario of one event: `base` with the flight condition named in the data's `#`
+/// metadata (`mach`, `altitude_m`, `alpha_deg`, `beta_deg`, `gamma_deg`; any subset), so that
+/// releases of the same store at different conditions can be fitted together.
+pub fn event_scenario(
+    base: &sepval_common::scenario::Scenario,
+    data: &Trajectory,
+    name: &str,
+) -> Result<sepval_common::scenario::Scenario> {
+    let mut s = base.clone();
+    let f = &mut s.flight;
+    for (key, field) in [
+        ("mach", &mut f.mach),
+        ("altitude_m", &mut f.altitude_m),
+        ("alpha_deg", &mut f.alpha_deg),
+        ("beta_deg", &mut f.beta_deg),
+        ("gamma_deg", &mut f.gamma_deg),
+    ] {
+        if let Some(text) = data.meta(key) {
+            *field = text
+                .parse()
+                .with_context(|| format!("{name}: metadata `# {key} = {text}` is not a number"))?;
+        }
+    }
+    s.validate(&format!("{name} (flight condition from its metadata)"))?;
+    Ok(s)
+}
+
+/// The events of `--validate FILE` (none: `None`), read like `--data` with the same scenario
+/// and extension; a file given both to fit and to validate is refused.
+pub fn validation_job(
+    paths: &[std::path::PathBuf],
+    data_paths: &[std::path::PathBuf],
+    scenario_path: Option<&Path>,
+    extension_path: Option<&Path>,
+) -> Result<Option<sepval_common::evaluation::Job>> {
+    use sepval_common::evaluation::{Event, Job};
+    use sepval_common::simulation::Simulator;
+    if paths.is_empty() {
+        return Ok(None);
+    }
+    let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    for (i, p) in paths.iter().enumerate() {
+        if let Some(q) = data_paths.iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--validate {} is the same file as --data {}: a release used for fitting cannot measure prediction",
+                p.display(),
+                q.display()
+            );
+        }
+        if let Some(q) = paths[..i].iter().find(|q| absolute(q) == absolute(p)) {
+            bail!(
+                "--validate {} is the same file as --validate {}: give each release once",
+                p.display(),
+                q.display()
+            );
+        }
+    }
+    let scen = scenario(scenario_path, extension_path)?;
+    let mut events = Vec::with_capacity(paths.len());
+    for p in paths {
+        let data = Trajectory::read(p).with_context(|| format!("--validate {}", p.display()))?;
+        let name = p.display().to_string();
+        let scenario = event_scenario(&scen, &data, &name)?;
+        events.push(Event {
+            name,
+            simulator: Simulator::new(&scenario),
+            data,
+        });
+    }
+    Ok(Some(Job::new(events)?))
+}

@@ -1,0 +1,223 @@
+//! One file per subcommand: each turns its raw flags into a validated configuration before any
+//! I/O, then calls the libraries and renders what they return. What several commands share
+//! lives here: counts and durations from flags, the evaluator configuration, the worker
+//! executable, and the rendering of transport notices and search progress.
+
+pub mod bench;
+pub mod clean_ipc;
+pub mod diagnose;
+pub mod effects;
+pub mod fit;
+pub mod gateway;
+pub mod goals;
+pub mod inputs;
+pub mod rerun;
+pub mod scenario;
+pub mod selftest;
+pub mod simulate;
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use sepval_solve::run::{Progress, ProgressObserver};
+use sepval_transport::RunId;
+use sepval_transport::dispatch::DispatchOptions;
+use sepval_transport::ipc::{IpcOptions, Launch, MAX_WORKERS};
+use sepval_transport::link::Notices;
+use sepval_transport::spec::EvaluatorSpec;
+
+use crate::cli::{EvalArgs, EvaluatorKind};
+
+/// A count given on the command line: at least 1; the number of cores when absent.
+pub fn count(flag: &str, requested: Option<usize>) -> Result<usize> {
+    match requested {
+        Some(0) => bail!("{flag} 0: expected at least 1"),
+        Some(n) => Ok(n),
+        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
+    }
+}
+
+/// A strictly positive, finite number given on the command line.
+pub fn positive(flag: &str, value: f64) -> Result<f64> {
+    if !(value.is_finite() && value > 0.0) {
+        bail!("{flag} = {value}: expected a finite number > 0");
+    }
+    Ok(value)
+}
+
+/// A duration in seconds given on the command line (finite, > 0, at most a year).
+pub fn seconds(flag: &str, value: f64) -> Result<Duration> {
+    let v = positive(flag, value)?;
+    if v > 3.2e7 {
+        bail!("{flag} = {value}: expected at most 32 000 000 s (a year)");
+    }
+    Ok(Duration::from_secs_f64(v))
+}
+
+/// The worker executable: $SEPVAL_WORKER, or `sepval-worker` beside this executable.
+pub fn worker_executable() -> Result<PathBuf> {
+    if let Some(p) = std::env::var_os("SEPVAL_WORKER") {
+        return Ok(PathBuf::from(p));
+    }
+    let me = std::env::current_exe().context("cannot locate the sepval executable")?;
+    let worker = me.with_file_name(format!("sepval-worker{}", std::env::consts::EXE_SUFFIX));
+    if !worker.exists() {
+        bail!(
+            "cannot find the worker executable {} (build it with `cargo build --release`, or set SEPVAL_WORKER)",
+            worker.display()
+        );
+    }
+    Ok(worker)
+}
+
+/// The evaluator of the shared evaluation flags, validated (nothing is started yet).
+pub fn evaluator_spec(args: &EvalArgs) -> Result<EvaluatorSpec> {
+    if args.evaluator != EvaluatorKind::Zenoh
+        && (args.listen.is_some() || args.zenoh_config.is_some())
+    {
+        bail!("--listen and --zenoh-config are for --evaluator zenoh");
+    }
+    let chunk_deadline = seconds("--worker-timeout", args.worker_timeout)?;
+    let join_timeout = seconds("--join-timeout", args.join_timeout)?;
+    match args.evaluator {
+        EvaluatorKind::Inproc => Ok(EvaluatorSpec::InProcess {
+            threads: count("--threads", args.threads)?,
+        }),
+        EvaluatorKind::Ipc => {
+            let workers = count("--workers", args.workers)?;
+            if workers > MAX_WORKERS {
+                bail!("--workers {workers}: expected at most {MAX_WORKERS}");
+            }
+            let (run_id, launch) = match &args.attach {
+                Some(id) => (id.clone(), Launch::Attach),
+                None => (
+                    args.run_id.clone().unwrap_or_else(RunId::fresh),
+                    Launch::Spawn {
+                        executable: worker_executable()?,
+                    },
+                ),
+            };
+            Ok(EvaluatorSpec::Ipc {
+                link: IpcOptions {
+                    run_id,
+                    workers,
+                    launch,
+                    max_respawns: 2 * workers + 2,
+                    join_timeout,
+                    announce_protocol: args.announce_protocol,
+                },
+                dispatch: DispatchOptions {
+                    min_workers: workers,
+                    join_timeout,
+                    chunk_deadline,
+                },
+            })
+        }
+        EvaluatorKind::Zenoh => zenoh_spec(args, join_timeout, chunk_deadline),
+    }
+}
+
+#[cfg(feature = "zenoh")]
+fn zenoh_spec(
+    args: &EvalArgs,
+    join_timeout: Duration,
+    chunk_deadline: Duration,
+) -> Result<EvaluatorSpec> {
+    use sepval_transport::zenoh::{ZenohOptions, validate_endpoint};
+    let listen = args
+        .listen
+        .clone()
+        .context("--evaluator zenoh needs --listen ENDPOINT (e.g. tcp/0.0.0.0:7447)")?;
+    validate_endpoint(&listen).context("--listen")?;
+    if args.attach.is_some() {
+        bail!("--attach is for --evaluator ipc; zenoh workers always join by themselves");
+    }
+    let workers = match args.workers {
+        Some(0) => bail!("--workers 0: expected at least 1"),
+        Some(n) => n,
+        None => 1,
+    };
+    Ok(EvaluatorSpec::Zenoh {
+        link: ZenohOptions {
+            run_id: args.run_id.clone().unwrap_or_else(RunId::fresh),
+            listen,
+            workers,
+            join_timeout,
+            zenoh_config: args.zenoh_config.clone(),
+            announce_protocol: args.announce_protocol,
+        },
+        dispatch: DispatchOptions {
+            min_workers: workers,
+            join_timeout,
+            chunk_deadline,
+        },
+    })
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn zenoh_spec(_: &EvalArgs, _: Duration, _: Duration) -> Result<EvaluatorSpec> {
+    bail!(
+        "--evaluator zenoh: this sepval was built without the zenoh transport; \
+         rebuild with `cargo build --release --features zenoh`"
+    )
+}
+
+/// Transport notices, printed to stderr as `sepval: ...`.
+pub fn notices() -> Notices {
+    Arc::new(|n| eprintln!("sepval: {n}"))
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal).
+pub struct Bar {
+    bar: ProgressBar,
+    started: std::time::Instant,
+}
+
+impl Bar {
+    /// A bar that draws only on a terminal.
+    pub fn new() -> Self {
+        Bar {
+            bar: ProgressBar::hidden(),
+            started: std::time::Instant::now(),
+        }
+    }
+}
+
+impl ProgressObserver for Bar {
+    fn start(&mut self, label: &str, steps: Option<usize>) {
+        self.started = std::time::Instant::now();
+        self.bar = if std::io::stderr().is_terminal() {
+            let bar = ProgressBar::with_draw_target(
+                steps.map(|s| s as u64),
+                ProgressDrawTarget::stderr(),
+            );
+            let template = if steps.is_some() {
+                format!("{label:<7} {{pos:>4}}/{{len}} {{wide_bar}} {{msg}}")
+            } else {
+                format!("{label:<7} {{pos:>4}} {{spinner}} {{msg}}")
+            };
+            bar.set_style(ProgressStyle::with_template(&template).expect("a valid template"));
+            bar
+        } else {
+            ProgressBar::hidden()
+        };
+    }
+
+    fn progress(&mut self, p: &Progress) {
+        self.bar.set_position(p.step as u64);
+        self.bar.set_message(format!(
+            "J_pos {:.4} m  J_att {:.3} deg  {:.0} sims/s",
+            p.best[0],
+            p.best[1],
+            p.evaluations as f64 / self.started.elapsed().as_secs_f64().max(1e-9)
+        ));
+    }
+
+    fn finish(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
