@@ -75,6 +75,12 @@ pub struct IpcOptions {
     pub announce_protocol: Option<u32>,
 }
 
+/// A worker found gone during a poll, and why (its [`LinkEvent::Lost`] to be).
+struct Loss {
+    worker: WorkerId,
+    reason: String,
+}
+
 /// The coordinator's end of the iceoryx2 transport.
 pub struct IpcLink {
     options: IpcOptions,
@@ -306,17 +312,15 @@ impl IpcLink {
         } else {
             None
         };
-        let gone: Vec<(WorkerId, String)> = self
+        let gone: Vec<Loss> = self
             .ports
             .iter_mut()
-            .filter_map(|(&id, p)| p.gone(alive.as_deref()).map(|reason| (id, reason)))
+            .filter_map(|(&worker, p)| {
+                let reason = p.gone(alive.as_deref())?;
+                Some(Loss { worker, reason })
+            })
             .collect();
-        for (id, reason) in gone {
-            self.remove(id);
-            events.push(LinkEvent::Lost { worker: id, reason });
-            self.replace(events)?;
-        }
-        Ok(())
+        self.lose(gone, events)
     }
 
     /// Takes every answer waiting.
@@ -329,15 +333,28 @@ impl IpcLink {
                         events.push(LinkEvent::Answer { worker: id, answer })
                     }
                     Received::WithoutSamples => {
-                        broken.push((id, "it sent answers without their samples".to_string()));
+                        broken.push(Loss {
+                            worker: id,
+                            reason: "it sent answers without their samples".to_string(),
+                        });
                         break;
                     }
                 }
             }
         }
-        for (id, reason) in broken {
-            self.remove(id);
-            events.push(LinkEvent::Lost { worker: id, reason });
+        self.lose(broken, events)
+    }
+
+    /// Removes the lost workers, reports them, and starts a replacement for each while the run
+    /// allows.
+    fn lose(
+        &mut self,
+        losses: Vec<Loss>,
+        events: &mut Vec<LinkEvent>,
+    ) -> Result<(), TransportError> {
+        for Loss { worker, reason } in losses {
+            self.remove(worker);
+            events.push(LinkEvent::Lost { worker, reason });
             self.replace(events)?;
         }
         Ok(())
