@@ -41,10 +41,7 @@ pub struct IpcWorker {
     run_id: RunId,
     cfg: Config,
     job: Arc<Job>,
-    requests: Subscriber<ipc::Service, [WireRequest], ChunkHeader>,
-    responses: Publisher<ipc::Service, [WireResponse], ChunkHeader>,
-    samples: Publisher<ipc::Service, [WireObservation], ChunkHeader>,
-    wake: Listener<ipc::Service>,
+    own: OwnServices,
     coordinator_wake: Notifier<ipc::Service>,
     /// Kept alive: a dropped publisher takes its unread hello with it.
     _hello: Publisher<ipc::Service, Hello, ()>,
@@ -71,31 +68,29 @@ fn retry_until<T>(
     }
 }
 
-impl IpcWorker {
-    /// Joins run `run_id`: creates this worker's services, waits up to `setup_timeout` for the
-    /// coordinator's setup, checks and decodes it, and announces this worker (announcing
-    /// `announce_protocol` instead of ours, for compatibility tests).
-    pub fn join(
-        run_id: RunId,
-        setup_timeout: Duration,
-        announce_protocol: Option<u32>,
-    ) -> Result<IpcWorker, TransportError> {
-        let cfg = super::run_config(&run_id)?;
-        let node = node(&cfg, WORKER_NODE)?;
-        let id = node.id().value();
-        // Our own services, created before we announce ourselves.
-        let requests = create_chunk_service::<WireRequest>(&node, &names::requests(id))?
+/// This worker's own services (named by its node id), created before it announces itself.
+struct OwnServices {
+    requests: Subscriber<ipc::Service, [WireRequest], ChunkHeader>,
+    responses: Publisher<ipc::Service, [WireResponse], ChunkHeader>,
+    samples: Publisher<ipc::Service, [WireObservation], ChunkHeader>,
+    wake: Listener<ipc::Service>,
+}
+
+impl OwnServices {
+    /// Creates the services of the worker whose node id is `id` on `node`.
+    fn create(node: &Node<ipc::Service>, id: u128) -> Result<OwnServices, TransportError> {
+        let requests = create_chunk_service::<WireRequest>(node, &names::requests(id))?
             .subscriber_builder()
             .buffer_size(REQUEST_BUFFER)
             .create()
             .map_err(iox("subscribing to requests"))?;
-        let responses = create_chunk_service::<WireResponse>(&node, &names::responses(id))?
+        let responses = create_chunk_service::<WireResponse>(node, &names::responses(id))?
             .publisher_builder()
             .initial_max_slice_len(64)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .create()
             .map_err(iox("publishing responses"))?;
-        let samples = create_chunk_service::<WireObservation>(&node, &names::samples(id))?
+        let samples = create_chunk_service::<WireObservation>(node, &names::samples(id))?
             .publisher_builder()
             .initial_max_slice_len(1024)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
@@ -111,27 +106,54 @@ impl IpcWorker {
             .listener_builder()
             .create()
             .map_err(iox("listening for wake-ups"))?;
+        Ok(OwnServices {
+            requests,
+            responses,
+            samples,
+            wake,
+        })
+    }
+}
 
-        // The run's services (the coordinator creates them).
-        let deadline = Instant::now() + setup_timeout;
-        let no_coordinator = |_| TransportError::NoCoordinator {
-            run: run_id.to_string(),
-            place: "on this host".to_string(),
-            seconds: setup_timeout.as_secs_f64(),
-        };
-        let setup = retry_until(deadline, || {
+/// Joining a run's services (the coordinator creates them): the run, and the one deadline of
+/// every wait until this worker has announced itself.
+struct Joining<'a> {
+    run_id: &'a RunId,
+    setup_timeout: Duration,
+    deadline: Instant,
+}
+
+impl Joining<'_> {
+    /// Subscribes to the job setup (its service is the last the coordinator creates): no setup
+    /// service by the deadline means no coordinator.
+    fn subscribe_setup(
+        &self,
+        node: &Node<ipc::Service>,
+    ) -> Result<Subscriber<ipc::Service, [u8], SetupHeader>, TransportError> {
+        retry_until(self.deadline, || {
             node.service_builder(&service_name(names::SETUP)?)
                 .publish_subscribe::<[u8]>()
                 .user_header::<SetupHeader>()
                 .open()
                 .map_err(iox("opening the setup service"))
         })
-        .map_err(no_coordinator)?
+        .map_err(|_| TransportError::NoCoordinator {
+            run: self.run_id.to_string(),
+            place: "on this host".to_string(),
+            seconds: self.setup_timeout.as_secs_f64(),
+        })?
         .subscriber_builder()
         .history_request(1)
         .create()
-        .map_err(iox("subscribing to the setup"))?;
-        let coordinator_wake = retry_until(deadline, || {
+        .map_err(iox("subscribing to the setup"))
+    }
+
+    /// A notifier of the coordinator's wake-up.
+    fn notify_coordinator(
+        &self,
+        node: &Node<ipc::Service>,
+    ) -> Result<Notifier<ipc::Service>, TransportError> {
+        retry_until(self.deadline, || {
             node.service_builder(&service_name(names::COORDINATOR_WAKE)?)
                 .event()
                 .open()
@@ -139,35 +161,50 @@ impl IpcWorker {
         })?
         .notifier_builder()
         .create()
-        .map_err(iox("notifying the coordinator"))?;
-        // The job setup (delivered from the service's history). A setup we refuse ends the
-        // worker at once; we announce ourselves only once we have accepted it.
+        .map_err(iox("notifying the coordinator"))
+    }
+
+    /// The job setup (delivered from the service's history), checked and decoded. A setup we
+    /// refuse ends the worker at once.
+    fn receive_setup(
+        &self,
+        setup: &Subscriber<ipc::Service, [u8], SetupHeader>,
+    ) -> Result<Job, TransportError> {
         let refuse = |reason: String| TransportError::SetupRefused {
-            run: run_id.to_string(),
+            run: self.run_id.to_string(),
             reason,
         };
-        let job = loop {
+        loop {
             if let Some(sample) = setup.receive().map_err(iox("receiving the setup"))? {
                 let header: SetupHeader = *sample.user_header();
                 check_setup_header(&header).map_err(|e| refuse(e.to_string()))?;
-                break decode_setup(&header, sample.payload()).map_err(|e| {
+                return decode_setup(&header, sample.payload()).map_err(|e| {
                     refuse(format!(
                         "setup {}: {}",
                         hex(&header.sha256),
                         crate::error_chain(&e)
                     ))
-                })?;
+                });
             }
-            if Instant::now() >= deadline {
+            if Instant::now() >= self.deadline {
                 return Err(refuse(format!(
                     "no job setup arrived within {} s",
-                    setup_timeout.as_secs_f64()
+                    self.setup_timeout.as_secs_f64()
                 )));
             }
             cancel::check()?;
             std::thread::sleep(Duration::from_millis(10));
-        };
-        let hello = retry_until(deadline, || {
+        }
+    }
+
+    /// Announces this worker on the hello service; the publisher is kept alive by the caller
+    /// (a dropped publisher takes its unread hello with it).
+    fn announce(
+        &self,
+        node: &Node<ipc::Service>,
+        hello: Hello,
+    ) -> Result<Publisher<ipc::Service, Hello, ()>, TransportError> {
+        let publisher = retry_until(self.deadline, || {
             node.service_builder(&service_name(names::HELLO)?)
                 .publish_subscribe::<Hello>()
                 .open()
@@ -176,23 +213,48 @@ impl IpcWorker {
         .publisher_builder()
         .create()
         .map_err(iox("publishing hello"))?;
-        hello
-            .send_copy(Hello {
+        publisher.send_copy(hello).map_err(iox("sending hello"))?;
+        Ok(publisher)
+    }
+}
+
+impl IpcWorker {
+    /// Joins run `run_id`: creates this worker's services, waits up to `setup_timeout` for the
+    /// coordinator's setup, checks and decodes it, and announces this worker (announcing
+    /// `announce_protocol` instead of ours, for compatibility tests).
+    pub fn join(
+        run_id: RunId,
+        setup_timeout: Duration,
+        announce_protocol: Option<u32>,
+    ) -> Result<IpcWorker, TransportError> {
+        let cfg = super::run_config(&run_id)?;
+        let node = node(&cfg, WORKER_NODE)?;
+        let id = node.id().value();
+        let own = OwnServices::create(&node, id)?;
+        let joining = Joining {
+            run_id: &run_id,
+            setup_timeout,
+            deadline: Instant::now() + setup_timeout,
+        };
+        let setup = joining.subscribe_setup(&node)?;
+        let coordinator_wake = joining.notify_coordinator(&node)?;
+        // We announce ourselves only once we have accepted the setup.
+        let job = joining.receive_setup(&setup)?;
+        let hello = joining.announce(
+            &node,
+            Hello {
                 magic: MAGIC,
                 protocol: announce_protocol.unwrap_or(PROTOCOL_VERSION),
                 pid: std::process::id(),
                 node_id: id,
-            })
-            .map_err(iox("sending hello"))?;
+            },
+        )?;
         let _ = coordinator_wake.notify();
         Ok(IpcWorker {
             run_id: run_id.clone(),
             cfg,
             job: Arc::new(job),
-            requests,
-            responses,
-            samples,
-            wake,
+            own,
             coordinator_wake,
             _hello: hello,
             checked: Instant::now(),
@@ -208,6 +270,7 @@ impl IpcWorker {
 
     fn take(&mut self) -> Result<Option<Chunk>, TransportError> {
         Ok(self
+            .own
             .requests
             .receive()
             .map_err(iox("receiving requests"))?
@@ -232,7 +295,7 @@ impl WorkerLink for IpcWorker {
         // Events are not latched: the requests were drained above before sleeping.
         // A signal interrupts the wait (sockets with a timeout are not restarted): the flag is
         // checked right after.
-        match self.wake.timed_wait(|_| {}, timeout.min(LIVENESS_TICK)) {
+        match self.own.wake.timed_wait(|_| {}, timeout.min(LIVENESS_TICK)) {
             Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
             Err(e) => return Err(iox("waiting for requests")(e)),
         }
@@ -254,6 +317,7 @@ impl WorkerLink for IpcWorker {
         // Samples first: the coordinator reads them when it reads the responses.
         if answer.header.with_samples != 0 {
             let mut s = self
+                .own
                 .samples
                 .loan_slice_uninit(answer.samples.len())
                 .map_err(iox("loaning a sample chunk"))?;
@@ -263,6 +327,7 @@ impl WorkerLink for IpcWorker {
                 .map_err(iox("sending samples"))?;
         }
         let mut s = self
+            .own
             .responses
             .loan_slice_uninit(answer.responses.len())
             .map_err(iox("loaning a response chunk"))?;

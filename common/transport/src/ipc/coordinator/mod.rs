@@ -11,35 +11,37 @@
 //! replaced while replacements are left. Dead nodes' resources are cleaned at start and after
 //! every loss; dropping the link stops the workers it spawned (SIGTERM, then SIGKILL after 2 s)
 //! and removes the run's resources from the host.
+//!
+//! The parts: `services` holds the run's services and the job setup on offer, `port` one
+//! connected worker (connect, send, read answers, tell whether it is gone), `processes` the
+//! spawned workers' processes; this module is the link that ties them together.
+
+mod port;
+mod processes;
+mod services;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::Child;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
 use iceoryx2::node::Node;
-use iceoryx2::port::listener::{Listener, ListenerWaitError};
-use iceoryx2::port::notifier::Notifier;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::port::listener::ListenerWaitError;
 use iceoryx2::prelude::*;
 use sepval_common::cancel;
 use sepval_common::evaluation::Job;
 
 use super::{
-    COORDINATOR_NODE, IN_FLIGHT_PER_WORKER, MAX_WORKERS, REQUEST_BUFFER, names, node, node_states,
-    open_chunk_service, presence, run_config, service_name,
+    COORDINATOR_NODE, IN_FLIGHT_PER_WORKER, MAX_WORKERS, node, node_states, presence, run_config,
 };
 use crate::link::{Link, LinkEvent, Notice, WorkerId};
-use crate::setup::encode_setup_as;
-use crate::wire::{
-    Answer, Chunk, ChunkHeader, Hello, MAGIC, PROTOCOL_VERSION, SetupHeader, WireObservation,
-    WireRequest, WireResponse,
-};
+use crate::wire::{Chunk, Hello, MAGIC, PROTOCOL_VERSION};
 use crate::{RunId, TransportError, iox};
+use port::{Port, Received};
+use processes::spawn_worker;
+use services::RunServices;
 
 /// How often the run's nodes are listed to find dead attached workers.
 const LISTING_PERIOD: Duration = Duration::from_millis(500);
@@ -73,15 +75,10 @@ pub struct IpcOptions {
     pub announce_protocol: Option<u32>,
 }
 
-/// One connected worker's ports.
-struct Port {
-    node_id: u128,
-    pid: u32,
-    child: Option<Child>,
-    requests: Publisher<ipc::Service, [WireRequest], ChunkHeader>,
-    responses: Subscriber<ipc::Service, [WireResponse], ChunkHeader>,
-    samples: Subscriber<ipc::Service, [WireObservation], ChunkHeader>,
-    wake: Notifier<ipc::Service>,
+/// A worker found gone during a poll, and why (its [`LinkEvent::Lost`] to be).
+struct Loss {
+    worker: WorkerId,
+    reason: String,
 }
 
 /// The coordinator's end of the iceoryx2 transport.
@@ -90,17 +87,8 @@ pub struct IpcLink {
     cfg: Config,
     node: Node<ipc::Service>,
     job: Arc<Job>,
-    setup_service: iceoryx2::service::port_factory::publish_subscribe::PortFactory<
-        ipc::Service,
-        [u8],
-        SetupHeader,
-    >,
-    /// The setup's publisher while workers may still join (its sample, in the service's
-    /// history, is as large as the data; it is dropped once every worker has joined and made
-    /// again for a replacement).
-    setup: Option<Publisher<ipc::Service, [u8], SetupHeader>>,
-    hello: Subscriber<ipc::Service, Hello, ()>,
-    wake: Listener<ipc::Service>,
+    /// The run's own services (hello, wake-up, the setup on offer).
+    services: RunServices,
     ports: BTreeMap<WorkerId, Port>,
     /// Spawned processes that have not said hello yet.
     starting: Vec<Child>,
@@ -150,39 +138,7 @@ impl IpcLink {
         if presence(&cfg, COORDINATOR_NODE)?.alive > 1 {
             return Err(TransportError::RunTaken(options.run_id.to_string()));
         }
-        let hello = node
-            .service_builder(&service_name(names::HELLO)?)
-            .publish_subscribe::<Hello>()
-            .max_publishers(MAX_WORKERS + 8)
-            .max_subscribers(1)
-            .subscriber_max_buffer_size(MAX_WORKERS + 8)
-            .history_size(0)
-            .create()
-            .map_err(iox("creating the hello service"))?
-            .subscriber_builder()
-            .create()
-            .map_err(iox("subscribing to hellos"))?;
-        let wake = node
-            .service_builder(&service_name(names::COORDINATOR_WAKE)?)
-            .event()
-            .max_notifiers(MAX_WORKERS + 8)
-            .max_listeners(1)
-            .create()
-            .map_err(iox("creating the coordinator's wake-up service"))?
-            .listener_builder()
-            .create()
-            .map_err(iox("listening for wake-ups"))?;
-        // The setup service last: a worker that finds it finds every run service.
-        let setup_service = node
-            .service_builder(&service_name(names::SETUP)?)
-            .publish_subscribe::<[u8]>()
-            .user_header::<SetupHeader>()
-            .max_publishers(1)
-            .max_subscribers(MAX_WORKERS + 8)
-            .history_size(1)
-            .subscriber_max_buffer_size(1)
-            .create()
-            .map_err(iox("creating the setup service"))?;
+        let services = RunServices::create(&node)?;
         if options.launch == Launch::Attach {
             early.push(Notice::Waiting {
                 run: options.run_id.to_string(),
@@ -196,10 +152,7 @@ impl IpcLink {
             cfg,
             node,
             job: Arc::clone(job),
-            setup_service,
-            setup: None,
-            hello,
-            wake,
+            services,
             ports: BTreeMap::new(),
             starting: Vec::new(),
             next_worker: 0,
@@ -208,7 +161,8 @@ impl IpcLink {
             early,
             _cleanup: super::RunCleanup(run_id),
         };
-        link.publish_setup()?;
+        let protocol = link.options.announce_protocol.unwrap_or(PROTOCOL_VERSION);
+        link.services.setup.publish(&link.job, protocol)?;
         if matches!(link.options.launch, Launch::Spawn { .. }) {
             for _ in 0..link.options.workers {
                 link.spawn()?;
@@ -217,39 +171,12 @@ impl IpcLink {
         Ok(link)
     }
 
-    /// Publishes the job setup (once per publisher: it stays in the service's history).
-    fn publish_setup(&mut self) -> Result<(), TransportError> {
-        if self.setup.is_some() {
-            return Ok(());
-        }
-        let (header, bytes) = encode_setup_as(
-            &self.job,
-            self.options.announce_protocol.unwrap_or(PROTOCOL_VERSION),
-        );
-        let setup = self
-            .setup_service
-            .publisher_builder()
-            .initial_max_slice_len(bytes.len())
-            .create()
-            .map_err(iox("publishing the setup"))?;
-        let mut sample = setup
-            .loan_slice_uninit(bytes.len())
-            .map_err(iox("loaning the setup"))?;
-        *sample.user_header_mut() = header;
-        sample
-            .write_from_slice(&bytes)
-            .send()
-            .map_err(iox("sending the setup"))?;
-        self.setup = Some(setup);
-        Ok(())
-    }
-
     /// Drops the setup's publisher once every spawned worker has joined (attached workers may
     /// come at any time: their setup stays).
     fn retire_setup(&mut self) {
         let spawned = matches!(self.options.launch, Launch::Spawn { .. });
         if spawned && self.starting.is_empty() && self.ports.len() >= self.options.workers {
-            self.setup = None;
+            self.services.setup.retire();
         }
     }
 
@@ -258,24 +185,15 @@ impl IpcLink {
         self.ports.values().map(|p| p.pid).collect()
     }
 
+    /// Starts a worker process, if workers are spawned, and puts the setup on offer for it.
     fn spawn(&mut self) -> Result<(), TransportError> {
-        if !matches!(self.options.launch, Launch::Spawn { .. }) {
-            return Ok(());
-        }
-        self.publish_setup()?;
         let Launch::Spawn { executable } = &self.options.launch else {
             return Ok(());
         };
-        let child = Command::new(executable)
-            .args(["--run", self.options.run_id.as_str()])
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .spawn()
-            .map_err(crate::io(format!(
-                "cannot start worker {}",
-                executable.display()
-            )))?;
-        self.starting.push(child);
+        let protocol = self.options.announce_protocol.unwrap_or(PROTOCOL_VERSION);
+        self.services.setup.publish(&self.job, protocol)?;
+        self.starting
+            .push(spawn_worker(executable, &self.options.run_id)?);
         Ok(())
     }
 
@@ -324,12 +242,13 @@ impl IpcLink {
     /// Delivers the setup to newly subscribed workers (from the service's history) and
     /// connects every worker that announced itself.
     fn accept_hellos(&mut self, events: &mut Vec<LinkEvent>) -> Result<(), TransportError> {
-        if let Some(setup) = &self.setup {
-            setup
-                .update_connections()
-                .map_err(iox("delivering the setup"))?;
-        }
-        while let Some(h) = self.hello.receive().map_err(iox("receiving hellos"))? {
+        self.services.setup.deliver()?;
+        while let Some(h) = self
+            .services
+            .hello
+            .receive()
+            .map_err(iox("receiving hellos"))?
+        {
             let h: Hello = *h;
             let label = format!("pid {}", h.pid);
             if h.magic != MAGIC || h.protocol != PROTOCOL_VERSION {
@@ -352,7 +271,7 @@ impl IpcLink {
                 .iter()
                 .position(|c| c.id() == h.pid)
                 .map(|i| self.starting.remove(i));
-            match self.connect(&h, child) {
+            match Port::connect(&self.node, &h, child) {
                 Ok(port) => {
                     let id = self.next_worker;
                     self.next_worker += 1;
@@ -370,46 +289,6 @@ impl IpcLink {
             }
         }
         Ok(())
-    }
-
-    fn connect(&self, h: &Hello, child: Option<Child>) -> Result<Port, TransportError> {
-        let requests = open_chunk_service::<WireRequest>(&self.node, &names::requests(h.node_id))?
-            .publisher_builder()
-            .initial_max_slice_len(16)
-            .allocation_strategy(AllocationStrategy::PowerOfTwo)
-            .max_loaned_samples(2)
-            .create()
-            .map_err(iox("publishing requests"))?;
-        let responses =
-            open_chunk_service::<WireResponse>(&self.node, &names::responses(h.node_id))?
-                .subscriber_builder()
-                .buffer_size(REQUEST_BUFFER)
-                .create()
-                .map_err(iox("subscribing to responses"))?;
-        let samples =
-            open_chunk_service::<WireObservation>(&self.node, &names::samples(h.node_id))?
-                .subscriber_builder()
-                .buffer_size(REQUEST_BUFFER)
-                .create()
-                .map_err(iox("subscribing to samples"))?;
-        let wake = self
-            .node
-            .service_builder(&service_name(&names::wake(h.node_id))?)
-            .event()
-            .open()
-            .map_err(iox("opening a worker's wake-up"))?
-            .notifier_builder()
-            .create()
-            .map_err(iox("notifying a worker"))?;
-        Ok(Port {
-            node_id: h.node_id,
-            pid: h.pid,
-            child,
-            requests,
-            responses,
-            samples,
-            wake,
-        })
     }
 
     /// Removes a worker: kills it if we own it and cleans its resources.
@@ -433,59 +312,49 @@ impl IpcLink {
         } else {
             None
         };
-        let mut gone = Vec::new();
-        for (&id, p) in self.ports.iter_mut() {
-            let reason = match p.child.as_mut().map(Child::try_wait) {
-                Some(Ok(Some(status))) => Some(format!("process exited: {status}")),
-                _ if p.child.is_none()
-                    && alive.as_ref().is_some_and(|a| !a.contains(&p.node_id)) =>
-                {
-                    Some("its node is dead".to_string())
-                }
-                _ => None,
-            };
-            if let Some(r) = reason {
-                gone.push((id, r));
-            }
-        }
-        for (id, reason) in gone {
-            self.remove(id);
-            events.push(LinkEvent::Lost { worker: id, reason });
-            self.replace(events)?;
-        }
-        Ok(())
+        let gone: Vec<Loss> = self
+            .ports
+            .iter_mut()
+            .filter_map(|(&worker, p)| {
+                let reason = p.gone(alive.as_deref())?;
+                Some(Loss { worker, reason })
+            })
+            .collect();
+        self.lose(gone, events)
     }
 
     /// Takes every answer waiting.
     fn collect(&mut self, events: &mut Vec<LinkEvent>) -> Result<(), TransportError> {
         let mut broken = Vec::new();
         for (&id, p) in self.ports.iter_mut() {
-            while let Some(sample) = p.responses.receive().map_err(iox("receiving answers"))? {
-                let header = *sample.user_header();
-                let samples = if header.with_samples != 0 {
-                    match p.samples.receive().map_err(iox("receiving samples"))? {
-                        Some(s) => s.payload().to_vec(),
-                        None => {
-                            broken.push((id, "it sent answers without their samples".to_string()));
-                            break;
-                        }
+            while let Some(received) = p.receive()? {
+                match received {
+                    Received::Answer(answer) => {
+                        events.push(LinkEvent::Answer { worker: id, answer })
                     }
-                } else {
-                    Vec::new()
-                };
-                events.push(LinkEvent::Answer {
-                    worker: id,
-                    answer: Answer {
-                        header,
-                        responses: sample.payload().to_vec(),
-                        samples,
-                    },
-                });
+                    Received::WithoutSamples => {
+                        broken.push(Loss {
+                            worker: id,
+                            reason: "it sent answers without their samples".to_string(),
+                        });
+                        break;
+                    }
+                }
             }
         }
-        for (id, reason) in broken {
-            self.remove(id);
-            events.push(LinkEvent::Lost { worker: id, reason });
+        self.lose(broken, events)
+    }
+
+    /// Removes the lost workers, reports them, and starts a replacement for each while the run
+    /// allows.
+    fn lose(
+        &mut self,
+        losses: Vec<Loss>,
+        events: &mut Vec<LinkEvent>,
+    ) -> Result<(), TransportError> {
+        for Loss { worker, reason } in losses {
+            self.remove(worker);
+            events.push(LinkEvent::Lost { worker, reason });
             self.replace(events)?;
         }
         Ok(())
@@ -502,21 +371,10 @@ impl IpcLink {
 
 impl Link for IpcLink {
     fn send(&mut self, worker: WorkerId, chunk: &Chunk) -> Result<(), String> {
-        let p = self
-            .ports
+        self.ports
             .get_mut(&worker)
-            .ok_or_else(|| format!("no worker {worker}"))?;
-        let mut sample = p
-            .requests
-            .loan_slice_uninit(chunk.requests.len())
-            .map_err(|e| format!("loaning a request chunk: {e:?}"))?;
-        *sample.user_header_mut() = chunk.header;
-        sample
-            .write_from_fn(|k| chunk.requests[k])
-            .send()
-            .map_err(|e| format!("sending a request chunk: {e:?}"))?;
-        let _ = p.wake.notify();
-        Ok(())
+            .ok_or_else(|| format!("no worker {worker}"))?
+            .send(chunk)
     }
 
     fn poll(
@@ -533,7 +391,7 @@ impl Link for IpcLink {
             // inputs were drained above first), or the timeout.
             // A signal interrupts the wait (sockets with a timeout are not restarted): the flag
             // is checked right after.
-            match self.wake.timed_wait(|_| {}, timeout) {
+            match self.services.wake.timed_wait(|_| {}, timeout) {
                 Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
                 Err(e) => return Err(iox("waiting for answers")(e)),
             }
@@ -582,28 +440,13 @@ impl Drop for IpcLink {
     fn drop(&mut self) {
         // Ask our workers to stop (SIGTERM sets their cancellation flag), then make sure they
         // did.
-        let mut children: Vec<Child> = self
-            .ports
-            .values_mut()
-            .filter_map(|p| p.child.take())
-            .chain(self.starting.drain(..))
-            .collect();
-        for c in &children {
-            // SAFETY: plain kill(2) on a process id we spawned and have not reaped.
-            unsafe {
-                libc::kill(c.id() as libc::pid_t, libc::SIGTERM);
-            }
-        }
-        let deadline = Instant::now() + Duration::from_secs(2);
-        for c in children.iter_mut() {
-            while matches!(c.try_wait(), Ok(None)) && Instant::now() < deadline {
-                std::thread::sleep(Duration::from_millis(5));
-            }
-            if matches!(c.try_wait(), Ok(None)) {
-                let _ = c.kill();
-                let _ = c.wait();
-            }
-        }
+        processes::stop_all(
+            self.ports
+                .values_mut()
+                .filter_map(|p| p.child.take())
+                .chain(self.starting.drain(..))
+                .collect(),
+        );
         self.ports.clear();
         self.node.try_cleanup_dead_nodes();
         // Then the fields drop, the node among them, and `_cleanup` last removes what
