@@ -1,0 +1,234 @@
+#!/usr/bin/env python3
+"""The shape of sepval's source, checked by .ci/run (ARCHITECTURE.md, "Invariants"):
+
+1. no source file over FILE_MAX lines and no function over FN_MAX lines, outside tests (files
+   named *tests.rs or *fuzz*.rs and `#[cfg(test)]` modules are left out); a function that must
+   stay long (a numeric kernel, a table of constants) says why in a comment line starting with
+   `// shape: long` just above it, among its doc comments and attributes;
+2. no module cycle within a crate: files are nodes, `crate::`, `super::` and `self::` paths edges
+   to the file that defines the module, and modules are folded to each crate's top modules as
+   well (a cycle between two folders is a cycle too); the effect plug-ins and the model that
+   lists them are the one intended exception (a registry);
+3. the crates depend on each other one way only, as ARCHITECTURE.md draws them: each crate's
+   `sepval-*` dependencies (normal, not dev) are within the set it may use.
+
+Usage: scripts/shape.py [ROOT]. Prints what breaks a rule and exits 1 if anything does.
+"""
+import os
+import re
+import sys
+
+FILE_MAX = 600
+FN_MAX = 100
+# A crate may depend on these sepval crates and no other (ARCHITECTURE.md).
+MAY_USE = {
+    "sepval-common": set(),
+    "sepval-transport": {"sepval-common"},
+    "sepval-solve": {"sepval-common"},
+    "sepval-report": {"sepval-common"},
+    "sepval-fit": {"sepval-common", "sepval-solve", "sepval-report"},
+    "sepval-diagnose": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-report"},
+    "sepval": {"sepval-common", "sepval-transport", "sepval-solve", "sepval-fit",
+               "sepval-diagnose", "sepval-report"},
+    "sepval-worker": {"sepval-common", "sepval-transport"},
+    "sepval-tests": set(),
+}
+# Intended cycle: the effect catalogue's plug-ins and the model that runs them.
+ALLOWED_CYCLE = re.compile(r"common/src/(effects(/|$)|model(/mod\.rs|$))")
+
+
+def blank(src):
+    """`src` with comments, strings and char literals replaced by spaces (lines kept)."""
+    out, i, n = [], 0, len(src)
+    while i < n:
+        c = src[i]
+        if src.startswith("//", i):
+            j = src.find("\n", i)
+            j = n if j < 0 else j
+        elif src.startswith("/*", i):
+            j = src.find("*/", i + 2)
+            j = n if j < 0 else j + 2
+        elif c == "r" and re.match(r'r#*"', src[i:i + 8]) and not (i and (src[i - 1].isalnum() or src[i - 1] == "_")):
+            hashes = re.match(r'r(#*)"', src[i:i + 8]).group(1)
+            j = src.find('"' + hashes, i + 2 + len(hashes))
+            j = n if j < 0 else j + 1 + len(hashes)
+        elif c == '"':
+            j = i + 1
+            while j < n and src[j] != '"':
+                j += 2 if src[j] == "\\" else 1
+            j += 1
+        elif c == "'" and re.match(r"'(\\.|[^\\'])'", src[i:i + 4]) or re.match(r"'\\u\{[0-9a-fA-F]+\}'", src[i:i + 12]):
+            j = src.find("'", i + 2) + 1
+        else:
+            out.append(c)
+            i += 1
+            continue
+        out.append(re.sub(r"[^\n]", " ", src[i:j]))
+        i = j
+    return "".join(out)
+
+
+def closing(text, open_at):
+    """Index of the brace that closes the one at `open_at`."""
+    depth = 0
+    for k in range(open_at, len(text)):
+        if text[k] == "{":
+            depth += 1
+        elif text[k] == "}":
+            depth -= 1
+            if depth == 0:
+                return k
+    return len(text) - 1
+
+
+def without_tests(text):
+    """`text` with every `#[cfg(test)]` module blanked (lines kept)."""
+    for m in reversed(list(re.finditer(r"#\[cfg\(test\)\]\s*(pub(\([^)]*\))?\s+)?mod\s+\w+\s*\{", text))):
+        end = closing(text, m.end() - 1)
+        text = text[:m.start()] + re.sub(r"[^\n]", " ", text[m.start():end + 1]) + text[end + 1:]
+    return text
+
+
+def sources(root):
+    for d, dirs, files in os.walk(root):
+        dirs[:] = sorted(x for x in dirs if x not in ("target", ".git", "python"))
+        if "Cargo.toml" in files and os.path.isdir(os.path.join(d, "src")):
+            yield d
+
+
+def rust_files(src):
+    for d, _, files in os.walk(src):
+        for f in sorted(files):
+            if f.endswith(".rs") and not f.endswith("tests.rs") and "fuzz" not in f and f != "testing.rs":
+                yield os.path.join(d, f)
+
+
+def sizes(root, path, raw, problems):
+    blanked = blank(raw)
+    text = without_tests(blanked)
+    lines = raw.split("\n")
+    rel = os.path.relpath(path, root)
+    # Lines outside test modules: a test module's lines are blank in `text` but not in `blanked`.
+    in_tests = sum(1 for a, b in zip(blanked.split("\n"), text.split("\n")) if a.strip() and not b.strip())
+    length = raw.count("\n") - in_tests
+    if length > FILE_MAX:
+        problems.append(f"file {rel}: {length} lines (limit {FILE_MAX})")
+    for m in re.finditer(r"\bfn\s+(\w+)[^;{]*\{", text):
+        start = text.count("\n", 0, m.start())
+        end = text.count("\n", 0, closing(text, m.end() - 1))
+        if end - start + 1 <= FN_MAX:
+            continue
+        k = start - 1
+        excused = False
+        while k >= 0 and re.match(r"\s*(///|//|#\[|#!\[)", lines[k]):
+            excused |= lines[k].strip().startswith("// shape: long")
+            k -= 1
+        if not excused:
+            problems.append(f"fn {rel}:{start + 1} {m.group(1)}: {end - start + 1} lines (limit {FN_MAX})")
+
+
+def module_of(src, path):
+    parts = os.path.relpath(path, src)[:-3].split(os.sep)
+    if parts[-1] in ("mod", "lib", "main"):
+        parts = parts[:-1]
+    return tuple(parts)
+
+
+def cycles(root, crate, problems):
+    src = os.path.join(crate, "src")
+    files = {module_of(src, p): os.path.relpath(p, root) for p in rust_files(src)}
+    edges = {}
+    for mod, rel in files.items():
+        text = without_tests(blank(open(os.path.join(root, rel), encoding="utf-8", errors="replace").read()))
+        here = mod if rel.endswith(("mod.rs", "lib.rs", "main.rs")) else mod
+        parent = here[:-1]
+        targets = set()
+        paths = [("crate", p) for p in re.findall(r"\bcrate::((?:\w+::)*\w+)", text)]
+        paths += [("super", p) for p in re.findall(r"\bsuper::((?:\w+::)*\w+)", text)]
+        for block in re.findall(r"\buse\s+crate::\{([^;]*)\}", text, flags=re.S):
+            paths += [("crate", p) for p in re.findall(r"\w+(?:::\w+)*", block)]
+        for base, p in paths:
+            full = (() if base == "crate" else parent) + tuple(p.split("::"))
+            for k in range(len(full), 0, -1):
+                if full[:k] in files:
+                    targets.add(files[full[:k]])
+                    break
+        targets.discard(rel)
+        edges[rel] = targets
+
+    def top(f):
+        m = re.match(r"(.*?/src/)([^/]+?)(\.rs|/.*)?$", f)
+        return m.group(1) + m.group(2) if m else f
+
+    folded = {}
+    for v, ws in edges.items():
+        folded.setdefault(top(v), set()).update(top(w) for w in ws if top(w) != top(v) and not top(w).endswith(("/lib", "/main")))
+    for graph in (edges, folded):
+        for comp in strongly_connected(graph):
+            if not all(ALLOWED_CYCLE.search(f) for f in comp):
+                problems.append("module cycle: " + " <-> ".join(sorted(comp)))
+
+
+def strongly_connected(graph):
+    """Tarjan's strongly connected components of more than one node, iteratively."""
+    index, low, on, stack, out, counter = {}, {}, set(), [], [], [0]
+    for root in list(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph.get(root, ()))))]
+        index[root] = low[root] = counter[0]; counter[0] += 1
+        stack.append(root); on.add(root)
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = counter[0]; counter[0] += 1
+                    stack.append(w); on.add(w)
+                    work.append((w, iter(sorted(graph.get(w, ())))))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop(); on.discard(w); comp.append(w)
+                    if w == v:
+                        break
+                if len(comp) > 1:
+                    out.append(comp)
+    return out
+
+
+def layers(root, crate, problems):
+    toml = open(os.path.join(crate, "Cargo.toml"), encoding="utf-8").read()
+    name = re.search(r'^name\s*=\s*"([^"]+)"', toml, flags=re.M).group(1)
+    deps = re.search(r"^\[dependencies\]\n(.*?)(^\[|\Z)", toml, flags=re.M | re.S)
+    used = set(re.findall(r"^(sepval[\w-]*)\s*[.=]", deps.group(1), flags=re.M)) if deps else set()
+    if name not in MAY_USE:
+        problems.append(f"crate {name}: not in scripts/shape.py's MAY_USE (add it, and to ARCHITECTURE.md)")
+        return
+    for d in sorted(used - MAY_USE[name]):
+        problems.append(f"crate {name} depends on {d}, which ARCHITECTURE.md does not allow")
+
+
+def main():
+    root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..")
+    root = os.path.abspath(root)
+    problems = []
+    for crate in sources(root):
+        for path in rust_files(os.path.join(crate, "src")):
+            sizes(root, path, open(path, encoding="utf-8", errors="replace").read(), problems)
+        cycles(root, crate, problems)
+        layers(root, crate, problems)
+    for p in problems:
+        print(p)
+    print(f"shape: {len(problems)} problem(s) (files <= {FILE_MAX} lines, functions <= {FN_MAX}, no module cycle, crates one way)")
+    sys.exit(1 if problems else 0)
+
+
+if __name__ == "__main__":
+    main()
