@@ -13,7 +13,7 @@
 //!   sockets, the benchmark's conventional baseline), `zenoh` (other hosts, feature `zenoh`,
 //!   with the gateway that serves a zenoh run with a host's iceoryx2 workers);
 //! - [`spec`]: which evaluator to start, as a validated configuration;
-//! - [`bench`]: simulations per second against worker count, per transport (`sepval bench`).
+//! - [`bench`](mod@bench): simulations per second against worker count, per transport (`sepval bench`).
 //!
 //! Nothing here prints: what the user should hear goes out as [`link::Notice`]s.
 

@@ -14,8 +14,8 @@
 //! strongly compensating parameters.
 //!
 //! A refinement moves through explicit stages, each a type of its own holding what it waits
-//! for: the start point, the derivative probes ([`Differencing`]), the curvature probes
-//! ([`Curving`]), the damped trials ([`Trying`]), then the next Jacobian or the end. Each
+//! for: the start point, the derivative probes (`Differencing`), the curvature probes
+//! (`Curving`), the damped trials (`Trying`), then the next Jacobian or the end. Each
 //! stage's points are asked in parts of at most the run's part size, so that a long record's
 //! residual vectors are reduced and dropped part by part.
 
