@@ -4,6 +4,12 @@
 //! resumed, or the user asked to clear it; and a directory is only ever cleared when it is a
 //! sepval output directory (it carries the marker file, or a sepval result).
 //!
+//! A claim has two steps, so that a refusal never deletes or rewrites anything: [`RunDir::claim`]
+//! takes the lock and checks the directory without changing what is in it, before anything
+//! runs (no worker is started for a refused `--out`); [`RunDir::prepare`], called once every
+//! input is checked (a resumed checkpoint re-evaluated and replayed included), clears the
+//! directory or removes the abandoned continuation of a resumed run, and writes the marker.
+//!
 //! Files: `DIR/.sepval-lock` (the holder's process id; removed when the run ends, left behind
 //! only by a killed process, and then taken over once that process is gone) and
 //! `DIR/.sepval-run` (the marker: which command made the directory).
@@ -27,10 +33,13 @@ pub enum Claim {
     Fresh,
     /// A new run into a directory whose contents may be cleared first.
     Overwrite,
-    /// Resuming the run of the checkpoint whose run directory this is: its contents stay.
+    /// Resuming the run of the checkpoint whose run directory this is: its contents stay but
+    /// for the checkpoints of generations after the one resumed from.
     Resume {
         /// The checkpoint resumed from.
         checkpoint: PathBuf,
+        /// Its generation.
+        generation: usize,
     },
 }
 
@@ -112,10 +121,14 @@ pub struct RunDir {
     path: PathBuf,
     lock: PathBuf,
     created: bool,
+    claim: Claim,
+    command: String,
 }
 
 impl RunDir {
-    /// Claims `path` for a run of `command` (created if absent).
+    /// Claims `path` for a run of `command` (created if absent): takes the lock and checks
+    /// that the directory may be used as `claim` says. Nothing in it is changed yet:
+    /// [`RunDir::prepare`] does that once the run's inputs are checked.
     pub fn claim(path: &Path, claim: Claim, command: &str) -> Result<RunDir, OutDirError> {
         let mut created = false;
         match std::fs::metadata(path) {
@@ -141,6 +154,8 @@ impl RunDir {
             path: path.to_path_buf(),
             lock,
             created,
+            claim: claim.clone(),
+            command: command.to_string(),
         };
         // From here on the lock is ours (released when `dir` drops, on error too).
         let others = entries(path)?;
@@ -154,26 +169,16 @@ impl RunDir {
                 }
             }
             Claim::Overwrite => {
-                if !others.is_empty() {
-                    let ours = others
-                        .iter()
-                        .any(|e| e == MARKER_FILE || SEPVAL_OUTPUTS.contains(&e.as_str()));
-                    if !ours {
-                        return Err(OutDirError::NotOurs {
-                            path: path.to_path_buf(),
-                        });
-                    }
-                    for e in &others {
-                        let p = path.join(e);
-                        if p.is_dir() {
-                            std::fs::remove_dir_all(&p).map_err(io("cannot clear", &p))?;
-                        } else {
-                            std::fs::remove_file(&p).map_err(io("cannot clear", &p))?;
-                        }
-                    }
+                let ours = others
+                    .iter()
+                    .any(|e| e == MARKER_FILE || SEPVAL_OUTPUTS.contains(&e.as_str()));
+                if !others.is_empty() && !ours {
+                    return Err(OutDirError::NotOurs {
+                        path: path.to_path_buf(),
+                    });
                 }
             }
-            Claim::Resume { checkpoint } => {
+            Claim::Resume { checkpoint, .. } => {
                 // DIR/generations/gen-NNNN.json belongs to DIR.
                 let expected = checkpoint
                     .parent()
@@ -193,13 +198,6 @@ impl RunDir {
                 }
             }
         }
-        let marker = format!("{{\"command\": {}}}\n", serde_json::json!(command));
-        sepval_common::atomic_file::write_atomically(&path.join(MARKER_FILE), marker.as_bytes())
-            .map_err(|e| OutDirError::Io {
-                what: "cannot write",
-                path: path.join(MARKER_FILE),
-                source: e.source,
-            })?;
         Ok(dir)
     }
 
@@ -208,12 +206,41 @@ impl RunDir {
         &self.path
     }
 
+    /// Makes the directory ready for the run, the first change to what is in it: clears it
+    /// ([`Claim::Overwrite`]), or removes the checkpoints of generations after the one resumed
+    /// from ([`Claim::Resume`]: those of the continuation being replaced), then writes the
+    /// marker. Returns the checkpoints removed when resuming.
+    pub fn prepare(&self) -> Result<Vec<PathBuf>, OutDirError> {
+        let removed = match &self.claim {
+            Claim::Fresh => Vec::new(),
+            Claim::Overwrite => {
+                for e in entries(&self.path)? {
+                    let p = self.path.join(e);
+                    if p.is_dir() {
+                        std::fs::remove_dir_all(&p).map_err(io("cannot clear", &p))?;
+                    } else {
+                        std::fs::remove_file(&p).map_err(io("cannot clear", &p))?;
+                    }
+                }
+                Vec::new()
+            }
+            Claim::Resume { generation, .. } => self.discard_generations_after(*generation)?,
+        };
+        let marker = format!("{{\"command\": {}}}\n", serde_json::json!(self.command));
+        let path = self.path.join(MARKER_FILE);
+        sepval_common::atomic_file::write_atomically(&path, marker.as_bytes()).map_err(|e| {
+            OutDirError::Io {
+                what: "cannot write",
+                path: path.clone(),
+                source: e.source,
+            }
+        })?;
+        Ok(removed)
+    }
+
     /// Removes the checkpoints of generations after `generation` (those of an abandoned
     /// continuation, when a run is resumed from an earlier generation) and returns them.
-    pub fn discard_generations_after(
-        &self,
-        generation: usize,
-    ) -> Result<Vec<PathBuf>, OutDirError> {
+    fn discard_generations_after(&self, generation: usize) -> Result<Vec<PathBuf>, OutDirError> {
         let dir = self.path.join("generations");
         let Ok(entries) = std::fs::read_dir(&dir) else {
             return Ok(Vec::new());
@@ -327,7 +354,12 @@ mod tests {
                 .contains("is not empty (it holds result.json)"),
             "{e}"
         );
+        // A claim refused later (an input, a worker) has cleared nothing: only prepare does.
+        drop(RunDir::claim(&d, Claim::Overwrite, "fit").unwrap());
+        assert!(d.join("result.json").exists() && !d.join(LOCK_FILE).exists());
         let again = RunDir::claim(&d, Claim::Overwrite, "fit").unwrap();
+        assert!(d.join("result.json").exists() && !d.join(MARKER_FILE).exists());
+        assert_eq!(again.prepare().unwrap(), Vec::<PathBuf>::new());
         assert!(!d.join("result.json").exists() && d.join(MARKER_FILE).exists());
         drop(again);
         // A directory sepval did not make is never cleared.
@@ -340,5 +372,32 @@ mod tests {
         // A killed run's lock is taken over.
         std::fs::write(d.join(LOCK_FILE), "999999999\n").unwrap();
         RunDir::claim(&d, Claim::Fresh, "fit").unwrap();
+    }
+
+    #[test]
+    fn a_resumed_run_removes_its_later_generations_only_when_prepared() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path().join("run");
+        let generations = d.join("generations");
+        std::fs::create_dir_all(&generations).unwrap();
+        for g in 1..=4 {
+            std::fs::write(generations.join(format!("gen-{g:04}.json")), "{}").unwrap();
+        }
+        let claim = || Claim::Resume {
+            checkpoint: generations.join("gen-0002.json"),
+            generation: 2,
+        };
+        drop(RunDir::claim(&d, claim(), "fit").unwrap());
+        assert!(generations.join("gen-0004.json").exists() && !d.join(MARKER_FILE).exists());
+        let resumed = RunDir::claim(&d, claim(), "fit").unwrap();
+        assert_eq!(
+            resumed.prepare().unwrap(),
+            vec![
+                generations.join("gen-0003.json"),
+                generations.join("gen-0004.json")
+            ]
+        );
+        assert!(generations.join("gen-0002.json").exists());
+        assert!(!generations.join("gen-0003.json").exists() && d.join(MARKER_FILE).exists());
     }
 }

@@ -72,16 +72,8 @@ pub struct GatewayArgs {
 
 #[derive(clap::Args)]
 pub struct FitArgs {
-    /// Measured trajectory (CSV; repeatable for several releases). Default: the embedded
-    /// synthetic flight test (truth factors plus noise).
-    #[arg(long, value_name = "FILE.csv")]
-    pub data: Vec<PathBuf>,
-    /// Scenario file (TOML); the embedded default when absent.
-    #[arg(long, value_name = "FILE")]
-    pub scenario: Option<PathBuf>,
-    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
-    #[arg(long, value_name = "FILE")]
-    pub extension: Option<PathBuf>,
+    #[command(flatten)]
+    pub inputs: InputArgs,
     /// Searches to run [default: both; when resuming: the checkpoint's].
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
@@ -123,13 +115,10 @@ pub struct FitArgs {
     /// Skip the figures.
     #[arg(long)]
     pub no_figures: bool,
-    /// Fail (exit 2, after writing result.json) when the best fit leaves one of the scenario's
-    /// tables (by default the value is held at the edge and the excursion reported).
-    #[arg(long)]
-    pub strict_tables: bool,
-    /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).
-    #[arg(long)]
-    pub overwrite: bool,
+    #[command(flatten)]
+    pub tables: TablesArgs,
+    #[command(flatten)]
+    pub overwrite: OverwriteArgs,
     /// Run directory (result.json, generations/, figures/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -137,15 +126,8 @@ pub struct FitArgs {
 
 #[derive(clap::Args)]
 pub struct DiagnoseArgs {
-    /// Measured trajectory (CSV; repeatable). Default: the embedded synthetic flight test.
-    #[arg(long, value_name = "FILE.csv")]
-    pub data: Vec<PathBuf>,
-    /// Scenario file (TOML); the embedded default when absent.
-    #[arg(long, value_name = "FILE")]
-    pub scenario: Option<PathBuf>,
-    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
-    #[arg(long, value_name = "FILE")]
-    pub extension: Option<PathBuf>,
+    #[command(flatten)]
+    pub inputs: InputArgs,
     /// A release not used for fitting (CSV; repeatable): the baseline and the answer predict it
     /// and their errors are reported, the honest measure of an extension.
     #[arg(long, value_name = "FILE.csv")]
@@ -170,9 +152,8 @@ pub struct DiagnoseArgs {
     /// Output directory (diagnosis.json, report.html, figures/, baseline/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).
-    #[arg(long)]
-    pub overwrite: bool,
+    #[command(flatten)]
+    pub overwrite: OverwriteArgs,
 }
 
 #[derive(Subcommand)]
@@ -222,22 +203,65 @@ pub struct BenchArgs {
     pub out: PathBuf,
 }
 
+/// The inputs' defaults are the checkpoint's record, each input on its own: the shared help
+/// says what they are for a fresh fit, so rerun says its own.
 #[derive(clap::Args)]
+#[command(
+    mut_arg("data", |a| a.help("Data files (default: those recorded in the checkpoint)")),
+    mut_arg("scenario", |a| a.help("Scenario file (default: the one recorded in the checkpoint)")),
+    mut_arg("extension", |a| a.help(
+        "Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the \
+         model (default: the one recorded in the checkpoint)"
+    )),
+)]
 pub struct RerunArgs {
     /// Checkpoint of the generation to re-evaluate.
     #[arg(value_name = "CHECKPOINT")]
     pub checkpoint: PathBuf,
-    /// Data files (default: those recorded in the checkpoint).
+    #[command(flatten)]
+    pub inputs: InputArgs,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+}
+
+/// The measured data and the model a fit runs on (fit, diagnose, rerun).
+#[derive(clap::Args)]
+pub struct InputArgs {
+    /// Measured trajectory (CSV; repeatable for several releases). Default: the embedded
+    /// synthetic flight test (truth factors plus noise).
     #[arg(long, value_name = "FILE.csv")]
     pub data: Vec<PathBuf>,
-    /// Scenario file (default: the one recorded in the checkpoint).
+    #[command(flatten)]
+    pub model: ModelArgs,
+}
+
+/// The model a command simulates (simulate, and through [`InputArgs`] fit, diagnose, rerun).
+#[derive(clap::Args)]
+pub struct ModelArgs {
+    /// Scenario file (TOML); the embedded default (Eglin benchmark store) when absent.
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
     /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
     #[arg(long, value_name = "FILE")]
     pub extension: Option<PathBuf>,
-    #[command(flatten)]
-    pub eval: EvalArgs,
+}
+
+/// What a run that leaves a table does (simulate, fit).
+#[derive(clap::Args)]
+pub struct TablesArgs {
+    /// Fail (exit 2) when the run leaves one of the scenario's tables (by default the value is
+    /// held at the table's edge and the excursion reported); simulate then writes nothing, fit
+    /// writes result.json, which records it.
+    #[arg(long)]
+    pub strict_tables: bool,
+}
+
+/// Whether an earlier run in `--out` may be cleared (fit, diagnose).
+#[derive(clap::Args)]
+pub struct OverwriteArgs {
+    /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).
+    #[arg(long)]
+    pub overwrite: bool,
 }
 
 /// The measurement noise that weights the goals (shared by every search command).
@@ -292,12 +316,8 @@ pub struct EvalArgs {
 
 #[derive(clap::Args)]
 pub struct SimulateArgs {
-    /// Scenario file (TOML); the embedded default (Eglin benchmark store) when absent.
-    #[arg(long, value_name = "FILE")]
-    pub scenario: Option<PathBuf>,
-    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
-    #[arg(long, value_name = "FILE")]
-    pub extension: Option<PathBuf>,
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Factors: `truth`, `nominal`, or a JSON file mapping the 17 factor names to values.
     #[arg(long, default_value = "truth", value_name = "truth|nominal|FILE.json")]
     pub factors: String,
@@ -314,10 +334,8 @@ pub struct SimulateArgs {
     /// Telemetry rate [Hz] (default: the scenario's).
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
-    /// Refuse a run that leaves one of the scenario's tables (by default the value is held at
-    /// the table's edge and the excursion reported).
-    #[arg(long)]
-    pub strict_tables: bool,
+    #[command(flatten)]
+    pub tables: TablesArgs,
     /// Output CSV file (written atomically).
     #[arg(long, value_name = "FILE.csv")]
     pub out: PathBuf,

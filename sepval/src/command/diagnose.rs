@@ -3,6 +3,7 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
 use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_fit::sigma::Sigma;
@@ -14,11 +15,13 @@ use sepval_solve::lm::LmSettings;
 use super::{Bar, evaluator_spec, inputs, notices};
 use crate::cli::DiagnoseArgs;
 
-/// Runs `sepval diagnose`.
+/// Runs `sepval diagnose`. The output directory is claimed (locked and checked) before anything
+/// runs, so that no worker starts for a refused `--out`, and cleared (`--overwrite`) only once
+/// every input is checked and the workers run: a refusal deletes nothing.
 pub fn run(args: DiagnoseArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     // The output directory, before anything runs (no worker is started for a refused --out).
-    let claim = if args.overwrite {
+    let claim = if args.overwrite.overwrite {
         Claim::Overwrite
     } else {
         Claim::Fresh
@@ -29,6 +32,25 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
             args.out.display()
         )
     })?;
+    let DiagnoseConfig { job, options } = configure(&args)?;
+    let mut evaluator = spec.start(Arc::new(job), notices())?;
+    run_dir.prepare()?;
+    let d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
+    print!("{}", summary_lines(&d, &args.out));
+    drop(run_dir);
+    Ok(())
+}
+
+/// A diagnosis as the flags ask for it, validated.
+struct DiagnoseConfig {
+    /// The job of the `--data` files.
+    job: Job,
+    /// The options of the diagnosis: its baseline fit, refinements and `--validate` releases.
+    options: DiagnoseOptions,
+}
+
+/// The flags as a validated configuration.
+fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
     let ga = GaSettings {
         population: args.population,
         generations: args.generations,
@@ -36,16 +58,18 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
         ..GaSettings::default()
     };
     ga.validate()?;
+    let given = &args.inputs;
     let (job, inputs) = inputs::job(
-        &args.data,
-        args.scenario.as_deref(),
-        args.extension.as_deref(),
+        &given.data,
+        given.model.scenario.as_deref(),
+        given.model.extension.as_deref(),
     )?;
     let validation = inputs::validation_job(
         &args.validate,
-        &args.data,
-        args.scenario.as_deref(),
-        args.extension.as_deref(),
+        &given.data,
+        &job,
+        given.model.scenario.as_deref(),
+        given.model.extension.as_deref(),
     )?;
     let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
         .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
@@ -78,11 +102,7 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
         },
         validation,
     };
-    let mut evaluator = spec.start(Arc::new(job), notices())?;
-    let d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
-    print!("{}", summary_lines(&d, &args.out));
-    drop(run_dir);
-    Ok(())
+    Ok(DiagnoseConfig { job, options })
 }
 
 /// The terminal summary: a few short lines.

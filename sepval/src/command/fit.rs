@@ -27,38 +27,83 @@ pub fn method(m: MethodArg) -> Method {
     }
 }
 
-/// Runs `sepval fit`.
+/// Runs `sepval fit`: the flags to a validated configuration, the run, the rendering. The run
+/// directory is claimed (locked and checked) first, so that no worker starts for a refused
+/// `--out`, but changed only once everything is checked, a resumed checkpoint re-evaluated and
+/// replayed included: a refusal deletes and rewrites nothing.
 pub fn run(args: FitArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let resume = args.resume.as_deref().map(Checkpoint::load).transpose()?;
-    // The run directory, before anything runs (no worker is started for a refused --out).
-    let claim = match (&args.resume, args.overwrite) {
-        (_, true) => Claim::Overwrite,
-        (Some(c), false) => Claim::Resume {
-            checkpoint: c.clone(),
+    let run_dir = claim(&args, resume.as_ref())?;
+    let FitConfig { job, options } = configure(&args, resume)?;
+    let mut evaluator = spec.start(Arc::new(job), notices())?;
+    if let (Some(c), Some(path)) = (&options.resume, args.resume.as_deref()) {
+        // Its members re-evaluated and its generation replayed before going on from it.
+        let report = sepval_fit::rerun::confirm(c, path, evaluator.as_mut())?;
+        eprintln!(
+            "sepval: resuming from {}: {}",
+            path.display(),
+            report.checked()
+        );
+    }
+    for removed in run_dir.prepare()? {
+        eprintln!(
+            "sepval: removed {} (a later generation of the continuation being replaced)",
+            removed.display()
+        );
+    }
+    let output = run_fit(&options, evaluator.as_mut(), &mut Bar::new())?;
+    render(&args, evaluator.job(), &output)?;
+    drop(run_dir);
+    // Tables left by the best fit: reported, or an error with --strict-tables.
+    let left = tables_left(&output);
+    if args.tables.strict_tables && !left.is_empty() {
+        anyhow::bail!(
+            "--strict-tables: the best fit {} (result.json records it)",
+            left.join("; and ")
+        );
+    }
+    for l in &left {
+        eprintln!("warning: {l}");
+    }
+    Ok(())
+}
+
+/// A fit as the flags ask for it, validated: the job to run and the options of the run.
+struct FitConfig {
+    job: Job,
+    options: FitOptions,
+}
+
+/// The run directory, claimed before anything runs (no worker is started for a refused --out)
+/// and changed by nothing yet.
+fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
+    let claim = match (&args.resume, resume, args.overwrite.overwrite) {
+        (_, _, true) => Claim::Overwrite,
+        (Some(path), Some(c), false) => Claim::Resume {
+            checkpoint: path.clone(),
+            generation: c.state.generation,
         },
-        (None, false) => Claim::Fresh,
+        _ => Claim::Fresh,
     };
-    let run_dir = RunDir::claim(&args.out, claim, "fit").with_context(|| {
+    RunDir::claim(&args.out, claim, "fit").with_context(|| {
         format!(
             "--out {} (--overwrite clears an earlier run)",
             args.out.display()
         )
-    })?;
-    if let (Some(c), false) = (&resume, args.overwrite) {
-        for removed in run_dir.discard_generations_after(c.state.generation)? {
-            eprintln!(
-                "sepval: removed {} (a later generation of the continuation being replaced)",
-                removed.display()
-            );
-        }
-    }
+    })
+}
+
+/// The flags (and the checkpoint resumed from) as a validated configuration: the inputs read
+/// and checked against the checkpoint, the settings of the searches, the truth for the report.
+fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
     // Inputs: the flags, or (when resuming without them) those recorded in the checkpoint.
+    let given = &args.inputs;
     let (data_paths, scenario_path, extension_path) = match (
         &resume,
-        args.data.is_empty(),
-        &args.scenario,
-        &args.extension,
+        given.data.is_empty(),
+        &given.model.scenario,
+        &given.model.extension,
     ) {
         (Some(c), true, None, None) => (
             c.inputs.data.clone(),
@@ -66,9 +111,9 @@ pub fn run(args: FitArgs) -> Result<()> {
             c.inputs.extension.clone(),
         ),
         _ => (
-            args.data.clone(),
-            args.scenario.clone(),
-            args.extension.clone(),
+            given.data.clone(),
+            given.model.scenario.clone(),
+            given.model.extension.clone(),
         ),
     };
     let (job, inputs) = inputs::job(
@@ -87,42 +132,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         })?,
         (None, None) => Method::Both,
     };
-    let (ga, hill, sigma) = match &resume {
-        Some(c) => {
-            let path = args.resume.as_deref().expect("resume path");
-            c.check_job(&job, path)?;
-            let mut ga = c.settings.clone();
-            if let Some(g) = args.generations {
-                if g < c.state.generation {
-                    bail!(
-                        "--generations {g}: the checkpoint is already at generation {}",
-                        c.state.generation
-                    );
-                }
-                ga.generations = g;
-            }
-            (ga, c.hill.clone(), c.sigma.clone())
-        }
-        None => {
-            let ga = GaSettings {
-                population: args.population,
-                generations: args.generations.unwrap_or(500),
-                p_crossover: args.p_crossover,
-                p_jump: args.p_jump,
-                p_creep: args.p_creep,
-                seed: args.seed,
-            };
-            let hill = HillSettings {
-                budget: args.hill_budget,
-                ..HillSettings::default()
-            };
-            let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
-                .context(
-                    "the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)",
-                )?;
-            (ga, hill, sigma)
-        }
-    };
+    let Searches { ga, hill, sigma } = searches(args, resume.as_ref(), &job)?;
     ga.validate()?;
     let truth = match &args.truth_factors {
         Some(p) => Some(inputs::factors(
@@ -150,25 +160,68 @@ pub fn run(args: FitArgs) -> Result<()> {
             ..LmSettings::default()
         },
     };
-    let mut evaluator = spec.start(Arc::new(job), notices())?;
-    if let (Some(c), Some(path)) = (&options.resume, args.resume.as_deref()) {
-        // Its members re-evaluated and its generation replayed before going on from it.
-        let report = sepval_fit::rerun::confirm(c, path, evaluator.as_mut())?;
-        eprintln!(
-            "sepval: resuming from {}: {}",
-            path.display(),
-            report.checked()
-        );
+    Ok(FitConfig { job, options })
+}
+
+/// The settings of the searches and the noise levels that weight the goals.
+struct Searches {
+    ga: GaSettings,
+    hill: HillSettings,
+    sigma: Sigma,
+}
+
+/// The checkpoint's searches when resuming (after checking it against the job; only the
+/// generations may grow), else those of the flags.
+fn searches(args: &FitArgs, resume: Option<&Checkpoint>, job: &Job) -> Result<Searches> {
+    if let Some(c) = resume {
+        let path = args.resume.as_deref().expect("resume path");
+        c.check_job(job, path)?;
+        let mut ga = c.settings.clone();
+        if let Some(g) = args.generations {
+            if g < c.state.generation {
+                bail!(
+                    "--generations {g}: the checkpoint is already at generation {}",
+                    c.state.generation
+                );
+            }
+            ga.generations = g;
+        }
+        return Ok(Searches {
+            ga,
+            hill: c.hill.clone(),
+            sigma: c.sigma.clone(),
+        });
     }
-    let output = run_fit(&options, evaluator.as_mut(), &mut Bar::new())?;
-    print_summary(&output);
+    let ga = GaSettings {
+        population: args.population,
+        generations: args.generations.unwrap_or(500),
+        p_crossover: args.p_crossover,
+        p_jump: args.p_jump,
+        p_creep: args.p_creep,
+        seed: args.seed,
+    };
+    let hill = HillSettings {
+        budget: args.hill_budget,
+        ..HillSettings::default()
+    };
+    let sigma = Sigma::resolve(job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
+        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
+    Ok(Searches { ga, hill, sigma })
+}
+
+/// The summary on stdout, the figures (unless --no-figures), and where the result is.
+fn render(args: &FitArgs, job: &Job, output: &FitOutput) -> Result<()> {
+    print_summary(output);
     if !args.no_figures {
-        figures(&args.out, evaluator.job(), &output)?;
+        figures(&args.out, job, output)?;
     }
     println!("results in {}", args.out.join("result.json").display());
-    drop(run_dir);
-    // Tables left by the best fit: reported, or an error with --strict-tables.
-    let left: Vec<String> = output
+    Ok(())
+}
+
+/// The tables the best fit left, one line per event and table.
+fn tables_left(output: &FitOutput) -> Vec<String> {
+    output
         .result
         .events
         .iter()
@@ -177,17 +230,7 @@ pub fn run(args: FitArgs) -> Result<()> {
                 .iter()
                 .map(move |x| format!("{}: {x}", e.name))
         })
-        .collect();
-    if args.strict_tables && !left.is_empty() {
-        anyhow::bail!(
-            "--strict-tables: the best fit {} (result.json records it)",
-            left.join("; and ")
-        );
-    }
-    for l in &left {
-        eprintln!("warning: {l}");
-    }
-    Ok(())
+        .collect()
 }
 
 fn print_summary(output: &FitOutput) {

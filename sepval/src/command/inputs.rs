@@ -141,10 +141,13 @@ pub fn event_scenario(
 }
 
 /// The events of `--validate FILE` (none: `None`), read like `--data` with the same scenario
-/// and extension; a file given both to fit and to validate is refused.
+/// and extension; a release given both to fit and to validate is refused, as is one given twice
+/// to validate: the same file by its path, a copy by its samples (`fitted`, the job of the
+/// `--data` files, holds theirs).
 pub fn validation_job(
     paths: &[std::path::PathBuf],
     data_paths: &[std::path::PathBuf],
+    fitted: &sepval_common::evaluation::Job,
     scenario_path: Option<&Path>,
     extension_path: Option<&Path>,
 ) -> Result<Option<sepval_common::evaluation::Job>> {
@@ -171,9 +174,32 @@ pub fn validation_job(
         }
     }
     let scen = scenario(scenario_path, extension_path)?;
-    let mut events = Vec::with_capacity(paths.len());
+    let mut events: Vec<Event> = Vec::with_capacity(paths.len());
     for p in paths {
         let data = Trajectory::read(p).with_context(|| format!("--validate {}", p.display()))?;
+        if let Some(e) = fitted
+            .events()
+            .iter()
+            .find(|e| same_samples(&e.data, &data))
+        {
+            let fitted = if data_paths.is_empty() {
+                format!("the data fitted ({})", e.name)
+            } else {
+                format!("--data {}", e.name)
+            };
+            bail!(
+                "--validate {} holds the same samples as {fitted}: a release used for fitting \
+                 cannot measure prediction",
+                p.display()
+            );
+        }
+        if let Some(e) = events.iter().find(|e| same_samples(&e.data, &data)) {
+            bail!(
+                "--validate {} holds the same samples as --validate {}: give each release once",
+                p.display(),
+                e.name
+            );
+        }
         let name = p.display().to_string();
         let scenario = event_scenario(&scen, &data, &name)?;
         events.push(Event {
@@ -183,4 +209,17 @@ pub fn validation_job(
         });
     }
     Ok(Some(Job::new(events)?))
+}
+
+/// Whether two records are the same release: the same samples bit for bit and the same
+/// metadata (the flight condition), whatever the files' names and other comments.
+fn same_samples(a: &Trajectory, b: &Trajectory) -> bool {
+    fn same<'a>(x: impl Iterator<Item = &'a f64>, y: impl Iterator<Item = &'a f64>) -> bool {
+        x.zip(y).all(|(u, v)| u.to_bits() == v.to_bits())
+    }
+    a.len() == b.len()
+        && a.metadata == b.metadata
+        && same(a.times_s.iter(), b.times_s.iter())
+        && same(a.pos_m.iter().flatten(), b.pos_m.iter().flatten())
+        && same(a.att_deg.iter().flatten(), b.att_deg.iter().flatten())
 }

@@ -1,5 +1,6 @@
 //! `sepval rerun`: a saved generation re-evaluated, replayed and checked bit for bit.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{Result, bail};
@@ -12,24 +13,24 @@ use crate::cli::RerunArgs;
 pub fn run(args: RerunArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let checkpoint = Checkpoint::load(&args.checkpoint)?;
-    let (data_paths, scenario_path, extension_path) =
-        if args.data.is_empty() && args.scenario.is_none() && args.extension.is_none() {
-            (
-                checkpoint.inputs.data.clone(),
-                checkpoint.inputs.scenario.clone(),
-                checkpoint.inputs.extension.clone(),
-            )
-        } else {
-            (
-                args.data.clone(),
-                args.scenario.clone(),
-                args.extension.clone(),
-            )
-        };
+    // Each input not given is the one the checkpoint records, independently of the others.
+    let given = &args.inputs;
+    let recorded = &checkpoint.inputs;
+    let data_paths = if given.data.is_empty() {
+        &recorded.data
+    } else {
+        &given.data
+    };
+    let scenario_path = given.model.scenario.as_ref().or(recorded.scenario.as_ref());
+    let extension_path = given
+        .model
+        .extension
+        .as_ref()
+        .or(recorded.extension.as_ref());
     let (job, _) = inputs::job(
-        &data_paths,
-        scenario_path.as_deref(),
-        extension_path.as_deref(),
+        data_paths,
+        scenario_path.map(PathBuf::as_path),
+        extension_path.map(PathBuf::as_path),
     )?;
     checkpoint.check_job(&job, &args.checkpoint)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;

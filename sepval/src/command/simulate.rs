@@ -13,7 +13,10 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     let t_end = args.t_end.map(|t| positive("--t-end", t)).transpose()?;
     let rate = args.rate.map(|r| positive("--rate", r)).transpose()?;
     let effects = inputs::effects(&args.effects)?;
-    let scenario = inputs::scenario(args.scenario.as_deref(), args.extension.as_deref())?;
+    let scenario = inputs::scenario(
+        args.model.scenario.as_deref(),
+        args.model.extension.as_deref(),
+    )?;
     let factors = inputs::factors(&args.factors, &scenario.factors)?;
     let t_end = t_end.unwrap_or(scenario.integrator.t_end_s);
     let rate = rate.unwrap_or(scenario.integrator.rate_hz);
@@ -27,7 +30,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
             .context("simulation failed")?;
     // Tables left: held at the edge and reported, or refused (docs/model.md section 3).
     let left = sim.table_excursions(&log);
-    if args.strict_tables && !left.is_empty() {
+    if args.tables.strict_tables && !left.is_empty() {
         let lines: Vec<String> = left.iter().map(|e| e.to_string()).collect();
         anyhow::bail!(
             "--strict-tables: the run {} (nothing written)",

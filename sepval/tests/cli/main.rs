@@ -12,5 +12,6 @@ mod discover;
 mod fit;
 mod fuzz;
 mod hardening;
+mod hardening_on_disk;
 mod refine;
 mod tables;
