@@ -22,6 +22,8 @@ use sha2::{Digest, Sha256};
 
 use crate::atmosphere::TROPOPAUSE_M;
 use crate::factors::{Factor, FactorSpec, FactorTable};
+use crate::input_file::read_string;
+use crate::limits::MAX_SCENARIO_BYTES;
 use crate::table::{
     Coefficient, DerivativeCoefficient, InterferenceCoefficient, StaticCoefficient, TableError,
 };
@@ -345,6 +347,9 @@ pub enum ScenarioError {
         /// The cause.
         source: std::io::Error,
     },
+    /// The path is not a regular file, or the file is over its byte limit.
+    #[error(transparent)]
+    Input(Box<crate::input_file::InputFileError>),
     /// The TOML does not parse or does not have the expected fields.
     #[error("scenario {origin}: {message}")]
     Parse {
@@ -353,8 +358,9 @@ pub enum ScenarioError {
         /// The parser's message (it names line and column).
         message: String,
     },
-    /// A table file that cannot be used (the error names its file, line and column).
-    #[error("scenario {origin}: `{field}`: {source}")]
+    /// A table file that cannot be used (its error, the source, names its file, line and
+    /// column; it is not repeated here, so that a printed cause chain says it once).
+    #[error("scenario {origin}: `{field}`")]
     Table {
         /// The scenario file.
         origin: String,
@@ -439,10 +445,14 @@ impl Scenario {
 
     /// Loads and validates a scenario file (its table files are read relative to it).
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            read_string(path, "scenario", MAX_SCENARIO_BYTES).map_err(|e| match e.into_io() {
+                Ok(source) => ScenarioError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                },
+                Err(refused) => ScenarioError::Input(Box::new(refused)),
+            })?;
         let dir = path.parent().unwrap_or(Path::new(""));
         Scenario::from_toml_str_in(&text, &path.display().to_string(), Some(dir))
     }

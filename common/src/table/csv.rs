@@ -1,6 +1,7 @@
 //! Table CSV files (docs/model.md section 1, "Tables"): a header naming each column and its
 //! unit, one row per grid point; the reader refuses a bad file with its line and column.
 
+use super::error::could_be_header;
 use super::*;
 
 /// Splits a CSV line into trimmed fields (double quotes around a whole field are removed).
@@ -29,10 +30,14 @@ enum Column {
 /// there are several). Lines starting with `#` and blank lines are skipped.
 pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, TableError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| TableError::Io {
-        file: file.clone(),
-        message: e.to_string(),
-    })?;
+    let text = crate::input_file::read_string(path, "table", crate::limits::MAX_TABLE_CSV_BYTES)
+        .map_err(|e| match e.into_io() {
+            Ok(io) => TableError::Io {
+                file: file.clone(),
+                message: io.to_string(),
+            },
+            Err(refused) => TableError::Input(Box::new(refused)),
+        })?;
     let mut lines = text
         .trim_start_matches('\u{feff}')
         .lines()
@@ -43,6 +48,13 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
         return Err(TableError::Empty { file });
     };
     let names = fields(header);
+    if let Some(k) = names.iter().position(|h| !could_be_header(h)) {
+        return Err(TableError::NotAHeader {
+            file,
+            line: header_line,
+            column: k + 1,
+        });
+    }
     let mut columns = Vec::with_capacity(names.len());
     for (k, h) in names.iter().enumerate() {
         let at = |reason: String| TableError::Header {

@@ -8,6 +8,7 @@ mod conformance;
 mod effects;
 mod elementary;
 mod fuzz;
+mod input_files;
 mod lanes;
 mod tables;
 mod verification;
