@@ -10,5 +10,6 @@ mod elementary;
 mod fuzz;
 mod input_files;
 mod lanes;
+mod locators;
 mod tables;
 mod verification;
