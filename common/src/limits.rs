@@ -27,15 +27,17 @@ pub const MAX_ANGLE_DEG: f64 = 3600.0;
 /// The file is streamed line by line (never held whole), so this bounds the time spent on it,
 /// not memory.
 pub const MAX_TELEMETRY_BYTES: u64 = MAX_SAMPLES as u64 * 512;
-/// Largest table CSV file \[bytes\]: a table of the most grid points
-/// ([`crate::table::MAX_TABLE_VALUES`]) in rows of 128 bytes (three axes and two value columns
-/// in full precision take 5 x 25). The file is held whole while it is read.
-pub const MAX_TABLE_CSV_BYTES: u64 = crate::table::MAX_TABLE_VALUES as u64 * 128;
+/// Most values one table may hold (its grid points).
+pub const MAX_TABLE_VALUES: usize = 1_000_000;
+/// Largest table CSV file \[bytes\]: a table of the most grid points ([`MAX_TABLE_VALUES`]) in
+/// rows of 128 bytes (three axes and two value columns in full precision take 5 x 25). The
+/// file is held whole while it is read.
+pub const MAX_TABLE_CSV_BYTES: u64 = MAX_TABLE_VALUES as u64 * 128;
 /// Largest scenario TOML file \[bytes\]: 64 MiB, room for inline tables of about two million
 /// values in full precision (a scenario written by sepval without tables is about 3 kB).
 pub const MAX_SCENARIO_BYTES: u64 = 64 << 20;
-/// Largest extension TOML file \[bytes\]: 1 MiB (at most [`crate::extension::MAX_TERMS`] terms of
-/// a few hundred bytes each, comments included).
+/// Largest extension TOML file \[bytes\]: 1 MiB (at most 8 terms, `extension::MAX_TERMS`, of a
+/// few hundred bytes each, comments included).
 pub const MAX_EXTENSION_BYTES: u64 = 1 << 20;
 /// Largest JSON input (a factors file; the binaries' checkpoints and results) \[bytes\]:
 /// 256 MiB. A factors file is under 2 kB; a checkpoint holds a population and an archive of
