@@ -202,50 +202,7 @@ impl Trajectory {
                     limit: max_samples,
                 });
             }
-            let mut values = [0.0; 7];
-            for (q, &(col, scale)) in columns.iter().enumerate() {
-                let text = fields[col];
-                let field_error =
-                    |value: &str| (file.clone(), col + 1, names[col].clone(), value.to_string());
-                let v: f64 = text.parse().map_err(|_| {
-                    let (file, column, header, value) = field_error(text);
-                    TelemetryError::NotNumeric {
-                        file,
-                        line,
-                        column,
-                        header,
-                        value,
-                    }
-                })?;
-                if !v.is_finite() {
-                    let (file, column, header, value) = field_error(text);
-                    return Err(TelemetryError::NotFinite {
-                        file,
-                        line,
-                        column,
-                        header,
-                        value,
-                    });
-                }
-                let si = v * scale;
-                let kind = match q {
-                    0 => Bound::Time,
-                    1..=3 => Bound::Position,
-                    _ => Bound::Angle,
-                };
-                if si.abs() > kind.bound() {
-                    let (file, column, header, value) = field_error(text);
-                    return Err(TelemetryError::Implausible {
-                        file,
-                        line,
-                        column,
-                        header,
-                        value,
-                        kind,
-                    });
-                }
-                values[q] = si;
-            }
+            let values = parse_row(&fields, names, columns, line, &file)?;
             if let Some(&previous_s) = out.times_s.last() {
                 if values[0] <= previous_s {
                     return Err(TelemetryError::TimeNotIncreasing {
@@ -305,6 +262,68 @@ impl Trajectory {
         self.comments.push(format!("{key} = {value}"));
         self.metadata.push((key.to_string(), value.to_string()));
     }
+}
+
+/// The seven values of a data row in SI (time, position, attitude): each field a finite number
+/// within the bounds of plausible telemetry.
+fn parse_row(
+    fields: &[&str],
+    names: &[String],
+    columns: &ColumnMap,
+    line: usize,
+    file: &str,
+) -> Result<[f64; 7], TelemetryError> {
+    let mut values = [0.0; 7];
+    for (q, &(col, scale)) in columns.iter().enumerate() {
+        let text = fields[col];
+        let field_error = |value: &str| {
+            (
+                file.to_string(),
+                col + 1,
+                names[col].clone(),
+                value.to_string(),
+            )
+        };
+        let v: f64 = text.parse().map_err(|_| {
+            let (file, column, header, value) = field_error(text);
+            TelemetryError::NotNumeric {
+                file,
+                line,
+                column,
+                header,
+                value,
+            }
+        })?;
+        if !v.is_finite() {
+            let (file, column, header, value) = field_error(text);
+            return Err(TelemetryError::NotFinite {
+                file,
+                line,
+                column,
+                header,
+                value,
+            });
+        }
+        let si = v * scale;
+        let kind = match q {
+            0 => Bound::Time,
+            1..=3 => Bound::Position,
+            _ => Bound::Angle,
+        };
+        if si.abs() > kind.bound() {
+            let (file, column, header, value) = field_error(text);
+            return Err(TelemetryError::Implausible {
+                file,
+                line,
+                column,
+                header,
+                value,
+                kind,
+            });
+        }
+        values[q] = si;
+    }
+    Ok(values)
 }
 
 /// The comma-separated fields of a line, trimmed, each with one pair of enclosing double
