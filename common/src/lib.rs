@@ -14,6 +14,8 @@
 //! - [`effects`]: section 7, the effect catalogue;
 //! - [`table`], [`table_form`]: sections 1 and 3, tabulated coefficients and interference;
 //! - [`noise`]: the measurement noise of the synthetic flight test (section 4);
+//! - [`input_file`]: how every input file is opened and read (regular files only, within the
+//!   byte limits of [`limits`]);
 //! - [`elementary`], [`lanes`]: section 9, sepval's own elementary functions (no C library),
 //!   written once for one double and for four lanes.
 
@@ -31,6 +33,7 @@ pub mod extension;
 pub mod factors;
 pub mod frames;
 pub mod goals;
+pub mod input_file;
 pub mod lanes;
 pub mod limits;
 pub mod model;

@@ -1,6 +1,8 @@
 //! One limit on the work of a run, applied wherever a run is set up (a scenario file, the
 //! `simulate` flags, a telemetry file, a job), each checked before anything is allocated and
-//! refused with the limit in the message; and the bounds of plausible telemetry values.
+//! refused with the limit in the message; the bounds of plausible telemetry values; and the
+//! largest input file of each kind ([`crate::input_file`] checks a file's size against its
+//! limit before anything is allocated, and again while it reads).
 //!
 //! The limits are generous for store separation (an event lasts seconds, is sampled at a few
 //! hundred hertz and integrated at a fraction of a millisecond) and small enough that one
@@ -18,6 +20,29 @@ pub const MAX_SPAN_S: f64 = 3600.0;
 pub const MAX_POSITION_M: f64 = 1e5;
 /// Largest plausible Euler angle in telemetry (ten turns) \[deg\].
 pub const MAX_ANGLE_DEG: f64 = 3600.0;
+
+/// Largest telemetry file \[bytes\]: [`MAX_SAMPLES`] rows of 512 bytes. A row of the seven
+/// columns in full precision takes at most 7 x 25 bytes (`-1.2345678901234567e-100,`) and
+/// sepval writes about 120; the rest is room for extra channels, which are read and ignored.
+/// The file is streamed line by line (never held whole), so this bounds the time spent on it,
+/// not memory.
+pub const MAX_TELEMETRY_BYTES: u64 = MAX_SAMPLES as u64 * 512;
+/// Most values one table may hold (its grid points).
+pub const MAX_TABLE_VALUES: usize = 1_000_000;
+/// Largest table CSV file \[bytes\]: a table of the most grid points ([`MAX_TABLE_VALUES`]) in
+/// rows of 128 bytes (three axes and two value columns in full precision take 5 x 25). The
+/// file is held whole while it is read.
+pub const MAX_TABLE_CSV_BYTES: u64 = MAX_TABLE_VALUES as u64 * 128;
+/// Largest scenario TOML file \[bytes\]: 64 MiB, room for inline tables of about two million
+/// values in full precision (a scenario written by sepval without tables is about 3 kB).
+pub const MAX_SCENARIO_BYTES: u64 = 64 << 20;
+/// Largest extension TOML file \[bytes\]: 1 MiB (at most 8 terms, `extension::MAX_TERMS`, of a
+/// few hundred bytes each, comments included).
+pub const MAX_EXTENSION_BYTES: u64 = 1 << 20;
+/// Largest JSON input (a factors file; the binaries' checkpoints and results) \[bytes\]:
+/// 256 MiB. A factors file is under 2 kB; a checkpoint holds a population and an archive of
+/// candidates, a few MB at the study's settings.
+pub const MAX_JSON_BYTES: u64 = 256 << 20;
 
 /// A run beyond the limits.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

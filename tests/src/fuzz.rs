@@ -1,7 +1,9 @@
 //! The shared parts of the property-based tests that feed arbitrary and mutated input to every
 //! reader of outside input (`common/tests/model/fuzz.rs`, `common/transport/src/fuzz_tests.rs`,
 //! `coordinator/tests/cli/fuzz.rs`): their configuration, an allocator that records the largest
-//! allocation a call makes, and structured mutations of a valid input.
+//! allocation a call makes, structured mutations of a valid input, and the kinds of path a
+//! reader may be given instead of a regular file ([`PathKind`], awaited with
+//! [`within_deadline`]).
 //!
 //! # Running more cases
 //!
@@ -518,4 +520,109 @@ mod tests {
         binary = apply(&binary, &[Edit::SetLength(first, u64::MAX)], &[4]);
         assert_eq!(&binary[4..12], &[0xff; 8]);
     }
+}
+
+/// A kind of path a user may give where a file is read: a regular file of some size (its bytes
+/// the caller's), or what is not a regular file (issue 21, items 1 and 2).
+#[derive(Debug, Clone, PartialEq)]
+pub enum PathKind {
+    /// A regular file holding the caller's bytes.
+    Regular,
+    /// A sparse regular file of this many bytes beyond the reader's limit (nothing written).
+    OverLimit(u64),
+    /// A directory.
+    Directory,
+    /// A FIFO with no writer (a blocking open would wait for good).
+    Fifo,
+    /// A character device that never ends (`/dev/zero`).
+    DevZero,
+    /// A character device that is empty (`/dev/null`).
+    DevNull,
+    /// A symbolic link to a FIFO (the kind is the target's).
+    LinkToFifo,
+    /// A path that does not exist.
+    Missing,
+}
+
+/// Every [`PathKind`], over-limit sizes from one byte beyond to twice the limit's scale.
+pub fn path_kind() -> BoxedStrategy<PathKind> {
+    prop_oneof![
+        2 => Just(PathKind::Regular),
+        1 => prop_oneof![Just(1u64), 1..1u64 << 32].prop_map(PathKind::OverLimit),
+        1 => Just(PathKind::Directory),
+        1 => Just(PathKind::Fifo),
+        1 => Just(PathKind::DevZero),
+        1 => Just(PathKind::DevNull),
+        1 => Just(PathKind::LinkToFifo),
+        1 => Just(PathKind::Missing),
+    ]
+    .boxed()
+}
+
+impl PathKind {
+    /// Makes the path `name` in `dir` of this kind (`bytes` for a regular file, `limit_bytes`
+    /// the reader's limit for an over-limit one) and returns it.
+    pub fn make(
+        &self,
+        dir: &std::path::Path,
+        name: &str,
+        bytes: &[u8],
+        limit_bytes: u64,
+    ) -> std::path::PathBuf {
+        let path = dir.join(name);
+        let mkfifo = |p: &std::path::Path| {
+            let ok = std::process::Command::new("mkfifo")
+                .arg(p)
+                .status()
+                .is_ok_and(|s| s.success());
+            assert!(ok, "mkfifo {}", p.display());
+        };
+        match self {
+            PathKind::Regular => std::fs::write(&path, bytes).expect("a file in the test's dir"),
+            PathKind::OverLimit(extra) => std::fs::File::create(&path)
+                .and_then(|f| f.set_len(limit_bytes + extra))
+                .expect("a sparse file in the test's dir"),
+            PathKind::Directory => std::fs::create_dir(&path).expect("a directory"),
+            PathKind::Fifo => mkfifo(&path),
+            PathKind::DevZero => return "/dev/zero".into(),
+            PathKind::DevNull => return "/dev/null".into(),
+            PathKind::LinkToFifo => {
+                let target = dir.join(format!("{name}.fifo"));
+                mkfifo(&target);
+                std::os::unix::fs::symlink(&target, &path).expect("a symbolic link");
+            }
+            PathKind::Missing => {}
+        }
+        path
+    }
+
+    /// What a refusal of this kind must say (`None` for a regular file, which may be read or
+    /// refused for its content, and for a missing one, refused by the system's message).
+    pub fn refusal(&self) -> Option<&'static str> {
+        match self {
+            PathKind::Regular | PathKind::Missing => None,
+            PathKind::OverLimit(_) => Some("more than the limit of"),
+            PathKind::Directory => Some("is a directory, not a regular file"),
+            PathKind::Fifo | PathKind::LinkToFifo => {
+                Some("is a FIFO (named pipe), not a regular file")
+            }
+            PathKind::DevZero | PathKind::DevNull => {
+                Some("is a character device, not a regular file")
+            }
+        }
+    }
+}
+
+/// Runs `read` in a thread and waits for its answer until [`MAX_CALL`]: a reader that blocks
+/// (a FIFO opened without `O_NONBLOCK`) fails the property instead of hanging it.
+pub fn within_deadline<T: Send + 'static>(
+    what: &str,
+    read: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, TestCaseError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(read());
+    });
+    rx.recv_timeout(MAX_CALL)
+        .map_err(|_| TestCaseError::fail(format!("{what}: no answer within {MAX_CALL:?}")))
 }

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Axis, Family, MAX_TERMS, Regressor, Term, TermError};
+use crate::limits::MAX_EXTENSION_BYTES;
 
 /// A term as files write it: `axis`, `family`, `regressor`, the family's locator by name, and
 /// `coefficient` (with `std_error` and `reading` kept as the diagnosis wrote them).
@@ -158,6 +159,9 @@ pub enum ExtensionError {
         #[source]
         source: std::io::Error,
     },
+    /// The path is not a regular file, or the file is over its byte limit.
+    #[error(transparent)]
+    Input(Box<crate::input_file::InputFileError>),
     /// Not TOML, or not the expected fields (the parser names line and column).
     #[error("extension {path}: {message}")]
     Parse {
@@ -243,10 +247,15 @@ pub fn parse_extension(text: &str, path: &str) -> Result<Vec<Term>, ExtensionErr
 /// Reads an extension file.
 pub fn load_extension(path: &std::path::Path) -> Result<Vec<Term>, ExtensionError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| ExtensionError::Io {
-        path: name.clone(),
-        source,
-    })?;
+    let text = crate::input_file::read_string(path, "extension", MAX_EXTENSION_BYTES).map_err(
+        |e| match e.into_io() {
+            Ok(source) => ExtensionError::Io {
+                path: name.clone(),
+                source,
+            },
+            Err(refused) => ExtensionError::Input(Box::new(refused)),
+        },
+    )?;
     parse_extension(&text, &name)
 }
 

@@ -30,6 +30,7 @@
 use serde::{Deserialize, Serialize};
 
 mod file;
+pub mod locator;
 pub use file::{
     EXTENSION_FORMAT, ExtensionError, TermRecord, extension_toml, load_extension, parse_extension,
 };
@@ -302,7 +303,7 @@ pub enum TermError {
         axis: &'static str,
     },
     /// A value that is not a finite number, or outside its domain.
-    #[error("{what} = {value}: {expected}")]
+    #[error("{what} = {}: {expected}", readable(*value))]
     Value {
         /// Which value.
         what: &'static str,
@@ -315,7 +316,7 @@ pub enum TermError {
 
 impl Term {
     /// Checks the term: its axis fits its regressor, its numbers are finite and its locator in
-    /// its domain.
+    /// its domain ([`locator`]: every value in it simulates).
     pub fn check(&self) -> Result<(), TermError> {
         let value = |what, value: f64, ok: bool, expected| {
             if ok && value.is_finite() {
@@ -328,6 +329,8 @@ impl Term {
                 })
             }
         };
+        let domain =
+            |d: locator::LocatorDomain, v: f64| value(d.name, v, d.contains(v), d.expected);
         if !self.regressor.fits(self.axis) {
             return Err(TermError::Axis {
                 family: self.regressor.family().name(),
@@ -343,12 +346,10 @@ impl Term {
         )?;
         let [a, b] = self.locator;
         match self.regressor.family() {
-            Family::Interference | Family::InterferenceFlowAngle => {
-                value("lambda_m", a, a > 0.0, "expected a decay length > 0")
-            }
-            Family::Mach => value("mach0", a, a > 0.0, "expected a Mach number > 0"),
-            Family::Step => value("t_on_s", a, true, "expected a finite time"),
-            Family::Oscillation => value("f_hz", a, a >= 0.0, "expected a frequency >= 0"),
+            Family::Interference | Family::InterferenceFlowAngle => domain(locator::LAMBDA_M, a),
+            Family::Mach => domain(locator::MACH0, a),
+            Family::Step => domain(locator::T_ON_S, a),
+            Family::Oscillation => domain(locator::F_HZ, a),
             Family::Window => {
                 value("t0_s", a, true, "expected a finite time")?;
                 value("t1_s", b, b > a, "expected a time after t0_s")
@@ -432,6 +433,16 @@ impl Term {
             Regressor::Stroke2 => "((sigma - 1/2)^2 - 1/12)".into(),
             Regressor::Window => format!("[{a} s <= t < {b} s]"),
         }
+    }
+}
+
+/// A value for a message: as written, in exponent form when very large or small (1e300, not
+/// three hundred digits).
+fn readable(v: f64) -> String {
+    if v.is_finite() && v != 0.0 && !(1e-6..1e16).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 

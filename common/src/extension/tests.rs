@@ -83,7 +83,7 @@ fn bad_terms_are_refused_by_name() {
     };
     assert_eq!(
         lam.check().unwrap_err().to_string(),
-        "lambda_m = 0: expected a decay length > 0"
+        "lambda_m = 0: expected a decay length in (0, 1000] m"
     );
 }
 

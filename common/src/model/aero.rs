@@ -11,9 +11,9 @@
 //! Cn = Cn_beta beta + Cn_r r^ + cnoff        + cnintfac * dCn0 * f(s)
 //! ```
 
+use super::tables::AeroAtMach;
 use crate::factors::{Factor, Factors};
 use crate::lanes::Real;
-use crate::table::AeroAtMach;
 
 /// The flow seen by the store at one force evaluation; effects' coefficient terms read it.
 /// (`R`: one run's doubles, or one lane per run; see [`crate::lanes`].)

@@ -27,6 +27,7 @@ mod dcm;
 pub mod ejector;
 mod equations;
 pub mod interference;
+pub mod tables;
 
 pub use dcm::Dcm;
 pub use equations::EquationsOfMotion;
@@ -40,7 +41,8 @@ use crate::elementary::{cos, sin};
 use crate::extension::{TermError, TermInput, TermSet};
 use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
-use crate::table::{AeroAtMach, PreparedTables};
+use crate::table::PreparedTables;
+use tables::AeroAtMach;
 
 pub use aero::{Coefficients, Flow};
 pub use ejector::EjectorCurve;
@@ -130,7 +132,7 @@ impl Model {
         let v_inf = f.mach * air.speed_of_sound_m_s;
         let (a, b) = (f.alpha_deg.to_radians(), f.beta_deg.to_radians());
         let theta_a = (f.alpha_deg + f.gamma_deg).to_radians();
-        let (aero_at_mach, interference_at_carriage, tables) = crate::table::prepare(scenario);
+        let (aero_at_mach, interference_at_carriage, tables) = tables::prepare(scenario);
         Model {
             scenario: scenario.clone(),
             mass_kg: s.mass_kg,

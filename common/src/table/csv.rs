@@ -1,6 +1,7 @@
 //! Table CSV files (docs/model.md section 1, "Tables"): a header naming each column and its
 //! unit, one row per grid point; the reader refuses a bad file with its line and column.
 
+use super::error::could_be_header;
 use super::*;
 
 /// Splits a CSV line into trimmed fields (double quotes around a whole field are removed).
@@ -23,16 +24,32 @@ enum Column {
     Value(String, Conversion),
 }
 
+/// The header row of a table file: its line, its field names, and what each column is.
+struct Header {
+    file: String,
+    line: usize,
+    names: Vec<String>,
+    columns: Vec<Column>,
+}
+
+/// The rows of a table file: (line, the fields converted to the scenario's units).
+type Rows = Vec<(usize, Vec<f64>)>;
+
 /// Reads the table of `kind` in a CSV file: a header row `name [unit]` per column, the axis
 /// columns first (in nesting order), then one or more value columns, then one row per grid
 /// point in row-major order (first axis slowest). `column` picks the value column (needed when
-/// there are several). Lines starting with `#` and blank lines are skipped.
+/// there are several). Lines starting with `#` and blank lines are skipped. Only a regular file
+/// of at most [`MAX_TABLE_CSV_BYTES`](crate::limits::MAX_TABLE_CSV_BYTES) is read.
 pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, TableError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| TableError::Io {
-        file: file.clone(),
-        message: e.to_string(),
-    })?;
+    let text = crate::input_file::read_string(path, "table", crate::limits::MAX_TABLE_CSV_BYTES)
+        .map_err(|e| match e.into_io() {
+            Ok(io) => TableError::Io {
+                file: file.clone(),
+                message: io.to_string(),
+            },
+            Err(refused) => TableError::Input(Box::new(refused)),
+        })?;
     let mut lines = text
         .trim_start_matches('\u{feff}')
         .lines()
@@ -42,12 +59,44 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
     let Some((header_line, header)) = lines.next() else {
         return Err(TableError::Empty { file });
     };
-    let names = fields(header);
-    let mut columns = Vec::with_capacity(names.len());
-    for (k, h) in names.iter().enumerate() {
+    let header = Header::parse(file, header_line, header, kind)?;
+    let chosen = header.chosen(column)?;
+    let rows = header.rows(lines)?;
+    header.table(&rows, chosen, kind)
+}
+
+impl Header {
+    /// Reads the header row: every field a column `name [unit]` the kind allows, axes first in
+    /// nesting order.
+    fn parse(file: String, line: usize, text: &str, kind: Kind) -> Result<Header, TableError> {
+        let names = fields(text);
+        if let Some(k) = names.iter().position(|h| !could_be_header(h)) {
+            return Err(TableError::NotAHeader {
+                file,
+                line,
+                column: k + 1,
+            });
+        }
+        let mut header = Header {
+            file,
+            line,
+            names,
+            columns: Vec::new(),
+        };
+        for k in 0..header.names.len() {
+            let c = header.column(k, kind)?;
+            header.columns.push(c);
+        }
+        header.check_axes(kind)?;
+        Ok(header)
+    }
+
+    /// Column `k` (0-based), given the columns before it.
+    fn column(&self, k: usize, kind: Kind) -> Result<Column, TableError> {
+        let (file, line, h) = (&self.file, self.line, &self.names[k]);
         let at = |reason: String| TableError::Header {
             file: file.clone(),
-            line: header_line,
+            line,
             column: k + 1,
             header: h.clone(),
             reason,
@@ -58,7 +107,7 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
                 let variable = Variable::ALL.iter().find(|v| v.csv_name() == h);
                 return Err(TableError::MissingUnit {
                     file: file.clone(),
-                    line: header_line,
+                    line,
                     column: k + 1,
                     header: h.clone(),
                     example: variable
@@ -68,18 +117,26 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
                 });
             }
         };
-        let unknown = |accepted: &[(&str, Conversion)]| TableError::UnknownUnit {
-            file: file.clone(),
-            line: header_line,
-            column: k + 1,
-            header: h.clone(),
-            expected: accepted
+        let conversion = |accepted: &[(&str, Conversion)]| {
+            let unknown = || TableError::UnknownUnit {
+                file: file.clone(),
+                line,
+                column: k + 1,
+                header: h.clone(),
+                expected: accepted
+                    .iter()
+                    .map(|(u, _)| format!("`{name} [{u}]`"))
+                    .collect::<Vec<_>>()
+                    .join(" or "),
+            };
+            accepted
                 .iter()
-                .map(|(u, _)| format!("`{name} [{u}]`"))
-                .collect::<Vec<_>>()
-                .join(" or "),
+                .find(|(u, _)| *u == unit)
+                .map(|(_, c)| *c)
+                .ok_or_else(unknown)
         };
-        let c = if let Some(v) = Variable::ALL.iter().find(|v| v.csv_name() == name) {
+        let columns = &self.columns;
+        if let Some(v) = Variable::ALL.iter().find(|v| v.csv_name() == name) {
             if !kind.allowed().contains(v) {
                 return Err(at(format!(
                     "{} may be tabulated over {} only, not over {name}",
@@ -87,12 +144,7 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
                     kind.allowed_list(", ")
                 )));
             }
-            let conv = v
-                .csv_units()
-                .iter()
-                .find(|(u, _)| *u == unit)
-                .ok_or_else(|| unknown(v.csv_units()))?
-                .1;
+            let conv = conversion(v.csv_units())?;
             if columns.iter().any(|c| matches!(c, Column::Value(..))) {
                 return Err(at("axis columns come before the value columns".into()));
             }
@@ -105,230 +157,268 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
                     kind.allowed_list(", ")
                 )));
             }
-            Column::Axis(*v, conv)
-        } else {
-            if name.is_empty() {
-                return Err(at("a column needs a name".into()));
-            }
-            let conv = kind
-                .value_units()
-                .iter()
-                .find(|(u, _)| *u == unit)
-                .ok_or_else(|| unknown(kind.value_units()))?
-                .1;
-            if columns
-                .iter()
-                .any(|c| matches!(c, Column::Value(n, _) if n == name))
-            {
-                return Err(at(format!("repeats the column `{name}`")));
-            }
-            Column::Value(name.to_string(), conv)
-        };
-        columns.push(c);
-    }
-    let n_axes = columns
-        .iter()
-        .filter(|c| matches!(c, Column::Axis(..)))
-        .count();
-    let value_names: Vec<&str> = columns
-        .iter()
-        .filter_map(|c| match c {
-            Column::Value(n, _) => Some(n.as_str()),
-            _ => None,
-        })
-        .collect();
-    let header_error = |column: usize, reason: String| TableError::Header {
-        file: file.clone(),
-        line: header_line,
-        column,
-        header: names
-            .get(column.saturating_sub(1))
-            .cloned()
-            .unwrap_or_default(),
-        reason,
-    };
-    if n_axes == 0 {
-        return Err(header_error(
-            1,
-            format!(
-                "no axis column: {} is tabulated over {}",
-                kind.what(),
-                kind.allowed_list(", ")
-            ),
-        ));
-    }
-    if let Some(r) = kind.required()
-        && !columns
+            return Ok(Column::Axis(*v, conv));
+        }
+        if name.is_empty() {
+            return Err(at("a column needs a name".into()));
+        }
+        let conv = conversion(kind.value_units())?;
+        if columns
             .iter()
-            .any(|c| matches!(c, Column::Axis(v, _) if *v == r))
-    {
-        return Err(header_error(
-            1,
-            format!("no {} column: {} needs one", r.csv_name(), kind.what()),
-        ));
+            .any(|c| matches!(c, Column::Value(n, _) if n == name))
+        {
+            return Err(at(format!("repeats the column `{name}`")));
+        }
+        Ok(Column::Value(name.to_string(), conv))
     }
-    let chosen = match column {
-        Some(want) => columns
+
+    /// An error about the header at `column` (1-based).
+    fn error(&self, column: usize, reason: String) -> TableError {
+        TableError::Header {
+            file: self.file.clone(),
+            line: self.line,
+            column,
+            header: self
+                .names
+                .get(column.saturating_sub(1))
+                .cloned()
+                .unwrap_or_default(),
+            reason,
+        }
+    }
+
+    fn n_axes(&self) -> usize {
+        self.columns
             .iter()
-            .position(|c| matches!(c, Column::Value(n, _) if n == want))
-            .ok_or_else(|| {
-                header_error(
-                    n_axes + 1,
-                    format!(
-                        "no value column `{want}` (the file has: {})",
-                        value_names.join(", ")
-                    ),
-                )
-            })?,
-        None if value_names.len() == 1 => n_axes,
-        None => {
-            return Err(header_error(
+            .filter(|c| matches!(c, Column::Axis(..)))
+            .count()
+    }
+
+    fn value_names(&self) -> Vec<&str> {
+        self.columns
+            .iter()
+            .filter_map(|c| match c {
+                Column::Value(n, _) => Some(n.as_str()),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// At least one axis, and the one every table of the kind needs.
+    fn check_axes(&self, kind: Kind) -> Result<(), TableError> {
+        if self.n_axes() == 0 {
+            return Err(self.error(
+                1,
+                format!(
+                    "no axis column: {} is tabulated over {}",
+                    kind.what(),
+                    kind.allowed_list(", ")
+                ),
+            ));
+        }
+        if let Some(r) = kind.required()
+            && !self
+                .columns
+                .iter()
+                .any(|c| matches!(c, Column::Axis(v, _) if *v == r))
+        {
+            return Err(self.error(
+                1,
+                format!("no {} column: {} needs one", r.csv_name(), kind.what()),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The index of the value column used: `want`, or the only one.
+    fn chosen(&self, want: Option<&str>) -> Result<usize, TableError> {
+        let (n_axes, value_names) = (self.n_axes(), self.value_names());
+        match want {
+            Some(want) => self
+                .columns
+                .iter()
+                .position(|c| matches!(c, Column::Value(n, _) if n == want))
+                .ok_or_else(|| {
+                    self.error(
+                        n_axes + 1,
+                        format!(
+                            "no value column `{want}` (the file has: {})",
+                            value_names.join(", ")
+                        ),
+                    )
+                }),
+            None if value_names.len() == 1 => Ok(n_axes),
+            None => Err(self.error(
                 n_axes + 1,
                 format!(
                     "{} value columns ({}): name one with `column = \"...\"` in the scenario",
                     value_names.len(),
                     value_names.join(", ")
                 ),
-            ));
+            )),
         }
-    };
-
-    // Rows: every field a finite number, converted to the scenario's units.
-    let mut rows: Vec<(usize, Vec<f64>)> = Vec::new();
-    for (line, text) in lines {
-        let f = fields(text);
-        if f.len() != columns.len() {
-            return Err(TableError::Ragged {
-                file,
-                line,
-                expected: columns.len(),
-                found: f.len(),
-            });
-        }
-        let mut row = Vec::with_capacity(f.len());
-        for (k, (s, c)) in f.iter().zip(&columns).enumerate() {
-            let v: f64 = match s.parse::<f64>() {
-                Ok(v) if v.is_finite() => v,
-                _ => {
-                    return Err(TableError::NotFinite {
-                        file,
-                        line,
-                        column: k + 1,
-                        header: names[k].clone(),
-                        value: s.clone(),
-                    });
-                }
-            };
-            let conv = match c {
-                Column::Axis(_, conv) | Column::Value(_, conv) => *conv,
-            };
-            row.push(conv.apply(v));
-        }
-        if rows.len() >= MAX_TABLE_VALUES {
-            return Err(TableError::Grid {
-                file,
-                line,
-                column: 1,
-                header: names[0].clone(),
-                reason: format!("more rows than the limit of {MAX_TABLE_VALUES} grid points"),
-            });
-        }
-        rows.push((line, row));
-    }
-    if rows.is_empty() {
-        return Err(header_error(1, "no rows after the header".into()));
     }
 
-    // The grid: the breakpoints of axis j are its values at rows 0, stride_j, 2 stride_j, ...
-    // while the slower axes keep row 0's values (stride_j: the product of the faster axes'
-    // sizes, found from the last axis backwards).
-    let grid_error = |r: usize, j: usize, reason: String| TableError::Grid {
-        file: file.clone(),
-        line: rows[r].0,
-        column: j + 1,
-        header: names[j].clone(),
-        reason,
-    };
-    let mut sizes = vec![0usize; n_axes];
-    let mut breakpoints: Vec<Vec<f64>> = vec![Vec::new(); n_axes];
-    let mut stride = 1usize;
-    for j in (0..n_axes).rev() {
-        let mut r = 0;
-        while r < rows.len() && (0..j).all(|i| rows[r].1[i].to_bits() == rows[0].1[i].to_bits()) {
-            let x = rows[r].1[j];
-            if let Some(&prev) = breakpoints[j].last()
-                && x <= prev
+    /// The rows: every field a finite number, converted to the scenario's units.
+    fn rows<'t>(&self, lines: impl Iterator<Item = (usize, &'t str)>) -> Result<Rows, TableError> {
+        let file = || self.file.clone();
+        let mut rows: Rows = Vec::new();
+        for (line, text) in lines {
+            let f = fields(text);
+            if f.len() != self.columns.len() {
+                return Err(TableError::Ragged {
+                    file: file(),
+                    line,
+                    expected: self.columns.len(),
+                    found: f.len(),
+                });
+            }
+            let mut row = Vec::with_capacity(f.len());
+            for (k, (s, c)) in f.iter().zip(&self.columns).enumerate() {
+                let v: f64 = match s.parse::<f64>() {
+                    Ok(v) if v.is_finite() => v,
+                    _ => {
+                        return Err(TableError::NotFinite {
+                            file: file(),
+                            line,
+                            column: k + 1,
+                            header: self.names[k].clone(),
+                            value: s.clone(),
+                        });
+                    }
+                };
+                let conv = match c {
+                    Column::Axis(_, conv) | Column::Value(_, conv) => *conv,
+                };
+                row.push(conv.apply(v));
+            }
+            if rows.len() >= MAX_TABLE_VALUES {
+                return Err(TableError::Grid {
+                    file: file(),
+                    line,
+                    column: 1,
+                    header: self.names[0].clone(),
+                    reason: format!("more rows than the limit of {MAX_TABLE_VALUES} grid points"),
+                });
+            }
+            rows.push((line, row));
+        }
+        if rows.is_empty() {
+            return Err(self.error(1, "no rows after the header".into()));
+        }
+        Ok(rows)
+    }
+
+    /// An error about row `r`, column `j` (0-based) of the grid.
+    fn grid_error(&self, rows: &Rows, r: usize, j: usize, reason: String) -> TableError {
+        TableError::Grid {
+            file: self.file.clone(),
+            line: rows[r].0,
+            column: j + 1,
+            header: self.names[j].clone(),
+            reason,
+        }
+    }
+
+    /// The breakpoints of each axis: axis j's are its values at rows 0, stride_j, 2 stride_j,
+    /// ... while the slower axes keep row 0's values (stride_j: the product of the faster axes'
+    /// sizes, found from the last axis backwards).
+    fn breakpoints(&self, rows: &Rows) -> Result<Vec<Vec<f64>>, TableError> {
+        let n_axes = self.n_axes();
+        let mut breakpoints: Vec<Vec<f64>> = vec![Vec::new(); n_axes];
+        let mut stride = 1usize;
+        for j in (0..n_axes).rev() {
+            let mut r = 0;
+            while r < rows.len() && (0..j).all(|i| rows[r].1[i].to_bits() == rows[0].1[i].to_bits())
             {
-                return Err(grid_error(
-                    r,
+                let x = rows[r].1[j];
+                if let Some(&prev) = breakpoints[j].last()
+                    && x <= prev
+                {
+                    return Err(self.grid_error(
+                        rows,
+                        r,
+                        j,
+                        format!(
+                            "breakpoints are not strictly increasing: {x} after {prev} (rows are in row-major order, the first axis slowest)"
+                        ),
+                    ));
+                }
+                breakpoints[j].push(x);
+                r += stride;
+            }
+            if breakpoints[j].len() < 2 {
+                return Err(self.grid_error(
+                    rows,
+                    0,
                     j,
                     format!(
-                        "breakpoints are not strictly increasing: {x} after {prev} (rows are in row-major order, the first axis slowest)"
+                        "axis {} has 1 breakpoint: expected at least 2 (give a constant instead of a table)",
+                        self.names[j]
                     ),
                 ));
             }
-            breakpoints[j].push(x);
-            r += stride;
+            stride *= breakpoints[j].len();
         }
-        sizes[j] = breakpoints[j].len();
-        if sizes[j] < 2 {
-            return Err(grid_error(
+        Ok(breakpoints)
+    }
+
+    /// The table: the grid complete and in row-major order, the chosen column's values.
+    fn table(&self, rows: &Rows, chosen: usize, kind: Kind) -> Result<Table, TableError> {
+        let n_axes = self.n_axes();
+        let breakpoints = self.breakpoints(rows)?;
+        let sizes: Vec<usize> = breakpoints.iter().map(Vec::len).collect();
+        let points: usize = sizes.iter().product();
+        if rows.len() != points {
+            let last = rows.len().min(points) - 1;
+            return Err(self.grid_error(
+                rows,
+                last,
                 0,
-                j,
                 format!(
-                    "axis {} has 1 breakpoint: expected at least 2 (give a constant instead of a table)",
-                    names[j]
+                    "the rows do not form a complete grid: {} rows for {} breakpoints ({points} rows expected)",
+                    rows.len(),
+                    sizes
+                        .iter()
+                        .map(|s| s.to_string())
+                        .collect::<Vec<_>>()
+                        .join(" x ")
                 ),
             ));
         }
-        stride *= sizes[j];
-    }
-    if rows.len() != stride {
-        let last = rows.len().min(stride) - 1;
-        return Err(grid_error(
-            last,
-            0,
-            format!(
-                "the rows do not form a complete grid: {} rows for {} breakpoints ({stride} rows expected)",
-                rows.len(),
-                sizes
-                    .iter()
-                    .map(|s| s.to_string())
-                    .collect::<Vec<_>>()
-                    .join(" x ")
-            ),
-        ));
-    }
-    let mut values = Vec::with_capacity(rows.len());
-    for (r, (_, row)) in rows.iter().enumerate() {
-        let mut rem = r;
-        for j in (0..n_axes).rev() {
-            let expected = breakpoints[j][rem % sizes[j]];
-            rem /= sizes[j];
-            if row[j].to_bits() != expected.to_bits() {
-                return Err(grid_error(
-                    r,
-                    j,
-                    format!(
-                        "expected {expected} here: rows list every grid point in row-major order (the first axis slowest)"
-                    ),
-                ));
+        let mut values = Vec::with_capacity(rows.len());
+        for (r, (_, row)) in rows.iter().enumerate() {
+            let mut rem = r;
+            for j in (0..n_axes).rev() {
+                let expected = breakpoints[j][rem % sizes[j]];
+                rem /= sizes[j];
+                if row[j].to_bits() != expected.to_bits() {
+                    return Err(self.grid_error(
+                        rows,
+                        r,
+                        j,
+                        format!(
+                            "expected {expected} here: rows list every grid point in row-major order (the first axis slowest)"
+                        ),
+                    ));
+                }
             }
+            values.push(row[chosen]);
         }
-        values.push(row[chosen]);
+        let axes = self
+            .columns
+            .iter()
+            .zip(breakpoints)
+            .filter_map(|(c, breakpoints)| match c {
+                Column::Axis(variable, _) => Some(Axis {
+                    variable: *variable,
+                    breakpoints,
+                }),
+                Column::Value(..) => None,
+            })
+            .collect();
+        Table::new(axes, values, kind).map_err(|reason| self.error(1, reason))
     }
-    let axes = columns
-        .iter()
-        .zip(breakpoints)
-        .filter_map(|(c, breakpoints)| match c {
-            Column::Axis(variable, _) => Some(Axis {
-                variable: *variable,
-                breakpoints,
-            }),
-            Column::Value(..) => None,
-        })
-        .collect();
-    Table::new(axes, values, kind).map_err(|reason| header_error(1, reason))
 }
 
 /// Writes a table as CSV (header `name [unit]`, one row per grid point, numbers in the shortest

@@ -13,11 +13,27 @@ pub enum TableError {
         /// The cause.
         message: String,
     },
+    /// The path is not a regular file, or the file is over its byte limit.
+    #[error(transparent)]
+    Input(Box<crate::input_file::InputFileError>),
     /// No header row.
     #[error("{file}: empty table: expected a header row such as `mach [-],alpha [deg],cz [-]`")]
     Empty {
         /// The file.
         file: String,
+    },
+    /// A header row that is not one of a table (its text is not quoted: the file may be
+    /// anything).
+    #[error(
+        "{file}: line {line}, column {column}: not a table header: expected columns `name [unit]` such as `mach [-],alpha [deg],cz [-]` (is it a table file?)"
+    )]
+    NotAHeader {
+        /// The file.
+        file: String,
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
     },
     /// A header without a unit.
     #[error(
@@ -77,9 +93,11 @@ pub enum TableError {
         /// Fields found.
         found: usize,
     },
-    /// A field that is not a finite number.
+    /// A field that is not a finite number (quoted when it is short and could be a number; a
+    /// field that could not be one is only described, see [`shown_field`]).
     #[error(
-        "{file}: line {line}, column {column} (`{header}`): expected a finite number, found `{value}`"
+        "{file}: line {line}, column {column} (`{header}`): expected a finite number, found {}",
+        shown_field(value)
     )]
     NotFinite {
         /// The file.
@@ -107,4 +125,34 @@ pub enum TableError {
         /// What is wrong.
         reason: String,
     },
+}
+
+/// Longest header field or value an error quotes \[characters\].
+const MAX_QUOTED_CHARS: usize = 32;
+
+/// Whether a header field could name a table column (`name [unit]`): short, of the characters
+/// of names and units. A field that could not is never quoted in a message (the file may be
+/// anything: issue 21, item 14).
+pub(crate) fn could_be_header(field: &str) -> bool {
+    field.len() <= 2 * MAX_QUOTED_CHARS
+        && field
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || " _-.[]/^()*".contains(c))
+}
+
+/// A field as an error shows it: quoted when it is short and made of the characters of numbers
+/// and names (`NaN`, `inf`, `1.2.3`), described by its length otherwise.
+pub fn shown_field(value: &str) -> String {
+    let plausible = value.len() <= MAX_QUOTED_CHARS
+        && value
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "+-._ ".contains(c));
+    if plausible {
+        format!("`{value}`")
+    } else {
+        format!(
+            "a field of {} characters that is not a number",
+            value.chars().count()
+        )
+    }
 }

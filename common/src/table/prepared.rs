@@ -1,6 +1,8 @@
 //! Interpolation at run time: tables prepared once per scenario and event (Mach axes
 //! interpolated at the flight condition, tables over the same axes grouped), looked up at
-//! every force evaluation without allocation, and the excursions outside them counted.
+//! every force evaluation without allocation, and the excursions outside them counted (in a
+//! run's [`TableState`], `excursion.rs`). Setting a scenario's tables up is the model's
+//! (`crate::model::tables`): this module knows tables, not scenarios.
 
 use super::*;
 
@@ -8,7 +10,7 @@ use super::*;
 pub const MAX_TABLES: usize = 19;
 /// Most run-time groups (tables sharing their axes): one per static coefficient and per
 /// interference increment at most.
-const MAX_GROUPS: usize = 12;
+pub(super) const MAX_GROUPS: usize = 12;
 
 /// Where a run-time table's value goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -260,6 +262,13 @@ impl PreparedTables {
         (id, table.axes[1..].to_vec(), values)
     }
 
+    /// Sets static coefficient `k` (CY, CZ, Cl, Cm, Cn as 1..=5) to the constant `v`, added at
+    /// every force evaluation (only when it is not 0).
+    pub fn add_constant(&mut self, k: usize, v: f64) {
+        self.constants[k] = v;
+        self.runtime |= v != 0.0;
+    }
+
     /// Adds a table (already sliced at the Mach, registered as `id`) for the force evaluation:
     /// a channel of the group with the same axes, or a new group.
     pub fn add_runtime(&mut self, id: usize, target: Target, axes: Vec<Axis>, values: Vec<f64>) {
@@ -435,105 +444,6 @@ impl PreparedTables {
     }
 }
 
-/// The freestream database's constants at the flight Mach: the scenario's constants, and its
-/// derivative tables (and a CA table over Mach only) interpolated at the Mach. A derivative
-/// left out (a static table replaces it) is 0; a CA tabulated over alpha or beta is 0 here and
-/// interpolated at each force evaluation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[allow(missing_docs)]
-pub struct AeroAtMach {
-    pub ca0: f64,
-    pub cz_alpha_per_rad: f64,
-    pub cy_beta_per_rad: f64,
-    pub cm_alpha_per_rad: f64,
-    pub cn_beta_per_rad: f64,
-    pub cl_p_per_rad: f64,
-    pub cm_q_per_rad: f64,
-    pub cn_r_per_rad: f64,
-}
-
-/// A scenario's tables set up at its flight Mach (docs/model.md section 3): the constants of
-/// the freestream database, the constant interference increments at carriage (0 for a
-/// tabulated one) and the tables the force evaluation interpolates.
-pub fn prepare(scenario: &crate::scenario::Scenario) -> (AeroAtMach, [f64; 6], PreparedTables) {
-    let mach = scenario.flight.mach;
-    let mut p = PreparedTables::default();
-    let a = &scenario.aero;
-    let unread = "a validated scenario holds no unread table files";
-    let derivative = |p: &mut PreparedTables, name: &str, c: Option<&Coefficient>| match c {
-        None => 0.0,
-        Some(Coefficient::Constant(v)) => *v,
-        Some(Coefficient::Table(t)) => p.slice_mach(name, t, mach).2[0],
-        Some(Coefficient::File(_)) => unreachable!("{unread}"),
-    };
-    let mut consts = AeroAtMach {
-        ca0: 0.0,
-        cz_alpha_per_rad: derivative(
-            &mut p,
-            "aero.cz_alpha_per_rad",
-            a.cz_alpha_per_rad.as_ref().map(|c| &c.value),
-        ),
-        cy_beta_per_rad: derivative(
-            &mut p,
-            "aero.cy_beta_per_rad",
-            a.cy_beta_per_rad.as_ref().map(|c| &c.value),
-        ),
-        cm_alpha_per_rad: derivative(
-            &mut p,
-            "aero.cm_alpha_per_rad",
-            a.cm_alpha_per_rad.as_ref().map(|c| &c.value),
-        ),
-        cn_beta_per_rad: derivative(
-            &mut p,
-            "aero.cn_beta_per_rad",
-            a.cn_beta_per_rad.as_ref().map(|c| &c.value),
-        ),
-        cl_p_per_rad: derivative(&mut p, "aero.cl_p_per_rad", Some(&a.cl_p_per_rad.value)),
-        cm_q_per_rad: derivative(&mut p, "aero.cm_q_per_rad", Some(&a.cm_q_per_rad.value)),
-        cn_r_per_rad: derivative(&mut p, "aero.cn_r_per_rad", Some(&a.cn_r_per_rad.value)),
-    };
-    let statics = [
-        ("aero.ca0", Some(&a.ca0)),
-        ("aero.cy", a.cy.as_ref()),
-        ("aero.cz", a.cz.as_ref()),
-        ("aero.cl", a.cl.as_ref()),
-        ("aero.cm", a.cm.as_ref()),
-        ("aero.cn", a.cn.as_ref()),
-    ];
-    for (k, (name, c)) in statics.into_iter().enumerate() {
-        match c.map(|c| &c.value) {
-            None => {}
-            Some(Coefficient::Constant(v)) if k == 0 => consts.ca0 = *v,
-            Some(Coefficient::Constant(v)) => {
-                p.constants[k] = *v;
-                p.runtime |= *v != 0.0;
-            }
-            Some(Coefficient::Table(t)) => {
-                let (id, axes, values) = p.slice_mach(name, t, mach);
-                if k == 0 && axes.is_empty() {
-                    // CA over Mach only: a constant of the run, as the contract's CA0.
-                    consts.ca0 = values[0];
-                } else {
-                    p.add_runtime(id, Target::Static(k), axes, values);
-                }
-            }
-            Some(Coefficient::File(_)) => unreachable!("{unread}"),
-        }
-    }
-    let mut increments = [0.0; 6];
-    for (k, (name, c)) in scenario.interference.increments().into_iter().enumerate() {
-        match &c.value {
-            Coefficient::Constant(v) => increments[k] = *v,
-            Coefficient::Table(t) => {
-                let (id, axes, values) = p.slice_mach(name, t, mach);
-                p.add_runtime(id, Target::Interference(k), axes, values);
-            }
-            Coefficient::File(_) => unreachable!("{unread}"),
-        }
-    }
-    (consts, increments, p)
-}
-
 fn strides(sizes: &[usize], channels: usize) -> [usize; 3] {
     let mut s = [0usize; 3];
     let mut acc = channels;
@@ -633,115 +543,4 @@ fn bilinear(c: &[f64], at: usize, x: f64, y: f64) -> [f64; 6] {
     let p = lin(x, lanes(c, at), lanes(c, at + 6));
     let q = lin(x, lanes(c, at + 12), lanes(c, at + 18));
     lin(y, &p, &q)
-}
-
-/// One propagation's table scratch: interval cursors and excursion counts (fixed size).
-#[derive(Debug, Default, Clone)]
-pub struct TableState {
-    cursor: [[Cell<u32>; 3]; MAX_GROUPS],
-    evaluations: Cell<u64>,
-    count: [Cell<u64>; MAX_TABLES],
-    worst: [[Cell<f64>; 5]; MAX_TABLES],
-}
-
-impl TableState {
-    /// Counts one force evaluation (of a scenario with tables).
-    #[inline(always)]
-    pub fn count_evaluation(&self) {
-        self.evaluations.set(self.evaluations.get() + 1);
-    }
-
-    /// Puts this state back to `saved` (cursors and counts): for a step taken again from where
-    /// `saved` was taken, so that the cursors' history, which decides the interval of an input
-    /// on a breakpoint, is the one of a single pass.
-    pub fn restore(&self, saved: &TableState) {
-        for (group, from) in self.cursor.iter().zip(&saved.cursor) {
-            for (c, f) in group.iter().zip(from) {
-                c.set(f.get());
-            }
-        }
-        self.evaluations.set(saved.evaluations.get());
-        for (c, f) in self.count.iter().zip(&saved.count) {
-            c.set(f.get());
-        }
-        for (w, f) in self.worst.iter().zip(&saved.worst) {
-            for (c, f) in w.iter().zip(f) {
-                c.set(f.get());
-            }
-        }
-    }
-
-    /// The counts so far.
-    pub fn excursions(&self) -> TableExcursions {
-        TableExcursions {
-            evaluations: self.evaluations.get(),
-            count: std::array::from_fn(|k| self.count[k].get()),
-            worst: std::array::from_fn(|k| std::array::from_fn(|v| self.worst[k][v].get())),
-        }
-    }
-}
-
-/// How often a run's force evaluations left each table, and how far (fixed size, in
-/// [`crate::propagator::RunLog`]); [`PreparedTables::report`] names them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TableExcursions {
-    /// Force evaluations that looked tables up.
-    pub evaluations: u64,
-    /// Per table: evaluations outside it (beyond an axis other than Mach).
-    pub count: [u64; MAX_TABLES],
-    /// Per table and variable ([`Variable::ALL`] order): the largest excursion, in the
-    /// variable's unit.
-    pub worst: [[f64; 5]; MAX_TABLES],
-}
-
-impl Default for TableExcursions {
-    fn default() -> Self {
-        TableExcursions {
-            evaluations: 0,
-            count: [0; MAX_TABLES],
-            worst: [[0.0; 5]; MAX_TABLES],
-        }
-    }
-}
-
-/// A table a run left: how often and how far beyond each axis.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TableExcursion {
-    /// The scenario field, e.g. `aero.cz`.
-    pub table: String,
-    /// Force evaluations (RK4 stages) outside the table, its value held at the edge.
-    pub evaluations_outside: u64,
-    /// Force evaluations of the run.
-    pub evaluations: u64,
-    /// Each axis left: its range and the largest excursion beyond it.
-    pub axes: Vec<AxisExcursion>,
-}
-
-/// The excursion beyond one axis of a table.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct AxisExcursion {
-    /// The variable, with its unit (`alpha_deg`, `distance_m`, `mach`).
-    pub variable: String,
-    /// The table's first and last breakpoint.
-    pub range: [f64; 2],
-    /// The largest distance beyond the range, in the variable's unit.
-    pub worst_excursion: f64,
-}
-
-impl fmt::Display for TableExcursion {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(
-            f,
-            "left table `{}` in {} of {} force evaluations (value held at the edge)",
-            self.table, self.evaluations_outside, self.evaluations
-        )?;
-        for a in &self.axes {
-            write!(
-                f,
-                "; {} up to {} beyond [{}, {}]",
-                a.variable, a.worst_excursion, a.range[0], a.range[1]
-            )?;
-        }
-        Ok(())
-    }
 }

@@ -16,6 +16,9 @@ pub enum TelemetryError {
         /// The cause.
         message: String,
     },
+    /// The path is not a regular file, or the file is over its byte limit.
+    #[error(transparent)]
+    Input(Box<crate::input_file::InputFileError>),
     /// No header row.
     #[error(
         "{file}: empty file: expected a header row `t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg`"

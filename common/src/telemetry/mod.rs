@@ -17,7 +17,8 @@
 //!   +-[`MAX_SPAN_S`](crate::limits::MAX_SPAN_S), positions within +-[`MAX_POSITION_M`](crate::limits::MAX_POSITION_M) and angles within
 //!   +-[`MAX_ANGLE_DEG`](crate::limits::MAX_ANGLE_DEG); a value beyond them is refused with its line and column (it is a
 //!   unit or export mistake, and it would overflow the goals).
-//! - Files are read line by line: the text is never held whole in memory.
+//! - Files are read line by line: the text is never held whole in memory. Only a regular file
+//!   is read, of at most [`MAX_TELEMETRY_BYTES`] ([`crate::input_file`]).
 //! - Files sepval writes print every number in the shortest form that reads back as the same
 //!   double, so writing and reading is exact.
 
@@ -26,7 +27,8 @@ use std::io::BufRead;
 use std::path::Path;
 
 use crate::atomic_file::{WriteError, write_atomically};
-use crate::limits::MAX_SAMPLES;
+use crate::input_file::{InputFile, InputFileError};
+use crate::limits::{MAX_SAMPLES, MAX_TELEMETRY_BYTES};
 use crate::units::M_PER_FT;
 
 mod error;
@@ -111,10 +113,16 @@ impl Trajectory {
     /// Reads a telemetry file, line by line.
     pub fn read(path: &Path) -> Result<Trajectory, TelemetryError> {
         let name = path.display().to_string();
-        let file = std::fs::File::open(path).map_err(|e| TelemetryError::Io {
-            file: name.clone(),
-            message: e.to_string(),
-        })?;
+        let file =
+            InputFile::open(path, "telemetry file", MAX_TELEMETRY_BYTES).map_err(|e| {
+                match e.into_io() {
+                    Ok(io) => TelemetryError::Io {
+                        file: name.clone(),
+                        message: io.to_string(),
+                    },
+                    Err(refused) => TelemetryError::Input(Box::new(refused)),
+                }
+            })?;
         let lines = std::io::BufReader::new(file).split(b'\n');
         Trajectory::parse_lines(lines, &name, MAX_SAMPLES)
     }
@@ -137,9 +145,17 @@ impl Trajectory {
         let mut header: Option<Header> = None;
         for (i, raw) in lines.enumerate() {
             let line = i + 1;
-            let raw = raw.map_err(|e| TelemetryError::Io {
-                file: file.clone(),
-                message: format!("line {line}: {e}"),
+            let raw = raw.map_err(|e| match InputFileError::from_io(&e) {
+                // A file that grew past its limit while read.
+                Some(_) => TelemetryError::Input(Box::new(
+                    *e.into_inner()
+                        .and_then(|inner| inner.downcast::<InputFileError>().ok())
+                        .expect("checked: it carries an InputFileError"),
+                )),
+                None => TelemetryError::Io {
+                    file: file.clone(),
+                    message: format!("line {line}: {e}"),
+                },
             })?;
             let text = std::str::from_utf8(&raw).map_err(|_| TelemetryError::NotText {
                 file: file.clone(),
@@ -186,50 +202,7 @@ impl Trajectory {
                     limit: max_samples,
                 });
             }
-            let mut values = [0.0; 7];
-            for (q, &(col, scale)) in columns.iter().enumerate() {
-                let text = fields[col];
-                let field_error =
-                    |value: &str| (file.clone(), col + 1, names[col].clone(), value.to_string());
-                let v: f64 = text.parse().map_err(|_| {
-                    let (file, column, header, value) = field_error(text);
-                    TelemetryError::NotNumeric {
-                        file,
-                        line,
-                        column,
-                        header,
-                        value,
-                    }
-                })?;
-                if !v.is_finite() {
-                    let (file, column, header, value) = field_error(text);
-                    return Err(TelemetryError::NotFinite {
-                        file,
-                        line,
-                        column,
-                        header,
-                        value,
-                    });
-                }
-                let si = v * scale;
-                let kind = match q {
-                    0 => Bound::Time,
-                    1..=3 => Bound::Position,
-                    _ => Bound::Angle,
-                };
-                if si.abs() > kind.bound() {
-                    let (file, column, header, value) = field_error(text);
-                    return Err(TelemetryError::Implausible {
-                        file,
-                        line,
-                        column,
-                        header,
-                        value,
-                        kind,
-                    });
-                }
-                values[q] = si;
-            }
+            let values = parse_row(&fields, names, columns, line, &file)?;
             if let Some(&previous_s) = out.times_s.last() {
                 if values[0] <= previous_s {
                     return Err(TelemetryError::TimeNotIncreasing {
@@ -289,6 +262,68 @@ impl Trajectory {
         self.comments.push(format!("{key} = {value}"));
         self.metadata.push((key.to_string(), value.to_string()));
     }
+}
+
+/// The seven values of a data row in SI (time, position, attitude): each field a finite number
+/// within the bounds of plausible telemetry.
+fn parse_row(
+    fields: &[&str],
+    names: &[String],
+    columns: &ColumnMap,
+    line: usize,
+    file: &str,
+) -> Result<[f64; 7], TelemetryError> {
+    let mut values = [0.0; 7];
+    for (q, &(col, scale)) in columns.iter().enumerate() {
+        let text = fields[col];
+        let field_error = |value: &str| {
+            (
+                file.to_string(),
+                col + 1,
+                names[col].clone(),
+                value.to_string(),
+            )
+        };
+        let v: f64 = text.parse().map_err(|_| {
+            let (file, column, header, value) = field_error(text);
+            TelemetryError::NotNumeric {
+                file,
+                line,
+                column,
+                header,
+                value,
+            }
+        })?;
+        if !v.is_finite() {
+            let (file, column, header, value) = field_error(text);
+            return Err(TelemetryError::NotFinite {
+                file,
+                line,
+                column,
+                header,
+                value,
+            });
+        }
+        let si = v * scale;
+        let kind = match q {
+            0 => Bound::Time,
+            1..=3 => Bound::Position,
+            _ => Bound::Angle,
+        };
+        if si.abs() > kind.bound() {
+            let (file, column, header, value) = field_error(text);
+            return Err(TelemetryError::Implausible {
+                file,
+                line,
+                column,
+                header,
+                value,
+                kind,
+            });
+        }
+        values[q] = si;
+    }
+    Ok(values)
 }
 
 /// The comma-separated fields of a line, trimmed, each with one pair of enclosing double

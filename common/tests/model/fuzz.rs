@@ -24,18 +24,24 @@ use proptest::prelude::*;
 use proptest::sample::select;
 use proptest::test_runner::TestCaseError;
 use sepval_common::effects::{CATALOGUE, EffectSet};
+use sepval_common::extension::locator::{F_HZ, LAMBDA_M, LocatorDomain, MACH0, T_ON_S};
 use sepval_common::extension::{
     Axis, EXTENSION_FORMAT, ExtensionError, Family, MAX_TERMS, Regressor, Term, TermRecord,
     extension_toml, parse_extension,
 };
 use sepval_common::factors::{FactorTable, Factors};
-use sepval_common::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
+use sepval_common::limits::{
+    MAX_ANGLE_DEG, MAX_EXTENSION_BYTES, MAX_POSITION_M, MAX_SCENARIO_BYTES, MAX_SPAN_S,
+    MAX_TABLE_CSV_BYTES, MAX_TELEMETRY_BYTES,
+};
 use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
 use sepval_common::synthetic::default_flight_test;
 use sepval_common::telemetry::{TelemetryError, Trajectory};
+use std::path::PathBuf;
+
 use sepval_tests::fuzz::{
-    CountingAllocator, Edit, apply, check_cost, check_typed, config, edits, measure, number_edits,
-    number_text, text_edit,
+    CountingAllocator, Edit, PathKind, apply, check_cost, check_typed, config, edits, measure,
+    number_edits, number_text, path_kind, text_edit, within_deadline,
 };
 
 #[global_allocator]
@@ -526,13 +532,34 @@ const EXTENSION_TOKENS: &[&str] = &[
     "1e309",
 ];
 
-/// A positive finite number: ordinary, tiny or huge.
-fn positive() -> BoxedStrategy<f64> {
+/// A value of a locator's domain: ordinary, or at its edges (the smallest positive doubles
+/// for an open lower bound).
+fn in_domain(d: LocatorDomain) -> BoxedStrategy<f64> {
+    // The neighbours by their bits (f64::next_up and next_down need Rust 1.86): max is
+    // positive, min negative or zero.
+    let toward_zero = |x: f64| f64::from_bits(x.to_bits() - 1);
+    let mut edges = vec![d.max, toward_zero(d.max)];
+    if d.min_open {
+        edges.extend([f64::MIN_POSITIVE, 5e-324, 1e-300]);
+    } else {
+        edges.push(d.min);
+        if d.min < 0.0 {
+            edges.push(toward_zero(d.min));
+        }
+    }
     prop_oneof![
         4 => 0.01..10.0f64,
-        1 => select(&[f64::MIN_POSITIVE, 5e-324, 1e-300, 1e300, f64::MAX][..]),
+        1 => select(edges),
     ]
     .boxed()
+}
+
+/// The domain of the locator named `name`.
+fn domain_of(name: &str) -> LocatorDomain {
+    [LAMBDA_M, MACH0, T_ON_S, F_HZ]
+        .into_iter()
+        .find(|d| d.name == name)
+        .expect("a locator of the library")
 }
 
 /// Any finite number, the extremes included.
@@ -559,15 +586,21 @@ fn valid_term() -> BoxedStrategy<Term> {
                 .into_iter()
                 .filter(|a| regressor.fits(*a))
                 .collect();
-            let locator = match regressor.family() {
-                Family::Interference | Family::InterferenceFlowAngle | Family::Mach => positive(),
-                Family::Step => finite(),
-                Family::Oscillation => prop_oneof![
-                    3 => 0.0..60.0f64,
-                    1 => select(&[0.0, -0.0, 1e300, f64::MAX][..]),
+            let locator = match regressor.family().locator() {
+                Some("t_on_s") => prop_oneof![
+                    2 => in_domain(T_ON_S),
+                    1 => -10.0..10.0f64,
+                    1 => Just(-0.0),
                 ]
                 .boxed(),
-                _ => Just(0.0).boxed(),
+                Some("f_hz") => prop_oneof![
+                    3 => 0.0..60.0f64,
+                    1 => in_domain(F_HZ),
+                    1 => Just(-0.0),
+                ]
+                .boxed(),
+                Some(name) => in_domain(domain_of(name)),
+                None => Just(0.0).boxed(),
             };
             (Just(regressor), select(axes), locator, finite())
         })
@@ -749,7 +782,23 @@ fn spoil() -> BoxedStrategy<Spoil> {
         Just(Spoil::RegressorName),
         select(&["nan", "inf", "-inf", "+nan"][..]).prop_map(Spoil::CoefficientNotFinite),
         Just(Spoil::CoefficientType),
-        select(&["0", "-0.0", "-1", "nan", "inf", "-inf"][..]).prop_map(Spoil::LocatorDomain),
+        select(
+            &[
+                "0",
+                "-0.0",
+                "-1",
+                "nan",
+                "inf",
+                "-inf",
+                "1e300",
+                "-1e300",
+                "1.7976931348623157e308",
+                "1000.0000000000001",
+                "7200.000000000001",
+                "1000000.0000000001"
+            ][..]
+        )
+        .prop_map(Spoil::LocatorDomain),
         Just(Spoil::LocatorExtra),
         Just(Spoil::UnknownKey),
     ]
@@ -824,9 +873,8 @@ fn spoiled_field(terms: &[Term], k: usize, how: &Spoil) -> Result<(), TestCaseEr
             true,
         ),
         Spoil::LocatorDomain(v) => match locator {
-            // A step time may be any finite time, a frequency zero.
-            Some("t_on_s") if !matches!(*v, "nan" | "inf" | "-inf") => return Ok(()),
-            Some("f_hz") if matches!(*v, "0" | "-0.0") => return Ok(()),
+            // A value of the domain (a step time of 0, a frequency of 0) spoils nothing.
+            Some(name) if v.parse().is_ok_and(|x| domain_of(name).contains(x)) => return Ok(()),
             Some(name) => (name, rewrite(name, v.to_string()), false),
             None => return Ok(()),
         },
@@ -939,4 +987,56 @@ fn the_bases_read() {
     telemetry_file(telemetry_base().as_bytes()).unwrap();
     assert_eq!(parse_extension(&extension_base(), "base").unwrap().len(), 6);
     extension_text(&extension_base()).unwrap();
+}
+
+/// Reads `path` with reader `reader` (0 telemetry, 1 a table through a scenario, 2 a scenario,
+/// 3 an extension): `Ok` or the error's chain.
+fn read_as(reader: usize, path: PathBuf, dir: PathBuf) -> Result<(), String> {
+    use crate::input_files::chain;
+    match reader {
+        0 => Trajectory::read(&path).map(drop).map_err(|e| chain(&e)),
+        1 => {
+            let text = DEFAULT_SCENARIO_TOML.replace(
+                "cl_p_per_rad = -40.0",
+                &format!(
+                    "cl_p_per_rad = {{ csv = {:?} }}",
+                    path.display().to_string()
+                ),
+            );
+            let s = dir.join("with-table.toml");
+            std::fs::write(&s, text).map_err(|e| e.to_string())?;
+            Scenario::load(&s).map(drop).map_err(|e| chain(&e))
+        }
+        2 => Scenario::load(&path).map(drop).map_err(|e| chain(&e)),
+        _ => sepval_common::extension::load_extension(&path)
+            .map(drop)
+            .map_err(|e| chain(&e)),
+    }
+}
+
+proptest! {
+    #![proptest_config(config(48))]
+
+    /// Every reader given every kind of path answers at once: what is not a regular file, or
+    /// is over the reader's limit, is refused naming the path and why; a regular file within
+    /// it is read or refused for its content.
+    #[test]
+    fn readers_refuse_what_is_not_a_regular_file_within_its_limit(
+        reader in 0..4usize,
+        kind in path_kind(),
+        bytes in prop::collection::vec(any::<u8>(), 0..200),
+    ) {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let limit = [MAX_TELEMETRY_BYTES, MAX_TABLE_CSV_BYTES, MAX_SCENARIO_BYTES, MAX_EXTENSION_BYTES][reader];
+        let path = kind.make(dir.path(), "input", &bytes, limit);
+        let shown = path.display().to_string();
+        let d = dir.path().to_path_buf();
+        let result = within_deadline(&format!("reader {reader} on {kind:?}"), move || read_as(reader, path, d))?;
+        match (kind.refusal(), result) {
+            (Some(why), Err(e)) => prop_assert!(e.contains(&format!("{shown}: ")) && e.contains(why), "{kind:?}: {e}"),
+            (Some(_), Ok(())) => prop_assert!(false, "{kind:?} read by reader {reader}"),
+            (None, Err(e)) => prop_assert!(!e.is_empty()),
+            (None, Ok(())) => prop_assert!(kind == PathKind::Regular),
+        }
+    }
 }

@@ -8,6 +8,8 @@ mod conformance;
 mod effects;
 mod elementary;
 mod fuzz;
+mod input_files;
 mod lanes;
+mod locators;
 mod tables;
 mod verification;

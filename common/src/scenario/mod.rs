@@ -20,14 +20,15 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::atmosphere::TROPOPAUSE_M;
 use crate::factors::{Factor, FactorSpec, FactorTable};
+use crate::input_file::read_string;
+use crate::limits::MAX_SCENARIO_BYTES;
 use crate::table::{
     Coefficient, DerivativeCoefficient, InterferenceCoefficient, StaticCoefficient, TableError,
 };
 
 /// The embedded default scenario text (docs/model.md section 1).
-pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../scenarios/eglin_default.toml");
+pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../../scenarios/eglin_default.toml");
 
 /// Mass properties and ejector geometry of the store (docs/model.md section 1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -345,6 +346,9 @@ pub enum ScenarioError {
         /// The cause.
         source: std::io::Error,
     },
+    /// The path is not a regular file, or the file is over its byte limit.
+    #[error(transparent)]
+    Input(Box<crate::input_file::InputFileError>),
     /// The TOML does not parse or does not have the expected fields.
     #[error("scenario {origin}: {message}")]
     Parse {
@@ -353,8 +357,9 @@ pub enum ScenarioError {
         /// The parser's message (it names line and column).
         message: String,
     },
-    /// A table file that cannot be used (the error names its file, line and column).
-    #[error("scenario {origin}: `{field}`: {source}")]
+    /// A table file that cannot be used (its error, the source, names its file, line and
+    /// column; it is not repeated here, so that a printed cause chain says it once).
+    #[error("scenario {origin}: `{field}`")]
     Table {
         /// The scenario file.
         origin: String,
@@ -439,10 +444,14 @@ impl Scenario {
 
     /// Loads and validates a scenario file (its table files are read relative to it).
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            read_string(path, "scenario", MAX_SCENARIO_BYTES).map_err(|e| match e.into_io() {
+                Ok(source) => ScenarioError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                },
+                Err(refused) => ScenarioError::Input(Box::new(refused)),
+            })?;
         let dir = path.parent().unwrap_or(Path::new(""));
         Scenario::from_toml_str_in(&text, &path.display().to_string(), Some(dir))
     }
@@ -468,203 +477,6 @@ impl Scenario {
         let json = serde_json::to_vec(self).expect("a scenario always serialises");
         hex_sha256(&json)
     }
-
-    /// Checks every value for its physical range.
-    pub fn validate(&self, origin: &str) -> Result<(), ScenarioError> {
-        let bad = |field: &str, reason: String| ScenarioError::Invalid {
-            origin: origin.to_string(),
-            field: field.to_string(),
-            reason,
-        };
-        let positive = |field: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(bad(field, format!("= {v}: expected a finite value > 0")))
-            }
-        };
-        let finite = |field: &str, v: f64| {
-            if v.is_finite() {
-                Ok(())
-            } else {
-                Err(bad(field, format!("= {v}: expected a finite value")))
-            }
-        };
-        let check_coefficient = |field: &str, c: &Coefficient| match c {
-            Coefficient::Constant(v) => finite(field, *v),
-            // Tables are checked when they are made (crate::table::Table::new).
-            Coefficient::Table(_) => Ok(()),
-            Coefficient::File(f) => Err(bad(
-                field,
-                format!(
-                    "refers to the table file {}, which was not read: a scenario with table files is loaded from its file (they are relative to it)",
-                    f.csv.display()
-                ),
-            )),
-        };
-        let s = &self.store;
-        positive("store.mass_kg", s.mass_kg)?;
-        positive("store.ixx_kg_m2", s.ixx_kg_m2)?;
-        positive("store.iyy_kg_m2", s.iyy_kg_m2)?;
-        positive("store.izz_kg_m2", s.izz_kg_m2)?;
-        positive("store.diameter_m", s.diameter_m)?;
-        positive("store.stroke_m", s.stroke_m)?;
-        finite("store.fwd_foot_x_m", s.fwd_foot_x_m)?;
-        finite("store.aft_foot_x_m", s.aft_foot_x_m)?;
-
-        let curve = &self.ejector.curve;
-        if curve.len() < 2 {
-            return Err(bad(
-                "ejector.curve",
-                format!(
-                    "has {} point(s): expected at least 2 (s_m, force_N) points",
-                    curve.len()
-                ),
-            ));
-        }
-        for (i, [x, f]) in curve.iter().enumerate() {
-            if !x.is_finite() || !f.is_finite() {
-                return Err(bad(
-                    &format!("ejector.curve[{i}]"),
-                    format!("= [{x}, {f}]: expected finite numbers"),
-                ));
-            }
-            if i > 0 && *x <= curve[i - 1][0] {
-                return Err(bad(
-                    &format!("ejector.curve[{i}]"),
-                    format!(
-                        "displacement {x} m: expected strictly increasing displacements (previous {} m)",
-                        curve[i - 1][0]
-                    ),
-                ));
-            }
-        }
-        let (first, last) = (curve[0][0], curve[curve.len() - 1][0]);
-        if first > 0.0 || last < s.stroke_m {
-            return Err(bad(
-                "ejector.curve",
-                format!(
-                    "covers [{first}, {last}] m: it must cover [0, stroke] = [0, {}] m",
-                    s.stroke_m
-                ),
-            ));
-        }
-
-        for (field, c) in self.aero.fields() {
-            check_coefficient(field, c)?;
-        }
-        for (field, c) in self.interference.increments() {
-            check_coefficient(field, &c.value)?;
-        }
-        let a = &self.aero;
-        for (slope, table, has_slope, has_table) in [
-            (
-                "aero.cz_alpha_per_rad",
-                "aero.cz",
-                a.cz_alpha_per_rad.is_some(),
-                a.cz.is_some(),
-            ),
-            (
-                "aero.cy_beta_per_rad",
-                "aero.cy",
-                a.cy_beta_per_rad.is_some(),
-                a.cy.is_some(),
-            ),
-            (
-                "aero.cm_alpha_per_rad",
-                "aero.cm",
-                a.cm_alpha_per_rad.is_some(),
-                a.cm.is_some(),
-            ),
-            (
-                "aero.cn_beta_per_rad",
-                "aero.cn",
-                a.cn_beta_per_rad.is_some(),
-                a.cn.is_some(),
-            ),
-        ] {
-            if !has_slope && !has_table {
-                return Err(bad(
-                    slope,
-                    format!("is missing: give it, or the static coefficient `{table}` as a table"),
-                ));
-            }
-        }
-        let i = &self.interference;
-        positive("interference.lambda_m", i.lambda_m)?;
-        positive("interference.s_end_m", i.s_end_m)?;
-
-        let f = &self.flight;
-        positive("flight.mach", f.mach)?;
-        if !(f.altitude_m.is_finite() && f.altitude_m < TROPOPAUSE_M) {
-            return Err(bad(
-                "flight.altitude_m",
-                format!(
-                    "= {}: expected a finite altitude below {TROPOPAUSE_M} m (ISA troposphere)",
-                    f.altitude_m
-                ),
-            ));
-        }
-        for (field, v) in [
-            ("flight.alpha_deg", f.alpha_deg),
-            ("flight.beta_deg", f.beta_deg),
-            ("flight.gamma_deg", f.gamma_deg),
-        ] {
-            if !(v.is_finite() && v.abs() < 90.0) {
-                return Err(bad(
-                    field,
-                    format!("= {v}: expected a finite angle within +-90 deg"),
-                ));
-            }
-        }
-
-        let n = &self.integrator;
-        positive("integrator.dt_s", n.dt_s)?;
-        positive("integrator.t_end_s", n.t_end_s)?;
-        positive("integrator.rate_hz", n.rate_hz)?;
-        if n.dt_s > n.t_end_s {
-            return Err(bad(
-                "integrator.dt_s",
-                format!(
-                    "= {}: longer than the event (t_end_s = {})",
-                    n.dt_s, n.t_end_s
-                ),
-            ));
-        }
-        // The work of one run (crate::limits), refused before anything is allocated.
-        crate::limits::check_steps(n.t_end_s, n.dt_s)
-            .map_err(|e| bad("integrator.dt_s", format!("= {}: {e}", n.dt_s)))?;
-        crate::limits::check_sampling(n.t_end_s, n.rate_hz)
-            .map_err(|e| bad("integrator.rate_hz", format!("= {}: {e}", n.rate_hz)))?;
-        for (k, v) in self.initial.velocity_m_s.iter().enumerate() {
-            finite(&format!("initial.velocity_m_s[{k}]"), *v)?;
-        }
-        for (k, v) in self.initial.rates_deg_s.iter().enumerate() {
-            finite(&format!("initial.rates_deg_s[{k}]"), *v)?;
-        }
-        if self.extension.len() > crate::extension::MAX_TERMS {
-            return Err(bad(
-                "extension",
-                format!(
-                    "has {} terms, at most {}",
-                    self.extension.len(),
-                    crate::extension::MAX_TERMS
-                ),
-            ));
-        }
-        for (k, r) in self.extension.iter().enumerate() {
-            r.term()
-                .map_err(|(field, message)| bad(&format!("extension[{k}].{field}"), message))?;
-        }
-        self.factors
-            .validate()
-            .map_err(|e| ScenarioError::Invalid {
-                origin: origin.to_string(),
-                field: "factors".to_string(),
-                reason: e.to_string(),
-            })?;
-        Ok(())
-    }
 }
 
 /// SHA-256 of `bytes`, lower-case hex.
@@ -673,108 +485,7 @@ pub fn hex_sha256(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+mod validate;
+
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::units::*;
-
-    #[test]
-    fn embedded_default_is_the_exact_conversion() {
-        let s = Scenario::embedded_default();
-        assert_eq!(s.store.mass_kg.to_bits(), (2000.0 * KG_PER_LB).to_bits());
-        assert_eq!(
-            s.store.ixx_kg_m2.to_bits(),
-            (20.0 * KG_M2_PER_SLUG_FT2).to_bits()
-        );
-        assert_eq!(
-            s.store.iyy_kg_m2.to_bits(),
-            (360.0 * KG_M2_PER_SLUG_FT2).to_bits()
-        );
-        assert_eq!(
-            s.store.izz_kg_m2.to_bits(),
-            (360.0 * KG_M2_PER_SLUG_FT2).to_bits()
-        );
-        assert_eq!(s.store.diameter_m.to_bits(), (20.0 * M_PER_IN).to_bits());
-        assert_eq!(s.store.fwd_foot_x_m.to_bits(), (0.59 * M_PER_FT).to_bits());
-        assert_eq!(s.store.aft_foot_x_m.to_bits(), (-1.08 * M_PER_FT).to_bits());
-        assert_eq!(s.store.stroke_m.to_bits(), (0.33 * M_PER_FT).to_bits());
-        let f = 12_000.0 * N_PER_LBF;
-        assert_eq!(s.ejector.curve, vec![[0.0, f], [0.33 * M_PER_FT, f]]);
-        assert_eq!(
-            s.flight.altitude_m.to_bits(),
-            (26_000.0 * M_PER_FT).to_bits()
-        );
-        assert_eq!(
-            s.interference.s_end_m.to_bits(),
-            (30.0 * M_PER_FT).to_bits()
-        );
-        assert_eq!(s.factors, FactorTable::default());
-    }
-
-    #[test]
-    fn toml_round_trip_is_exact() {
-        let s = Scenario::embedded_default();
-        let back = Scenario::from_toml_str(&s.to_toml_string(), "round trip").unwrap();
-        assert_eq!(back, s);
-        assert_eq!(back.content_hash(), s.content_hash());
-    }
-
-    #[test]
-    fn refusals_name_the_field() {
-        let text = DEFAULT_SCENARIO_TOML.replace("stroke_m = 0.100584", "stroke_m = 0.2");
-        let e = Scenario::from_toml_str(&text, "x.toml")
-            .unwrap_err()
-            .to_string();
-        assert_eq!(
-            e,
-            "scenario x.toml: `ejector.curve` covers [0, 0.100584] m: it must cover [0, stroke] = [0, 0.2] m"
-        );
-        let text = DEFAULT_SCENARIO_TOML.replace("mass_kg = 907.18474", "mass_kg = -1.0");
-        let e = Scenario::from_toml_str(&text, "x.toml")
-            .unwrap_err()
-            .to_string();
-        assert_eq!(
-            e,
-            "scenario x.toml: `store.mass_kg` = -1: expected a finite value > 0"
-        );
-        let text = DEFAULT_SCENARIO_TOML.replace("mach = 0.95", "mach = 0.95\nmahc = 1");
-        let e = Scenario::from_toml_str(&text, "x.toml")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("unknown field `mahc`") && e.contains("line"),
-            "{e}"
-        );
-        let text = DEFAULT_SCENARIO_TOML.replace("cloff = {", "clof = {");
-        let e = Scenario::from_toml_str(&text, "x.toml")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("unknown factor `clof`"), "{e}");
-        let text = DEFAULT_SCENARIO_TOML.replace(
-            "fwdfac = { min = 0.2, max = 1.0, bits = 5 }",
-            "fwdfac = { min = 1.2, max = 1.0, bits = 5 }",
-        );
-        let e = Scenario::from_toml_str(&text, "x.toml")
-            .unwrap_err()
-            .to_string();
-        assert_eq!(
-            e,
-            "scenario x.toml: `factors` factor `fwdfac`: min 1.2 must be below max 1"
-        );
-    }
-
-    #[test]
-    fn partial_factor_table_keeps_table_one_for_the_rest() {
-        let start = DEFAULT_SCENARIO_TOML.find("[factors]").unwrap();
-        let text = format!(
-            "{}[factors]\ncmoff = {{ min = -0.3, max = 0.3, bits = 8 }}\n",
-            &DEFAULT_SCENARIO_TOML[..start]
-        );
-        let s = Scenario::from_toml_str(&text, "x.toml").unwrap();
-        assert_eq!(s.factors.spec(Factor::Cmoff).bits, 8);
-        assert_eq!(
-            s.factors.spec(Factor::Fwdfac),
-            FactorTable::default().spec(Factor::Fwdfac)
-        );
-    }
-}
+mod tests;
