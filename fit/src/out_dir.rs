@@ -303,7 +303,9 @@ fn take_lock(dir: &Path, lock: &Path) -> Result<(), OutDirError> {
                 return Ok(());
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                let holder = std::fs::read_to_string(lock)
+                // Read as any input (a FIFO or a huge file planted as the lock must not hang or
+                // exhaust the run): a lock that cannot be read is a killed run's.
+                let holder = sepval_common::input_file::read_string(lock, "lock file", 4096)
                     .ok()
                     .and_then(|t| t.trim().parse::<u32>().ok());
                 match holder {

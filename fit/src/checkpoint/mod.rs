@@ -79,15 +79,9 @@ use sepval_solve::hill::HillSettings;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum CheckpointError {
-    /// The file cannot be read.
-    #[error("cannot read checkpoint {path}")]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
-    },
+    /// The file cannot be read (missing, not a regular file, over the size limit).
+    #[error(transparent)]
+    Read(#[from] sepval_common::input_file::InputFileError),
     /// The file is not a checkpoint.
     #[error("checkpoint {path} is not a sepval checkpoint")]
     Parse {
@@ -230,10 +224,11 @@ impl Checkpoint {
     /// content (see the module documentation); [`Checkpoint::check_job`] checks the rest
     /// against the job.
     pub fn load(path: &Path) -> Result<Checkpoint, CheckpointError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CheckpointError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = sepval_common::input_file::read_string(
+            path,
+            "checkpoint",
+            sepval_common::limits::MAX_JSON_BYTES,
+        )?;
         let parse = |source| CheckpointError::Parse {
             path: path.to_path_buf(),
             source,

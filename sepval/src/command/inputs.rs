@@ -32,8 +32,11 @@ pub fn factors(spec: &str, table: &FactorTable) -> Result<Factors> {
         "truth" => Factors::TRUTH,
         "nominal" => Factors::NOMINAL,
         path => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read factors file {path}"))?;
+            let text = sepval_common::input_file::read_string(
+                Path::new(path),
+                "factors file",
+                sepval_common::limits::MAX_JSON_BYTES,
+            )?;
             return Factors::from_json_str(&text, table)
                 .with_context(|| format!("factors file {path}"));
         }

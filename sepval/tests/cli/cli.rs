@@ -117,7 +117,7 @@ fn bad_factors_files_are_refused_and_nothing_is_written() {
         &["simulate", "--factors", "missing.json", "--out", "o.csv"],
         dir.path(),
     );
-    refused(&out, "cannot read factors file missing.json");
+    refused(&out, "missing.json: cannot read factors file");
 }
 
 #[test]
