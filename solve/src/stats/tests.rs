@@ -76,7 +76,7 @@ fn f_tail_matches_known_values_to_1e_12() {
     let known = [
         ([2.443_204_762_186_487, 1.0, 30.0], 0.128_523_464_353_326_68),
         ([3.0, 4.0, 100.0], 0.021_996_867_431_635_51),
-        ([0.5, 3.0, 1_183.0], 0.682_343_467_813_307_94),
+        ([0.5, 3.0, 1_183.0], 0.682_343_467_813_307_9),
         ([6.0, 2.0, 1_183.0], 0.002_554_820_967_926_669_4),
         ([20.0, 6.0, 1_183.0], 2.338_063_772_785_604e-22),
     ];
@@ -109,15 +109,15 @@ fn statrs_f_tail_is_not_the_same_to_1e_12() {
 
 #[test]
 fn edges_are_as_before() {
-    assert_eq!(chi2_sf(0.0, 3.0), 1.0);
-    assert_eq!(chi2_sf(-1.0, 3.0), 1.0);
-    assert_eq!(chi2_sf(f64::INFINITY, 3.0), 0.0);
+    assert_eq!(chi2_sf(0.0, 3.0).to_bits(), 1.0f64.to_bits());
+    assert_eq!(chi2_sf(-1.0, 3.0).to_bits(), 1.0f64.to_bits());
+    assert_eq!(chi2_sf(f64::INFINITY, 3.0).to_bits(), 0.0f64.to_bits());
     assert!(chi2_sf(f64::NAN, 3.0).is_nan());
-    assert_eq!(f_sf(0.0, 2.0, 10.0), 1.0);
-    assert_eq!(f_sf(f64::INFINITY, 2.0, 10.0), 0.0);
+    assert_eq!(f_sf(0.0, 2.0, 10.0).to_bits(), 1.0f64.to_bits());
+    assert_eq!(f_sf(f64::INFINITY, 2.0, 10.0).to_bits(), 0.0f64.to_bits());
     assert!(f_sf(f64::NAN, 2.0, 10.0).is_nan());
     // A perfect extended fit (rss1 = 0) is infinitely significant, as before.
-    assert_eq!(f_test(1.0, 0.0, 2, 100, 5).1, 0.0);
+    assert_eq!(f_test(1.0, 0.0, 2, 100, 5).1.to_bits(), 0.0f64.to_bits());
 }
 
 /// The former chi-square tail, unchanged (its log-gamma function is the one the F tail still
