@@ -6,6 +6,7 @@ use sepval_common::evaluation::Job;
 use sepval_common::factors::Factors;
 use sepval_common::goals::residual;
 use sepval_common::propagator::Observation;
+use sepval_solve::best::BestSoFar;
 use serde::{Deserialize, Serialize};
 
 /// Format tag of result files.
@@ -178,18 +179,10 @@ pub struct FrontPoint {
 pub struct HistoryPoint {
     /// Generation (GA) or iteration (hill climber) number.
     pub step: usize,
-    /// Simulations so far.
-    pub evaluations: u64,
-    /// Smallest J_pos in the population (the point itself for the hill climber) \[m\]
-    /// (`"inf"` when no member finished).
-    #[serde(with = "sepval_common::nonfinite")]
-    pub best_j_pos_m: f64,
-    /// Smallest J_att \[deg\].
-    #[serde(with = "sepval_common::nonfinite")]
-    pub best_j_att_deg: f64,
-    /// Smallest weighted sum.
-    #[serde(with = "sepval_common::nonfinite")]
-    pub best_weighted: f64,
+    /// The best so far: for the GA the smallest goals in the population, for the hill climber
+    /// the point itself (`"inf"` when no member finished).
+    #[serde(flatten)]
+    pub best: BestSoFar,
 }
 
 /// RMS residual (simulated minus measured) per channel, pooled over events.

@@ -110,102 +110,161 @@ pub fn identifiability(
     jac: &DMatrix<f64>,
     event_samples: &[usize],
 ) -> Identifiability {
-    let n = space.len();
-    // M = J^T J in units where every column of J has norm 1 (D = diag(1 / |J_i|)), so that
-    // what counts as "no information" does not depend on the parameters' units: the inverse
-    // is D (D M D)^+ D. A column of zeros is undetermined.
-    let scale: Vec<f64> = (0..n)
-        .map(|i| {
-            let c = jac.column(i).norm();
-            if c > 0.0 && c.is_finite() {
-                1.0 / c
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let mut m = jac.tr_mul(jac);
-    for i in 0..n {
-        for j in 0..n {
-            m[(i, j)] *= scale[i] * scale[j];
-        }
-    }
-    // Inverse of M on its range; directions with no information are undetermined.
-    // A bounded number of sweeps: on a pathological matrix (non-finite entries) the
-    // decomposition gives up and every parameter is reported undetermined.
-    let Some(eig) = m
-        .iter()
-        .all(|v| v.is_finite())
-        .then(|| SymmetricEigen::try_new(m.clone(), f64::EPSILON, 1000))
-        .flatten()
-    else {
+    let Some(white) = WhiteCovariance::of(jac) else {
         return undetermined_everywhere(space, x, event_samples);
     };
-    let lmax = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
-    let tol = lmax * 1e-13;
-    let mut m_inv = DMatrix::zeros(n, n);
-    let mut undetermined = vec![false; n];
-    for k in 0..n {
-        let v = eig.eigenvectors.column(k);
-        if eig.eigenvalues[k] > tol && eig.eigenvalues[k] > 0.0 {
-            m_inv += v * v.transpose() / eig.eigenvalues[k];
-        } else {
-            for i in 0..n {
-                if v[i].abs() > 1e-6 {
-                    undetermined[i] = true;
+    let colour = ColourCorrection::of(r, jac, event_samples);
+    let cov = &white.m_inv * colour.middle * &white.m_inv;
+    let (parameters, not_identifiable) = estimates(space, x, &cov, &white);
+    let (correlation, compensating) = correlations(space, &cov, &white.undetermined);
+    Identifiability {
+        parameters,
+        names: space.names.clone(),
+        correlation,
+        compensating,
+        not_identifiable,
+        max_lag: colour.max_lag,
+    }
+}
+
+/// The plain Cramer-Rao bound: the inverse of the Fisher information M = J^T J on its range,
+/// and the parameters it does not determine.
+struct WhiteCovariance {
+    /// M^-1 (pseudo-inverse; 0 in the directions without information).
+    m_inv: DMatrix<f64>,
+    /// The parameters in a direction without information, or whose column of J is zero.
+    undetermined: Vec<bool>,
+}
+
+impl WhiteCovariance {
+    /// From the Jacobian, or `None` when M has non-finite entries or its eigen-decomposition
+    /// does not converge (a bounded number of sweeps).
+    fn of(jac: &DMatrix<f64>) -> Option<Self> {
+        let n = jac.ncols();
+        // M = J^T J in units where every column of J has norm 1 (D = diag(1 / |J_i|)), so that
+        // what counts as "no information" does not depend on the parameters' units: the
+        // inverse is D (D M D)^+ D. A column of zeros is undetermined.
+        let scale: Vec<f64> = (0..n)
+            .map(|i| {
+                let c = jac.column(i).norm();
+                if c > 0.0 && c.is_finite() {
+                    1.0 / c
+                } else {
+                    0.0
                 }
+            })
+            .collect();
+        let mut m = jac.tr_mul(jac);
+        for i in 0..n {
+            for j in 0..n {
+                m[(i, j)] *= scale[i] * scale[j];
             }
         }
-    }
-    for i in 0..n {
-        if scale[i] == 0.0 {
-            undetermined[i] = true;
-        }
-        for j in 0..n {
-            m_inv[(i, j)] *= scale[i] * scale[j];
-        }
-    }
-    // Coloured-residual correction (SIDPAC m_colores), per event, Bartlett-tapered.
-    let mut middle = DMatrix::zeros(n, n);
-    let mut max_lag = 0;
-    let mut row0 = 0;
-    for &ns in event_samples {
-        // Lags up to a fifth of the event, at most 50, and at most MAX_COLOUR_PAIRS (sample,
-        // lag) pairs per event, so that the correction stays cheap on long records (there it
-        // uses fewer lags and the standard errors lean low).
-        let lag_max = (ns / 5).min(50).min(MAX_COLOUR_PAIRS / ns.max(1)).max(1);
-        max_lag = max_lag.max(lag_max);
-        let v = |i: usize, c: usize| r[row0 + 6 * i + c];
-        for lag in 0..=lag_max.min(ns.saturating_sub(1)) {
-            let w = 1.0 - lag as f64 / (lag_max as f64 + 1.0);
-            // R(lag), 6 x 6
-            let mut rk = DMatrix::zeros(6, 6);
-            for i in 0..ns - lag {
-                for a in 0..6 {
-                    for b in 0..6 {
-                        rk[(a, b)] += v(i, a) * v(i + lag, b);
+        let eig = m
+            .iter()
+            .all(|v| v.is_finite())
+            .then(|| SymmetricEigen::try_new(m.clone(), f64::EPSILON, 1000))
+            .flatten()?;
+        // Inverse of M on its range; directions with no information are undetermined.
+        let lmax = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+        let tol = lmax * 1e-13;
+        let mut m_inv = DMatrix::zeros(n, n);
+        let mut undetermined = vec![false; n];
+        for k in 0..n {
+            let v = eig.eigenvectors.column(k);
+            if eig.eigenvalues[k] > tol && eig.eigenvalues[k] > 0.0 {
+                m_inv += v * v.transpose() / eig.eigenvalues[k];
+            } else {
+                for i in 0..n {
+                    if v[i].abs() > 1e-6 {
+                        undetermined[i] = true;
                     }
                 }
             }
-            rk /= ns as f64;
-            // sum_i S_i^T R(lag) S_{i+lag}, and its transpose for the negative lag.
-            let mut acc = DMatrix::zeros(n, n);
-            for i in 0..ns - lag {
-                let si = jac.rows(row0 + 6 * i, 6);
-                let sj = jac.rows(row0 + 6 * (i + lag), 6);
-                acc += si.transpose() * &rk * sj;
+        }
+        for i in 0..n {
+            if scale[i] == 0.0 {
+                undetermined[i] = true;
             }
-            if lag == 0 {
-                middle += acc * w;
-            } else {
-                middle += (&acc + acc.transpose()) * w;
+            for j in 0..n {
+                m_inv[(i, j)] *= scale[i] * scale[j];
             }
         }
-        row0 += 6 * ns;
+        Some(WhiteCovariance {
+            m_inv,
+            undetermined,
+        })
     }
-    let cov = &m_inv * middle * &m_inv;
+}
+
+/// The coloured-residual correction (SIDPAC `m_colores`): the middle of
+/// M^-1 [ sum_i sum_j S_i^T R(i - j) S_j ] M^-1, per event, Bartlett-tapered.
+struct ColourCorrection {
+    middle: DMatrix<f64>,
+    /// Largest lag used.
+    max_lag: usize,
+}
+
+impl ColourCorrection {
+    fn of(r: &[f64], jac: &DMatrix<f64>, event_samples: &[usize]) -> Self {
+        let n = jac.ncols();
+        let mut middle = DMatrix::zeros(n, n);
+        let mut max_lag = 0;
+        let mut row0 = 0;
+        for &ns in event_samples {
+            // Lags up to a fifth of the event, at most 50, and at most MAX_COLOUR_PAIRS (sample,
+            // lag) pairs per event, so that the correction stays cheap on long records (there
+            // it uses fewer lags and the standard errors lean low).
+            let lag_max = (ns / 5).min(50).min(MAX_COLOUR_PAIRS / ns.max(1)).max(1);
+            max_lag = max_lag.max(lag_max);
+            for lag in 0..=lag_max.min(ns.saturating_sub(1)) {
+                let w = 1.0 - lag as f64 / (lag_max as f64 + 1.0);
+                let acc = lag_term(r, jac, row0, ns, lag);
+                if lag == 0 {
+                    middle += acc * w;
+                } else {
+                    middle += (&acc + acc.transpose()) * w;
+                }
+            }
+            row0 += 6 * ns;
+        }
+        ColourCorrection { middle, max_lag }
+    }
+}
+
+/// sum_i S_i^T R(lag) S_{i+lag} over the event of `ns` samples whose rows start at `row0`, with
+/// R(lag) = (1/N) sum_i v(i) v(i + lag)^T (6 x 6).
+fn lag_term(r: &[f64], jac: &DMatrix<f64>, row0: usize, ns: usize, lag: usize) -> DMatrix<f64> {
+    let v = |i: usize, c: usize| r[row0 + 6 * i + c];
+    let mut rk = DMatrix::zeros(6, 6);
+    for i in 0..ns - lag {
+        for a in 0..6 {
+            for b in 0..6 {
+                rk[(a, b)] += v(i, a) * v(i + lag, b);
+            }
+        }
+    }
+    rk /= ns as f64;
+    let mut acc = DMatrix::zeros(jac.ncols(), jac.ncols());
+    for i in 0..ns - lag {
+        let si = jac.rows(row0 + 6 * i, 6);
+        let sj = jac.rows(row0 + 6 * (i + lag), 6);
+        acc += si.transpose() * &rk * sj;
+    }
+    acc
+}
+
+/// Each parameter's estimate with its standard errors (coloured from `cov`, white from
+/// `white`), and the names of those the data do not determine within their range.
+fn estimates(
+    space: &Params,
+    x: &[f64],
+    cov: &DMatrix<f64>,
+    white: &WhiteCovariance,
+) -> (Vec<ParamEstimate>, Vec<String>) {
+    let n = space.len();
     let se = |c: &DMatrix<f64>, i: usize| -> Option<f64> {
-        if undetermined[i] {
+        if white.undetermined[i] {
             None
         } else {
             Some(c[(i, i)].max(0.0).sqrt())
@@ -214,7 +273,7 @@ pub fn identifiability(
     let mut parameters = Vec::with_capacity(n);
     let mut not_identifiable = Vec::new();
     for i in 0..n {
-        let s = se(&cov, i);
+        let s = se(cov, i);
         let identifiable = s.is_some_and(|s| s < space.range(i));
         if !identifiable {
             not_identifiable.push(space.names[i].clone());
@@ -224,10 +283,21 @@ pub fn identifiability(
             unit: space.units[i].clone(),
             value: x[i],
             std_error: s,
-            std_error_white: se(&m_inv, i),
+            std_error_white: se(&white.m_inv, i),
             identifiable,
         });
     }
+    (parameters, not_identifiable)
+}
+
+/// The correlation matrix of `cov` (0 where a parameter is not determined) and the pairs with
+/// |rho| > [`COMPENSATING_RHO`], strongest first.
+fn correlations(
+    space: &Params,
+    cov: &DMatrix<f64>,
+    undetermined: &[bool],
+) -> (Vec<Vec<f64>>, Vec<Compensating>) {
+    let n = space.len();
     let mut correlation = vec![vec![0.0; n]; n];
     let mut compensating = Vec::new();
     for i in 0..n {
@@ -252,14 +322,7 @@ pub fn identifiability(
         }
     }
     compensating.sort_by(|p, q| q.rho.abs().total_cmp(&p.rho.abs()));
-    Identifiability {
-        parameters,
-        names: space.names.clone(),
-        correlation,
-        compensating,
-        not_identifiable,
-        max_lag,
-    }
+    (correlation, compensating)
 }
 
 #[cfg(test)]

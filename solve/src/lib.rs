@@ -1,5 +1,5 @@
 //! sepval's solvers, generic over the problem they solve: the one ask-and-tell loop that runs
-//! every search ([`run`]), the study's elitist Pareto genetic algorithm ([`ga`]) and hill
+//! every search ([`run`]) and the best-so-far record of its history ([`best`]), the study's elitist Pareto genetic algorithm ([`ga`]) and hill
 //! climber ([`hill`]), a bounded Levenberg-Marquardt least-squares refinement ([`lm`]), the
 //! Pareto machinery ([`pareto`]), how sure a least-squares estimate is ([`identifiability`]),
 //! the distribution functions and tests the diagnosis uses ([`stats`]), and the ZDT test
@@ -17,6 +17,7 @@
 // Matrix and array code indexes by (row, column) as the equations it implements do.
 #![allow(clippy::needless_range_loop)]
 
+pub mod best;
 pub mod ga;
 pub mod hill;
 pub mod identifiability;

@@ -3,7 +3,7 @@
 //! or on a doubling schedule; once a probe reaches the noise floor, the stage ends. And the
 //! observer that writes one checkpoint per generation.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Candidate, Evaluation, Job};
@@ -183,21 +183,46 @@ impl Solver for GaStage {
 /// generator, the probes, the settings and the hashes of the data and scenario.
 pub struct Checkpointer {
     /// Run directory.
-    pub out: PathBuf,
-    /// The method being run (`ga`, `both`, ...).
-    pub method: String,
-    /// GA settings.
-    pub settings: GaSettings,
-    /// Hill-climber settings.
-    pub hill: HillSettings,
-    /// Noise levels.
-    pub sigma: Sigma,
-    /// SHA-256 of the data.
-    pub data_sha256: String,
-    /// SHA-256 of the scenario(s).
-    pub scenario_sha256: String,
-    /// Where the inputs came from.
-    pub inputs: InputsRecord,
+    out: PathBuf,
+    /// Every checkpoint of the run but its state and probes, which each generation fills in.
+    template: Checkpoint,
+}
+
+impl Checkpointer {
+    /// Writes into `out`/generations checkpoints made from `template` ([`Checkpointer::template`]).
+    pub fn new(out: &Path, template: Checkpoint) -> Self {
+        Checkpointer {
+            out: out.to_path_buf(),
+            template,
+        }
+    }
+
+    /// The template of a run's checkpoints: its method, settings, noise levels, the hashes of
+    /// `job`'s data and scenario and where its inputs came from, with the search as it is
+    /// before its first generation and no probes.
+    pub fn template(
+        method: &str,
+        settings: &GaSettings,
+        hill: &HillSettings,
+        sigma: &Sigma,
+        job: &Job,
+        inputs: &InputsRecord,
+    ) -> Checkpoint {
+        Checkpoint {
+            format: CHECKPOINT_FORMAT.to_string(),
+            digest: None,
+            arithmetic: Some(sepval_common::ARITHMETIC_VERSION),
+            method: method.to_string(),
+            settings: settings.clone(),
+            hill: hill.clone(),
+            sigma: sigma.clone(),
+            data_sha256: job.data_sha256().to_string(),
+            scenario_sha256: job.scenario_sha256().to_string(),
+            inputs: inputs.clone(),
+            state: GaState::unstarted(settings.seed),
+            probes: Vec::new(),
+        }
+    }
 }
 
 impl Observer<GaStage> for Checkpointer {
@@ -206,18 +231,9 @@ impl Observer<GaStage> for Checkpointer {
             return Ok(Control::Continue);
         };
         let checkpoint = Checkpoint {
-            format: CHECKPOINT_FORMAT.to_string(),
-            digest: None,
-            arithmetic: Some(sepval_common::ARITHMETIC_VERSION),
-            method: self.method.clone(),
-            settings: self.settings.clone(),
-            hill: self.hill.clone(),
-            sigma: self.sigma.clone(),
-            data_sha256: self.data_sha256.clone(),
-            scenario_sha256: self.scenario_sha256.clone(),
-            inputs: self.inputs.clone(),
             state: state.clone(),
             probes: stage.probes().to_vec(),
+            ..self.template.clone()
         };
         checkpoint
             .save(&Checkpoint::path(&self.out, state.generation))

@@ -1,8 +1,8 @@
 //! What a fit reports: each method's result (best member, Pareto front, history, per-channel
-//! residuals), what one grid step of each factor does at the best fit, the results file and the
-//! figures.
+//! residuals), what one grid step of each factor does at the best fit, and the results file (the
+//! figures are in `figures.rs`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use sepval_common::atomic_file::write_atomically;
@@ -12,7 +12,7 @@ use sepval_common::goals::GoalSums;
 use sepval_common::model::StateVector;
 use sepval_common::propagator::{Observation, SampleSink, propagate};
 
-use super::{FitError, FitOutput};
+use super::FitError;
 use crate::problem::factors_of;
 use sepval_solve::lm::LmResult;
 
@@ -30,8 +30,8 @@ pub(super) fn first_at_floor(
 ) -> Option<u64> {
     history
         .iter()
-        .find(|h| at_floor([h.best_j_pos_m, h.best_j_att_deg]))
-        .map(|h| h.evaluations)
+        .find(|h| at_floor(h.best.goals()))
+        .map(|h| h.best.evaluations)
 }
 
 pub(super) fn lm_first_at_floor(
@@ -45,6 +45,18 @@ pub(super) fn lm_first_at_floor(
         .map(|(n, _)| before + n)
 }
 
+/// A method's best member as the result file and the figures carry it.
+pub(super) struct Carried {
+    /// The member (refined, for `+lm` methods).
+    pub member: Member,
+    /// Its RMS residual per channel.
+    pub channel_rms: ChannelRms,
+    /// Its samples the figures draw.
+    pub plotted: Vec<Observation>,
+    /// The refinement record (`+lm` methods).
+    pub refinement: Option<Refinement>,
+}
+
 /// The refined member, its channel summary and plotted samples (simulated again here, as for
 /// a search's best member), and the refinement record.
 pub(super) fn refined_member(
@@ -52,7 +64,7 @@ pub(super) fn refined_member(
     lm: &LmResult,
     start: &Member,
     probes: Vec<Probe>,
-) -> Result<(Member, ChannelRms, Vec<Observation>, Refinement), FitError> {
+) -> Result<Carried, FitError> {
     let values = lm.x[..FACTOR_COUNT].to_vec();
     let member = Member {
         chromosome: sepval_common::encoding::Chromosome::encode_values(
@@ -73,7 +85,12 @@ pub(super) fn refined_member(
         stop: lm.stop.clone(),
         probes,
     };
-    Ok((member, rms, plotted, refinement))
+    Ok(Carried {
+        member,
+        channel_rms: rms,
+        plotted,
+        refinement: Some(refinement),
+    })
 }
 
 /// Simulates `c` on every event of `job` in this process, handing each sample to
@@ -187,9 +204,12 @@ pub fn resolution_advice(
     Ok(rows)
 }
 
+/// Most samples of one series a trajectory figure draws.
+const MAX_PLOTTED_SAMPLES: usize = 20_000;
+
 /// Every how many samples a trajectory figure draws the first event (a figure has about a
 /// thousand pixels across: a long record is thinned to at most [`MAX_PLOTTED_SAMPLES`]).
-fn plot_stride(job: &Job) -> usize {
+pub(super) fn plot_stride(job: &Job) -> usize {
     job.events()[0]
         .data
         .len()
@@ -270,140 +290,4 @@ pub fn write_result(dir: &Path, result: &FitResult) -> Result<(), FitError> {
     let json = serde_json::to_vec_pretty(result).expect("a result serialises");
     write_atomically(&dir.join("result.json"), &json)?;
     Ok(())
-}
-
-/// Most samples of one series a trajectory figure draws.
-const MAX_PLOTTED_SAMPLES: usize = 20_000;
-
-/// Writes the fit's figures into DIR/figures: the study's Figures 1-6 (trajectories of the
-/// first event against each method's best), Figure 7 (factors beside the truth, when known),
-/// the Pareto fronts and the convergence histories. Returns the files written.
-pub fn write_fit_figures(
-    dir: &Path,
-    job: &Job,
-    output: &FitOutput,
-) -> Result<Vec<PathBuf>, FitError> {
-    use sepval_common::factors::Factor;
-    use sepval_report::figures::{
-        Series, convergence_figure, factor_figure, pareto_figure, trajectory_figures,
-    };
-    let fig_dir = dir.join("figures");
-    std::fs::create_dir_all(&fig_dir).map_err(|source| FitError::Dir {
-        path: fig_dir.clone(),
-        source,
-    })?;
-    let r = &output.result;
-    fn label(m: &str) -> String {
-        match m {
-            "ga" => "genetic algorithm".to_string(),
-            "hill" => "hill climber".to_string(),
-            other => other.to_string(),
-        }
-    }
-    let first = &job.events()[0];
-    // A long record is drawn from every k-th sample (a figure has about a thousand pixels
-    // across; the plotted copies stay small).
-    let stride = plot_stride(job);
-    let pick = |n: usize| (0..n).step_by(stride);
-    let data = sepval_common::telemetry::Trajectory {
-        times_s: pick(first.data.len())
-            .map(|k| first.data.times_s[k])
-            .collect(),
-        pos_m: pick(first.data.len())
-            .map(|k| first.data.pos_m[k])
-            .collect(),
-        att_deg: pick(first.data.len())
-            .map(|k| first.data.att_deg[k])
-            .collect(),
-        ..Default::default()
-    };
-    let fits: Vec<(String, sepval_common::telemetry::Trajectory)> = output
-        .best_plotted
-        .iter()
-        .map(|(m, plotted)| {
-            let traj = sepval_common::telemetry::Trajectory {
-                times_s: data.times_s.clone(),
-                pos_m: plotted.iter().map(|o| o.pos_m).collect(),
-                att_deg: plotted.iter().map(|o| o.att_deg).collect(),
-                ..Default::default()
-            };
-            (label(m), traj)
-        })
-        .collect();
-    let series: Vec<Series> = fits
-        .iter()
-        .map(|(l, t)| Series { label: l, traj: t })
-        .collect();
-    let mut written = trajectory_figures(&fig_dir, &data, &series)?;
-
-    let table = job.factor_table();
-    let ranges: Vec<(f64, f64)> = table.0.iter().map(|s| (s.min, s.max)).collect();
-    let method_values: Vec<(String, Vec<f64>)> = r
-        .methods
-        .iter()
-        .map(|(m, v)| (label(m), v.best.factors.0.to_vec()))
-        .collect();
-    let methods: Vec<(&str, &[f64])> = method_values
-        .iter()
-        .map(|(l, v)| (l.as_str(), v.as_slice()))
-        .collect();
-    let truth = r.truth.map(|t| t.0.to_vec());
-    let path = fig_dir.join("fig7_factors.png");
-    factor_figure(&path, &Factor::NAMES, &ranges, &methods, truth.as_deref())?;
-    written.push(path);
-
-    let fronts_data: Vec<(String, Vec<[f64; 2]>)> = r
-        .methods
-        .iter()
-        .map(|(m, v)| {
-            (
-                label(m),
-                v.pareto_front
-                    .iter()
-                    .map(|p| [p.j_pos_m, p.j_att_deg])
-                    .collect(),
-            )
-        })
-        .collect();
-    let fronts: Vec<(&str, &[[f64; 2]])> = fronts_data
-        .iter()
-        .map(|(l, v)| (l.as_str(), v.as_slice()))
-        .collect();
-    let path = fig_dir.join("pareto_front.png");
-    pareto_figure(&path, &fronts, Some((r.sigma_pos_m, r.sigma_att_deg)))?;
-    written.push(path);
-
-    let hist_data: Vec<(String, Vec<(u64, f64)>)> = r
-        .methods
-        .iter()
-        .map(|(m, v)| {
-            (
-                label(m),
-                v.history
-                    .iter()
-                    .map(|h| (h.evaluations, h.best_weighted))
-                    .collect(),
-            )
-        })
-        .collect();
-    let hists: Vec<(&str, &[(u64, f64)])> = hist_data
-        .iter()
-        .map(|(l, v)| (l.as_str(), v.as_slice()))
-        .collect();
-    let path = fig_dir.join("convergence.png");
-    convergence_figure(&path, &hists, Some(2.0))?;
-    written.push(path);
-
-    if let Some(id) = &r.identifiability {
-        let names: Vec<&str> = id.names.iter().map(String::as_str).collect();
-        let path = fig_dir.join("correlation.png");
-        sepval_report::figures::correlation_figure(
-            &path,
-            &names,
-            &id.correlation,
-            "Correlation of the refined estimates (|rho| > 0.9: compensating)",
-        )?;
-        written.push(path);
-    }
-    Ok(written)
 }

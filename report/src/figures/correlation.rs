@@ -7,7 +7,7 @@ use plotters::style::FontTransform;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::FigureError;
-use super::kit::{estimate_width, fmt_tick, render, text};
+use super::kit::{DrawResult, Root, estimate_width, fmt_tick, render, text};
 
 /// The most rows and columns a correlation figure draws (2 px a cell).
 const MAX_CORRELATION_NAMES: usize = 450;
@@ -45,51 +45,16 @@ pub fn correlation_figure(
     rho: &[Vec<f64>],
     title: &str,
 ) -> Result<(), FigureError> {
-    let n = names.len();
-    if rho.len() != n || rho.iter().any(|row| row.len() != n) {
-        let shape: Vec<usize> = rho.iter().map(Vec::len).collect();
-        return Err(FigureError::Input {
-            path: path.to_path_buf(),
-            message: format!(
-                "the correlation matrix must be {n} × {n} for {n} names, found {} rows of lengths {shape:?}",
-                rho.len()
-            ),
-        });
-    }
-    if n > MAX_CORRELATION_NAMES {
-        return Err(FigureError::Input {
-            path: path.to_path_buf(),
-            message: format!(
-                "{n} names: a correlation figure draws at most {MAX_CORRELATION_NAMES}"
-            ),
-        });
-    }
-    let cell = if n == 0 {
-        40
-    } else {
-        (900 / n as u32).clamp(2, 90)
-    };
-    let grid = cell * n as u32;
-    let name_size = (f64::from(cell) * 0.45).clamp(9.0, 16.0);
-    let value_size = (f64::from(cell) * 0.3).clamp(8.0, 16.0);
-    let widest = names
-        .iter()
-        .map(|s| estimate_width(s, name_size))
-        .max()
-        .unwrap_or(0)
-        .min(300);
-    let (left, top) = ((widest + 30).max(60), 80u32);
-    let bottom = (widest + 30).max(60);
-    let bar_area = 130u32;
-    let content = left + grid + bar_area;
-    let width = content.max(800);
-    let height = (top + grid + bottom).max(600);
+    check_shape(names.len(), rho).map_err(|message| FigureError::Input {
+        path: path.to_path_buf(),
+        message,
+    })?;
+    let layout = Layout::of(names);
+    let (width, height) = (layout.width, layout.height);
     render(path, (width, height), |root| {
         let title_style = text(26.0).pos(Pos::new(HPos::Center, VPos::Center));
         root.draw(&Text::new(title, (width as i32 / 2, 36), title_style))?;
-        let x0 = (left + (width - content) / 2) as i32;
-        let (y0, c) = (top as i32, cell as i32);
-        if n == 0 {
+        if names.is_empty() {
             let style = text(18.0).pos(Pos::new(HPos::Center, VPos::Center));
             root.draw(&Text::new(
                 "(no factors)",
@@ -97,86 +62,176 @@ pub fn correlation_figure(
                 style,
             ))?;
         }
-        for (i, row) in rho.iter().enumerate() {
-            for (j, &v) in row.iter().enumerate() {
-                let (cx, cy) = (x0 + j as i32 * c, y0 + i as i32 * c);
-                root.draw(&Rectangle::new(
-                    [(cx, cy), (cx + c, cy + c)],
-                    diverging(v).filled(),
-                ))?;
-                if n <= 24 && v.is_finite() {
-                    let ink = if v.abs() > 0.55 { WHITE } else { BLACK };
-                    let style = text(value_size)
-                        .color(&ink)
-                        .pos(Pos::new(HPos::Center, VPos::Center));
-                    let s = format!("{:.2}", v.clamp(-99.0, 99.0));
-                    root.draw(&Text::new(s, (cx + c / 2, cy + c / 2), style))?;
-                }
-            }
+        draw_cells(root, rho, &layout)?;
+        draw_names(root, names, &layout)?;
+        draw_colour_bar(root, &layout)
+    })
+}
+
+/// Checks that `rho` is n × n and that n is not above [`MAX_CORRELATION_NAMES`].
+fn check_shape(n: usize, rho: &[Vec<f64>]) -> Result<(), String> {
+    if rho.len() != n || rho.iter().any(|row| row.len() != n) {
+        let shape: Vec<usize> = rho.iter().map(Vec::len).collect();
+        return Err(format!(
+            "the correlation matrix must be {n} × {n} for {n} names, found {} rows of lengths {shape:?}",
+            rho.len()
+        ));
+    }
+    if n > MAX_CORRELATION_NAMES {
+        return Err(format!(
+            "{n} names: a correlation figure draws at most {MAX_CORRELATION_NAMES}"
+        ));
+    }
+    Ok(())
+}
+
+/// The sizes of a correlation figure, in pixels.
+struct Layout {
+    n: usize,
+    /// Side of one cell.
+    cell: u32,
+    /// Side of the matrix.
+    grid: u32,
+    /// Font size of the names and of the values in the cells.
+    name_size: f64,
+    value_size: f64,
+    width: u32,
+    height: u32,
+    /// The matrix's upper left corner.
+    x0: i32,
+    y0: i32,
+}
+
+impl Layout {
+    fn of(names: &[&str]) -> Self {
+        let n = names.len();
+        let cell = if n == 0 {
+            40
+        } else {
+            (900 / n as u32).clamp(2, 90)
+        };
+        let grid = cell * n as u32;
+        let name_size = (f64::from(cell) * 0.45).clamp(9.0, 16.0);
+        let value_size = (f64::from(cell) * 0.3).clamp(8.0, 16.0);
+        let widest = names
+            .iter()
+            .map(|s| estimate_width(s, name_size))
+            .max()
+            .unwrap_or(0)
+            .min(300);
+        let (left, top) = ((widest + 30).max(60), 80u32);
+        let bottom = (widest + 30).max(60);
+        let bar_area = 130u32;
+        let content = left + grid + bar_area;
+        let width = content.max(800);
+        let height = (top + grid + bottom).max(600);
+        Layout {
+            n,
+            cell,
+            grid,
+            name_size,
+            value_size,
+            width,
+            height,
+            x0: (left + (width - content) / 2) as i32,
+            y0: top as i32,
         }
-        // Thin white lines between cells, and a frame.
-        if n > 0 && cell >= 16 {
-            for k in 1..n as i32 {
-                let style = WHITE.stroke_width(1);
-                root.draw(&PathElement::new(
-                    vec![(x0 + k * c, y0), (x0 + k * c, y0 + n as i32 * c)],
-                    style,
-                ))?;
-                root.draw(&PathElement::new(
-                    vec![(x0, y0 + k * c), (x0 + n as i32 * c, y0 + k * c)],
-                    style,
-                ))?;
-            }
-        }
-        if n > 0 {
-            let g = grid as i32;
+    }
+}
+
+/// The cells in their colours with their values (n ≤ 24), thin white lines between them when
+/// they are large enough, and a frame.
+fn draw_cells(root: &Root, rho: &[Vec<f64>], l: &Layout) -> DrawResult {
+    let (x0, y0, c, n) = (l.x0, l.y0, l.cell as i32, l.n);
+    for (i, row) in rho.iter().enumerate() {
+        for (j, &v) in row.iter().enumerate() {
+            let (cx, cy) = (x0 + j as i32 * c, y0 + i as i32 * c);
             root.draw(&Rectangle::new(
-                [(x0, y0), (x0 + g, y0 + g)],
-                RGBColor(80, 80, 80).stroke_width(1),
+                [(cx, cy), (cx + c, cy + c)],
+                diverging(v).filled(),
             ))?;
+            if n <= 24 && v.is_finite() {
+                let ink = if v.abs() > 0.55 { WHITE } else { BLACK };
+                let style = text(l.value_size)
+                    .color(&ink)
+                    .pos(Pos::new(HPos::Center, VPos::Center));
+                let s = format!("{:.2}", v.clamp(-99.0, 99.0));
+                root.draw(&Text::new(s, (cx + c / 2, cy + c / 2), style))?;
+            }
         }
-        // Every name while they fit side by side, else every `step`-th.
-        let step = (9 / cell.max(1) + 1) as usize;
-        for (k, name) in names.iter().enumerate().step_by(step) {
-            let mid = k as i32 * c + c / 2;
-            let row_style = text(name_size).pos(Pos::new(HPos::Right, VPos::Center));
-            root.draw(&Text::new(*name, (x0 - 8, y0 + mid), row_style))?;
-            let col_style = text(name_size)
-                .transform(FontTransform::Rotate270)
-                .pos(Pos::new(HPos::Right, VPos::Center));
-            root.draw(&Text::new(
-                *name,
-                (x0 + mid, y0 + grid as i32 + 8),
-                col_style,
-            ))?;
-        }
-        // Colour bar.
-        let bar_h = (grid as i32).clamp(200, 500);
-        let (bx, by) = (x0 + grid as i32 + 40, y0 + (grid as i32 - bar_h).max(0) / 2);
-        for p in 0..bar_h {
-            let v = 1.0 - 2.0 * f64::from(p) / f64::from(bar_h - 1);
+    }
+    if n > 0 && l.cell >= 16 {
+        for k in 1..n as i32 {
+            let style = WHITE.stroke_width(1);
             root.draw(&PathElement::new(
-                vec![(bx, by + p), (bx + 24, by + p)],
-                diverging(v).stroke_width(1),
+                vec![(x0 + k * c, y0), (x0 + k * c, y0 + n as i32 * c)],
+                style,
+            ))?;
+            root.draw(&PathElement::new(
+                vec![(x0, y0 + k * c), (x0 + n as i32 * c, y0 + k * c)],
+                style,
             ))?;
         }
+    }
+    if n > 0 {
+        let g = l.grid as i32;
         root.draw(&Rectangle::new(
-            [(bx, by), (bx + 24, by + bar_h)],
+            [(x0, y0), (x0 + g, y0 + g)],
             RGBColor(80, 80, 80).stroke_width(1),
         ))?;
-        for tick in [-1.0, -0.5, 0.0, 0.5, 1.0] {
-            let ty = by + ((1.0 - tick) / 2.0 * f64::from(bar_h - 1)).round() as i32;
-            root.draw(&PathElement::new(
-                vec![(bx + 24, ty), (bx + 30, ty)],
-                BLACK.stroke_width(1),
-            ))?;
-            let style = text(14.0).pos(Pos::new(HPos::Left, VPos::Center));
-            root.draw(&Text::new(fmt_tick(tick), (bx + 34, ty), style))?;
-        }
-        let style = text(18.0).pos(Pos::new(HPos::Center, VPos::Bottom));
-        root.draw(&Text::new("ρ", (bx + 12, by - 10), style))?;
-        Ok(())
-    })
+    }
+    Ok(())
+}
+
+/// The names left of the rows and under the columns: every name while they fit side by side,
+/// else every `step`-th.
+fn draw_names(root: &Root, names: &[&str], l: &Layout) -> DrawResult {
+    let (x0, y0, c) = (l.x0, l.y0, l.cell as i32);
+    let step = (9 / l.cell.max(1) + 1) as usize;
+    for (k, name) in names.iter().enumerate().step_by(step) {
+        let mid = k as i32 * c + c / 2;
+        let row_style = text(l.name_size).pos(Pos::new(HPos::Right, VPos::Center));
+        root.draw(&Text::new(*name, (x0 - 8, y0 + mid), row_style))?;
+        let col_style = text(l.name_size)
+            .transform(FontTransform::Rotate270)
+            .pos(Pos::new(HPos::Right, VPos::Center));
+        root.draw(&Text::new(
+            *name,
+            (x0 + mid, y0 + l.grid as i32 + 8),
+            col_style,
+        ))?;
+    }
+    Ok(())
+}
+
+/// The colour bar right of the matrix, from +1 (top) to −1, with its ticks and ρ above it.
+fn draw_colour_bar(root: &Root, l: &Layout) -> DrawResult {
+    let grid = l.grid as i32;
+    let bar_h = grid.clamp(200, 500);
+    let (bx, by) = (l.x0 + grid + 40, l.y0 + (grid - bar_h).max(0) / 2);
+    for p in 0..bar_h {
+        let v = 1.0 - 2.0 * f64::from(p) / f64::from(bar_h - 1);
+        root.draw(&PathElement::new(
+            vec![(bx, by + p), (bx + 24, by + p)],
+            diverging(v).stroke_width(1),
+        ))?;
+    }
+    root.draw(&Rectangle::new(
+        [(bx, by), (bx + 24, by + bar_h)],
+        RGBColor(80, 80, 80).stroke_width(1),
+    ))?;
+    for tick in [-1.0, -0.5, 0.0, 0.5, 1.0] {
+        let ty = by + ((1.0 - tick) / 2.0 * f64::from(bar_h - 1)).round() as i32;
+        root.draw(&PathElement::new(
+            vec![(bx + 24, ty), (bx + 30, ty)],
+            BLACK.stroke_width(1),
+        ))?;
+        let style = text(14.0).pos(Pos::new(HPos::Left, VPos::Center));
+        root.draw(&Text::new(fmt_tick(tick), (bx + 34, ty), style))?;
+    }
+    let style = text(18.0).pos(Pos::new(HPos::Center, VPos::Bottom));
+    root.draw(&Text::new("ρ", (bx + 12, by - 10), style))?;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -36,7 +36,8 @@ pub(super) type Root<'b> = DrawingArea<BitMapBackend<'b>, Shift>;
 pub(super) type DrawResult = Result<(), Box<dyn Error>>;
 /// A pixel position.
 type Px = (i32, i32);
-type Chart2d<'a, 'b, X, Y> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<X, Y>>;
+/// A chart with two axes drawn into a figure in memory.
+pub(super) type Chart2d<'a, 'b, X, Y> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<X, Y>>;
 
 /// Draws a figure of `(width, height)` pixels with `draw` and writes it to `path` as PNG,
 /// atomically.

@@ -19,6 +19,7 @@ use sepval_common::evaluation::{EvalError, Outcome};
 use sepval_common::factors::FactorSpec;
 use serde::{Deserialize, Serialize};
 
+use crate::best::BestSoFar;
 use crate::ga::operators::{
     creep_mutation, crossover, jump_mutation, random_chromosome, tournament,
 };
@@ -134,22 +135,30 @@ impl Member {
 }
 
 /// The best of one generation. The goals are infinite when no member of the population
-/// finished; in JSON they are then the string `"inf"` ([`sepval_common::nonfinite`]).
+/// finished; in JSON they are then the string `"inf"` ([`sepval_common::nonfinite`]). Its
+/// fields after `generation` are [`BestSoFar`]'s, read through `Deref` as before
+/// (`stats.best_j_pos_m`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GenerationStats {
     /// Generation number (1 = the initial population).
     pub generation: usize,
-    /// Simulations run so far.
-    pub evaluations: u64,
-    /// Smallest first objective in the population.
-    #[serde(with = "sepval_common::nonfinite")]
-    pub best_j_pos_m: f64,
-    /// Smallest second objective in the population.
-    #[serde(with = "sepval_common::nonfinite")]
-    pub best_j_att_deg: f64,
-    /// Smallest weighted sum w0 J_pos + w1 J_att in the population.
-    #[serde(with = "sepval_common::nonfinite")]
-    pub best_weighted: f64,
+    /// The best of the population and the simulations so far.
+    #[serde(flatten)]
+    pub best: BestSoFar,
+}
+
+impl std::ops::Deref for GenerationStats {
+    type Target = BestSoFar;
+
+    fn deref(&self) -> &BestSoFar {
+        &self.best
+    }
+}
+
+impl std::ops::DerefMut for GenerationStats {
+    fn deref_mut(&mut self) -> &mut BestSoFar {
+        &mut self.best
+    }
 }
 
 /// The search's state after a generation.
@@ -170,6 +179,19 @@ pub struct GaState {
 }
 
 impl GaState {
+    /// The search before its first generation: nothing evaluated, the generator as seeded
+    /// by `seed` (what the first generation draws its population from).
+    pub fn unstarted(seed: u64) -> Self {
+        GaState {
+            generation: 0,
+            evaluations: 0,
+            population: Vec::new(),
+            archive: Vec::new(),
+            rng: RngState::of(&seeded(seed)),
+            history: Vec::new(),
+        }
+    }
+
     /// The member of the population with the smallest weighted sum of objectives.
     pub fn best(&self, weights: [f64; 2]) -> Option<&Member> {
         best_weighted(&self.population, weights)
@@ -320,12 +342,14 @@ impl GaSearch {
         };
         GenerationStats {
             generation: state.generation,
-            evaluations: state.evaluations,
-            best_j_pos_m: min(0),
-            best_j_att_deg: min(1),
-            best_weighted: state
-                .best(self.weights)
-                .map_or(f64::INFINITY, |m| weighted(m, self.weights)),
+            best: BestSoFar {
+                evaluations: state.evaluations,
+                best_j_pos_m: min(0),
+                best_j_att_deg: min(1),
+                best_weighted: state
+                    .best(self.weights)
+                    .map_or(f64::INFINITY, |m| weighted(m, self.weights)),
+            },
         }
     }
 }

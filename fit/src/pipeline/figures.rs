@@ -1,0 +1,168 @@
+//! The fit's figures, DIR/figures: the study's Figures 1-6 (trajectories), Figure 7 (factors),
+//! the Pareto fronts, the convergence histories and, for refined fits, the correlation of the
+//! estimates; drawn by `sepval_report::figures` from the result and the plotted samples.
+
+use std::path::{Path, PathBuf};
+
+use sepval_common::evaluation::Job;
+use sepval_common::factors::Factor;
+use sepval_common::telemetry::Trajectory;
+use sepval_report::figures::{
+    Series, convergence_figure, correlation_figure, factor_figure, pareto_figure,
+    trajectory_figures,
+};
+
+use super::outputs::plot_stride;
+use super::{FitError, FitOutput};
+use crate::results::{FitResult, MethodResult};
+
+/// Writes the fit's figures into DIR/figures: the study's Figures 1-6 (trajectories of the
+/// first event against each method's best), Figure 7 (factors beside the truth, when known),
+/// the Pareto fronts and the convergence histories. Returns the files written.
+pub fn write_fit_figures(
+    dir: &Path,
+    job: &Job,
+    output: &FitOutput,
+) -> Result<Vec<PathBuf>, FitError> {
+    let fig_dir = dir.join("figures");
+    std::fs::create_dir_all(&fig_dir).map_err(|source| FitError::Dir {
+        path: fig_dir.clone(),
+        source,
+    })?;
+    let r = &output.result;
+    let mut written = write_trajectories(&fig_dir, job, output)?;
+    written.push(write_factors(&fig_dir, job, r)?);
+    written.push(write_fronts(&fig_dir, r)?);
+    written.push(write_convergence(&fig_dir, r)?);
+    if let Some(id) = &r.identifiability {
+        let names: Vec<&str> = id.names.iter().map(String::as_str).collect();
+        let path = fig_dir.join("correlation.png");
+        correlation_figure(
+            &path,
+            &names,
+            &id.correlation,
+            "Correlation of the refined estimates (|rho| > 0.9: compensating)",
+        )?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// A method's name as the legends write it.
+fn label(m: &str) -> String {
+    match m {
+        "ga" => "genetic algorithm".to_string(),
+        "hill" => "hill climber".to_string(),
+        other => other.to_string(),
+    }
+}
+
+/// Per method, its legend label and `values` of its result.
+fn per_method<T>(r: &FitResult, values: impl Fn(&MethodResult) -> Vec<T>) -> Vec<(String, Vec<T>)> {
+    r.methods
+        .iter()
+        .map(|(m, v)| (label(m), values(v)))
+        .collect()
+}
+
+/// The borrowed form the figures take of [`per_method`]'s.
+fn borrowed<T>(owned: &[(String, Vec<T>)]) -> Vec<(&str, &[T])> {
+    owned
+        .iter()
+        .map(|(l, v)| (l.as_str(), v.as_slice()))
+        .collect()
+}
+
+/// Figures 1-6: the first event's data against each method's best trajectory. A long record
+/// is drawn from every k-th sample (a figure has about a thousand pixels across; the plotted
+/// copies stay small).
+fn write_trajectories(
+    fig_dir: &Path,
+    job: &Job,
+    output: &FitOutput,
+) -> Result<Vec<PathBuf>, FitError> {
+    let first = &job.events()[0];
+    let stride = plot_stride(job);
+    let pick = |n: usize| (0..n).step_by(stride);
+    let data = Trajectory {
+        times_s: pick(first.data.len())
+            .map(|k| first.data.times_s[k])
+            .collect(),
+        pos_m: pick(first.data.len())
+            .map(|k| first.data.pos_m[k])
+            .collect(),
+        att_deg: pick(first.data.len())
+            .map(|k| first.data.att_deg[k])
+            .collect(),
+        ..Default::default()
+    };
+    let fits: Vec<(String, Trajectory)> = output
+        .best_plotted
+        .iter()
+        .map(|(m, plotted)| {
+            let traj = Trajectory {
+                times_s: data.times_s.clone(),
+                pos_m: plotted.iter().map(|o| o.pos_m).collect(),
+                att_deg: plotted.iter().map(|o| o.att_deg).collect(),
+                ..Default::default()
+            };
+            (label(m), traj)
+        })
+        .collect();
+    let series: Vec<Series> = fits
+        .iter()
+        .map(|(l, t)| Series { label: l, traj: t })
+        .collect();
+    Ok(trajectory_figures(fig_dir, &data, &series)?)
+}
+
+/// Figure 7: each method's factors beside the truth, when known.
+fn write_factors(fig_dir: &Path, job: &Job, r: &FitResult) -> Result<PathBuf, FitError> {
+    let ranges: Vec<(f64, f64)> = job
+        .factor_table()
+        .0
+        .iter()
+        .map(|s| (s.min, s.max))
+        .collect();
+    let values = per_method(r, |v| v.best.factors.0.to_vec());
+    let truth = r.truth.map(|t| t.0.to_vec());
+    let path = fig_dir.join("fig7_factors.png");
+    factor_figure(
+        &path,
+        &Factor::NAMES,
+        &ranges,
+        &borrowed(&values),
+        truth.as_deref(),
+    )?;
+    Ok(path)
+}
+
+/// Each method's Pareto front, with the noise levels.
+fn write_fronts(fig_dir: &Path, r: &FitResult) -> Result<PathBuf, FitError> {
+    let fronts = per_method(r, |v| {
+        v.pareto_front
+            .iter()
+            .map(|p| [p.j_pos_m, p.j_att_deg])
+            .collect()
+    });
+    let path = fig_dir.join("pareto_front.png");
+    pareto_figure(
+        &path,
+        &borrowed(&fronts),
+        Some((r.sigma_pos_m, r.sigma_att_deg)),
+    )?;
+    Ok(path)
+}
+
+/// Each method's best weighted goal against its simulations.
+fn write_convergence(fig_dir: &Path, r: &FitResult) -> Result<PathBuf, FitError> {
+    let histories = per_method(r, |v| {
+        v.history
+            .iter()
+            .map(|h| (h.best.evaluations, h.best.best_weighted))
+            .collect()
+    });
+    let path = fig_dir.join("convergence.png");
+    convergence_figure(&path, &borrowed(&histories), Some(2.0))?;
+    Ok(path)
+}
