@@ -143,8 +143,6 @@ pub(super) fn select(
     settings: &LmSettings,
     evaluations: &mut u64,
 ) -> Result<CatalogueOutcome> {
-    let events: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
-    let m = 6 * job.sample_count();
     let mut current = Fitted {
         effects: EffectSet::NONE,
         terms: Vec::new(),
@@ -159,68 +157,23 @@ pub(super) fn select(
         if remaining.is_empty() {
             break;
         }
-        let threshold = ALPHA / remaining.len() as f64;
+        let judge = Judge {
+            job,
+            current: &current,
+            round,
+            threshold: ALPHA / remaining.len() as f64,
+            noise,
+        };
         let tried = try_extensions(evaluator, job, &current, &remaining, noise, settings)?;
         let mut best: Option<(usize, f64)> = None;
         let mut fitted_by_index = BTreeMap::new();
         for (index, fitted) in tried {
             *evaluations += fitted.lm.evaluations;
-            let effect = CATALOGUE[index];
-            let q = effect.params().len();
-            let p1 = FACTOR_COUNT + fitted.effects.param_count();
-            let (f, p) = f_test(current.lm.cost, fitted.lm.cost, q, m, p1);
-            let delta_bic = bic(fitted.lm.cost, p1, m) - bic(current.lm.cost, p1 - q, m);
-            let space = fitted.space(job);
-            let from = space.len() - q;
-            let parameters = param_values(&space, &fitted, &events, from);
-            let significant = p < threshold && delta_bic < 0.0;
-            let note = if significant {
-                String::new()
-            } else {
-                format!(
-                    "not significant (p = {p:.2e}, threshold {threshold:.1e}; BIC change {delta_bic:+.1}); the data bound it to {}",
-                    parameters
-                        .iter()
-                        .map(|v| match v.std_error {
-                            Some(se) => format!(
-                                "|{}| <~ {:.3e} {} (2 SE)",
-                                v.name,
-                                v.value.abs() + 2.0 * se,
-                                v.unit
-                            ),
-                            None => format!("{}: undetermined", v.name),
-                        })
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            };
-            if significant && best.is_none_or(|(_, b)| delta_bic < b) {
-                best = Some((index, delta_bic));
+            let report = judge.report(index, &fitted);
+            if report.significant && best.is_none_or(|(_, b)| report.delta_bic < b) {
+                best = Some((index, report.delta_bic));
             }
-            candidates.push(CandidateReport {
-                id: effect.id().to_string(),
-                adds: effect.adds().to_string(),
-                round,
-                parameters,
-                chi2: fitted.lm.cost,
-                chi2_drop: current.lm.cost - fitted.lm.cost,
-                f,
-                p_value: p,
-                p_threshold: threshold,
-                delta_bic,
-                significant,
-                goals: fitted.lm.goals.as_array(),
-                channel_rms: rms_channels(&physical_residuals(
-                    &fitted.lm.residuals,
-                    noise,
-                    &events,
-                )),
-                note,
-                refinement: format!(
-                    "{} after {} iterations",
-                    fitted.lm.stop, fitted.lm.iterations
-                ),
-            });
+            candidates.push(report);
             fitted_by_index.insert(index, fitted);
         }
         let Some((index, _)) = best else {
@@ -237,4 +190,76 @@ pub(super) fn select(
         chosen,
         candidates,
     })
+}
+
+/// How one round judges its candidates: against the current model, at the round's
+/// Bonferroni-corrected threshold.
+struct Judge<'a> {
+    job: &'a Arc<Job>,
+    current: &'a Fitted,
+    round: usize,
+    threshold: f64,
+    noise: Noise,
+}
+
+impl Judge<'_> {
+    /// The report of effect `index`, `fitted` with it: its F test, BIC change and estimates.
+    fn report(&self, index: usize, fitted: &Fitted) -> CandidateReport {
+        let (job, current, threshold) = (self.job, self.current, self.threshold);
+        let events: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
+        let m = 6 * job.sample_count();
+        let effect = CATALOGUE[index];
+        let q = effect.params().len();
+        let p1 = FACTOR_COUNT + fitted.effects.param_count();
+        let (f, p) = f_test(current.lm.cost, fitted.lm.cost, q, m, p1);
+        let delta_bic = bic(fitted.lm.cost, p1, m) - bic(current.lm.cost, p1 - q, m);
+        let space = fitted.space(job);
+        let from = space.len() - q;
+        let parameters = param_values(&space, fitted, &events, from);
+        let significant = p < threshold && delta_bic < 0.0;
+        let note = if significant {
+            String::new()
+        } else {
+            format!(
+                "not significant (p = {p:.2e}, threshold {threshold:.1e}; BIC change {delta_bic:+.1}); the data bound it to {}",
+                parameters
+                    .iter()
+                    .map(|v| match v.std_error {
+                        Some(se) => format!(
+                            "|{}| <~ {:.3e} {} (2 SE)",
+                            v.name,
+                            v.value.abs() + 2.0 * se,
+                            v.unit
+                        ),
+                        None => format!("{}: undetermined", v.name),
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
+        CandidateReport {
+            id: effect.id().to_string(),
+            adds: effect.adds().to_string(),
+            round: self.round,
+            parameters,
+            chi2: fitted.lm.cost,
+            chi2_drop: current.lm.cost - fitted.lm.cost,
+            f,
+            p_value: p,
+            p_threshold: threshold,
+            delta_bic,
+            significant,
+            goals: fitted.lm.goals.as_array(),
+            channel_rms: rms_channels(&physical_residuals(
+                &fitted.lm.residuals,
+                self.noise,
+                &events,
+            )),
+            note,
+            refinement: format!(
+                "{} after {} iterations",
+                fitted.lm.stop, fitted.lm.iterations
+            ),
+        }
+    }
 }

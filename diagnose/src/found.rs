@@ -98,13 +98,23 @@ pub struct DiscoveredTerm {
     pub group: Vec<GroupMember>,
 }
 
+/// A verified extension: the refitted model, its terms (most important first) and its gain over
+/// the baseline.
+pub(super) struct Found {
+    /// The model extended by the terms, refitted.
+    pub fitted: Fitted,
+    /// Its terms, most important first.
+    pub terms: Vec<DiscoveredTerm>,
+    /// Its gain over the baseline.
+    pub gain: Gain,
+}
+
 /// What discovery found.
 pub(super) struct Discovery {
     /// Per event, the reconstructed increments.
     pub reconstruction: Vec<Reconstruction>,
-    /// The verified extension, when one is significant: the refitted model, its terms (most
-    /// important first) and its gain over the baseline.
-    pub found: Option<(Fitted, Vec<DiscoveredTerm>, Gain)>,
+    /// The verified extension, when one is significant.
+    pub found: Option<Found>,
     /// What happened (why nothing was found, or what was dropped).
     pub notes: Vec<String>,
     /// Each step of the selection: what the regression ranked, what the refits gave.

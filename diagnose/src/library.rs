@@ -97,6 +97,30 @@ impl Entry {
     pub fn axis(&self) -> Axis {
         self.terms[0].axis
     }
+
+    /// The same axis and regressor as `other` (any locator).
+    pub fn same_kind(&self, other: &Entry) -> bool {
+        self.axis() == other.axis() && self.terms[0].regressor == other.terms[0].regressor
+    }
+
+    /// A readable formula: its term's, or an oscillation pair's as one sinusoid.
+    pub fn formula(&self) -> String {
+        match self.terms.as_slice() {
+            [a, b] if a.regressor == Regressor::Sin && b.regressor == Regressor::Cos => {
+                format!(
+                    "sin(2 pi {} Hz t + phase)",
+                    super::readings::fmt_num(a.locator[0])
+                )
+            }
+            [t, ..] => t.formula(),
+            [] => String::new(),
+        }
+    }
+
+    /// Its axis and formula, as the notes name it.
+    pub fn label(&self) -> String {
+        format!("{} {}", self.axis().name(), self.formula())
+    }
 }
 
 /// The largest |regressor| of `term` along the history (ejector terms: during the stroke).

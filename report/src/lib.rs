@@ -1,8 +1,10 @@
 //! What sepval writes for people: figures as PNG files ([`figures`]), drawn from plain
-//! data. Fits, diagnoses and the commands to come describe what
-//! to show; this crate knows nothing of how it was computed.
+//! data, and HTML pages ([`html`]) in one layout and one stylesheet, each page from its own
+//! template. Fits, diagnoses and the commands to come describe what to show; this crate knows
+//! nothing of how it was computed.
 
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod figures;
+pub mod html;

@@ -1,0 +1,367 @@
+//! The diagnosis record from the decided answer (`docs/model.md` section 7 and 11): the causes
+//! and their estimates, whether the catalogue's answer explains the data to the noise, the
+//! alternatives, the discovered extension's report, the residuals before and after, the
+//! verdict, the prediction of the `--validate` events, and the contents of the files that only
+//! a discovered answer writes. Nothing here writes a file (`outputs` does).
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use sepval_common::evaluation::Job;
+use sepval_common::extension::{TermRecord, extension_toml};
+use sepval_common::factors::FACTOR_COUNT;
+
+use crate::answer::{Answer, Rival, Setting};
+use crate::found::{DiscoveredTerm, DiscoveryStep, Found, Gain};
+use crate::increments::{Curves, model_increments};
+use crate::reconstruct::Reconstruction;
+use crate::residuals::{physical_residuals, residual_report, rms_channels};
+use crate::validation::{prediction_caveat, validate};
+use crate::verdict::{VerdictInput, verdict};
+use crate::{
+    Alternative, BIC_MARGIN, CandidateReport, DIAGNOSIS_FORMAT, DiagnoseError, DiagnoseOptions,
+    Diagnosis, ExtensionReport, Fitted, ModelSummary, ParamValue, Result, ValidationReport,
+    catalogue, readings,
+};
+
+/// Everything the stages before the analysis produced.
+pub(super) struct Decided {
+    /// The converged baseline.
+    pub baseline: Fitted,
+    /// The answer.
+    pub answer: Answer,
+    /// Every catalogue candidate tried, every round.
+    pub candidates: Vec<CandidateReport>,
+    /// Discovery's reconstruction of the baseline's misfit, per event.
+    pub reconstruction: Vec<Reconstruction>,
+    /// Discovery's notes.
+    pub notes: Vec<String>,
+    /// Discovery's steps.
+    pub steps: Vec<DiscoveryStep>,
+    /// Simulations run.
+    pub evaluations: u64,
+}
+
+/// The diagnosis and what the outputs need beside it.
+pub(super) struct Analysis {
+    /// DIR/diagnosis.json.
+    pub diagnosis: Diagnosis,
+    /// The converged baseline.
+    pub baseline: Fitted,
+    /// The answer.
+    pub answer: Answer,
+    /// What the discovered terms give along their trajectory (empty without a discovered
+    /// extension).
+    pub curves: Curves,
+    /// DIR/extension.toml and DIR/factors.json, when a discovered extension is the answer.
+    pub extension: Option<ExtensionFiles>,
+}
+
+/// The files of a discovered answer.
+pub(super) struct ExtensionFiles {
+    /// DIR/extension.toml.
+    pub toml: String,
+    /// DIR/factors.json: the factors fitted with the terms (`--factors DIR/factors.json
+    /// --extension DIR/extension.toml` reproduces the answer).
+    pub factors_json: Vec<u8>,
+}
+
+/// The diagnosis of `d`; `t0` is when the diagnosis started.
+pub(super) fn analyse(
+    options: &DiagnoseOptions,
+    setting: &Setting,
+    d: Decided,
+    t0: Instant,
+) -> Result<Analysis> {
+    let (job, noise, floor) = (&*setting.job, setting.noise, setting.floor);
+    let answer_fit = d.answer.model(&d.baseline);
+    // The catalogue's model: the baseline when it chose no effect.
+    let cat_fit = d.answer.selected().map_or(&d.baseline, |s| &s.fitted);
+    let cat_report = residual_report(job, &cat_fit.lm, &cat_fit.candidate(job)?, noise, floor);
+    let explained = cat_report.white && cat_report.at_noise_floor;
+    let (causes, discovered) = match &d.answer {
+        Answer::Catalogue { selected, .. } => (selected.names(), Vec::new()),
+        Answer::Discovered { found, .. } => (Vec::new(), found.terms.clone()),
+        Answer::Baseline => (Vec::new(), Vec::new()),
+    };
+    let parameters = d
+        .answer
+        .selected()
+        .map(|s| effect_parameters(setting, &s.fitted))
+        .unwrap_or_default();
+    let alternatives = alternatives(setting, &d.answer, answer_fit, explained);
+    let extension = match d.answer.found() {
+        Some(f) => Some(extension_report(setting, &d.answer, f)?),
+        None => None,
+    };
+    let final_report = residual_report(
+        job,
+        &answer_fit.lm,
+        &answer_fit.candidate(job)?,
+        noise,
+        floor,
+    );
+    let base_report = residual_report(
+        job,
+        &d.baseline.lm,
+        &d.baseline.candidate(job)?,
+        noise,
+        floor,
+    );
+    let base_summary = summary(setting, &d.baseline);
+    let ext_summary = summary(setting, answer_fit);
+    let mut verdict = verdict(&VerdictInput {
+        causes: &causes,
+        explained,
+        parameters: &parameters,
+        discovered: &discovered,
+        extension: extension.as_ref().filter(|e| e.answer),
+        alternatives: &alternatives,
+        base: &base_summary,
+        ext: &ext_summary,
+        noise,
+    });
+    let validation = predictions(options, setting, &d.baseline, &d.answer)?;
+    let caution = prediction_caveat(&validation, noise);
+    if let Some(c) = &caution {
+        verdict.push_str(&format!("; caution: {c}"));
+    }
+    let mut residuals = BTreeMap::new();
+    residuals.insert("baseline".to_string(), base_report);
+    residuals.insert("extended".to_string(), final_report);
+    let diagnosis = Diagnosis {
+        format: DIAGNOSIS_FORMAT.to_string(),
+        causes,
+        explained,
+        verdict,
+        caution,
+        discovered,
+        alternatives,
+        extension,
+        discovery_notes: d.notes,
+        discovery_steps: d.steps,
+        sigma_pos_m: noise.pos_m,
+        sigma_att_deg: noise.att_deg,
+        sigma_source: options.fit.sigma.source.clone(),
+        baseline: base_summary,
+        extended: ext_summary,
+        parameters,
+        candidates: d.candidates,
+        residuals,
+        reconstruction: d.reconstruction,
+        validation,
+        evaluations: d.evaluations,
+        wall_s: t0.elapsed().as_secs_f64(),
+    };
+    let (curves, extension) = for_outputs(job, &d.answer)?;
+    Ok(Analysis {
+        diagnosis,
+        baseline: d.baseline,
+        answer: d.answer,
+        curves,
+        extension,
+    })
+}
+
+/// What the outputs draw and write beside the diagnosis: the discovered terms' increments
+/// (the answer or not) and, when they are the answer, their files.
+fn for_outputs(job: &Job, answer: &Answer) -> Result<(Curves, Option<ExtensionFiles>)> {
+    let curves = match answer.found() {
+        Some(f) => model_increments(job, &f.fitted)?,
+        None => Vec::new(),
+    };
+    let files = match answer {
+        Answer::Discovered { found, .. } => Some(extension_files(job, found)?),
+        _ => None,
+    };
+    Ok((curves, files))
+}
+
+/// A fitted model's summary.
+fn summary(setting: &Setting, fitted: &Fitted) -> ModelSummary {
+    let job = &*setting.job;
+    let terms = fitted
+        .space(job)
+        .terms_at(&fitted.lm.x)
+        .unwrap_or_default()
+        .iter()
+        .map(|t| format!("{}: {}", t.axis.name(), t.formula()))
+        .collect();
+    ModelSummary {
+        effects: fitted
+            .effects
+            .iter()
+            .map(|a| a.effect().id().to_string())
+            .collect(),
+        terms,
+        parameters: fitted.space(job).len(),
+        j_pos_m: fitted.lm.goals.j_pos_m,
+        j_att_deg: fitted.lm.goals.j_att_deg,
+        chi2: fitted.lm.cost,
+        channel_rms: rms_channels(&physical_residuals(
+            &fitted.lm.residuals,
+            setting.noise,
+            &setting.events,
+        )),
+        factors: fitted.candidate(job).ok().map(|c| c.factors),
+    }
+}
+
+/// Each chosen effect's parameters with standard errors, by effect id.
+fn effect_parameters(setting: &Setting, fitted: &Fitted) -> BTreeMap<String, Vec<ParamValue>> {
+    let space = fitted.space(&setting.job);
+    let all = catalogue::param_values(&space, fitted, &setting.events, FACTOR_COUNT);
+    let mut parameters = BTreeMap::new();
+    let mut pos = 0;
+    for a in fitted.effects.iter() {
+        let n = a.effect().params().len();
+        parameters.insert(a.effect().id().to_string(), all[pos..pos + n].to_vec());
+        pos += n;
+    }
+    parameters
+}
+
+/// The model that lost to the answer, as an alternative; `explained`: whether the catalogue's
+/// model explains the data to the noise.
+fn alternatives(
+    setting: &Setting,
+    answer: &Answer,
+    answer_fit: &Fitted,
+    explained: bool,
+) -> Vec<Alternative> {
+    let answer_bic = setting.bic(answer_fit);
+    let Some(rival) = answer.rival() else {
+        return Vec::new();
+    };
+    let d_bic = setting.bic(rival.fitted()) - answer_bic;
+    let (kind, names, note) = match rival {
+        Rival::Catalogue(s) => (
+            "catalogue",
+            s.names(),
+            format!(
+                "significant on its own, but the discovered terms explain the data better by {d_bic:.1} in BIC (more than {BIC_MARGIN}): a mimic, not the cause{}",
+                if explained {
+                    " (it even reaches the noise floor: the data alone cannot rule it out)"
+                } else {
+                    ""
+                }
+            ),
+        ),
+        Rival::Discovered(f) => (
+            "discovered",
+            f.terms
+                .iter()
+                .map(|t| format!("{}: {}", t.axis, t.term))
+                .collect(),
+            format!(
+                "significant against the baseline, but it does not beat the catalogue's answer by more than {BIC_MARGIN} in BIC (difference {d_bic:+.1}): the catalogue effect stays the cause"
+            ),
+        ),
+    };
+    vec![Alternative {
+        kind: kind.into(),
+        names,
+        model: summary(setting, rival.fitted()),
+        delta_bic_vs_answer: d_bic,
+        note,
+    }]
+}
+
+/// The report of the discovered extension `f`, the answer or not.
+fn extension_report(setting: &Setting, answer: &Answer, f: &Found) -> Result<ExtensionReport> {
+    let job = &*setting.job;
+    let fitted = &f.fitted;
+    let report = residual_report(
+        job,
+        &fitted.lm,
+        &fitted.candidate(job)?,
+        setting.noise,
+        setting.floor,
+    );
+    let is_answer = matches!(answer, Answer::Discovered { .. });
+    Ok(ExtensionReport {
+        answer: is_answer,
+        file: is_answer.then(|| "extension.toml".to_string()),
+        model: summary(setting, fitted),
+        gain: f.gain.clone(),
+        white: report.white,
+        at_noise_floor: report.at_noise_floor,
+        explained: report.white && report.at_noise_floor,
+        refinement: format!(
+            "{} after {} iterations",
+            fitted.lm.stop, fitted.lm.iterations
+        ),
+    })
+}
+
+/// The baseline's, the answer's and its rival's goals on the `--validate` events.
+fn predictions(
+    options: &DiagnoseOptions,
+    setting: &Setting,
+    baseline: &Fitted,
+    answer: &Answer,
+) -> Result<Vec<ValidationReport>> {
+    let Some(v) = &options.validation else {
+        return Ok(Vec::new());
+    };
+    let job = &*setting.job;
+    let rivals = match answer.rival() {
+        Some(r) => vec![r.prediction(job)?],
+        None => Vec::new(),
+    };
+    Ok(validate(
+        v,
+        &baseline.candidate(job)?,
+        &answer.model(baseline).candidate(job)?,
+        &rivals,
+    ))
+}
+
+/// The files of the discovered answer `found`.
+fn extension_files(job: &Job, found: &Found) -> Result<ExtensionFiles> {
+    let toml = extension_file(job, &found.fitted, &found.terms, &found.gain)?;
+    let factors_json = serde_json::to_vec_pretty(&found.fitted.candidate(job)?.factors)
+        .expect("factors serialise");
+    Ok(ExtensionFiles { toml, factors_json })
+}
+
+/// DIR/extension.toml: the discovered terms at their refitted values, with a header that says
+/// where they came from.
+fn extension_file(job: &Job, f: &Fitted, found: &[DiscoveredTerm], gain: &Gain) -> Result<String> {
+    let terms = f.space(job).terms_at(&f.lm.x)?;
+    let records: Vec<TermRecord> = terms
+        .iter()
+        .map(|t| {
+            let mut r = TermRecord::of(t);
+            r.reading = Some(readings::reading(
+                t,
+                &job.events()[0].simulator.scenario().interference,
+            ));
+            r
+        })
+        .collect();
+    let mut text = format!(
+        "# Found by `sepval diagnose` beyond the effect catalogue, from: {}\n",
+        job.events()
+            .iter()
+            .map(|e| e.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    for d in found {
+        text.push_str(&format!(
+            "# {} {} ({}): {}\n",
+            d.axis, d.term, d.family, d.reading
+        ));
+    }
+    text.push_str(&format!(
+        "# Gain over the baseline: chi-square drop {:.1}, F = {:.1}, p = {:.2e}, BIC change {:+.1}\n",
+        gain.chi2_drop, gain.f, gain.p_value, gain.delta_bic
+    ));
+    text.push_str(&extension_toml(&records));
+    // What is written must read back.
+    sepval_common::extension::parse_extension(&text, "extension.toml").map_err(|e| {
+        DiagnoseError::Model(format!("the extension written does not read back: {e}"))
+    })?;
+    Ok(text)
+}

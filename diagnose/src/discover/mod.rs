@@ -1,0 +1,203 @@
+//! Discovery beyond the catalogue: what force and moment the fitted baseline lacks, which terms
+//! of a documented library explain it, and what the model extended by them gains
+//! (`docs/model.md` section 11).
+//!
+//! 1. **Sensitivities.** One batch simulates the fitted baseline with each library term added at
+//!    a small probe coefficient, and with each reconstruction window; the change of the
+//!    normalised residuals per unit coefficient is each term's column (`probe`). Long records
+//!    use a subset of their samples here.
+//! 2. **Reconstruction** (`reconstruct`): per event, the coefficient increments dCA ... dCn and
+//!    the ejector increment as time histories with bands, from the window columns by a
+//!    regularised output-error estimate.
+//! 3. **Selection** (`stepwise`): stepwise regression of the residuals on the library's columns
+//!    with the factors' sensitivities always in (what a factor change absorbs is no finding),
+//!    F-to-enter and F-to-remove at 1 % family-wise and the predicted square error; correlated
+//!    entries are reported as one group.
+//! 4. **Locators.** Each selected term's locator (step time, frequency, decay length) is refined
+//!    on a grid eight times finer than the library's, around the selected one.
+//! 5. **Verification.** The baseline's 17 factors and the selected terms' coefficients (and the
+//!    step times and decay lengths) are refitted together by output error on every sample
+//!    (the real trajectory fit, not the regression), each candidate for at most
+//!    `VERIFY_ITERATIONS`, the best on to convergence. An entry is kept when its F test against
+//!    the current model (the previous step's) passes at 1 % divided by the number of library
+//!    entries screened in that step, and its BIC is lower; with several terms, each is refitted
+//!    out in turn, and a term whose removal is not significant leaves. The gain over the
+//!    baseline is reported, not tested again.
+//!
+//! The sensitivities are linear about the fit: they screen, the refit decides.
+//!
+//! In code, one step is `screen` (1 to 3), `locate` (4), `verify` (5) and `remove`
+//! (F-to-remove); `picked` keeps the entries in and where their parameters sit; `naming` turns
+//! the final model into the found terms.
+
+use std::sync::Arc;
+
+use sepval_common::evaluation::{Evaluator, Job};
+use sepval_common::factors::FACTOR_COUNT;
+use sepval_fit::space::Noise;
+use sepval_solve::lm::LmSettings;
+
+use crate::catalogue::converge;
+use crate::found::{Discovery, Found, Gain};
+use crate::reconstruct::Reconstruction;
+use crate::{Fitted, Result, stepwise};
+use picked::Picked;
+use search::{Search, Selection, Trail};
+use verify::Refit;
+
+mod locate;
+mod naming;
+mod picked;
+mod remove;
+mod screen;
+mod search;
+mod verify;
+
+/// Runs discovery from the converged `baseline` (no effects, no terms): forward stepwise
+/// selection, re-linearised at each step, each step's best entries verified by output-error
+/// refits.
+pub(super) fn discover(
+    evaluator: &mut dyn Evaluator,
+    job: &Arc<Job>,
+    baseline: &Fitted,
+    noise: Noise,
+    settings: &LmSettings,
+) -> Result<Discovery> {
+    let search = Search::new(job, noise, settings);
+    let mut trail = Trail::default();
+    let mut reconstruction = Vec::new();
+    let mut sel = Selection {
+        current: baseline.clone(),
+        picked: Picked::default(),
+        groups: Vec::new(),
+    };
+    for step in 0..stepwise::MAX_ENTRIES {
+        let Some(entered) = enter(
+            evaluator,
+            &search,
+            &sel,
+            step,
+            &mut trail,
+            &mut reconstruction,
+        )?
+        else {
+            break;
+        };
+        sel = remove::f_to_remove(evaluator, &search, entered, &mut trail)?;
+    }
+    let found = conclude(evaluator, &search, baseline, sel, &mut trail)?;
+    Ok(Discovery {
+        reconstruction,
+        found,
+        notes: trail.notes,
+        steps: trail.steps,
+        evaluations: trail.evaluations,
+    })
+}
+
+/// One step of the forward selection from `sel`: screening (and, at the first step, the
+/// reconstruction), the locator zoom, the verification refits and the winner's test; the
+/// model with the entry that entered, or `None` when the selection ends here.
+fn enter(
+    evaluator: &mut dyn Evaluator,
+    search: &Search,
+    sel: &Selection,
+    step: usize,
+    trail: &mut Trail,
+    reconstruction: &mut Vec<Reconstruction>,
+) -> Result<Option<Selection>> {
+    let Some(mut s) = screen::screen(evaluator, search, sel, step, trail)? else {
+        return Ok(None);
+    };
+    if let Some(r) = s.reconstruction.take() {
+        *reconstruction = r;
+    }
+    let mut record = s.record(step, sel.current.lm.cost);
+    let best = s.to_verify();
+    if best.is_empty() {
+        trail.steps.push(record);
+        trail.notes.push(s.nothing_significant(step));
+        return Ok(None);
+    }
+    let located = locate::locate(
+        evaluator,
+        search,
+        &s,
+        &sel.current,
+        &best,
+        &mut trail.evaluations,
+    )?;
+    let now = sel.picked.at(search.job, &sel.current)?;
+    let refits = verify::refit_candidates(
+        evaluator,
+        search,
+        &sel.current,
+        &now,
+        located,
+        &mut trail.evaluations,
+    )?;
+    record.verified = refits.iter().map(Refit::verified).collect();
+    let Some(winner) = refits.first() else {
+        trail.steps.push(record);
+        return Ok(None);
+    };
+    // The winner's refit runs on to convergence.
+    let fitted = converge(
+        evaluator,
+        search.job,
+        winner.fitted.clone(),
+        search.noise,
+        search.settings,
+        &mut trail.evaluations,
+    )?;
+    let gain = verify::gain_over(search, &sel.current, &fitted);
+    if !(gain.p_value < s.threshold && gain.delta_bic < 0.0) {
+        trail
+            .notes
+            .push(verify::not_passing(step, &s, &refits, &gain));
+        trail.steps.push(record);
+        return Ok(None);
+    }
+    record.accepted = Some(verify::accepted(&winner.entry, &gain));
+    trail.steps.push(record);
+    let mut groups = sel.groups.clone();
+    groups.push(verify::group(&s, &refits, &fitted));
+    let picked = now.with(winner.entry.clone()).at(search.job, &fitted)?;
+    Ok(Some(Selection {
+        current: fitted,
+        picked,
+        groups,
+    }))
+}
+
+/// The extension the selection ended with, named, with its gain over the baseline; `None` when
+/// no entry is in.
+fn conclude(
+    evaluator: &mut dyn Evaluator,
+    search: &Search,
+    baseline: &Fitted,
+    sel: Selection,
+    trail: &mut Trail,
+) -> Result<Option<Found>> {
+    if sel.picked.is_empty() {
+        return Ok(None);
+    }
+    let job = search.job;
+    let fitted = sel.current;
+    let picked = sel.picked.at(job, &fitted)?;
+    let p_with = fitted.space(job).len();
+    let gain = Gain::of(
+        baseline.lm.cost,
+        fitted.lm.cost,
+        p_with - FACTOR_COUNT,
+        p_with,
+        search.m,
+    );
+    let gains = remove::entry_gains(evaluator, search, &fitted, &picked, &gain, trail)?;
+    let terms = naming::name_terms(job, &fitted, &picked, &gains, &gain, &sel.groups);
+    Ok(Some(Found {
+        fitted,
+        terms,
+        gain,
+    }))
+}

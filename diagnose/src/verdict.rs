@@ -1,0 +1,148 @@
+//! The diagnosis in words: the verdict sentence, and how estimates read (a catalogue
+//! parameter's value with its standard error, a discovered term's with its locator); the
+//! terminal summary and the HTML page use the same wording.
+
+use std::collections::BTreeMap;
+
+use sepval_common::effects::CATALOGUE;
+use sepval_fit::space::Noise;
+
+use crate::{Alternative, DiscoveredTerm, ExtensionReport, ModelSummary, ParamValue};
+
+/// A catalogue parameter's value: `name = value ± se unit`.
+pub(super) fn fmt_value(v: &ParamValue) -> String {
+    match v.std_error {
+        Some(se) => format!(
+            "{} = {:.4} ± {:.2} {}",
+            v.name,
+            v.value,
+            se,
+            per_unit(&v.unit)
+        ),
+        None => format!(
+            "{} = {:.4} {} (undetermined)",
+            v.name,
+            v.value,
+            per_unit(&v.unit)
+        ),
+    }
+}
+
+fn per_unit(unit: &str) -> String {
+    match unit.strip_prefix("1/") {
+        Some(u) => format!("per {u}"),
+        None => unit.to_string(),
+    }
+}
+
+/// What the verdict sentence is made of.
+pub(super) struct VerdictInput<'a> {
+    pub causes: &'a [String],
+    pub explained: bool,
+    pub parameters: &'a BTreeMap<String, Vec<ParamValue>>,
+    pub discovered: &'a [DiscoveredTerm],
+    /// The discovered extension, when it is the answer.
+    pub extension: Option<&'a ExtensionReport>,
+    pub alternatives: &'a [Alternative],
+    pub base: &'a ModelSummary,
+    pub ext: &'a ModelSummary,
+    pub noise: Noise,
+}
+
+/// A discovered term's value: `coefficient ± se` and its locator.
+pub fn fmt_discovered(d: &DiscoveredTerm) -> String {
+    let value = match d.std_error {
+        Some(se) => format!("{:.4} ± {:.2}", d.coefficient, se),
+        None => format!("{:.4} (undetermined)", d.coefficient),
+    };
+    let locator = match (d.t_on_s, d.f_hz, d.lambda_m) {
+        (Some(t), _, _) => format!(", t_on = {t:.3} s"),
+        (_, Some(f), _) => format!(", f = {f:.2} Hz"),
+        (_, _, Some(l)) => format!(", lambda = {l:.2} m"),
+        _ => String::new(),
+    };
+    let locator = match (d.locator_std_error, locator.is_empty()) {
+        (Some(se), false) => format!("{locator} ± {se:.2}"),
+        _ => locator,
+    };
+    format!("{} {} = {value}{locator}", d.axis, d.term)
+}
+
+/// The verdict in one sentence.
+pub(super) fn verdict(v: &VerdictInput) -> String {
+    let (bp, ba) = (v.base.j_pos_m, v.base.j_att_deg);
+    let (ep, ea) = (v.ext.j_pos_m, v.ext.j_att_deg);
+    let gains =
+        format!("position RMS {bp:.4} m -> {ep:.4} m, attitude RMS {ba:.3} deg -> {ea:.3} deg");
+    if let (Some(e), Some(first)) = (v.extension, v.discovered.first()) {
+        let mut reading = first.reading.clone();
+        if let Some(c) = reading.get(0..1) {
+            reading = c.to_lowercase() + &reading[1..];
+        }
+        let more = if v.discovered.len() > 1 {
+            format!(" and {} more term(s)", v.discovered.len() - 1)
+        } else {
+            String::new()
+        };
+        let fit = if e.explained {
+            "with it the model explains the data to the noise"
+        } else {
+            "with it the model still leaves structure beyond the noise"
+        };
+        let mimic = v
+            .alternatives
+            .iter()
+            .find(|a| a.kind == "catalogue")
+            .map(|a| {
+                format!(
+                    "; the catalogue's stand-in, {}, explains less (BIC {:+.1})",
+                    a.names.join(" with "),
+                    a.delta_bic_vs_answer
+                )
+            })
+            .unwrap_or_default();
+        return format!(
+            "not explained by the catalogue: {reading} ({}){more}; {fit} ({gains}){mimic}",
+            fmt_discovered(first)
+        );
+    }
+    if v.causes.is_empty() {
+        return if v.explained {
+            format!(
+                "the baseline model explains the data to the noise level (position RMS {bp:.4} m, sigma {:.4} m; attitude RMS {ba:.3} deg, sigma {:.3} deg)",
+                v.noise.pos_m, v.noise.att_deg
+            )
+        } else {
+            format!(
+                "not explained: the residuals keep structure beyond the noise (position RMS {bp:.4} m, attitude RMS {ba:.3} deg) and neither an effect of the catalogue nor a term of the library accounts for it: the cause lies outside both"
+            )
+        };
+    }
+    let named: Vec<String> = v
+        .causes
+        .iter()
+        .map(|id| {
+            let adds = CATALOGUE
+                .iter()
+                .find(|e| e.id() == id)
+                .map_or(id.as_str(), |e| e.adds());
+            let values = v
+                .parameters
+                .get(id)
+                .map(|v| v.iter().map(fmt_value).collect::<Vec<_>>().join(", "))
+                .unwrap_or_default();
+            format!(
+                "missing {} ({id}), {values}",
+                adds.split(':').next().unwrap_or(adds)
+            )
+        })
+        .collect();
+    if v.explained {
+        format!("{}; {gains}", named.join("; and "))
+    } else {
+        format!(
+            "not explained: the closest extension of the catalogue, {}, improves the fit ({gains}) but leaves structure beyond the noise: part of the cause lies outside the catalogue",
+            named.join(" with ")
+        )
+    }
+}
