@@ -51,21 +51,21 @@ fn grid(from: f64, to: f64, step: f64) -> Vec<f64> {
     (0..=n).map(|k| from + k as f64 * step).collect()
 }
 
-/// Writes the constant coefficients of `scenario` (without tables) as tables; the interference
-/// too when `interference` is set. Refuses a scenario that already has tables.
-pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, String> {
-    if scenario.has_tables() {
-        return Err(
-            "the scenario already has tables: only a constant form is written as tables".into(),
-        );
-    }
-    let constant = |c: &Coefficient| match c {
+/// The value of a coefficient that is a constant (the scenario was checked to have no tables).
+fn constant(c: &Coefficient) -> f64 {
+    match c {
         Coefficient::Constant(v) => *v,
         _ => unreachable!("checked: no tables"),
-    };
-    let a = &scenario.aero;
-    let slope = |c: &Option<DerivativeCoefficient>| c.as_ref().map_or(0.0, |c| constant(&c.value));
-    let mach_flight = scenario.flight.mach;
+    }
+}
+
+/// The slope of a derivative that may be absent (zero then).
+fn slope(c: &Option<DerivativeCoefficient>) -> f64 {
+    c.as_ref().map_or(0.0, |c| constant(&c.value))
+}
+
+/// The Mach breakpoints of the tables: 0.4 to 1.6, widened to the flight's Mach.
+fn mach_breakpoints(mach_flight: f64) -> Vec<f64> {
     let mut mach = vec![0.4, 0.8, 1.2, 1.6];
     if mach_flight < mach[0] {
         mach.insert(0, mach_flight);
@@ -73,11 +73,16 @@ pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, 
     if mach_flight > mach[mach.len() - 1] {
         mach.push(mach_flight);
     }
+    mach
+}
+
+/// The static coefficients over Mach, alpha and beta (-45 to 45 deg by 5), as CSV.
+fn static_table(a: &crate::scenario::Aero, mach: &[f64]) -> String {
     let angles = grid(-45.0, 45.0, 5.0);
     let axes = vec![
         Axis {
             variable: Variable::Mach,
-            breakpoints: mach.clone(),
+            breakpoints: mach.to_vec(),
         },
         Axis {
             variable: Variable::Alpha,
@@ -96,7 +101,7 @@ pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, 
         slope(&a.cn_beta_per_rad),
     );
     let mut columns: [Vec<f64>; 6] = Default::default();
-    for _ in &mach {
+    for _ in mach {
         for al in &angles {
             for be in &angles {
                 let (al, be) = (al.to_radians(), be.to_radians());
@@ -109,7 +114,7 @@ pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, 
             }
         }
     }
-    let static_csv = write_csv(
+    write_csv(
         &axes,
         &[
             ("ca", "-", &columns[0]),
@@ -119,23 +124,78 @@ pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, 
             ("cm", "-", &columns[4]),
             ("cn", "-", &columns[5]),
         ],
-    );
+    )
+}
+
+/// The damping derivatives over Mach, as CSV.
+fn damping_table(a: &crate::scenario::Aero, mach: &[f64]) -> String {
     let mach_axis = [Axis {
         variable: Variable::Mach,
-        breakpoints: mach.clone(),
+        breakpoints: mach.to_vec(),
     }];
     let damping: Vec<Vec<f64>> = [&a.cl_p_per_rad, &a.cm_q_per_rad, &a.cn_r_per_rad]
         .iter()
         .map(|c| vec![constant(&c.value); mach.len()])
         .collect();
-    let derivatives_csv = write_csv(
+    write_csv(
         &mach_axis,
         &[
             ("cl_p", "1/rad", &damping[0]),
             ("cm_q", "1/rad", &damping[1]),
             ("cn_r", "1/rad", &damping[2]),
         ],
+    )
+}
+
+/// Names of the interference increments' columns.
+const INTERFERENCE_COLUMNS: [&str; 6] = ["dcx", "dcy", "dcz", "dcl", "dcm", "dcn"];
+
+/// The interference increments sampled over distance from carriage (finely near the aircraft),
+/// as CSV.
+fn interference_table(i: &crate::scenario::Interference) -> String {
+    let decay = InterferenceDecay::new(i.lambda_m, i.s_end_m);
+    let mut d = grid(0.0, 1.0, 0.01);
+    d.extend(grid(1.0, 3.0, 0.05).into_iter().skip(1));
+    d.extend(
+        grid(3.0, i.s_end_m, 0.25)
+            .into_iter()
+            .skip(1)
+            .filter(|&x| x < i.s_end_m),
     );
+    d.extend([i.s_end_m, (i.s_end_m + 1.0).max(100.0)]);
+    let values: Vec<Vec<f64>> = i
+        .increments()
+        .iter()
+        .map(|(_, c)| {
+            let c0 = constant(&c.value);
+            d.iter().map(|&s| c0 * decay.factor(s)).collect()
+        })
+        .collect();
+    let cols: Vec<(&str, &str, &[f64])> = INTERFERENCE_COLUMNS
+        .iter()
+        .zip(&values)
+        .map(|(n, v)| (*n, "-", v.as_slice()))
+        .collect();
+    write_csv(
+        &[Axis {
+            variable: Variable::Distance,
+            breakpoints: d,
+        }],
+        &cols,
+    )
+}
+
+/// Writes the constant coefficients of `scenario` (without tables) as tables; the interference
+/// too when `interference` is set. Refuses a scenario that already has tables.
+pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, String> {
+    if scenario.has_tables() {
+        return Err(
+            "the scenario already has tables: only a constant form is written as tables".into(),
+        );
+    }
+    let mach = mach_breakpoints(scenario.flight.mach);
+    let static_csv = static_table(&scenario.aero, &mach);
+    let derivatives_csv = damping_table(&scenario.aero, &mach);
 
     let mut s = scenario.clone();
     s.description = format!(
@@ -160,42 +220,12 @@ pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, 
         (PathBuf::from("tables/aero_damping.csv"), derivatives_csv),
     ];
     if interference {
-        let i = &scenario.interference;
-        let decay = InterferenceDecay::new(i.lambda_m, i.s_end_m);
-        let mut d = grid(0.0, 1.0, 0.01);
-        d.extend(grid(1.0, 3.0, 0.05).into_iter().skip(1));
-        d.extend(
-            grid(3.0, i.s_end_m, 0.25)
-                .into_iter()
-                .skip(1)
-                .filter(|&x| x < i.s_end_m),
-        );
-        d.extend([i.s_end_m, (i.s_end_m + 1.0).max(100.0)]);
-        let names = ["dcx", "dcy", "dcz", "dcl", "dcm", "dcn"];
-        let values: Vec<Vec<f64>> = i
-            .increments()
-            .iter()
-            .map(|(_, c)| {
-                let c0 = constant(&c.value);
-                d.iter().map(|&s| c0 * decay.factor(s)).collect()
-            })
-            .collect();
-        let cols: Vec<(&str, &str, &[f64])> = names
-            .iter()
-            .zip(&values)
-            .map(|(n, v)| (*n, "-", v.as_slice()))
-            .collect();
         files.push((
             PathBuf::from("tables/interference.csv"),
-            write_csv(
-                &[Axis {
-                    variable: Variable::Distance,
-                    breakpoints: d,
-                }],
-                &cols,
-            ),
+            interference_table(&scenario.interference),
         ));
-        for ((_, c), n) in s.interference.increments_mut().into_iter().zip(names) {
+        let increments = s.interference.increments_mut();
+        for ((_, c), n) in increments.into_iter().zip(INTERFERENCE_COLUMNS) {
             *c = file::<crate::table::InterferenceKind>("tables/interference.csv", n);
         }
     }

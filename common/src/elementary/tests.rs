@@ -5,6 +5,7 @@
 
 #![allow(clippy::float_cmp)] // these tests check exact values on purpose
 
+use super::trig::MEDIUM_MAX;
 use super::*;
 use crate::lanes::F64x4;
 

@@ -192,6 +192,7 @@ fn diverged(y: &[F64x4; STATE_LEN]) -> [bool; LANES] {
 /// (lane masks, saved table states, the four states in flight) lives in locals the compiler
 /// keeps in registers; split into functions that pass that state by reference, it would go
 /// through memory at every step.
+// shape: long (the lane propagator's inner loop, kept whole for speed: see above)
 #[inline(always)]
 fn lanes_inline<S: SampleSink>(
     model: &Model,
