@@ -4,7 +4,7 @@
 //! Q(dof / 2, x / 2) of `statrs` (`function::gamma::gamma_ur`, after Cephes); the F tail as the
 //! regularised incomplete beta function I_{d2 / (d2 + d1 f)}(d2 / 2, d1 / 2) by its continued
 //! fraction (W. H. Press et al., "Numerical Recipes", 3rd ed., sections 5.2, 6.1 and 6.4, in
-//! [`beta`]); the F test of nested least-squares models; the Ljung-Box portmanteau statistic
+//! `beta`); the F test of nested least-squares models; the Ljung-Box portmanteau statistic
 //! Q = N (N + 2) sum_{k=1}^{h} rho_k^2 / (N - k) (G. M. Ljung and G. E. P. Box, Biometrika 65,
 //! 1978), chi-square with h degrees of freedom for white residuals.
 //!
@@ -18,7 +18,7 @@
 //! `beta_reg` does not for the F tail: with 30 or more denominator degrees of freedom (every fit
 //! has more than 1 000 residuals) it differs by up to 1e-9 relative, not only in deep tails, as
 //! both lose digits to the prefactor exp(ln Gamma(a + b) - ln Gamma(a) - ln Gamma(b) + ...)
-//! of large a; so the incomplete beta function stays hand-written ([`beta`]), unchanged.
+//! of large a; so the incomplete beta function stays hand-written (`beta`), unchanged.
 //!
 //! These run on the coordinator only, after the simulations, so they use the standard library's
 //! elementary functions (`exp`, `ln`, ...); the simulation itself uses none (docs/model.md
