@@ -10,6 +10,7 @@ use std::sync::Arc;
 use sepval_common::effects::CATALOGUE;
 use sepval_common::evaluation::{Candidate, Job};
 use sepval_fit::FitOptions;
+use sepval_fit::pipeline::FLOOR_FACTOR;
 use sepval_fit::space::Noise;
 
 use crate::found::Found;
@@ -32,16 +33,13 @@ pub(super) struct Setting {
 impl Setting {
     /// The setting of a diagnosis of `job` with the fit options `fit`.
     pub fn new(job: Arc<Job>, fit: &FitOptions) -> Setting {
-        let noise = Noise {
-            pos_m: fit.sigma.pos_m,
-            att_deg: fit.sigma.att_deg,
-        };
+        let noise = fit.sigma.noise();
         let events = job.events().iter().map(|e| e.data.len()).collect();
         let m = 6 * job.sample_count();
         Setting {
             job,
             noise,
-            floor: [1.1 * noise.pos_m, 1.1 * noise.att_deg],
+            floor: [FLOOR_FACTOR * noise.pos_m, FLOOR_FACTOR * noise.att_deg],
             events,
             m,
         }

@@ -73,6 +73,14 @@ impl Sigma {
         })
     }
 
+    /// The noise that normalises a fit's residuals.
+    pub fn noise(&self) -> crate::space::Noise {
+        crate::space::Noise {
+            pos_m: self.pos_m,
+            att_deg: self.att_deg,
+        }
+    }
+
     /// Weights (1/sigma_pos, 1/sigma_att).
     pub fn weights(&self) -> [f64; 2] {
         [1.0 / self.pos_m, 1.0 / self.att_deg]

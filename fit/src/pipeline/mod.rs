@@ -181,10 +181,7 @@ impl Context<'_> {
 
 /// What every method run shares, from the options and the evaluator's job.
 fn context<'a>(options: &'a FitOptions, job: Arc<Job>) -> Context<'a> {
-    let noise = Noise {
-        pos_m: options.sigma.pos_m,
-        att_deg: options.sigma.att_deg,
-    };
+    let noise = options.sigma.noise();
     Context {
         options,
         space: ParamSpace::new(job.factor_table(), &EffectSet::NONE),
