@@ -10,6 +10,7 @@ use std::time::Instant;
 use sepval_common::evaluation::Job;
 use sepval_common::extension::{TermRecord, extension_toml};
 use sepval_common::factors::FACTOR_COUNT;
+use sepval_fit::model_spec::ModelSpec;
 
 use crate::answer::{Answer, Rival, Setting};
 use crate::found::{DiscoveredTerm, DiscoveryStep, Found, Gain};
@@ -108,6 +109,7 @@ pub(super) fn analyse(
         noise,
         floor,
     );
+    let model = ModelSpec::of(&answer_fit.candidate(job)?);
     let base_summary = summary(setting, &d.baseline);
     let ext_summary = summary(setting, answer_fit);
     let mut verdict = verdict(&VerdictInput {
@@ -136,6 +138,8 @@ pub(super) fn analyse(
         verdict,
         caution,
         discovered,
+        ambiguous: false,
+        rivals: Vec::new(),
         alternatives,
         extension,
         discovery_notes: d.notes,
@@ -145,6 +149,8 @@ pub(super) fn analyse(
         sigma_source: options.fit.sigma.source.clone(),
         baseline: base_summary,
         extended: ext_summary,
+        model,
+        inputs: options.fit.inputs.clone(),
         parameters,
         candidates: d.candidates,
         residuals,

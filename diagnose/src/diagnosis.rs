@@ -9,6 +9,9 @@ use serde::{Deserialize, Serialize};
 use super::{
     DiscoveredTerm, DiscoveryStep, Gain, Reconstruction, ResidualReport, ValidationReport,
 };
+use sepval_common::extension::TermRecord;
+use sepval_fit::checkpoint::InputsRecord;
+use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::results::ChannelRms;
 
 /// One parameter's estimate.
@@ -118,6 +121,32 @@ pub struct Alternative {
     pub note: String,
 }
 
+/// An explanation the data cannot tell from the answer: its evidence is within
+/// [`RIVAL_MARGIN`](super::RIVAL_MARGIN) of the answer's in BIC.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RivalReport {
+    /// `catalogue` (effects only) or `discovered` (terms, with effects when it mixes both).
+    pub kind: String,
+    /// Its catalogue effects' ids.
+    pub effects: Vec<String>,
+    /// Its extension terms (axis, family, regressor, the family's locator, coefficient).
+    pub terms: Vec<TermRecord>,
+    /// Its BIC minus the answer's (negative: it fits better, by less than the margin).
+    pub delta_bic: f64,
+    /// Sum of squared normalised residuals of its refit.
+    pub chi2: f64,
+    /// RMS position error \[m\].
+    pub j_pos_m: f64,
+    /// RMS attitude error \[deg\].
+    pub j_att_deg: f64,
+    /// Its free parameters.
+    pub parameters: usize,
+    /// How it came to be tried (which pool, against which part of the answer).
+    pub origin: String,
+    /// The model, to rebuild its candidate.
+    pub model: ModelSpec,
+}
+
 /// DIR/diagnosis.json.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
@@ -140,6 +169,10 @@ pub struct Diagnosis {
     pub caution: Option<String>,
     /// Terms found beyond the catalogue, most important first, when they are the answer.
     pub discovered: Vec<DiscoveredTerm>,
+    /// Whether the data cannot tell the answer from another explanation (`rivals` not empty).
+    pub ambiguous: bool,
+    /// Explanations the data cannot tell from the answer, best first.
+    pub rivals: Vec<RivalReport>,
     /// Models that explain part of the data but not as well as the answer (mimics).
     pub alternatives: Vec<Alternative>,
     /// The discovered extension and its gain, when discovery verified one.
@@ -158,6 +191,10 @@ pub struct Diagnosis {
     pub baseline: ModelSummary,
     /// The answer's model; the baseline when nothing is named.
     pub extended: ModelSummary,
+    /// The answer's model as other commands rebuild it (`sepval plan`, `sepval predict`).
+    pub model: ModelSpec,
+    /// Where the inputs came from: data, scenario and extension file.
+    pub inputs: InputsRecord,
     /// Each named effect's parameters with standard errors.
     pub parameters: BTreeMap<String, Vec<ParamValue>>,
     /// Every candidate tried, every round.

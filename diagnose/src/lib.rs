@@ -110,7 +110,7 @@ mod validation;
 mod verdict;
 
 pub use diagnosis::{
-    Alternative, CandidateReport, Diagnosis, ExtensionReport, ModelSummary, ParamValue,
+    Alternative, CandidateReport, Diagnosis, ExtensionReport, ModelSummary, ParamValue, RivalReport,
 };
 pub use found::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
 pub use reconstruct::{IncrementSeries, Reconstruction};
@@ -127,6 +127,9 @@ pub const DIAGNOSIS_FORMAT: &str = "sepval-diagnosis/2";
 pub const ALPHA: f64 = 0.01;
 /// The BIC lead by which a discovered extension must beat the catalogue's answer to replace it.
 pub const BIC_MARGIN: f64 = 6.0;
+/// The BIC distance within which an explanation is a rival of the answer: the data cannot tell
+/// them apart (Kass and Raftery 1995: below 6 the evidence is not strong).
+pub const RIVAL_MARGIN: f64 = 6.0;
 
 /// Settings of a diagnosis.
 pub struct DiagnoseOptions {

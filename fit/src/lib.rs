@@ -13,6 +13,7 @@
 //! - [`results`]: DIR/result.json; [`out_dir`]: output directories, locked and protected;
 //! - [`refine`]: a model refined to the optimum by Levenberg-Marquardt, several sharing each
 //!   batch;
+//! - [`model_spec`]: a fitted model as files hold it, rebuilt exactly by other commands;
 //! - [`sigma`]: the noise that weights the goals; [`method`]: which searches to run.
 //!
 //! The library returns typed errors and prints nothing: progress reaches the caller through a
@@ -25,6 +26,7 @@
 
 pub mod checkpoint;
 pub mod method;
+pub mod model_spec;
 pub mod out_dir;
 pub mod pipeline;
 pub mod problem;
