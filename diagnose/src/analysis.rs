@@ -17,12 +17,13 @@ use crate::found::{DiscoveredTerm, DiscoveryStep, Found, Gain};
 use crate::increments::{Curves, model_increments};
 use crate::reconstruct::Reconstruction;
 use crate::residuals::{physical_residuals, residual_report, rms_channels};
+use crate::rivals::{Contender, same_model};
 use crate::validation::{prediction_caveat, validate};
-use crate::verdict::{VerdictInput, verdict};
+use crate::verdict::{VerdictInput, ambiguity, verdict};
 use crate::{
     Alternative, BIC_MARGIN, CandidateReport, DIAGNOSIS_FORMAT, DiagnoseError, DiagnoseOptions,
-    Diagnosis, ExtensionReport, Fitted, ModelSummary, ParamValue, Result, ValidationReport,
-    catalogue, readings,
+    Diagnosis, ExtensionReport, Fitted, ModelSummary, ParamValue, Result, RivalReport,
+    ValidationReport, catalogue, readings,
 };
 
 /// Everything the stages before the analysis produced.
@@ -31,6 +32,8 @@ pub(super) struct Decided {
     pub baseline: Fitted,
     /// The answer.
     pub answer: Answer,
+    /// The explanations the data cannot tell from the answer, best first.
+    pub rivals: Vec<(Contender, RivalReport)>,
     /// Every catalogue candidate tried, every round.
     pub candidates: Vec<CandidateReport>,
     /// Discovery's reconstruction of the baseline's misfit, per event.
@@ -90,7 +93,19 @@ pub(super) fn analyse(
         .selected()
         .map(|s| effect_parameters(setting, &s.fitted))
         .unwrap_or_default();
-    let alternatives = alternatives(setting, &d.answer, answer_fit, explained);
+    let rivals: Vec<RivalReport> = d.rivals.iter().map(|(_, r)| r.clone()).collect();
+    let alternatives = alternatives(setting, &d.answer, answer_fit, explained)
+        .into_iter()
+        .filter(|_| {
+            // The loser of the answer's decision is listed once: as a rival when the data
+            // cannot tell it from the answer.
+            d.answer.rival().is_none_or(|r| {
+                !d.rivals
+                    .iter()
+                    .any(|(c, _)| same_model(&c.fitted, r.fitted(), job))
+            })
+        })
+        .collect::<Vec<_>>();
     let extension = match d.answer.found() {
         Some(f) => Some(extension_report(setting, &d.answer, f)?),
         None => None,
@@ -123,6 +138,9 @@ pub(super) fn analyse(
         ext: &ext_summary,
         noise,
     });
+    if let Some(a) = ambiguity(&rivals, job.events().len()) {
+        verdict.push_str(&format!("; {a}"));
+    }
     let validation = predictions(options, setting, &d.baseline, &d.answer)?;
     let caution = prediction_caveat(&validation, noise);
     if let Some(c) = &caution {
@@ -138,8 +156,8 @@ pub(super) fn analyse(
         verdict,
         caution,
         discovered,
-        ambiguous: false,
-        rivals: Vec::new(),
+        ambiguous: !rivals.is_empty(),
+        rivals,
         alternatives,
         extension,
         discovery_notes: d.notes,

@@ -174,6 +174,20 @@ impl Rival<'_> {
         }
     }
 
+    /// Its model as a contender of the rival search (it passed its own pool's tests).
+    pub fn contender(&self) -> crate::rivals::Contender {
+        use crate::rivals::{Contender, light};
+        let origin = match self {
+            Rival::Catalogue(_) => "the catalogue's selection",
+            Rival::Discovered(_) => "the discovered extension",
+        };
+        Contender {
+            fitted: light(self.fitted()),
+            pool_size: 1,
+            origin: origin.to_string(),
+        }
+    }
+
     /// How the validation names it, and its candidate.
     pub fn prediction(&self, job: &Job) -> Result<(String, Candidate)> {
         let name = match self {

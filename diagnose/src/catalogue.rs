@@ -13,6 +13,7 @@ use sepval_common::evaluation::{Evaluator, Job};
 use sepval_common::factors::FACTOR_COUNT;
 
 use super::residuals::{physical_residuals, rms_channels};
+use super::rivals::{Contender, light};
 use super::{ALPHA, CandidateReport, DiagnoseError, Fitted, ParamValue, Result, bic};
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
@@ -132,6 +133,8 @@ pub(super) struct CatalogueOutcome {
     pub chosen: Vec<usize>,
     /// Every candidate tried, every round.
     pub candidates: Vec<CandidateReport>,
+    /// Each effect refitted alone from the baseline (the first round), for the rival search.
+    pub contenders: Vec<Contender>,
 }
 
 /// Forward selection over the catalogue from the converged `baseline`.
@@ -150,6 +153,7 @@ pub(super) fn select(
     };
     let mut chosen: Vec<usize> = Vec::new();
     let mut candidates = Vec::new();
+    let mut contenders = Vec::new();
     for round in 1..=MAX_ACTIVE_EFFECTS {
         let remaining: Vec<usize> = (0..CATALOGUE.len())
             .filter(|i| !chosen.contains(i))
@@ -174,6 +178,13 @@ pub(super) fn select(
                 best = Some((index, report.delta_bic));
             }
             candidates.push(report);
+            if round == 1 {
+                contenders.push(Contender {
+                    fitted: light(&fitted),
+                    pool_size: remaining.len(),
+                    origin: format!("catalogue effect alone: {}", CATALOGUE[index].id()),
+                });
+            }
             fitted_by_index.insert(index, fitted);
         }
         let Some((index, _)) = best else {
@@ -189,6 +200,7 @@ pub(super) fn select(
         fitted: current,
         chosen,
         candidates,
+        contenders,
     })
 }
 

@@ -121,6 +121,9 @@ pub(super) struct Discovery {
     pub steps: Vec<DiscoveryStep>,
     /// Simulations run.
     pub evaluations: u64,
+    /// The first step's refits and the library's mimics of the catalogue's answer, for the
+    /// rival search.
+    pub contenders: Vec<crate::rivals::Contender>,
 }
 
 /// One library entry as the regression ranked it.

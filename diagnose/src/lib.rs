@@ -105,6 +105,7 @@ mod probe;
 pub mod readings;
 mod reconstruct;
 mod residuals;
+mod rivals;
 mod stepwise;
 mod validation;
 mod verdict;
@@ -118,6 +119,7 @@ pub use residuals::{
     CHANNELS, ChannelReport, LAGS, ResidualReport, SegmentRms, WHITENESS_P, physical_residuals,
     residual_report,
 };
+pub use rivals::rival_name;
 pub use validation::{AlternativePrediction, ValidationReport};
 pub use verdict::fmt_discovered;
 
@@ -196,12 +198,18 @@ pub fn diagnose(
         &options.candidate_lm,
         &mut evaluations,
     )?;
+    // What the catalogue's answer changes in the residuals: discovery looks for its mimics.
+    let signature: Option<Vec<f64>> = (!cat.chosen.is_empty()).then(|| {
+        let (b, c) = (&baseline.lm.residuals, &cat.fitted.lm.residuals);
+        b.iter().zip(c).map(|(b, c)| b - c).collect()
+    });
     let disc = discover::discover(
         evaluator,
         job,
         &baseline,
         setting.noise,
         &options.candidate_lm,
+        signature.as_deref(),
     )?;
     evaluations += disc.evaluations;
     let selected = (!cat.chosen.is_empty()).then_some(Selected {
@@ -209,9 +217,22 @@ pub fn diagnose(
         chosen: cat.chosen,
     });
     let answer = Answer::decide(&setting, selected, disc.found);
+    let mut contenders = cat.contenders;
+    contenders.extend(disc.contenders);
+    contenders.extend(answer.rival().map(|r| r.contender()));
+    let rivals = rivals::rivals(
+        evaluator,
+        &setting,
+        &baseline,
+        &answer,
+        contenders,
+        &options.candidate_lm,
+        &mut evaluations,
+    )?;
     let decided = Decided {
         baseline,
         answer,
+        rivals,
         candidates: cat.candidates,
         reconstruction: disc.reconstruction,
         notes: disc.notes,

@@ -28,6 +28,7 @@ struct Page<'a> {
     validation: Vec<ValidationRow<'a>>,
     figures: &'a [String],
     alternatives: Vec<AlternativeRow<'a>>,
+    rivals: Vec<RivalRow<'a>>,
     discovery: Option<DiscoveryTable<'a>>,
     channels: Vec<ChannelRow>,
     candidates: Vec<CandidateRow<'a>>,
@@ -207,6 +208,7 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> Result<String, H
         validation: validation_rows(d),
         figures,
         alternatives: alternative_rows(d),
+        rivals: rival_rows(d),
         discovery: (!d.discovery_steps.is_empty() || !d.discovery_notes.is_empty()).then(|| {
             DiscoveryTable {
                 steps: step_rows(d),
@@ -301,6 +303,33 @@ fn validation_rows(d: &Diagnosis) -> Vec<ValidationRow<'_>> {
                 .collect::<Vec<_>>()
                 .join("; "),
             note: &v.note,
+        })
+        .collect()
+}
+
+/// A rival as the page lists it.
+#[derive(Serialize)]
+struct RivalRow<'a> {
+    kind: &'a str,
+    model: String,
+    chi2: String,
+    j_pos_m: String,
+    j_att_deg: String,
+    delta_bic: String,
+    origin: &'a str,
+}
+
+fn rival_rows(d: &Diagnosis) -> Vec<RivalRow<'_>> {
+    d.rivals
+        .iter()
+        .map(|r| RivalRow {
+            kind: &r.kind,
+            model: crate::rivals::rival_name(r),
+            chi2: format!("{:.1}", r.chi2),
+            j_pos_m: format!("{:.5}", r.j_pos_m),
+            j_att_deg: format!("{:.4}", r.j_att_deg),
+            delta_bic: format!("{:+.1}", r.delta_bic),
+            origin: &r.origin,
         })
         .collect()
 }

@@ -146,3 +146,24 @@ pub(super) fn verdict(v: &VerdictInput) -> String {
         )
     }
 }
+
+/// The clause that says what the data cannot tell apart, when the answer has rivals: "this
+/// release cannot tell it from A (BIC -1.2) or from B (BIC +3.4)".
+pub(super) fn ambiguity(rivals: &[crate::RivalReport], events: usize) -> Option<String> {
+    if rivals.is_empty() {
+        return None;
+    }
+    let data = if events == 1 {
+        "this release"
+    } else {
+        "these releases"
+    };
+    let named: Vec<String> = rivals
+        .iter()
+        .map(|r| format!("{} (BIC {:+.1})", crate::rivals::rival_name(r), r.delta_bic))
+        .collect();
+    Some(format!(
+        "{data} cannot tell it from {}: a release that separates them settles it (`sepval plan`)",
+        named.join(" or from ")
+    ))
+}

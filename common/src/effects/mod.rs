@@ -63,6 +63,12 @@ pub trait Effect: Send + Sync {
     fn params(&self) -> &'static [ParamSpec];
     /// Applies the effect with parameters `p` (as many as [`Effect::params`], finite) to a run.
     fn apply(&self, p: &[f64], run: &mut RunSetup) -> Result<(), EffectError>;
+    /// The extension term it equals, when it is one term of the library (`docs/model.md`
+    /// section 11): its first parameter is then that term's coefficient. A diagnosis does not
+    /// call the two rivals: they are one explanation in two vocabularies.
+    fn as_term(&self) -> Option<(crate::extension::Axis, crate::extension::Regressor)> {
+        None
+    }
 }
 
 /// Every effect, in docs/model.md order: the one place to register an effect.

@@ -28,6 +28,12 @@ impl Effect for PitchStiffnessCubic {
             scale: 20.0,
         }]
     }
+    fn as_term(&self) -> Option<(crate::extension::Axis, crate::extension::Regressor)> {
+        Some((
+            crate::extension::Axis::Cm,
+            crate::extension::Regressor::Alpha3,
+        ))
+    }
     fn apply(&self, p: &[f64], run: &mut RunSetup) -> Result<(), EffectError> {
         run.add_coefficient_term(term, [p[0], 0.0, 0.0])
     }

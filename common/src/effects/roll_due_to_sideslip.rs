@@ -27,6 +27,12 @@ impl Effect for RollDueToSideslip {
             scale: 0.3,
         }]
     }
+    fn as_term(&self) -> Option<(crate::extension::Axis, crate::extension::Regressor)> {
+        Some((
+            crate::extension::Axis::Cl,
+            crate::extension::Regressor::Beta,
+        ))
+    }
     fn apply(&self, p: &[f64], run: &mut RunSetup) -> Result<(), EffectError> {
         run.add_coefficient_term(term, [p[0], 0.0, 0.0])
     }

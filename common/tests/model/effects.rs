@@ -320,3 +320,49 @@ fn tracked_point_offset_reports_a_body_point() {
         assert_eq!(obs.att_deg, euler_321_deg(&c).map(|a| a + 0.0));
     }
 }
+
+#[test]
+fn an_effect_that_names_its_term_is_that_term() {
+    // `Effect::as_term`: the diagnosis does not call the two rivals, so they must simulate
+    // the same release (the same sum in the same coefficient; the order of two additions may
+    // differ, so to rounding).
+    use sepval_common::extension::{Term, TermSet};
+    let sim = Simulator::embedded_default();
+    let times = sim.default_times();
+    let mut checked = 0;
+    for effect in CATALOGUE.iter() {
+        let Some((axis, regressor)) = effect.as_term() else {
+            continue;
+        };
+        let value = 0.4 * effect.params()[0].scale;
+        let set = effects(&format!("{}={value}", effect.id()));
+        let by_effect = trajectory(&sim, &set, &times);
+        let mut terms = TermSet::NONE;
+        terms
+            .push(Term {
+                axis,
+                regressor,
+                locator: [0.0; 2],
+                coefficient: value,
+            })
+            .unwrap();
+        let run = sim
+            .run_setup_with(&BASE, &EffectSet::NONE, &terms)
+            .unwrap();
+        let mut obs: Vec<Observation> = Vec::new();
+        propagate(sim.model(), &run, &times, &mut obs).unwrap();
+        let baseline = trajectory(&sim, &EffectSet::NONE, &times);
+        let mut moved = 0.0_f64;
+        for (k, o) in obs.iter().enumerate() {
+            for i in 0..3 {
+                let d = (o.att_deg[i] - by_effect.att_deg[k][i]).abs();
+                assert!(d < 1e-9, "{} at sample {k}: {d}", effect.id());
+                assert!((o.pos_m[i] - by_effect.pos_m[k][i]).abs() < 1e-9);
+                moved = moved.max((o.att_deg[i] - baseline.att_deg[k][i]).abs());
+            }
+        }
+        assert!(moved > 1e-3, "{} does not move the store", effect.id());
+        checked += 1;
+    }
+    assert_eq!(checked, 2, "roll_due_to_sideslip and pitch_stiffness_cubic");
+}

@@ -46,6 +46,7 @@ use search::{Search, Selection, Trail};
 use verify::Refit;
 
 mod locate;
+mod mimic;
 mod naming;
 mod picked;
 mod remove;
@@ -62,6 +63,7 @@ pub(super) fn discover(
     baseline: &Fitted,
     noise: Noise,
     settings: &LmSettings,
+    signature: Option<&[f64]>,
 ) -> Result<Discovery> {
     let search = Search::new(job, noise, settings);
     let mut trail = Trail::default();
@@ -76,7 +78,10 @@ pub(super) fn discover(
             evaluator,
             &search,
             &sel,
-            step,
+            Step {
+                step,
+                signature: signature.filter(|_| step == 0),
+            },
             &mut trail,
             &mut reconstruction,
         )?
@@ -92,7 +97,18 @@ pub(super) fn discover(
         notes: trail.notes,
         steps: trail.steps,
         evaluations: trail.evaluations,
+        contenders: trail.contenders,
     })
+}
+
+/// Which step of the selection, and at the first, what the rival search asks of it.
+#[derive(Clone, Copy)]
+struct Step<'a> {
+    /// The step (0: against the baseline).
+    step: usize,
+    /// What the catalogue's answer changes in the residuals, whose library mimics the first
+    /// step refits for the rival search.
+    signature: Option<&'a [f64]>,
 }
 
 /// One step of the forward selection from `sel`: screening (and, at the first step, the
@@ -102,13 +118,26 @@ fn enter(
     evaluator: &mut dyn Evaluator,
     search: &Search,
     sel: &Selection,
-    step: usize,
+    at: Step,
     trail: &mut Trail,
     reconstruction: &mut Vec<Reconstruction>,
 ) -> Result<Option<Selection>> {
+    let step = at.step;
     let Some(mut s) = screen::screen(evaluator, search, sel, step, trail)? else {
         return Ok(None);
     };
+    if let Some(signature) = at.signature {
+        let exclude = s.to_verify();
+        mimic::mimics(
+            evaluator,
+            search,
+            &s,
+            &sel.current,
+            signature,
+            &exclude,
+            trail,
+        )?;
+    }
     if let Some(r) = s.reconstruction.take() {
         *reconstruction = r;
     }
@@ -137,6 +166,9 @@ fn enter(
         &mut trail.evaluations,
     )?;
     record.verified = refits.iter().map(Refit::verified).collect();
+    if step == 0 {
+        mimic::from_refits(&s, &refits, trail);
+    }
     let Some(winner) = refits.first() else {
         trail.steps.push(record);
         return Ok(None);

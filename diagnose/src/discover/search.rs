@@ -96,4 +96,6 @@ pub(super) struct Trail {
     pub steps: Vec<DiscoveryStep>,
     /// Simulations run.
     pub evaluations: u64,
+    /// The first step's refits (and mimics), for the rival search.
+    pub contenders: Vec<crate::rivals::Contender>,
 }

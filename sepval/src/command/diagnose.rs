@@ -158,6 +158,9 @@ fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
         d.evaluations,
         d.wall_s
     ));
+    if !d.rivals.is_empty() {
+        s.push_str(&rivals_line(d));
+    }
     for v in &d.validation {
         let f = |v: Option<f64>, p: usize| {
             v.map_or("-".to_string(), |v| format!("{v:.prec$}", prec = p))
@@ -193,4 +196,26 @@ fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
         out.join("report.html").display()
     ));
     s
+}
+
+/// The line that says what the data cannot tell from the answer, at most 160 characters.
+fn rivals_line(d: &sepval_diagnose::Diagnosis) -> String {
+    const WIDTH: usize = 160;
+    let mut line = "rivals:    the data cannot tell it from".to_string();
+    for (k, r) in d.rivals.iter().enumerate() {
+        let item = format!(
+            "{} {} (BIC {:+.1})",
+            if k == 0 { "" } else { "," },
+            sepval_diagnose::rival_name(r),
+            r.delta_bic
+        );
+        let rest = format!(" ... ({} in all, see diagnosis.json)", d.rivals.len());
+        if line.chars().count() + item.chars().count() + rest.chars().count() > WIDTH {
+            line.push_str(&rest);
+            break;
+        }
+        line.push_str(&item);
+    }
+    line.push('\n');
+    line
 }

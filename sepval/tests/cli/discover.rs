@@ -25,11 +25,11 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
  "cnintfac": 0.8, "clintfac": 1.6}"#;
 
 /// A hidden coefficient function and its parameters.
-type Hidden = (CoefficientFn, [f64; MAX_EFFECT_PARAMS]);
+pub(crate) type Hidden = (CoefficientFn, [f64; MAX_EFFECT_PARAMS]);
 
 /// One release: `scenario` (its flight condition written as metadata) simulated with the base
 /// factors and the hidden term, 1 s at 200 Hz, noisy.
-fn release(scenario: &Scenario, hidden: Option<Hidden>, seed: u64) -> Trajectory {
+pub(crate) fn release(scenario: &Scenario, hidden: Option<Hidden>, seed: u64) -> Trajectory {
     let sim = Simulator::new(scenario);
     let factors = Factors::from_json_str(BASE, &scenario.factors).unwrap();
     let mut run = RunSetup::new(sim.model(), &factors, &EffectSet::NONE).unwrap();
@@ -64,7 +64,12 @@ fn release(scenario: &Scenario, hidden: Option<Hidden>, seed: u64) -> Trajectory
 
 /// Writes the releases, diagnoses them (the first `fit` of them fitted, the rest validated)
 /// with `scenario` (the embedded default when `None`), and returns the diagnosis.
-fn diagnose(dir: &Path, releases: &[Trajectory], fit: usize, scenario: Option<&Scenario>) -> Value {
+pub(crate) fn diagnose(
+    dir: &Path,
+    releases: &[Trajectory],
+    fit: usize,
+    scenario: Option<&Scenario>,
+) -> Value {
     let mut args: Vec<String> = vec!["diagnose".into()];
     if let Some(s) = scenario {
         std::fs::write(dir.join("scenario.toml"), s.to_toml_string()).unwrap();
@@ -161,7 +166,7 @@ fn found_first<'a>(d: &'a Value, dir: &Path, axis: &str, family: &str) -> &'a Va
     first
 }
 
-fn default_scenario() -> Scenario {
+pub(crate) fn default_scenario() -> Scenario {
     Scenario::embedded_default()
 }
 
@@ -187,7 +192,7 @@ fn drag_rise(p: &[f64; MAX_EFFECT_PARAMS], flow: &Flow, k: &mut Coefficients) {
     k.cx -= p[0] * (flow.mach - 0.85);
 }
 
-fn params(v: &[f64]) -> [f64; MAX_EFFECT_PARAMS] {
+pub(crate) fn params(v: &[f64]) -> [f64; MAX_EFFECT_PARAMS] {
     let mut p = [0.0; MAX_EFFECT_PARAMS];
     p[..v.len()].copy_from_slice(v);
     p
@@ -344,6 +349,9 @@ fn null_data_name_neither_an_effect_nor_a_term() {
             d["verdict"]
         );
         assert_eq!(d["explained"], true, "{}", d["verdict"]);
+        // Null data have no answer, so nothing rivals it.
+        assert_eq!(d["ambiguous"], false, "{}", d["verdict"]);
+        assert!(d["rivals"].as_array().unwrap().is_empty());
         assert!(!dir.path().join("diag/extension.toml").exists());
     }
 }

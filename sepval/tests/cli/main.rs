@@ -14,4 +14,5 @@ mod fuzz;
 mod hardening;
 mod hardening_on_disk;
 mod refine;
+mod rivals;
 mod tables;

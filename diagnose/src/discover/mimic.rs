@@ -1,0 +1,100 @@
+//! The library's contenders of a diagnosis's rival search (`crate::rivals`), gathered at
+//! discovery's first step, where the sensitivities about the baseline are at hand: the step's
+//! verification refits, and the library terms that best reproduce a signature (what the
+//! catalogue's answer changes in the residuals), the best of each family by F-to-enter beyond
+//! the model's own sensitivities, each located and refitted as the step's own entries are.
+
+use nalgebra::DVector;
+use sepval_common::evaluation::Evaluator;
+use sepval_common::extension::Family;
+
+use super::locate;
+use super::picked::Picked;
+use super::screen::Screening;
+use super::search::{Search, Trail};
+use super::verify::{Refit, refit_candidates};
+use crate::rivals::{Contender, light};
+use crate::{Fitted, Result, stepwise};
+
+/// Library terms tried as mimics of a signature, at most (one per family).
+pub const MIMICS: usize = 3;
+
+/// A step's refit as a contender of the rival search.
+fn contender(r: &Refit, pool_size: usize, origin: &str) -> Contender {
+    Contender {
+        fitted: light(&r.fitted),
+        pool_size,
+        origin: format!("{origin}: {}", r.entry.label()),
+    }
+}
+
+/// The first step's verification refits as contenders.
+pub(super) fn from_refits(s: &Screening, refits: &[Refit], trail: &mut Trail) {
+    let n = s.entries.len();
+    trail.contenders.extend(
+        refits
+            .iter()
+            .map(|r| contender(r, n, "discovery's first-step refit")),
+    );
+}
+
+/// The entries of `s` that best reproduce `signature` (full residual vector), one per family,
+/// skipping the kinds in `exclude`; best first.
+fn rank(s: &Screening, search: &Search, signature: &[f64], exclude: &[usize]) -> Vec<usize> {
+    let sig = DVector::from_iterator(search.rows.len(), search.rows.iter().map(|&i| signature[i]));
+    let scores = stepwise::screen(&sig, &s.linear.fixed, &s.lib_cols, &s.entry_cols);
+    let mut families: Vec<Family> = Vec::new();
+    let mut out = Vec::new();
+    for sc in scores {
+        let e = &s.entries[sc.entry];
+        if exclude.iter().any(|&x| s.entries[x].same_kind(e)) || families.contains(&e.family()) {
+            continue;
+        }
+        families.push(e.family());
+        out.push(sc.entry);
+        if out.len() == MIMICS {
+            break;
+        }
+    }
+    out
+}
+
+/// The library's best mimics of `signature` about the baseline `current`, located and
+/// refitted, as contenders.
+pub(super) fn mimics(
+    evaluator: &mut dyn Evaluator,
+    search: &Search,
+    s: &Screening,
+    current: &Fitted,
+    signature: &[f64],
+    exclude: &[usize],
+    trail: &mut Trail,
+) -> Result<()> {
+    let picked = rank(s, search, signature, exclude);
+    if picked.is_empty() {
+        return Ok(());
+    }
+    let located = locate::locate(
+        evaluator,
+        search,
+        s,
+        current,
+        &picked,
+        &mut trail.evaluations,
+    )?;
+    let refits = refit_candidates(
+        evaluator,
+        search,
+        current,
+        &Picked::default(),
+        located,
+        &mut trail.evaluations,
+    )?;
+    let n = s.entries.len();
+    trail.contenders.extend(
+        refits
+            .iter()
+            .map(|r| contender(r, n, "library mimic of the catalogue's answer")),
+    );
+    Ok(())
+}

@@ -1,0 +1,241 @@
+//! Rivals: every explanation the data cannot tell from the answer (`docs/model.md` section
+//! 11.5, step 4a).
+//!
+//! One release often admits several explanations: the study itself concludes that "many
+//! parameter combinations are capable of producing reasonable trajectories" (M. B. Anderson).
+//! A diagnosis that names one of them must name the others. The contenders come from both
+//! pools, so that a mimic found on one release comes with the cause it mimics:
+//!
+//! - the catalogue's: every effect refitted alone from the baseline (the catalogue stage's first
+//!   round), and the catalogue's selection when it is not the answer;
+//! - the library's: the terms discovery refitted at its first step (the best of each axis and
+//!   regressor by F-to-enter), the discovered extension when it is not the answer, and, for a
+//!   catalogue answer, the library terms that best reproduce what the answer's effects change
+//!   (its *signature*: the baseline's residuals minus the answer's), the best of each family
+//!   beyond the model's own sensitivities (the active search for a mimic).
+//!
+//! **The rule.** A contender is a rival when (1) it is significant against the baseline by the
+//! rule of its pool (the F test of its extra parameters at 1 % divided by the size of the pool,
+//! and a lower BIC), and (2) its BIC, after a refit to convergence, lies within
+//! [`RIVAL_MARGIN`](crate::RIVAL_MARGIN) = 6 of the answer's, either way: below 6 the evidence
+//! between two models is not "strong" on R. E. Kass and A. E. Raftery's scale (JASA 90, 1995).
+//! The answer stays the answer (it is chosen by the rules of 11.5); its rivals are what the
+//! data do not rule out. Null data name no answer, so they have no rivals.
+
+use std::sync::Arc;
+
+use sepval_common::effects::{CATALOGUE, EffectSet};
+use sepval_common::evaluation::Job;
+use sepval_common::extension::{Axis, TermRecord};
+use sepval_fit::model_spec::ModelSpec;
+use sepval_fit::refine::{ModelLm, refine_together};
+use sepval_solve::lm::LmSettings;
+
+use crate::answer::{Answer, Setting};
+use crate::found::Gain;
+use crate::{ALPHA, Fitted, RIVAL_MARGIN, Result, RivalReport};
+use sepval_common::evaluation::Evaluator;
+
+/// Contenders within this BIC distance of the answer are refitted to convergence before the
+/// rule is applied (a screening refit stops early and overstates its chi-square).
+const CONVERGE_WITHIN: f64 = 3.0 * RIVAL_MARGIN;
+
+/// A fitted model that may explain the data as well as the answer.
+#[derive(Clone)]
+pub(crate) struct Contender {
+    /// Its fit.
+    pub fitted: Fitted,
+    /// How many models its pool tried (its significance threshold is 1 % over this).
+    pub pool_size: usize,
+    /// How it came to be tried.
+    pub origin: String,
+}
+
+impl Contender {
+    /// Its effects' ids, and its terms' records at its fitted values.
+    fn names(&self, job: &Job) -> (Vec<String>, Vec<TermRecord>) {
+        let effects = effect_ids(&self.fitted.effects);
+        let terms = self
+            .fitted
+            .space(job)
+            .terms_at(&self.fitted.lm.x)
+            .unwrap_or_default()
+            .iter()
+            .map(TermRecord::of)
+            .collect();
+        (effects, terms)
+    }
+
+    /// The same model as `other`: the same effects and the same terms (axis, regressor and
+    /// locators within a thousandth).
+    fn same_model(&self, other: &Fitted, job: &Job) -> bool {
+        same_model(&self.fitted, other, job)
+    }
+}
+
+/// A fit without its Jacobian, residuals and history (a contender keeps only where it is).
+pub(crate) fn light(f: &Fitted) -> Fitted {
+    let mut out = f.clone();
+    out.lm.jacobian = nalgebra::DMatrix::zeros(0, 0);
+    out.lm.residuals = Vec::new();
+    out.lm.history = Vec::new();
+    out
+}
+
+/// The ids of a set of effects.
+fn effect_ids(effects: &EffectSet) -> Vec<String> {
+    effects
+        .iter()
+        .map(|a| CATALOGUE[a.index].id().to_string())
+        .collect()
+}
+
+/// Whether two fitted models have the same effects and the same terms (an effect that is one
+/// library term counted as that term: the same explanation in two vocabularies).
+pub(crate) fn same_model(a: &Fitted, b: &Fitted, job: &Job) -> bool {
+    let key = |f: &Fitted| {
+        let mut terms: Vec<(Axis, String, i64)> = f
+            .space(job)
+            .terms_at(&f.lm.x)
+            .unwrap_or_default()
+            .iter()
+            .map(|t| {
+                (
+                    t.axis,
+                    t.regressor.name().to_string(),
+                    (t.locator[0] * 1000.0).round() as i64,
+                )
+            })
+            .collect();
+        let mut effects = Vec::new();
+        for a in f.effects.iter() {
+            match a.effect().as_term() {
+                Some((axis, regressor)) => terms.push((axis, regressor.name().to_string(), 0)),
+                None => effects.push(a.effect().id().to_string()),
+            }
+        }
+        terms.sort();
+        effects.sort();
+        (effects, terms)
+    };
+    key(a) == key(b)
+}
+
+/// The rivals of `answer` among `contenders`, best (lowest BIC) first, each refitted to
+/// convergence; `notes` receives what the search saw beyond them.
+pub(crate) fn rivals(
+    evaluator: &mut dyn Evaluator,
+    setting: &Setting,
+    baseline: &Fitted,
+    answer: &Answer,
+    contenders: Vec<Contender>,
+    settings: &LmSettings,
+    evaluations: &mut u64,
+) -> Result<Vec<(Contender, RivalReport)>> {
+    let job = &setting.job;
+    if matches!(answer, Answer::Baseline) {
+        return Ok(Vec::new());
+    }
+    let model = answer.model(baseline);
+    let answer_bic = setting.bic(model);
+    let mut near: Vec<Contender> = Vec::new();
+    for c in contenders {
+        if c.same_model(model, job) || near.iter().any(|n| n.same_model(&c.fitted, job)) {
+            continue;
+        }
+        if (setting.bic(&c.fitted) - answer_bic).abs() < CONVERGE_WITHIN {
+            near.push(c);
+        }
+    }
+    converge_all(evaluator, job, &mut near, setting, settings, evaluations)?;
+    let mut out: Vec<(Contender, RivalReport)> = near
+        .into_iter()
+        .filter(|c| significant(setting, baseline, c))
+        .filter_map(|c| {
+            let delta_bic = setting.bic(&c.fitted) - answer_bic;
+            (delta_bic.abs() < RIVAL_MARGIN).then(|| {
+                let report = report(setting, &c, delta_bic);
+                report.map(|r| (c, r))
+            })
+        })
+        .collect::<Result<_>>()?;
+    out.sort_by(|a, b| a.1.delta_bic.total_cmp(&b.1.delta_bic));
+    Ok(out)
+}
+
+/// Whether a contender is significant against the baseline by its pool's rule.
+fn significant(setting: &Setting, baseline: &Fitted, c: &Contender) -> bool {
+    let job = &setting.job;
+    let p_with = c.fitted.space(job).len();
+    let q = p_with - baseline.space(job).len();
+    let gain = Gain::of(baseline.lm.cost, c.fitted.lm.cost, q, p_with, setting.m);
+    gain.significant(ALPHA / c.pool_size.max(1) as f64)
+}
+
+/// Every contender refined on to convergence from its refit, all sharing each batch; each
+/// keeps the better of the two.
+fn converge_all(
+    evaluator: &mut dyn Evaluator,
+    job: &Arc<Job>,
+    near: &mut [Contender],
+    setting: &Setting,
+    settings: &LmSettings,
+    evaluations: &mut u64,
+) -> Result<()> {
+    let mut runs: Vec<ModelLm> = near
+        .iter()
+        .map(|c| {
+            ModelLm::new(
+                c.fitted.space(job),
+                Arc::clone(job),
+                &c.fitted.lm.x,
+                setting.noise,
+                settings.clone(),
+            )
+        })
+        .collect();
+    refine_together(evaluator, &mut runs)?;
+    for (c, run) in near.iter_mut().zip(runs) {
+        let lm = run.finish();
+        *evaluations += lm.evaluations;
+        if lm.cost < c.fitted.lm.cost {
+            c.fitted.lm = lm;
+        }
+    }
+    Ok(())
+}
+
+/// A rival as diagnosis.json lists it.
+fn report(setting: &Setting, c: &Contender, delta_bic: f64) -> Result<RivalReport> {
+    let job = &setting.job;
+    let (effects, terms) = c.names(job);
+    let kind = if terms.is_empty() {
+        "catalogue"
+    } else {
+        "discovered"
+    };
+    Ok(RivalReport {
+        kind: kind.to_string(),
+        effects,
+        terms,
+        delta_bic,
+        chi2: c.fitted.lm.cost,
+        j_pos_m: c.fitted.lm.goals.j_pos_m,
+        j_att_deg: c.fitted.lm.goals.j_att_deg,
+        parameters: c.fitted.space(job).len(),
+        origin: c.origin.clone(),
+        model: ModelSpec::of(&c.fitted.candidate(job)?),
+    })
+}
+
+/// A rival's name in a sentence: its effects' ids and its terms' `axis formula`.
+pub fn rival_name(r: &RivalReport) -> String {
+    let mut parts: Vec<String> = r.effects.clone();
+    for t in &r.terms {
+        match t.term() {
+            Ok(term) => parts.push(format!("{} {}", t.axis, term.formula())),
+            Err(_) => parts.push(format!("{} {}", t.axis, t.regressor)),
+        }
+    }
+    parts.join(" + ")
+}
