@@ -13,11 +13,12 @@ use sepval_common::factors::FACTOR_COUNT;
 use sepval_fit::model_spec::ModelSpec;
 
 use crate::answer::{Answer, Rival, Setting};
+use crate::contender::Contender;
 use crate::found::{DiscoveredTerm, DiscoveryStep, Found, Gain};
 use crate::increments::{Curves, model_increments};
 use crate::reconstruct::Reconstruction;
 use crate::residuals::{physical_residuals, residual_report, rms_channels};
-use crate::rivals::{Contender, same_model};
+use crate::rivals::same_model;
 use crate::validation::{prediction_caveat, validate};
 use crate::verdict::{VerdictInput, ambiguity, verdict};
 use crate::{
@@ -83,47 +84,32 @@ pub(super) fn analyse(
     let cat_fit = d.answer.selected().map_or(&d.baseline, |s| &s.fitted);
     let cat_report = residual_report(job, &cat_fit.lm, &cat_fit.candidate(job)?, noise, floor);
     let explained = cat_report.white && cat_report.at_noise_floor;
-    let (causes, discovered) = match &d.answer {
-        Answer::Catalogue { selected, .. } => (selected.names(), Vec::new()),
-        Answer::Discovered { found, .. } => (Vec::new(), found.terms.clone()),
-        Answer::Baseline => (Vec::new(), Vec::new()),
-    };
+    let (causes, discovered) = d.answer.named();
     let parameters = d
         .answer
         .selected()
         .map(|s| effect_parameters(setting, &s.fitted))
         .unwrap_or_default();
     let rivals: Vec<RivalReport> = d.rivals.iter().map(|(_, r)| r.clone()).collect();
-    let alternatives = alternatives(setting, &d.answer, answer_fit, explained)
-        .into_iter()
-        .filter(|_| {
-            // The loser of the answer's decision is listed once: as a rival when the data
-            // cannot tell it from the answer.
-            d.answer.rival().is_none_or(|r| {
-                !d.rivals
-                    .iter()
-                    .any(|(c, _)| same_model(&c.fitted, r.fitted(), job))
-            })
-        })
-        .collect::<Vec<_>>();
-    let extension = match d.answer.found() {
-        Some(f) => Some(extension_report(setting, &d.answer, f)?),
-        None => None,
+    let alternatives = if loser_is_rival(job, &d) {
+        Vec::new()
+    } else {
+        alternatives(setting, &d.answer, answer_fit, explained)
     };
-    let final_report = residual_report(
-        job,
-        &answer_fit.lm,
-        &answer_fit.candidate(job)?,
-        noise,
-        floor,
-    );
-    let base_report = residual_report(
-        job,
-        &d.baseline.lm,
-        &d.baseline.candidate(job)?,
-        noise,
-        floor,
-    );
+    let extension = (d.answer.found())
+        .map(|f| extension_report(setting, &d.answer, f))
+        .transpose()?;
+    let report_of = |f: &Fitted| -> Result<_> {
+        Ok(residual_report(
+            job,
+            &f.lm,
+            &f.candidate(job)?,
+            noise,
+            floor,
+        ))
+    };
+    let final_report = report_of(answer_fit)?;
+    let base_report = report_of(&d.baseline)?;
     let model = ModelSpec::of(&answer_fit.candidate(job)?);
     let base_summary = summary(setting, &d.baseline);
     let ext_summary = summary(setting, answer_fit);
@@ -146,9 +132,6 @@ pub(super) fn analyse(
     if let Some(c) = &caution {
         verdict.push_str(&format!("; caution: {c}"));
     }
-    let mut residuals = BTreeMap::new();
-    residuals.insert("baseline".to_string(), base_report);
-    residuals.insert("extended".to_string(), final_report);
     let diagnosis = Diagnosis {
         format: DIAGNOSIS_FORMAT.to_string(),
         causes,
@@ -171,7 +154,10 @@ pub(super) fn analyse(
         inputs: options.fit.inputs.clone(),
         parameters,
         candidates: d.candidates,
-        residuals,
+        residuals: BTreeMap::from([
+            ("baseline".to_string(), base_report),
+            ("extended".to_string(), final_report),
+        ]),
         reconstruction: d.reconstruction,
         validation,
         evaluations: d.evaluations,
@@ -184,6 +170,16 @@ pub(super) fn analyse(
         answer: d.answer,
         curves,
         extension,
+    })
+}
+
+/// Whether the model that lost the answer's decision is a rival: it is then listed once, as
+/// a rival, not as an alternative.
+fn loser_is_rival(job: &Job, d: &Decided) -> bool {
+    d.answer.rival().is_some_and(|r| {
+        d.rivals
+            .iter()
+            .any(|(c, _)| same_model(&c.fitted, r.fitted(), job))
     })
 }
 

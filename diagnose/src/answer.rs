@@ -123,6 +123,16 @@ impl Answer {
         }
     }
 
+    /// What it names: the catalogue's causes, or the discovered terms (one of the two is
+    /// empty; both for the baseline).
+    pub fn named(&self) -> (Vec<String>, Vec<crate::DiscoveredTerm>) {
+        match self {
+            Answer::Catalogue { selected, .. } => (selected.names(), Vec::new()),
+            Answer::Discovered { found, .. } => (Vec::new(), found.terms.clone()),
+            Answer::Baseline => (Vec::new(), Vec::new()),
+        }
+    }
+
     /// The answer's model.
     pub fn model<'a>(&'a self, baseline: &'a Fitted) -> &'a Fitted {
         match self {
@@ -175,17 +185,12 @@ impl Rival<'_> {
     }
 
     /// Its model as a contender of the rival search (it passed its own pool's tests).
-    pub fn contender(&self) -> crate::rivals::Contender {
-        use crate::rivals::{Contender, light};
+    pub fn contender(&self) -> crate::contender::Contender {
         let origin = match self {
             Rival::Catalogue(_) => "the catalogue's selection",
             Rival::Discovered(_) => "the discovered extension",
         };
-        Contender {
-            fitted: light(self.fitted()),
-            pool_size: 1,
-            origin: origin.to_string(),
-        }
+        crate::contender::Contender::new(self.fitted(), 1, origin.to_string())
     }
 
     /// How the validation names it, and its candidate.

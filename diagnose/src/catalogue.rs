@@ -12,8 +12,8 @@ use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS};
 use sepval_common::evaluation::{Evaluator, Job};
 use sepval_common::factors::FACTOR_COUNT;
 
+use super::contender::Contender;
 use super::residuals::{physical_residuals, rms_channels};
-use super::rivals::{Contender, light};
 use super::{ALPHA, CandidateReport, DiagnoseError, Fitted, ParamValue, Result, bic};
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
@@ -179,11 +179,11 @@ pub(super) fn select(
             }
             candidates.push(report);
             if round == 1 {
-                contenders.push(Contender {
-                    fitted: light(&fitted),
-                    pool_size: remaining.len(),
-                    origin: format!("catalogue effect alone: {}", CATALOGUE[index].id()),
-                });
+                contenders.push(Contender::new(
+                    &fitted,
+                    remaining.len(),
+                    format!("catalogue effect alone: {}", CATALOGUE[index].id()),
+                ));
             }
             fitted_by_index.insert(index, fitted);
         }

@@ -123,7 +123,7 @@ pub(super) struct Discovery {
     pub evaluations: u64,
     /// The first step's refits and the library's mimics of the catalogue's answer, for the
     /// rival search.
-    pub contenders: Vec<crate::rivals::Contender>,
+    pub contenders: Vec<crate::contender::Contender>,
 }
 
 /// One library entry as the regression ranked it.

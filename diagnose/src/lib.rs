@@ -94,6 +94,7 @@ type Result<T> = std::result::Result<T, DiagnoseError>;
 mod analysis;
 mod answer;
 mod catalogue;
+mod contender;
 mod diagnosis;
 mod discover;
 mod found;

@@ -32,6 +32,7 @@ use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_solve::lm::LmSettings;
 
 use crate::answer::{Answer, Setting};
+use crate::contender::Contender;
 use crate::found::Gain;
 use crate::{ALPHA, Fitted, RIVAL_MARGIN, Result, RivalReport};
 use sepval_common::evaluation::Evaluator;
@@ -39,48 +40,6 @@ use sepval_common::evaluation::Evaluator;
 /// Contenders within this BIC distance of the answer are refitted to convergence before the
 /// rule is applied (a screening refit stops early and overstates its chi-square).
 const CONVERGE_WITHIN: f64 = 3.0 * RIVAL_MARGIN;
-
-/// A fitted model that may explain the data as well as the answer.
-#[derive(Clone)]
-pub(crate) struct Contender {
-    /// Its fit.
-    pub fitted: Fitted,
-    /// How many models its pool tried (its significance threshold is 1 % over this).
-    pub pool_size: usize,
-    /// How it came to be tried.
-    pub origin: String,
-}
-
-impl Contender {
-    /// Its effects' ids, and its terms' records at its fitted values.
-    fn names(&self, job: &Job) -> (Vec<String>, Vec<TermRecord>) {
-        let effects = effect_ids(&self.fitted.effects);
-        let terms = self
-            .fitted
-            .space(job)
-            .terms_at(&self.fitted.lm.x)
-            .unwrap_or_default()
-            .iter()
-            .map(TermRecord::of)
-            .collect();
-        (effects, terms)
-    }
-
-    /// The same model as `other`: the same effects and the same terms (axis, regressor and
-    /// locators within a thousandth).
-    fn same_model(&self, other: &Fitted, job: &Job) -> bool {
-        same_model(&self.fitted, other, job)
-    }
-}
-
-/// A fit without its Jacobian, residuals and history (a contender keeps only where it is).
-pub(crate) fn light(f: &Fitted) -> Fitted {
-    let mut out = f.clone();
-    out.lm.jacobian = nalgebra::DMatrix::zeros(0, 0);
-    out.lm.residuals = Vec::new();
-    out.lm.history = Vec::new();
-    out
-}
 
 /// The ids of a set of effects.
 fn effect_ids(effects: &EffectSet) -> Vec<String> {
@@ -121,6 +80,20 @@ pub(crate) fn same_model(a: &Fitted, b: &Fitted, job: &Job) -> bool {
     key(a) == key(b)
 }
 
+/// A contender's effects' ids, and its terms' records at its fitted values.
+fn names(c: &Contender, job: &Job) -> (Vec<String>, Vec<TermRecord>) {
+    let effects = effect_ids(&c.fitted.effects);
+    let terms = c
+        .fitted
+        .space(job)
+        .terms_at(&c.fitted.lm.x)
+        .unwrap_or_default()
+        .iter()
+        .map(TermRecord::of)
+        .collect();
+    (effects, terms)
+}
+
 /// The rivals of `answer` among `contenders`, best (lowest BIC) first, each refitted to
 /// convergence; `notes` receives what the search saw beyond them.
 pub(crate) fn rivals(
@@ -140,7 +113,9 @@ pub(crate) fn rivals(
     let answer_bic = setting.bic(model);
     let mut near: Vec<Contender> = Vec::new();
     for c in contenders {
-        if c.same_model(model, job) || near.iter().any(|n| n.same_model(&c.fitted, job)) {
+        if same_model(&c.fitted, model, job)
+            || near.iter().any(|n| same_model(&n.fitted, &c.fitted, job))
+        {
             continue;
         }
         if (setting.bic(&c.fitted) - answer_bic).abs() < CONVERGE_WITHIN {
@@ -208,7 +183,7 @@ fn converge_all(
 /// A rival as diagnosis.json lists it.
 fn report(setting: &Setting, c: &Contender, delta_bic: f64) -> Result<RivalReport> {
     let job = &setting.job;
-    let (effects, terms) = c.names(job);
+    let (effects, terms) = names(c, job);
     let kind = if terms.is_empty() {
         "catalogue"
     } else {

@@ -346,9 +346,7 @@ fn an_effect_that_names_its_term_is_that_term() {
                 coefficient: value,
             })
             .unwrap();
-        let run = sim
-            .run_setup_with(&BASE, &EffectSet::NONE, &terms)
-            .unwrap();
+        let run = sim.run_setup_with(&BASE, &EffectSet::NONE, &terms).unwrap();
         let mut obs: Vec<Observation> = Vec::new();
         propagate(sim.model(), &run, &times, &mut obs).unwrap();
         let baseline = trajectory(&sim, &EffectSet::NONE, &times);

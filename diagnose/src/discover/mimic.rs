@@ -13,7 +13,7 @@ use super::picked::Picked;
 use super::screen::Screening;
 use super::search::{Search, Trail};
 use super::verify::{Refit, refit_candidates};
-use crate::rivals::{Contender, light};
+use crate::contender::Contender;
 use crate::{Fitted, Result, stepwise};
 
 /// Library terms tried as mimics of a signature, at most (one per family).
@@ -21,11 +21,11 @@ pub const MIMICS: usize = 3;
 
 /// A step's refit as a contender of the rival search.
 fn contender(r: &Refit, pool_size: usize, origin: &str) -> Contender {
-    Contender {
-        fitted: light(&r.fitted),
+    Contender::new(
+        &r.fitted,
         pool_size,
-        origin: format!("{origin}: {}", r.entry.label()),
-    }
+        format!("{origin}: {}", r.entry.label()),
+    )
 }
 
 /// The first step's verification refits as contenders.

@@ -97,5 +97,5 @@ pub(super) struct Trail {
     /// Simulations run.
     pub evaluations: u64,
     /// The first step's refits (and mimics), for the rival search.
-    pub contenders: Vec<crate::rivals::Contender>,
+    pub contenders: Vec<crate::contender::Contender>,
 }
