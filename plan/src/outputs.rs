@@ -381,9 +381,14 @@ fn rivals_figure(
         .map(|(l, v)| (l.as_str(), v.as_slice()))
         .collect();
     let f = &prepared.conditions.list[best.index].flight;
+    let n = crate::page::number;
     let title = format!(
         "The models at the recommended condition (Mach {}, {} m, alpha {} deg, beta {} deg, gamma {} deg)",
-        f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg
+        n(f.mach),
+        n(f.altitude_m),
+        n(f.alpha_deg),
+        n(f.beta_deg),
+        n(f.gamma_deg)
     );
     channel_figure(path, times, &sets, &title)?;
     Ok(Some(path.to_path_buf()))

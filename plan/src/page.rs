@@ -130,9 +130,14 @@ fn headline(file: &PlanFile) -> (String, String) {
     };
     let at = condition_words(best);
     let gain = opt(best.information_gain);
-    let shrink = best
-        .information_gain
-        .map_or("-".into(), |g| number((0.5 * g).exp()));
+    let shrink = best.information_gain.map_or("-".into(), |g| {
+        let f = (0.5 * g).exp();
+        if f < 1e3 {
+            number(f)
+        } else {
+            format!("{f:.1e}")
+        }
+    });
     let information = format!(
         "pooled with the releases flown, it would add {gain} to ln det of the information on the answer's {} parameters (their joint confidence region shrinks {shrink}-fold)",
         file.models[0].parameters
