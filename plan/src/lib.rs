@@ -16,7 +16,8 @@
 //!    condition (a linearised refit, [`refit`]) and the D-optimal information gain;
 //! 5. [`tables`]: the tables a release there would leave;
 //! 6. [`ranking`]: the conditions best first;
-//! 7. [`outputs`]: DIR/plan.json, DIR/plan.html and the figures, written atomically.
+//! 7. [`record`] and [`outputs`]: DIR/plan.json, DIR/plan.html and the figures, written
+//!    atomically.
 
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
@@ -27,6 +28,7 @@ pub mod models;
 pub mod outputs;
 mod page;
 pub mod ranking;
+pub mod record;
 pub mod refit;
 pub mod separation;
 pub mod simulate;
@@ -41,8 +43,9 @@ use sepval_solve::run::ProgressObserver;
 
 pub use conditions::{Conditions, DEFAULT_POINTS, Quantity, Range};
 pub use models::Models;
-pub use outputs::{PLAN_FORMAT, write_outputs};
+pub use outputs::write_outputs;
 pub use ranking::Ranking;
+pub use record::{PLAN_FORMAT, PlanFile, plan_file};
 
 /// A plan that cannot be made.
 #[derive(Debug, thiserror::Error)]

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use sepval_report::html::{HtmlError, PageTemplate, render_page};
 use serde::Serialize;
 
-use crate::outputs::{ConditionRecord, PlanFile};
 use crate::ranking::Standing;
+use crate::record::{ConditionRecord, PlanFile};
 
 /// The page's template.
 const PLAN: PageTemplate = PageTemplate {

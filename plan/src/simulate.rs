@@ -223,6 +223,8 @@ struct Runner<'a> {
 
 /// Per event, the samples of a run or why there are none.
 type EventSamples = Vec<Result<Vec<Observation>, String>>;
+/// Per event, a model's sensitivity columns or why there are none.
+type EventColumns = Vec<Result<Vec<Vec<f64>>, String>>;
 
 impl Runner<'_> {
     /// The samples of each candidate at each event.
@@ -282,9 +284,9 @@ impl Runner<'_> {
         m: &PlanModel,
         nominal: &EventSamples,
         noise: Noise,
-    ) -> Result<Vec<Result<Vec<Vec<f64>>, String>>, SimulateError> {
+    ) -> Result<EventColumns, SimulateError> {
         let probes = m.probes();
-        let mut columns: Vec<Result<Vec<Vec<f64>>, String>> = nominal
+        let mut columns: EventColumns = nominal
             .iter()
             .map(|n| match n {
                 Ok(_) => Ok(Vec::with_capacity(m.parameters())),
@@ -326,7 +328,7 @@ pub fn difference(a: &[Observation], b: &[Observation], noise: Noise, scale: f64
 /// Model `i`'s normal equations at each event from its columns and every model's trajectory.
 fn reduce(
     i: usize,
-    columns: &[Result<Vec<Vec<f64>>, String>],
+    columns: &EventColumns,
     nominal: &[EventSamples],
     noise: Noise,
 ) -> Vec<Result<EventNormal, String>> {

@@ -98,7 +98,7 @@ fn a_difference_a_factor_absorbs_does_not_separate_and_a_real_one_does() {
     let mut moved = Factors::TRUTH;
     // 0.5 % of cmoff's range: the trajectories differ by many noise sigmas, yet a refit of
     // either model moves cmoff and absorbs it all (to its second-order remainder).
-    let table = flown().factor_table().clone();
+    let table = *flown().factor_table();
     moved.0[cmoff] += 0.005 * (table.0[cmoff].max - table.0[cmoff].min);
     let r = run(
         &[

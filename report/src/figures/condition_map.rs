@@ -6,7 +6,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::FigureError;
-use super::kit::{draw_mesh, fmt_tick, plottable, render, text};
+use super::kit::{DrawResult, Root, draw_mesh, fmt_tick, plottable, render, text};
 
 /// One axis of a condition map: its label and its values (increasing).
 #[derive(Debug, Clone, Copy)]
@@ -87,6 +87,8 @@ pub fn condition_map(
         .collect();
     let lo = finite.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    // No finite cell: an empty map over a unit scale.
+    let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
     let span = if hi > lo { hi - lo } else { 1.0 };
     let fraction = |v: f64| {
         if plottable(v) {
@@ -139,32 +141,38 @@ pub fn condition_map(
             let rect = [(xe[ix], ye[iy]), (xe[ix + 1], ye[iy + 1])];
             chart.draw_series(std::iter::once(Rectangle::new(rect, RED.stroke_width(4))))?;
         }
-        let mut scale = ChartBuilder::on(&bar)
-            .margin_top(80)
-            .margin_bottom(75)
-            .margin_right(10)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..1.0, lo.min(hi)..if hi > lo { hi } else { lo + 1.0 })?;
-        scale
-            .configure_mesh()
-            .disable_x_mesh()
-            .disable_x_axis()
-            .y_desc(value_label)
-            .axis_desc_style(text(17.0))
-            .label_style(text(14.0))
-            .y_label_formatter(&|v| fmt_tick(*v))
-            .draw()?;
-        let steps = 64;
-        for i in 0..steps {
-            let (a, b) = (i as f64 / steps as f64, (i + 1) as f64 / steps as f64);
-            let rect = [(0.0, lo + a * span), (1.0, lo + b * span)];
-            scale.draw_series(std::iter::once(Rectangle::new(
-                rect,
-                sequential(a).filled(),
-            )))?;
-        }
-        Ok(())
+        draw_colour_bar(&bar, lo, hi, value_label)
     })
+}
+
+/// The colour bar of a map from `lo` to `hi`, labelled `value_label`.
+fn draw_colour_bar(bar: &Root<'_>, lo: f64, hi: f64, value_label: &str) -> DrawResult {
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let mut scale = ChartBuilder::on(bar)
+        .margin_top(80)
+        .margin_bottom(75)
+        .margin_right(10)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, lo.min(hi)..if hi > lo { hi } else { lo + 1.0 })?;
+    scale
+        .configure_mesh()
+        .disable_x_mesh()
+        .disable_x_axis()
+        .y_desc(value_label)
+        .axis_desc_style(text(17.0))
+        .label_style(text(14.0))
+        .y_label_formatter(&|v| fmt_tick(*v))
+        .draw()?;
+    let steps = 64;
+    for i in 0..steps {
+        let (a, b) = (i as f64 / steps as f64, (i + 1) as f64 / steps as f64);
+        let rect = [(0.0, lo + a * span), (1.0, lo + b * span)];
+        scale.draw_series(std::iter::once(Rectangle::new(
+            rect,
+            sequential(a).filled(),
+        )))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

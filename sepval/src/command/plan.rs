@@ -6,8 +6,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use sepval_fit::out_dir::{Claim, RunDir};
-use sepval_plan::outputs::{PlanFile, plan_file};
-use sepval_plan::{Quantity, Range, plan, prepare, read_diagnosis, write_outputs};
+use sepval_plan::{
+    PlanFile, Quantity, Range, plan, plan_file, prepare, read_diagnosis, write_outputs,
+};
 
 use super::{Bar, evaluator_spec, inputs, notices};
 use crate::cli::PlanArgs;
