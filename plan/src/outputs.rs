@@ -1,8 +1,8 @@
-//! The plan's outputs: DIR/plan.json (its record, [`crate::record`]), DIR/plan.html (the recommendation first, [`crate::page`]) and
-//! two figures, DIR/figures/separation.png (the ranking's score over the two axes that vary it
-//! most) and DIR/figures/rivals.png (every model's predicted trajectory at the recommended
-//! condition). Each file is written atomically: a failed or interrupted plan leaves no partial
-//! file.
+//! The plan's outputs: DIR/plan.json (its record, [`crate::record`]), DIR/plan.html (the
+//! recommendation first, the private module `page`) and two figures,
+//! DIR/figures/separation.png (the ranking's score over the two axes that vary it most) and
+//! DIR/figures/rivals.png (every model's predicted trajectory at the recommended condition).
+//! Each file is written atomically: a failed or interrupted plan leaves no partial file.
 
 use std::path::{Path, PathBuf};
 
