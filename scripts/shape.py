@@ -28,8 +28,10 @@ MAY_USE = {
     "sepval-report": {"sepval-common"},
     "sepval-fit": {"sepval-common", "sepval-solve", "sepval-report"},
     "sepval-diagnose": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-report"},
+    "sepval-plan": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-diagnose",
+                    "sepval-report"},
     "sepval": {"sepval-common", "sepval-transport", "sepval-solve", "sepval-fit",
-               "sepval-diagnose", "sepval-report"},
+               "sepval-diagnose", "sepval-plan", "sepval-report"},
     "sepval-worker": {"sepval-common", "sepval-transport"},
     "sepval-tests": set(),
 }

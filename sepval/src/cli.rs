@@ -36,6 +36,9 @@ pub enum Command {
     /// Show what the simulation still gets wrong after a fit, name the cause from the effect
     /// catalogue, extend the model and measure the gain.
     Diagnose(Box<DiagnoseArgs>),
+    /// Plan the next release: the flight condition that would best tell a diagnosis's answer
+    /// from its rivals, or (with no rivals) most shrink the uncertainty of its parameters.
+    Plan(Box<PlanArgs>),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
     /// Check the Pareto machinery on problems with known fronts.
@@ -154,6 +157,36 @@ pub struct DiagnoseArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub overwrite: OverwriteArgs,
+}
+
+#[derive(clap::Args)]
+pub struct PlanArgs {
+    /// The output directory of `sepval diagnose` to plan from (its diagnosis.json).
+    #[arg(long, value_name = "DIR")]
+    pub from: PathBuf,
+    /// Range of the candidate conditions' Mach number [default: the first release's].
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub mach: Option<String>,
+    /// Range of the candidate conditions' altitude [m] [default: the first release's].
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub altitude_m: Option<String>,
+    /// Range of the candidate conditions' aircraft angle of attack [deg] [default: the first release's].
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub alpha_deg: Option<String>,
+    /// Range of the candidate conditions' aircraft sideslip [deg] [default: the first release's].
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub beta_deg: Option<String>,
+    /// Range of the candidate conditions' flight-path angle [deg] [default: the first release's].
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub gamma_deg: Option<String>,
+    /// Points per axis given with LO < HI (the grid has points^axes conditions).
+    #[arg(long, default_value_t = sepval_plan::DEFAULT_POINTS, value_name = "N")]
+    pub points: usize,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// Output directory (plan.json, plan.html, figures/).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
 }
 
 #[derive(Subcommand)]

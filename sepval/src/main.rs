@@ -2,7 +2,7 @@
 //!
 //! The command line only: [`cli`] declares the flags, each file of [`command`] turns one
 //! subcommand's flags into a validated configuration and calls the libraries
-//! (`sepval_fit`, `sepval_diagnose`, `sepval_transport`, `sepval_common`, ...), and this file dispatches and
+//! (`sepval_fit`, `sepval_diagnose`, `sepval_plan`, `sepval_transport`, `sepval_common`, ...), and this file dispatches and
 //! reports errors: the whole cause chain, exit status 2 (130 after SIGINT/SIGTERM).
 
 // The doc comments here are clap's --help text, where units read `[s]`, `[m]`; rustdoc would
@@ -72,6 +72,7 @@ fn main() -> ExitCode {
         Command::Fit(args) => command::fit::run(*args),
         Command::Rerun(args) => command::rerun::run(args),
         Command::Diagnose(args) => command::diagnose::run(*args),
+        Command::Plan(args) => command::plan::run(*args),
         Command::Bench(args) => command::bench::run(args),
         Command::Gateway(args) => command::gateway::run(args),
         Command::Selftest(c) => command::selftest::run(c),

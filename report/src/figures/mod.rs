@@ -18,6 +18,8 @@
 //! - [`correlation_figure`]: a heat map of a correlation matrix (for example of the fitted
 //!   factors over the final population).
 //! - [`throughput_figure`]: simulations per second against worker count, per transport.
+//! - [`condition_map`]: a score over a grid of conditions (a plan's separation), the best cell
+//!   outlined; [`channel_figure`]: several models' predicted trajectories, six channels.
 //!
 //! Choices made here:
 //! - Rendering needs no system library and no installed font: `plotters` draws into an in-memory
@@ -46,6 +48,8 @@ use std::path::{Path, PathBuf};
 
 use sepval_common::telemetry::Trajectory;
 
+mod channels;
+mod condition_map;
 mod convergence;
 mod correlation;
 mod factors;
@@ -58,6 +62,8 @@ mod testing;
 mod throughput;
 mod trajectory;
 
+pub use channels::channel_figure;
+pub use condition_map::{MapAxis, condition_map};
 pub use convergence::convergence_figure;
 pub use correlation::correlation_figure;
 pub use factors::factor_figure;

@@ -11,6 +11,7 @@ pub mod fit;
 pub mod gateway;
 pub mod goals;
 pub mod inputs;
+pub mod plan;
 pub mod rerun;
 pub mod scenario;
 pub mod selftest;
@@ -209,12 +210,17 @@ impl ProgressObserver for Bar {
 
     fn progress(&mut self, p: &Progress) {
         self.bar.set_position(p.step as u64);
-        self.bar.set_message(format!(
-            "J_pos {:.4} m  J_att {:.3} deg  {:.0} sims/s",
-            p.best[0],
-            p.best[1],
-            p.evaluations as f64 / self.started.elapsed().as_secs_f64().max(1e-9)
-        ));
+        let rate = p.evaluations as f64 / self.started.elapsed().as_secs_f64().max(1e-9);
+        // A stage without goals (a plan's simulations) shows its rate alone.
+        self.bar
+            .set_message(if p.best.iter().all(|v| v.is_finite()) {
+                format!(
+                    "J_pos {:.4} m  J_att {:.3} deg  {rate:.0} sims/s",
+                    p.best[0], p.best[1]
+                )
+            } else {
+                format!("{rate:.0} sims/s")
+            });
     }
 
     fn finish(&mut self) {

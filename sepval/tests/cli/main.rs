@@ -1,5 +1,5 @@
 //! The `sepval` command line end to end, in one test binary: the commands as a user runs them,
-//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, `diagnose`, and
+//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, `diagnose`, `plan`, and
 //! property-based hardening of the checkpoint reader on arbitrary and mutated files. The binary
 //! is run through the shared support of the end-to-end tests (`sepval-tests`). Keep this the
 //! package's only integration test: it is also what makes `cargo test --workspace` build
@@ -13,6 +13,7 @@ mod fit;
 mod fuzz;
 mod hardening;
 mod hardening_on_disk;
+mod plan;
 mod refine;
 mod rivals;
 mod tables;

@@ -1,0 +1,112 @@
+//! `sepval plan`: the next release to fly, from a diagnosis.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_plan::{
+    PlanFile, Quantity, Range, plan, plan_file, prepare, read_diagnosis, write_outputs,
+};
+
+use super::{Bar, evaluator_spec, inputs, notices};
+use crate::cli::PlanArgs;
+
+/// Runs `sepval plan`. Every input (the flags, the diagnosis, its releases, the ranges against
+/// its scenario) is checked before the output directory is claimed or a worker started, so a
+/// refusal writes nothing.
+pub fn run(args: PlanArgs) -> Result<()> {
+    let spec = evaluator_spec(&args.eval)?;
+    let ranges = ranges(&args)?;
+    let diagnosis = read_diagnosis(&args.from)?;
+    let record = diagnosis.inputs.clone();
+    let (flown, _) = inputs::job(
+        &record.data,
+        record.scenario.as_deref(),
+        record.extension.as_deref(),
+    )
+    .with_context(|| {
+        format!(
+            "--from {}: the releases the diagnosis was made from",
+            args.from.display()
+        )
+    })?;
+    let prepared = prepare(diagnosis, &flown, &ranges, args.points)?;
+    let run_dir = RunDir::claim(&args.out, Claim::Fresh, "plan")
+        .with_context(|| format!("--out {}", args.out.display()))?;
+    let start = Instant::now();
+    let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
+    run_dir.prepare()?;
+    let found = plan(&prepared, evaluator.as_mut(), &mut Bar::new())?;
+    drop(evaluator);
+    let file = plan_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
+    write_outputs(&prepared, &found, &file, &args.out)?;
+    print!("{}", summary_lines(&file, &args.out));
+    drop(run_dir);
+    Ok(())
+}
+
+/// The ranges of the five condition flags.
+fn ranges(args: &PlanArgs) -> Result<Vec<Range>> {
+    let given = [
+        (Quantity::Mach, &args.mach),
+        (Quantity::AltitudeM, &args.altitude_m),
+        (Quantity::AlphaDeg, &args.alpha_deg),
+        (Quantity::BetaDeg, &args.beta_deg),
+        (Quantity::GammaDeg, &args.gamma_deg),
+    ];
+    let mut out = Vec::new();
+    for (quantity, text) in given {
+        let Some(text) = text else { continue };
+        let flag = quantity.flag();
+        let number = |s: &str| -> Result<f64> {
+            s.trim()
+                .parse::<f64>()
+                .with_context(|| format!("{flag} {text}: `{s}` is not a number (expected LO:HI)"))
+        };
+        let (lo, hi) = match text.split_once(':') {
+            Some((lo, hi)) => (number(lo)?, number(hi)?),
+            None => bail!("{flag} {text}: expected LO:HI (two numbers, e.g. 0.6:0.9)"),
+        };
+        out.push(Range { quantity, lo, hi });
+    }
+    Ok(out)
+}
+
+/// The terminal summary: a few short lines.
+fn summary_lines(file: &PlanFile, out: &Path) -> String {
+    let mut s = String::new();
+    match file.conditions.first() {
+        Some(c) => {
+            s.push_str(&format!(
+                "recommend: Mach {}, altitude {} m, alpha {} deg, beta {} deg, gamma {} deg\n",
+                c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg
+            ));
+            if file.ranked_by == "separation" {
+                s.push_str(&format!(
+                    "separates: {} of {} pair(s) (separation {:.1}, threshold {})\n",
+                    c.separates.len(),
+                    c.pairs.len(),
+                    c.separation.unwrap_or(f64::NAN),
+                    file.threshold
+                ));
+            } else {
+                s.push_str("rivals:    none: planned for information alone\n");
+            }
+            s.push_str(&format!(
+                "gain:      {:.3} in ln det of the answer's information\n",
+                c.information_gain.unwrap_or(f64::NAN)
+            ));
+        }
+        None => s.push_str("recommend: nothing (no condition)\n"),
+    }
+    s.push_str(&format!(
+        "plan:      {} conditions, {} simulations, {:.1} s\n",
+        file.conditions.len(),
+        file.evaluations,
+        file.wall_s
+    ));
+    s.push_str(&format!("report:    {}\n", out.join("plan.html").display()));
+    s
+}
