@@ -121,6 +121,10 @@ pub(super) struct Discovery {
     pub steps: Vec<DiscoveryStep>,
     /// Simulations run.
     pub evaluations: u64,
+    /// Refits that did not simulate and were left out.
+    pub skipped: Vec<crate::SkippedRefit>,
+    /// Why discovery could not run at all (the term budget full), if it could not.
+    pub blocked: Option<String>,
 }
 
 /// One library entry as the regression ranked it.

@@ -24,7 +24,10 @@
 //!    out in turn, and a term whose removal is not significant leaves. The gain over the
 //!    baseline is reported, not tested again.
 //!
-//! The sensitivities are linear about the fit: they screen, the refit decides.
+//! The sensitivities are linear about the fit: they screen, the refit decides. A refit that
+//! does not simulate is reported as skipped and left out. When the model already holds
+//! [`MAX_TERMS`] extension terms (the scenario's and `--extension`'s), no term can be added:
+//! discovery does not run, and says so (issue 21, item 10).
 //!
 //! In code, one step is `screen` (1 to 3), `locate` (4), `verify` (5) and `remove`
 //! (F-to-remove); `picked` keeps the entries in and where their parameters sit; `naming` turns
@@ -33,6 +36,7 @@
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Evaluator, Job};
+use sepval_common::extension::MAX_TERMS;
 use sepval_common::factors::FACTOR_COUNT;
 use sepval_fit::space::Noise;
 use sepval_solve::lm::LmSettings;
@@ -65,6 +69,21 @@ pub(super) fn discover(
 ) -> Result<Discovery> {
     let search = Search::new(job, noise, settings);
     let mut trail = Trail::default();
+    if search.room == 0 {
+        let why = format!(
+            "discovery could not run: the term budget is full (the model already holds {MAX_TERMS} extension terms, the scenario's and --extension's, the most a run can take)"
+        );
+        trail.notes.push(why.clone());
+        return Ok(Discovery {
+            reconstruction: Vec::new(),
+            found: None,
+            notes: trail.notes,
+            steps: Vec::new(),
+            evaluations: 0,
+            skipped: Vec::new(),
+            blocked: Some(why),
+        });
+    }
     let mut reconstruction = Vec::new();
     let mut sel = Selection {
         current: baseline.clone(),
@@ -92,6 +111,8 @@ pub(super) fn discover(
         notes: trail.notes,
         steps: trail.steps,
         evaluations: trail.evaluations,
+        skipped: trail.skipped,
+        blocked: None,
     })
 }
 
@@ -128,14 +149,7 @@ fn enter(
         &mut trail.evaluations,
     )?;
     let now = sel.picked.at(search.job, &sel.current)?;
-    let refits = verify::refit_candidates(
-        evaluator,
-        search,
-        &sel.current,
-        &now,
-        located,
-        &mut trail.evaluations,
-    )?;
+    let refits = verify::refit_candidates(evaluator, search, &sel.current, &now, located, trail)?;
     record.verified = refits.iter().map(Refit::verified).collect();
     let Some(winner) = refits.first() else {
         trail.steps.push(record);
@@ -149,6 +163,7 @@ fn enter(
         search.noise,
         search.settings,
         &mut trail.evaluations,
+        &mut trail.skipped,
     )?;
     let gain = verify::gain_over(search, &sel.current, &fitted);
     if !(gain.p_value < s.threshold && gain.delta_bic < 0.0) {

@@ -96,4 +96,21 @@ pub(super) struct Trail {
     pub steps: Vec<DiscoveryStep>,
     /// Simulations run.
     pub evaluations: u64,
+    /// Refits that did not simulate and were left out.
+    pub skipped: Vec<crate::SkippedRefit>,
+}
+
+impl Trail {
+    /// Records a refit of `model` at `stage` that did not simulate (`reason`), left out: in the
+    /// notes and among the skipped refits.
+    pub fn skip(&mut self, stage: String, model: String, reason: String) {
+        self.notes.push(format!(
+            "{stage}: the refit of {model} was left out: {reason}"
+        ));
+        self.skipped.push(crate::SkippedRefit {
+            stage,
+            model,
+            reason,
+        });
+    }
 }
