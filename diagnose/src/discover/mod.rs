@@ -2,10 +2,11 @@
 //! of a documented library explain it, and what the model extended by them gains
 //! (`docs/model.md` section 11).
 //!
-//! 1. **Sensitivities.** One batch simulates the fitted baseline with each library term added at
-//!    a small probe coefficient, and with each reconstruction window; the change of the
-//!    normalised residuals per unit coefficient is each term's column (`probe`). Long records
-//!    use a subset of their samples here.
+//! 1. **Sensitivities.** The fitted baseline is simulated with each reconstruction window, then
+//!    with each library term, added at a small probe coefficient; the change of the normalised
+//!    residuals per unit coefficient is each term's column (`probe`: in parts within a sample
+//!    budget, each part reduced to its columns at once). Long records use a subset of their
+//!    samples here.
 //! 2. **Reconstruction** (`reconstruct`): per event, the coefficient increments dCA ... dCn and
 //!    the ejector increment as time histories with bands, from the window columns by a
 //!    regularised output-error estimate.
