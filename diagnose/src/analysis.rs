@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use sepval_common::evaluation::Job;
-use sepval_common::extension::{TermRecord, extension_toml};
+use sepval_common::extension::{Term, TermRecord, extension_toml};
 use sepval_common::factors::FACTOR_COUNT;
 use sepval_fit::model_spec::ModelSpec;
 
@@ -17,15 +17,16 @@ use crate::contender::Contender;
 use crate::found::{DiscoveredTerm, DiscoveryStep, Found, Gain};
 use crate::increments::{Curves, model_increments};
 use crate::reconstruct::Reconstruction;
-use crate::residuals::{physical_residuals, residual_report, rms_channels};
+use crate::residuals::{ResidualReport, physical_residuals, residual_report, rms_channels};
 use crate::rivals::same_model;
 use crate::validation::{prediction_caveat, validate};
 use crate::verdict::{VerdictInput, ambiguity, verdict};
 use crate::{
-    Alternative, BIC_MARGIN, CandidateReport, DIAGNOSIS_FORMAT, DiagnoseError, DiagnoseOptions,
-    Diagnosis, ExtensionReport, Fitted, ModelSummary, ParamValue, Result, RivalReport,
-    ValidationReport, catalogue, readings,
+    Alternative, BASELINE_LIMIT_SIGMA, BIC_MARGIN, CandidateReport, DIAGNOSIS_FORMAT,
+    DiagnoseError, DiagnoseOptions, Diagnosis, ExtensionReport, Fitted, ModelSummary, ParamValue,
+    Result, RivalReport, SkippedRefit, ValidationReport, catalogue, readings, tables,
 };
+use sepval_fit::space::Noise;
 
 /// Everything the stages before the analysis produced.
 pub(super) struct Decided {
@@ -43,6 +44,12 @@ pub(super) struct Decided {
     pub notes: Vec<String>,
     /// Discovery's steps.
     pub steps: Vec<DiscoveryStep>,
+    /// Why discovery could not run, if it could not.
+    pub blocked: Option<String>,
+    /// Refits that did not simulate and were left out.
+    pub skipped: Vec<SkippedRefit>,
+    /// The tables the baseline's runs left.
+    pub tables_left: Vec<String>,
     /// Simulations run.
     pub evaluations: u64,
 }
@@ -71,6 +78,21 @@ pub(super) struct ExtensionFiles {
     pub factors_json: Vec<u8>,
 }
 
+/// Why the converged baseline counts as a failed fit (a goal beyond
+/// [`BASELINE_LIMIT_SIGMA`] sigma), or `None` when it reached near the noise.
+fn baseline_failure(baseline: &ModelSummary, noise: Noise) -> Option<String> {
+    let (np, na) = (
+        baseline.j_pos_m / noise.pos_m,
+        baseline.j_att_deg / noise.att_deg,
+    );
+    (np > BASELINE_LIMIT_SIGMA || na > BASELINE_LIMIT_SIGMA).then(|| {
+        format!(
+            "the baseline fit did not reach near the noise (J_pos {:.4} m = {np:.0} sigma, J_att {:.3} deg = {na:.0} sigma; the limit is {BASELINE_LIMIT_SIGMA} sigma), so no test against it can name a cause",
+            baseline.j_pos_m, baseline.j_att_deg
+        )
+    })
+}
+
 /// The diagnosis of `d`; `t0` is when the diagnosis started.
 pub(super) fn analyse(
     options: &DiagnoseOptions,
@@ -80,10 +102,12 @@ pub(super) fn analyse(
 ) -> Result<Analysis> {
     let (job, noise, floor) = (&*setting.job, setting.noise, setting.floor);
     let answer_fit = d.answer.model(&d.baseline);
+    let base_summary = summary(setting, &d.baseline);
+    let unreliable = baseline_failure(&base_summary, noise);
     // The catalogue's model: the baseline when it chose no effect.
     let cat_fit = d.answer.selected().map_or(&d.baseline, |s| &s.fitted);
     let cat_report = residual_report(job, &cat_fit.lm, &cat_fit.candidate(job)?, noise, floor);
-    let explained = cat_report.white && cat_report.at_noise_floor;
+    let explained = cat_report.white && cat_report.at_noise_floor && unreliable.is_none();
     let (causes, discovered) = d.answer.named();
     let parameters = d
         .answer
@@ -97,21 +121,9 @@ pub(super) fn analyse(
         alternatives(setting, &d.answer, answer_fit, explained)
     };
     let extension = (d.answer.found())
-        .map(|f| extension_report(setting, &d.answer, f))
+        .map(|f| extension_report(setting, &d.answer, f, unreliable.is_none()))
         .transpose()?;
-    let report_of = |f: &Fitted| -> Result<_> {
-        Ok(residual_report(
-            job,
-            &f.lm,
-            &f.candidate(job)?,
-            noise,
-            floor,
-        ))
-    };
-    let final_report = report_of(answer_fit)?;
-    let base_report = report_of(&d.baseline)?;
     let model = ModelSpec::of(&answer_fit.candidate(job)?);
-    let base_summary = summary(setting, &d.baseline);
     let ext_summary = summary(setting, answer_fit);
     let mut verdict = verdict(&VerdictInput {
         causes: &causes,
@@ -123,20 +135,31 @@ pub(super) fn analyse(
         base: &base_summary,
         ext: &ext_summary,
         noise,
+        blocked: d.blocked.as_deref(),
     });
     if let Some(a) = ambiguity(&rivals, job.events().len()) {
         verdict.push_str(&format!("; {a}"));
+    }
+    if let Some(why) = &unreliable {
+        verdict = format!("unreliable: {why}; as found: {verdict}");
     }
     let validation = predictions(options, setting, &d.baseline, &d.answer)?;
     let caution = prediction_caveat(&validation, noise);
     if let Some(c) = &caution {
         verdict.push_str(&format!("; caution: {c}"));
     }
+    let mut tables_left = d.tables_left;
+    if let Answer::Catalogue { selected, .. } = &d.answer {
+        let answer = tables::tables_left(job, &selected.fitted.candidate(job)?);
+        tables_left.extend(answer.iter().map(|l| format!("answer, {l}")));
+    }
     let diagnosis = Diagnosis {
         format: DIAGNOSIS_FORMAT.to_string(),
         causes,
         explained,
         verdict,
+        baseline_converged: unreliable.is_none(),
+        baseline_unreliable: unreliable,
         caution,
         discovered,
         ambiguous: !rivals.is_empty(),
@@ -145,6 +168,8 @@ pub(super) fn analyse(
         extension,
         discovery_notes: d.notes,
         discovery_steps: d.steps,
+        skipped: d.skipped,
+        tables_left,
         sigma_pos_m: noise.pos_m,
         sigma_att_deg: noise.att_deg,
         sigma_source: options.fit.sigma.source.clone(),
@@ -154,16 +179,13 @@ pub(super) fn analyse(
         inputs: options.fit.inputs.clone(),
         parameters,
         candidates: d.candidates,
-        residuals: BTreeMap::from([
-            ("baseline".to_string(), base_report),
-            ("extended".to_string(), final_report),
-        ]),
+        residuals: before_after(setting, &d.baseline, answer_fit)?,
         reconstruction: d.reconstruction,
         validation,
         evaluations: d.evaluations,
         wall_s: t0.elapsed().as_secs_f64(),
     };
-    let (curves, extension) = for_outputs(job, &d.answer)?;
+    let (curves, extension) = for_outputs(job, &d.answer, &options.given_terms)?;
     Ok(Analysis {
         diagnosis,
         baseline: d.baseline,
@@ -183,15 +205,41 @@ fn loser_is_rival(job: &Job, d: &Decided) -> bool {
     })
 }
 
+/// The residual analysis of the baseline and of the answer's model.
+fn before_after(
+    setting: &Setting,
+    baseline: &Fitted,
+    answer: &Fitted,
+) -> Result<BTreeMap<String, ResidualReport>> {
+    let job = &*setting.job;
+    let report = |f: &Fitted| -> Result<ResidualReport> {
+        Ok(residual_report(
+            job,
+            &f.lm,
+            &f.candidate(job)?,
+            setting.noise,
+            setting.floor,
+        ))
+    };
+    let mut residuals = BTreeMap::new();
+    residuals.insert("baseline".to_string(), report(baseline)?);
+    residuals.insert("extended".to_string(), report(answer)?);
+    Ok(residuals)
+}
+
 /// What the outputs draw and write beside the diagnosis: the discovered terms' increments
 /// (the answer or not) and, when they are the answer, their files.
-fn for_outputs(job: &Job, answer: &Answer) -> Result<(Curves, Option<ExtensionFiles>)> {
+fn for_outputs(
+    job: &Job,
+    answer: &Answer,
+    given: &[Term],
+) -> Result<(Curves, Option<ExtensionFiles>)> {
     let curves = match answer.found() {
         Some(f) => model_increments(job, &f.fitted)?,
         None => Vec::new(),
     };
     let files = match answer {
-        Answer::Discovered { found, .. } => Some(extension_files(job, found)?),
+        Answer::Discovered { found, .. } => Some(extension_files(job, found, given)?),
         _ => None,
     };
     Ok((curves, files))
@@ -287,8 +335,14 @@ fn alternatives(
     }]
 }
 
-/// The report of the discovered extension `f`, the answer or not.
-fn extension_report(setting: &Setting, answer: &Answer, f: &Found) -> Result<ExtensionReport> {
+/// The report of the discovered extension `f`, the answer or not; `converged`: whether the
+/// baseline it is measured against reached near the noise (else it explains nothing).
+fn extension_report(
+    setting: &Setting,
+    answer: &Answer,
+    f: &Found,
+    converged: bool,
+) -> Result<ExtensionReport> {
     let job = &*setting.job;
     let fitted = &f.fitted;
     let report = residual_report(
@@ -306,7 +360,7 @@ fn extension_report(setting: &Setting, answer: &Answer, f: &Found) -> Result<Ext
         gain: f.gain.clone(),
         white: report.white,
         at_noise_floor: report.at_noise_floor,
-        explained: report.white && report.at_noise_floor,
+        explained: report.white && report.at_noise_floor && converged,
         refinement: format!(
             "{} after {} iterations",
             fitted.lm.stop, fitted.lm.iterations
@@ -337,28 +391,38 @@ fn predictions(
     ))
 }
 
-/// The files of the discovered answer `found`.
-fn extension_files(job: &Job, found: &Found) -> Result<ExtensionFiles> {
-    let toml = extension_file(job, &found.fitted, &found.terms, &found.gain)?;
+/// The files of the discovered answer `found`, the terms `given` with `--extension` included.
+fn extension_files(job: &Job, found: &Found, given: &[Term]) -> Result<ExtensionFiles> {
+    let toml = extension_file(job, &found.fitted, &found.terms, &found.gain, given)?;
     let factors_json = serde_json::to_vec_pretty(&found.fitted.candidate(job)?.factors)
         .expect("factors serialise");
     Ok(ExtensionFiles { toml, factors_json })
 }
 
-/// DIR/extension.toml: the discovered terms at their refitted values, with a header that says
-/// where they came from.
-fn extension_file(job: &Job, f: &Fitted, found: &[DiscoveredTerm], gain: &Gain) -> Result<String> {
+/// DIR/extension.toml: every term of the answer's model beyond the scenario file's, that is
+/// the terms `given` with `--extension` (fixed in every fit, as given) and the discovered terms
+/// at their refitted values, with a header that says where they came from; `sepval simulate
+/// --factors DIR/factors.json --extension DIR/extension.toml` (with the diagnosis's scenario)
+/// reproduces the answer.
+fn extension_file(
+    job: &Job,
+    f: &Fitted,
+    found: &[DiscoveredTerm],
+    gain: &Gain,
+    given: &[Term],
+) -> Result<String> {
     let terms = f.space(job).terms_at(&f.lm.x)?;
-    let records: Vec<TermRecord> = terms
+    let records: Vec<TermRecord> = given
         .iter()
-        .map(|t| {
+        .map(TermRecord::of)
+        .chain(terms.iter().map(|t| {
             let mut r = TermRecord::of(t);
             r.reading = Some(readings::reading(
                 t,
                 &job.events()[0].simulator.scenario().interference,
             ));
             r
-        })
+        }))
         .collect();
     let mut text = format!(
         "# Found by `sepval diagnose` beyond the effect catalogue, from: {}\n",
@@ -368,6 +432,13 @@ fn extension_file(job: &Job, f: &Fitted, found: &[DiscoveredTerm], gain: &Gain) 
             .collect::<Vec<_>>()
             .join(", ")
     );
+    for t in given {
+        text.push_str(&format!(
+            "# {} {}: given with --extension, fixed\n",
+            t.axis.name(),
+            t.formula()
+        ));
+    }
     for d in found {
         text.push_str(&format!(
             "# {} {} ({}): {}\n",

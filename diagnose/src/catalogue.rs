@@ -3,7 +3,8 @@
 //! sharing each batch sent to the workers; each is judged by nested least squares (chi-square
 //! drop, the F test of its extra parameters, Bonferroni-corrected over the round, and the BIC
 //! change, G. Schwarz 1978); the significant one of lowest BIC is chosen, and further effects
-//! are added while each addition is itself significant (forward selection).
+//! are added while each addition is itself significant (forward selection). A candidate whose
+//! refit does not simulate is reported as skipped and not judged; the others go on.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -14,7 +15,7 @@ use sepval_common::factors::FACTOR_COUNT;
 
 use super::contender::Contender;
 use super::residuals::{physical_residuals, rms_channels};
-use super::{ALPHA, CandidateReport, DiagnoseError, Fitted, ParamValue, Result, bic};
+use super::{ALPHA, CandidateReport, DiagnoseError, Fitted, ParamValue, Result, SkippedRefit, bic};
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_solve::identifiability::identifiability;
@@ -23,6 +24,7 @@ use sepval_solve::stats::f_test;
 
 /// Refines a model again from its optimum until it converges (a reference model must be
 /// converged for the drops of its extensions to measure them); keeps the better of the two.
+/// A refinement that does not simulate leaves the model as it was, reported in `skipped`.
 pub(super) fn converge(
     evaluator: &mut dyn Evaluator,
     job: &Arc<Job>,
@@ -30,6 +32,7 @@ pub(super) fn converge(
     noise: Noise,
     settings: &LmSettings,
     evaluations: &mut u64,
+    skipped: &mut Vec<SkippedRefit>,
 ) -> Result<Fitted> {
     let mut run = [ModelLm::new(
         fitted.space(job),
@@ -40,8 +43,17 @@ pub(super) fn converge(
     )];
     refine_together(evaluator, &mut run)?;
     let [run] = run;
+    let failure = run.failure().map(str::to_string);
     let lm = run.finish();
     *evaluations += lm.evaluations;
+    if let Some(reason) = failure {
+        skipped.push(SkippedRefit {
+            stage: "convergence".into(),
+            model: model_name(&fitted),
+            reason,
+        });
+        return Ok(fitted);
+    }
     Ok(if lm.cost < fitted.lm.cost {
         Fitted { lm, ..fitted }
     } else {
@@ -49,7 +61,27 @@ pub(super) fn converge(
     })
 }
 
-/// The extensions of `base` by each effect of `ids`, refitted together from `base`'s optimum.
+/// How a skipped refit names its model: its effects and terms, or `baseline`.
+fn model_name(f: &Fitted) -> String {
+    let mut names: Vec<String> = f
+        .effects
+        .iter()
+        .map(|a| a.effect().id().to_string())
+        .collect();
+    names.extend(
+        f.terms
+            .iter()
+            .map(|t| format!("{}: {}", t.term.axis.name(), t.term.formula())),
+    );
+    if names.is_empty() {
+        "baseline".into()
+    } else {
+        names.join(" + ")
+    }
+}
+
+/// The extensions of `base` by each effect of `ids`, refitted together from `base`'s optimum;
+/// `Err` with the reason for one whose refit did not simulate.
 fn try_extensions(
     evaluator: &mut dyn Evaluator,
     job: &Arc<Job>,
@@ -57,7 +89,7 @@ fn try_extensions(
     ids: &[usize],
     noise: Noise,
     settings: &LmSettings,
-) -> Result<Vec<(usize, Fitted)>> {
+) -> Result<Vec<(usize, std::result::Result<Fitted, String>)>> {
     let table = *job.factor_table();
     let mut runs = Vec::new();
     let mut sets = Vec::new();
@@ -87,14 +119,15 @@ fn try_extensions(
         .into_iter()
         .zip(runs)
         .map(|((index, effects), run)| {
-            (
-                index,
-                Fitted {
+            let fitted = match run.failure() {
+                Some(reason) => Err(reason.to_string()),
+                None => Ok(Fitted {
                     effects,
                     terms: Vec::new(),
                     lm: run.finish(),
-                },
-            )
+                }),
+            };
+            (index, fitted)
         })
         .collect())
 }
@@ -145,6 +178,7 @@ pub(super) fn select(
     noise: Noise,
     settings: &LmSettings,
     evaluations: &mut u64,
+    skipped: &mut Vec<SkippedRefit>,
 ) -> Result<CatalogueOutcome> {
     let mut current = Fitted {
         effects: EffectSet::NONE,
@@ -172,6 +206,17 @@ pub(super) fn select(
         let mut best: Option<(usize, f64)> = None;
         let mut fitted_by_index = BTreeMap::new();
         for (index, fitted) in tried {
+            let fitted = match fitted {
+                Ok(f) => f,
+                Err(reason) => {
+                    skipped.push(SkippedRefit {
+                        stage: format!("catalogue round {round}"),
+                        model: CATALOGUE[index].id().to_string(),
+                        reason,
+                    });
+                    continue;
+                }
+            };
             *evaluations += fitted.lm.evaluations;
             let report = judge.report(index, &fitted);
             if report.significant && best.is_none_or(|(_, b)| report.delta_bic < b) {
@@ -194,7 +239,15 @@ pub(super) fn select(
         let Some(picked) = fitted_by_index.remove(&index) else {
             break;
         };
-        current = converge(evaluator, job, picked, noise, settings, evaluations)?;
+        current = converge(
+            evaluator,
+            job,
+            picked,
+            noise,
+            settings,
+            evaluations,
+            skipped,
+        )?;
     }
     Ok(CatalogueOutcome {
         fitted: current,

@@ -147,6 +147,22 @@ pub struct RivalReport {
     pub model: ModelSpec,
 }
 
+/// A refit that did not simulate (its start or a derivative probe): left out, and the
+/// diagnosis went on without it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SkippedRefit {
+    /// Where: `catalogue round 1`, `discovery step 2`, `F-to-remove`, `convergence`.
+    pub stage: String,
+    /// The model refitted: an effect id, a library entry, `the model without ...`.
+    pub model: String,
+    /// Why it stopped (`the derivative probe of Cl.cos(2pi13Hzt) did not simulate`).
+    pub reason: String,
+}
+
+fn yes() -> bool {
+    true
+}
+
 /// DIR/diagnosis.json.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
@@ -161,8 +177,18 @@ pub struct Diagnosis {
     /// extension's own verdict is `extension.explained`; the terminal summary shows the
     /// answer's.
     pub explained: bool,
-    /// The verdict in one sentence (ending with the caution when there is one).
+    /// The verdict in one sentence (ending with the caution when there is one; starting with
+    /// the warning when the baseline fit failed).
     pub verdict: String,
+    /// Whether the converged baseline reached near the noise (both goals within
+    /// [`BASELINE_LIMIT_SIGMA`](super::BASELINE_LIMIT_SIGMA) sigma). When it did not, the
+    /// answer below is unreliable (a refit may have found another optimum of the factors, not
+    /// a cause) and nothing is `explained`.
+    #[serde(default = "yes")]
+    pub baseline_converged: bool,
+    /// Why the baseline counts as not converged (its goals against the limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline_unreliable: Option<String>,
     /// Why the answer may not name the cause: an alternative predicts the `--validate` events
     /// clearly better.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -181,6 +207,13 @@ pub struct Diagnosis {
     pub discovery_notes: Vec<String>,
     /// Each step of discovery's selection: the entries ranked, the refits, what entered.
     pub discovery_steps: Vec<DiscoveryStep>,
+    /// Refits that did not simulate and were left out (the diagnosis went on without them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skipped: Vec<SkippedRefit>,
+    /// The scenario tables the fitted runs left (held at the edge), one line per model, event
+    /// and table: the baseline's, and a catalogue answer's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tables_left: Vec<String>,
     /// Position noise \[m\].
     pub sigma_pos_m: f64,
     /// Attitude noise \[deg\].

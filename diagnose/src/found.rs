@@ -124,6 +124,10 @@ pub(super) struct Discovery {
     /// The first step's refits and the library's mimics of the catalogue's answer, for the
     /// rival search.
     pub contenders: Vec<crate::contender::Contender>,
+    /// Refits that did not simulate and were left out.
+    pub skipped: Vec<crate::SkippedRefit>,
+    /// Why discovery could not run at all (the term budget full), if it could not.
+    pub blocked: Option<String>,
 }
 
 /// One library entry as the regression ranked it.

@@ -2,10 +2,17 @@
 //! and the answer, and the reconstructed increments beside what the discovered terms give),
 //! DIR/extension.toml and DIR/factors.json when a discovered extension is the answer,
 //! DIR/diagnosis.json and DIR/report.html.
+//!
+//! Every file is written atomically (`sepval_common::atomic_file`), and a signal is observed
+//! before each one (issue 21, item 9): a diagnosis interrupted here ends with
+//! `RunError::Interrupted` (exit status 130), the files already written stay whole and the
+//! others are not begun. The progress observer sees this stage as `outputs`, one step per file.
 
 use std::path::Path;
 
 use sepval_common::atomic_file::write_atomically;
+use sepval_common::cancel;
+use sepval_solve::run::{Progress, ProgressObserver, RunError};
 
 use crate::Result;
 use crate::analysis::Analysis;
@@ -14,9 +21,55 @@ use crate::increments::increment_figure;
 use crate::page::report_html;
 use crate::residuals::residual_figures;
 
+/// The outputs stage as its observer sees it: a signal checked before each file, each file
+/// written counted as a step.
+struct Steps<'a> {
+    progress: &'a mut dyn ProgressObserver,
+    done: usize,
+    files: usize,
+    goals: [f64; 2],
+}
+
+impl Steps<'_> {
+    /// Before a file: `Err` once a signal asked the process to stop.
+    fn next(&self) -> Result<()> {
+        cancel::check().map_err(RunError::from)?;
+        Ok(())
+    }
+
+    /// After a file (or a group of figures).
+    fn written(&mut self, files: usize) {
+        self.done += files;
+        self.progress.progress(&Progress {
+            step: self.done,
+            steps: Some(self.files),
+            evaluations: 0,
+            best: self.goals,
+        });
+    }
+}
+
 /// Writes the outputs of `a` into `out`.
-pub(super) fn write_outputs(out: &Path, setting: &Setting, a: &Analysis) -> Result<()> {
+pub(super) fn write_outputs(
+    out: &Path,
+    setting: &Setting,
+    a: &Analysis,
+    progress: &mut dyn ProgressObserver,
+) -> Result<()> {
     let d = &a.diagnosis;
+    let events = setting.job.events().len();
+    let files = events
+        + usize::from(!d.reconstruction.is_empty())
+        + 2 * usize::from(a.extension.is_some())
+        + 2;
+    progress.start("outputs", Some(files));
+    let mut steps = Steps {
+        progress,
+        done: 0,
+        files,
+        goals: [d.extended.j_pos_m, d.extended.j_att_deg],
+    };
+    steps.next()?;
     let mut figures = residual_figures(
         out,
         &setting.job,
@@ -25,18 +78,30 @@ pub(super) fn write_outputs(out: &Path, setting: &Setting, a: &Analysis) -> Resu
         setting.noise,
         &setting.events,
     )?;
+    steps.written(events);
     if !d.reconstruction.is_empty() {
+        steps.next()?;
         let name = "figures/increments.png";
         increment_figure(&out.join(name), &d.reconstruction, &a.curves)?;
         figures.insert(0, name.to_string());
+        steps.written(1);
     }
     if let Some(x) = &a.extension {
+        steps.next()?;
         write_atomically(&out.join("extension.toml"), x.toml.as_bytes())?;
+        steps.written(1);
+        steps.next()?;
         write_atomically(&out.join("factors.json"), &x.factors_json)?;
+        steps.written(1);
     }
     let html = report_html(d, &figures)?;
     let json = serde_json::to_vec_pretty(d).expect("a diagnosis serialises");
+    steps.next()?;
     write_atomically(&out.join("diagnosis.json"), &json)?;
+    steps.written(1);
+    steps.next()?;
     write_atomically(&out.join("report.html"), html.as_bytes())?;
+    steps.written(1);
+    steps.progress.finish();
     Ok(())
 }

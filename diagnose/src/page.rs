@@ -20,6 +20,12 @@ const REPORT: PageTemplate = PageTemplate {
 #[derive(Serialize)]
 struct Page<'a> {
     verdict: &'a str,
+    /// Why the answer is unreliable (the baseline fit failed), shown before everything else.
+    unreliable: Option<&'a str>,
+    /// Refits that did not simulate, left out.
+    skipped: Vec<String>,
+    /// Tables the fitted runs left.
+    tables_left: &'a [String],
     discovered: Vec<FoundRow>,
     causes: Vec<CauseRow<'a>>,
     models: Vec<ModelRow>,
@@ -182,6 +188,13 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> Result<String, H
     };
     let page = Page {
         verdict: &d.verdict,
+        unreliable: d.baseline_unreliable.as_deref(),
+        skipped: d
+            .skipped
+            .iter()
+            .map(|k| format!("{}: {}: {}", k.stage, k.model, k.reason))
+            .collect(),
+        tables_left: &d.tables_left,
         discovered: found_rows(d),
         causes: cause_rows(d),
         models: vec![

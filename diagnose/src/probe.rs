@@ -1,8 +1,11 @@
 //! Sensitivities of the fitted model's residuals to added terms: for each probe term (a small
 //! coefficient on one regressor, or one time window), one simulation of the fitted candidate
 //! with the term added, and the change of the normalised residual vector per unit coefficient
-//! (a forward difference, as the refinement's Jacobian). One batch carries every probe, so the
-//! workers share them.
+//! (a forward difference, as the refinement's Jacobian). The probes go to the workers in parts
+//! of at most [`PROBE_SAMPLES`] simulated samples, and each part's trajectories are reduced to
+//! their columns and dropped before the next part is asked (issue 21, item 7: a 10 kHz, 1-s
+//! record's thousand probes brought back whole were 15 million observations at once); a part
+//! is evaluated as one batch, so the workers share its probes.
 //!
 //! Long records are analysed on a subset of their samples (every k-th, at most
 //! [`MAX_ROWS_SAMPLES`] samples in all), which keeps the matrices small; the fits that verify
@@ -13,9 +16,14 @@ use sepval_common::evaluation::{Candidate, Evaluator, Job};
 use sepval_common::extension::Term;
 
 use super::DiagnoseError;
-use sepval_fit::problem::Evaluate;
+use sepval_fit::problem::SAMPLE_BUDGET;
 use sepval_fit::space::{Noise, residual_vector};
-use sepval_solve::run::Problem;
+
+/// Most simulated samples one part of the probes brings back: a quarter of the fit's
+/// [`SAMPLE_BUDGET`] (24 MB as observations), as the column matrix they fill is the larger
+/// part of a diagnosis's memory; a record of the default 201 samples still sends its 2 000-odd
+/// probes in one batch.
+pub const PROBE_SAMPLES: usize = SAMPLE_BUDGET / 4;
 
 /// Most samples (over all events) the discovery's linear algebra uses.
 pub const MAX_ROWS_SAMPLES: usize = 20_000;
@@ -49,7 +57,8 @@ pub fn event_rows(job: &Job, rows: &[usize]) -> Vec<(usize, usize)> {
 
 /// The sensitivity columns of `probes` at `base` (whose normalised residuals are `r0`),
 /// restricted to `rows`: column j = (r(base + probe j) - r0) / coefficient j. A probe that does
-/// not simulate gives a zero column.
+/// not simulate gives a zero column. The probes are evaluated in parts of at most
+/// [`PROBE_SAMPLES`] samples, each reduced to its columns before the next is asked.
 pub fn columns(
     evaluator: &mut dyn Evaluator,
     job: &Job,
@@ -69,13 +78,18 @@ pub fn columns(
             Ok(c)
         })
         .collect::<Result<_, DiagnoseError>>()?;
-    let out = Evaluate(evaluator).evaluate(&batch, true)?;
+    let part = (PROBE_SAMPLES / job.sample_count().max(1)).max(1);
     let mut m = DMatrix::zeros(rows.len(), probes.len());
-    for (j, (e, t)) in out.into_iter().zip(probes).enumerate() {
-        if let Some(samples) = e.samples {
-            let r = residual_vector(job, &samples, noise);
-            for (i, &row) in rows.iter().enumerate() {
-                m[(i, j)] = (r[row] - r0[row]) / t.coefficient;
+    for (k, chunk) in batch.chunks(part).enumerate() {
+        let out = evaluator.evaluate(chunk, true)?;
+        let first = k * part;
+        for (j, (e, t)) in out.into_iter().zip(&probes[first..]).enumerate() {
+            if let Some(samples) = e.samples {
+                let r = residual_vector(job, &samples, noise);
+                let mut column = m.column_mut(first + j);
+                for (i, &row) in rows.iter().enumerate() {
+                    column[i] = (r[row] - r0[row]) / t.coefficient;
+                }
             }
         }
     }

@@ -23,7 +23,7 @@
 //! (J^T J + P)^-1. The factors stay free, so what a factor change can absorb is not blamed on an
 //! increment. Each event is reconstructed from its own residuals.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DMatrixView, DVector, DVectorView};
 use serde::{Deserialize, Serialize};
 
 use sepval_common::extension::{Axis, Term};
@@ -60,22 +60,23 @@ pub struct Reconstruction {
 type Solved = (f64, f64, DMatrix<f64>, DVector<f64>, f64);
 
 /// Reconstructs one event from its residual rows `r0`, factor sensitivities `jac` and window
-/// sensitivities `win` (columns in the order of `windows`).
+/// sensitivities `win` (columns in the order of `windows`), each a view into the discovery's
+/// matrices (no copy).
 pub fn reconstruct(
     event: &str,
-    r0: &DVector<f64>,
-    jac: &DMatrix<f64>,
-    win: &DMatrix<f64>,
+    r0: DVectorView<f64>,
+    jac: DMatrixView<f64>,
+    win: DMatrixView<f64>,
     windows: &[Term],
 ) -> Reconstruction {
     let nf = jac.ncols();
     let nw = win.ncols();
     let n = nf + nw;
     let mut a = DMatrix::zeros(r0.len(), n);
-    a.columns_mut(0, nf).copy_from(jac);
-    a.columns_mut(nf, nw).copy_from(win);
+    a.columns_mut(0, nf).copy_from(&jac);
+    a.columns_mut(nf, nw).copy_from(&win);
     let ata = a.tr_mul(&a);
-    let atr = a.tr_mul(r0);
+    let atr = a.tr_mul(&r0);
     // The smoothness penalty: first differences within each axis, scaled by the axis's mean
     // information per window.
     let mut pen = DMatrix::zeros(n, n);

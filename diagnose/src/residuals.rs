@@ -249,6 +249,8 @@ pub fn residual_figures(
     let e = physical_residuals(&ext.residuals, noise, events);
     let mut names = Vec::new();
     for (k, event) in job.events().iter().enumerate() {
+        // A signal is observed before each figure (each is written whole or not at all).
+        sepval_common::cancel::check().map_err(sepval_solve::run::RunError::from)?;
         let name = format!("figures/residuals_event{}.png", k + 1);
         sepval_report::figures::residual_figure(
             &dir.join(&name),

@@ -171,9 +171,11 @@ fn converge_all(
         .collect();
     refine_together(evaluator, &mut runs)?;
     for (c, run) in near.iter_mut().zip(runs) {
+        // A refinement that failed on its own leaves the contender at its first refit.
+        let failed = run.failure().is_some();
         let lm = run.finish();
         *evaluations += lm.evaluations;
-        if lm.cost < c.fitted.lm.cost {
+        if !failed && lm.cost < c.fitted.lm.cost {
             c.fitted.lm = lm;
         }
     }

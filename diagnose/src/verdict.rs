@@ -47,6 +47,8 @@ pub(super) struct VerdictInput<'a> {
     pub base: &'a ModelSummary,
     pub ext: &'a ModelSummary,
     pub noise: Noise,
+    /// Why discovery beyond the catalogue could not run (the term budget full), if it could not.
+    pub blocked: Option<&'a str>,
 }
 
 /// A discovered term's value: `coefficient ± se` and its locator.
@@ -112,6 +114,10 @@ pub(super) fn verdict(v: &VerdictInput) -> String {
                 "the baseline model explains the data to the noise level (position RMS {bp:.4} m, sigma {:.4} m; attitude RMS {ba:.3} deg, sigma {:.3} deg)",
                 v.noise.pos_m, v.noise.att_deg
             )
+        } else if let Some(why) = v.blocked {
+            format!(
+                "not explained: the residuals keep structure beyond the noise (position RMS {bp:.4} m, attitude RMS {ba:.3} deg) and no effect of the catalogue accounts for it; {why}, so terms beyond the catalogue were not looked for"
+            )
         } else {
             format!(
                 "not explained: the residuals keep structure beyond the noise (position RMS {bp:.4} m, attitude RMS {ba:.3} deg) and neither an effect of the catalogue nor a term of the library accounts for it: the cause lies outside both"
@@ -140,8 +146,12 @@ pub(super) fn verdict(v: &VerdictInput) -> String {
     if v.explained {
         format!("{}; {gains}", named.join("; and "))
     } else {
+        let blocked = v
+            .blocked
+            .map(|why| format!("; {why}, so terms beyond the catalogue were not looked for"))
+            .unwrap_or_default();
         format!(
-            "not explained: the closest extension of the catalogue, {}, improves the fit ({gains}) but leaves structure beyond the noise: part of the cause lies outside the catalogue",
+            "not explained: the closest extension of the catalogue, {}, improves the fit ({gains}) but leaves structure beyond the noise: part of the cause lies outside the catalogue{blocked}",
             named.join(" with ")
         )
     }

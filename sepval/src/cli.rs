@@ -152,6 +152,8 @@ pub struct DiagnoseArgs {
     pub eval: EvalArgs,
     #[command(flatten)]
     pub noise: NoiseArgs,
+    #[command(flatten)]
+    pub tables: TablesArgs,
     /// Output directory (diagnosis.json, report.html, figures/, baseline/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -279,12 +281,12 @@ pub struct ModelArgs {
     pub extension: Option<PathBuf>,
 }
 
-/// What a run that leaves a table does (simulate, fit).
+/// What a run that leaves a table does (simulate, fit, diagnose).
 #[derive(clap::Args)]
 pub struct TablesArgs {
     /// Fail (exit 2) when the run leaves one of the scenario's tables (by default the value is
     /// held at the table's edge and the excursion reported); simulate then writes nothing, fit
-    /// writes result.json, which records it.
+    /// writes result.json, which records it, diagnose stops after its baseline fit.
     #[arg(long)]
     pub strict_tables: bool,
 }

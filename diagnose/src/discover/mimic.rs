@@ -88,7 +88,7 @@ pub(super) fn mimics(
         current,
         &Picked::default(),
         located,
-        &mut trail.evaluations,
+        trail,
     )?;
     let n = s.entries.len();
     trail.contenders.extend(

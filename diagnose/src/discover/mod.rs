@@ -2,10 +2,11 @@
 //! of a documented library explain it, and what the model extended by them gains
 //! (`docs/model.md` section 11).
 //!
-//! 1. **Sensitivities.** One batch simulates the fitted baseline with each library term added at
-//!    a small probe coefficient, and with each reconstruction window; the change of the
-//!    normalised residuals per unit coefficient is each term's column (`probe`). Long records
-//!    use a subset of their samples here.
+//! 1. **Sensitivities.** The fitted baseline is simulated with each reconstruction window, then
+//!    with each library term, added at a small probe coefficient; the change of the normalised
+//!    residuals per unit coefficient is each term's column (`probe`: in parts within a sample
+//!    budget, each part reduced to its columns at once). Long records use a subset of their
+//!    samples here.
 //! 2. **Reconstruction** (`reconstruct`): per event, the coefficient increments dCA ... dCn and
 //!    the ejector increment as time histories with bands, from the window columns by a
 //!    regularised output-error estimate.
@@ -24,7 +25,10 @@
 //!    out in turn, and a term whose removal is not significant leaves. The gain over the
 //!    baseline is reported, not tested again.
 //!
-//! The sensitivities are linear about the fit: they screen, the refit decides.
+//! The sensitivities are linear about the fit: they screen, the refit decides. A refit that
+//! does not simulate is reported as skipped and left out. When the model already holds
+//! [`MAX_TERMS`] extension terms (the scenario's and `--extension`'s), no term can be added:
+//! discovery does not run, and says so (issue 21, item 10).
 //!
 //! In code, one step is `screen` (1 to 3), `locate` (4), `verify` (5) and `remove`
 //! (F-to-remove); `picked` keeps the entries in and where their parameters sit; `naming` turns
@@ -33,6 +37,7 @@
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Evaluator, Job};
+use sepval_common::extension::MAX_TERMS;
 use sepval_common::factors::FACTOR_COUNT;
 use sepval_fit::space::Noise;
 use sepval_solve::lm::LmSettings;
@@ -67,6 +72,22 @@ pub(super) fn discover(
 ) -> Result<Discovery> {
     let search = Search::new(job, noise, settings);
     let mut trail = Trail::default();
+    if search.room == 0 {
+        let why = format!(
+            "discovery could not run: the term budget is full (the model already holds {MAX_TERMS} extension terms, the scenario's and --extension's, the most a run can take)"
+        );
+        trail.notes.push(why.clone());
+        return Ok(Discovery {
+            reconstruction: Vec::new(),
+            found: None,
+            notes: trail.notes,
+            steps: Vec::new(),
+            evaluations: 0,
+            contenders: Vec::new(),
+            skipped: Vec::new(),
+            blocked: Some(why),
+        });
+    }
     let mut reconstruction = Vec::new();
     let mut sel = Selection {
         current: baseline.clone(),
@@ -98,6 +119,8 @@ pub(super) fn discover(
         steps: trail.steps,
         evaluations: trail.evaluations,
         contenders: trail.contenders,
+        skipped: trail.skipped,
+        blocked: None,
     })
 }
 
@@ -157,14 +180,7 @@ fn enter(
         &mut trail.evaluations,
     )?;
     let now = sel.picked.at(search.job, &sel.current)?;
-    let refits = verify::refit_candidates(
-        evaluator,
-        search,
-        &sel.current,
-        &now,
-        located,
-        &mut trail.evaluations,
-    )?;
+    let refits = verify::refit_candidates(evaluator, search, &sel.current, &now, located, trail)?;
     record.verified = refits.iter().map(Refit::verified).collect();
     if step == 0 {
         mimic::from_refits(&s, &refits, trail);
@@ -181,6 +197,7 @@ fn enter(
         search.noise,
         search.settings,
         &mut trail.evaluations,
+        &mut trail.skipped,
     )?;
     let gain = verify::gain_over(search, &sel.current, &fitted);
     if !(gain.p_value < s.threshold && gain.delta_bic < 0.0) {

@@ -1,15 +1,16 @@
 //! F-to-remove (`docs/model.md` section 11.5): every entry of a model refitted out in turn from
 //! the model's optimum (all refits sharing each batch); an entry whose removal is no longer
-//! significant leaves, and each entry's gain is what its removal costs.
+//! significant leaves, and each entry's gain is what its removal costs. A refit without an
+//! entry that does not simulate is left out (recorded in the trail): that entry stays, and its
+//! gain is the extension's whole gain.
 
 use std::sync::Arc;
 
 use sepval_common::effects::EffectSet;
-use sepval_common::evaluation::{Evaluator, Job};
+use sepval_common::evaluation::Evaluator;
 use sepval_common::factors::FACTOR_COUNT;
 use sepval_fit::refine::{ModelLm, refine_together};
-use sepval_fit::space::{FreeTerm, Noise, ParamSpace};
-use sepval_solve::lm::LmSettings;
+use sepval_fit::space::{FreeTerm, ParamSpace};
 
 use super::picked::Picked;
 use super::search::{Search, Selection, Trail};
@@ -17,15 +18,16 @@ use crate::found::Gain;
 use crate::{ALPHA, DiagnoseError, Fitted, Result};
 
 /// For each entry of `fitted` (made of `picked`), the refit without it, from `fitted`'s
-/// optimum; all refits share each batch.
+/// optimum; all refits share each batch. `None` for a refit that did not simulate (recorded in
+/// `trail`).
 pub(super) fn leave_one_out(
     evaluator: &mut dyn Evaluator,
-    job: &Arc<Job>,
+    search: &Search,
     fitted: &Fitted,
     picked: &Picked,
-    noise: Noise,
-    settings: &LmSettings,
-) -> Result<Vec<Fitted>> {
+    trail: &mut Trail,
+) -> Result<Vec<Option<Fitted>>> {
+    let (job, noise, settings) = (search.job, search.noise, search.settings);
     let layout = picked.params(&fitted.terms);
     let mut runs = Vec::new();
     let mut kept_terms = Vec::new();
@@ -49,15 +51,28 @@ pub(super) fn leave_one_out(
         kept_terms.push(terms);
     }
     refine_together(evaluator, &mut runs)?;
-    Ok(runs
-        .into_iter()
-        .zip(kept_terms)
-        .map(|(run, terms)| Fitted {
-            effects: EffectSet::NONE,
-            terms,
-            lm: run.finish(),
-        })
-        .collect())
+    let mut out = Vec::with_capacity(runs.len());
+    for ((run, terms), entry) in runs.into_iter().zip(kept_terms).zip(picked.entries()) {
+        let failure = run.failure().map(str::to_string);
+        let lm = run.finish();
+        trail.evaluations += lm.evaluations;
+        match failure {
+            Some(reason) => {
+                trail.skip(
+                    "F-to-remove".into(),
+                    format!("the model without {}", entry.label()),
+                    reason,
+                );
+                out.push(None);
+            }
+            None => out.push(Some(Fitted {
+                effects: EffectSet::NONE,
+                terms,
+                lm,
+            })),
+        }
+    }
+    Ok(out)
 }
 
 /// F-to-remove after an entry entered `sel`: the entry whose removal is least significant
@@ -72,18 +87,11 @@ pub(super) fn f_to_remove(
         return Ok(sel);
     }
     let job = search.job;
-    let without = leave_one_out(
-        evaluator,
-        job,
-        &sel.current,
-        &sel.picked,
-        search.noise,
-        search.settings,
-    )?;
+    let without = leave_one_out(evaluator, search, &sel.current, &sel.picked, trail)?;
     let p_with = sel.current.space(job).len();
     let mut weakest: Option<(usize, f64)> = None;
     for (k, f) in without.iter().enumerate() {
-        trail.evaluations += f.lm.evaluations;
+        let Some(f) = f else { continue };
         let q = p_with - f.space(job).len();
         let g = Gain::of(f.lm.cost, sel.current.lm.cost, q, p_with, search.m);
         if !g.significant(ALPHA) && weakest.is_none_or(|(_, d)| g.chi2_drop < d) {
@@ -102,6 +110,7 @@ pub(super) fn f_to_remove(
         sel.current = without
             .into_iter()
             .nth(k)
+            .flatten()
             .ok_or_else(|| DiagnoseError::Model("a leave-one-out refit is missing".into()))?;
     }
     Ok(sel)
@@ -122,25 +131,18 @@ pub(super) fn entry_gains(
     }
     let job = search.job;
     let p_with = fitted.space(job).len();
-    let without = leave_one_out(
-        evaluator,
-        job,
-        fitted,
-        picked,
-        search.noise,
-        search.settings,
-    )?;
+    let without = leave_one_out(evaluator, search, fitted, picked, trail)?;
     Ok(without
         .iter()
-        .map(|f| {
-            trail.evaluations += f.lm.evaluations;
-            Gain::of(
+        .map(|f| match f {
+            Some(f) => Gain::of(
                 f.lm.cost,
                 fitted.lm.cost,
                 p_with - f.space(job).len(),
                 p_with,
                 search.m,
-            )
+            ),
+            None => total.clone(),
         })
         .collect())
 }

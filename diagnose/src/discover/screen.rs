@@ -1,9 +1,9 @@
 //! One step's screening (`docs/model.md` section 11.3): the library's entries not yet in, their
-//! sensitivities about the current model in one batch (and, at the first step, the
-//! reconstruction windows'), the regression's F-to-enter against a Bonferroni threshold with the
+//! sensitivities about the current model (and, at the first step, before them, the
+//! reconstruction windows', reduced to the reconstruction and dropped), the regression's F-to-enter against a Bonferroni threshold with the
 //! predicted square error, and the entries worth an output-error refit.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DMatrixView, DVector};
 use sepval_common::evaluation::{Candidate, Evaluator, Job};
 use sepval_common::extension::Term;
 
@@ -93,23 +93,25 @@ pub(super) fn screen(
     if entries.is_empty() {
         return Ok(None);
     }
-    let windows = if step == 0 {
-        library::windows(&history)
-    } else {
-        Vec::new()
-    };
     let linear = linearisation(job, &sel.current, &search.rows);
+    // At the first step, the reconstruction, from the windows' columns alone, which go before
+    // the library's are made (issue 21, item 7: the two matrices are never held together).
+    let reconstruction = if step == 0 {
+        Some(reconstruction(
+            evaluator, search, sel, &base, &history, &linear, trail,
+        )?)
+    } else {
+        None
+    };
 
-    // Every entry's (and, at the first step, window's) sensitivity, in one batch.
+    // Every entry's sensitivity.
     let mut probes: Vec<Term> = Vec::new();
     let mut entry_cols: Vec<Vec<usize>> = Vec::new();
     for e in &entries {
         entry_cols.push((probes.len()..probes.len() + e.terms.len()).collect());
         probes.extend(e.terms.iter().copied());
     }
-    let n_entry_cols = probes.len();
-    probes.extend(windows.iter().copied());
-    let cols = probe::columns(
+    let lib_cols = probe::columns(
         evaluator,
         job,
         &base,
@@ -120,13 +122,7 @@ pub(super) fn screen(
     )?;
     trail.evaluations += probes.len() as u64;
 
-    let reconstruction = (step == 0).then(|| {
-        let win = cols.columns(n_entry_cols, windows.len()).into_owned();
-        reconstruct_events(job, &search.rows, &linear, &win, &windows)
-    });
-
     // F-to-enter against the Bonferroni threshold, and the PSE.
-    let lib_cols = cols.columns(0, n_entry_cols).into_owned();
     let threshold = stepwise::ALPHA / entries.len() as f64;
     let scores = stepwise::screen(&linear.r0, &linear.fixed, &lib_cols, &entry_cols);
     Ok(Some(Screening {
@@ -142,12 +138,43 @@ pub(super) fn screen(
     }))
 }
 
+/// The baseline's misfit (the model of `sel`, linearised as `linear`, at `base`; `history`:
+/// what the store saw) reconstructed per event from the sensitivities of the time windows.
+fn reconstruction(
+    evaluator: &mut dyn Evaluator,
+    search: &Search,
+    sel: &Selection,
+    base: &Candidate,
+    history: &[Vec<Sample>],
+    linear: &Linearisation,
+    trail: &mut Trail,
+) -> Result<Vec<Reconstruction>> {
+    let windows = library::windows(history);
+    let win = probe::columns(
+        evaluator,
+        search.job,
+        base,
+        &windows,
+        &sel.current.lm.residuals,
+        search.noise,
+        &search.rows,
+    )?;
+    trail.evaluations += windows.len() as u64;
+    Ok(reconstruct_events(
+        search.job,
+        &search.rows,
+        linear,
+        win.as_view(),
+        &windows,
+    ))
+}
+
 /// The baseline's misfit reconstructed per event from the windows' columns.
 fn reconstruct_events(
     job: &Job,
     rows: &[usize],
     linear: &Linearisation,
-    win: &DMatrix<f64>,
+    win: DMatrixView<f64>,
     windows: &[Term],
 ) -> Vec<Reconstruction> {
     probe::event_rows(job, rows)
@@ -156,9 +183,9 @@ fn reconstruct_events(
         .map(|((a, b), e)| {
             reconstruct(
                 &e.name,
-                &linear.r0.rows(a, b - a).into_owned(),
-                &linear.fixed.rows(a, b - a).into_owned(),
-                &win.rows(a, b - a).into_owned(),
+                linear.r0.rows(a, b - a),
+                linear.fixed.rows(a, b - a),
+                win.rows(a, b - a),
                 windows,
             )
         })

@@ -98,4 +98,21 @@ pub(super) struct Trail {
     pub evaluations: u64,
     /// The first step's refits (and mimics), for the rival search.
     pub contenders: Vec<crate::contender::Contender>,
+    /// Refits that did not simulate and were left out.
+    pub skipped: Vec<crate::SkippedRefit>,
+}
+
+impl Trail {
+    /// Records a refit of `model` at `stage` that did not simulate (`reason`), left out: in the
+    /// notes and among the skipped refits.
+    pub fn skip(&mut self, stage: String, model: String, reason: String) {
+        self.notes.push(format!(
+            "{stage}: the refit of {model} was left out: {reason}"
+        ));
+        self.skipped.push(crate::SkippedRefit {
+            stage,
+            model,
+            reason,
+        });
+    }
 }

@@ -14,7 +14,7 @@ use sepval_solve::lm::LmSettings;
 use super::locate::Located;
 use super::picked::Picked;
 use super::screen::Screening;
-use super::search::Search;
+use super::search::{Search, Trail};
 use crate::found::{Gain, GroupMember, Verified};
 use crate::library::Entry;
 use crate::{Fitted, Result, stepwise};
@@ -71,14 +71,15 @@ fn refit_run(
 /// Each located entry refitted, for at most the screening's iterations, with `current`'s
 /// factors and `now` (the entries in, at `current`'s values); best first. Each refit starts
 /// from the current optimum with the new entry at zero (the linear estimate, which can
-/// overshoot where the response is not linear, sets its bounds).
+/// overshoot where the response is not linear, sets its bounds). A refit that does not simulate
+/// is left out, recorded in `trail`.
 pub(super) fn refit_candidates(
     evaluator: &mut dyn Evaluator,
     search: &Search,
     current: &Fitted,
     now: &Picked,
     located: Vec<Located>,
-    evaluations: &mut u64,
+    trail: &mut Trail,
 ) -> Result<Vec<Refit>> {
     let mut runs: Vec<ModelLm> = located
         .iter()
@@ -88,24 +89,30 @@ pub(super) fn refit_candidates(
         })
         .collect();
     refine_together(evaluator, &mut runs)?;
-    let mut refits: Vec<Refit> = located
-        .into_iter()
-        .zip(runs)
-        .map(|(l, run)| {
-            let space = run.space().clone();
-            let lm = run.finish();
-            *evaluations += lm.evaluations;
-            Refit {
-                entry: l.entry,
-                fitted: Fitted {
-                    effects: EffectSet::NONE,
-                    terms: space.terms.clone(),
-                    lm,
-                },
-                index: l.index,
-            }
-        })
-        .collect();
+    let mut refits: Vec<Refit> = Vec::with_capacity(runs.len());
+    for (l, run) in located.into_iter().zip(runs) {
+        let space = run.space().clone();
+        let failure = run.failure().map(str::to_string);
+        let lm = run.finish();
+        trail.evaluations += lm.evaluations;
+        if let Some(reason) = failure {
+            trail.skip(
+                format!("discovery step {}", trail.steps.len() + 1),
+                l.entry.label(),
+                reason,
+            );
+            continue;
+        }
+        refits.push(Refit {
+            entry: l.entry,
+            fitted: Fitted {
+                effects: EffectSet::NONE,
+                terms: space.terms.clone(),
+                lm,
+            },
+            index: l.index,
+        });
+    }
     refits.sort_by(|a, b| a.fitted.lm.cost.total_cmp(&b.fitted.lm.cost));
     Ok(refits)
 }

@@ -38,6 +38,11 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
     print!("{}", summary_lines(&d, &args.out));
     drop(run_dir);
+    // Tables left by the fitted runs, as simulate and fit report them (--strict-tables refused
+    // them after the baseline fit, before any other work).
+    for l in &d.tables_left {
+        eprintln!("warning: {l}");
+    }
     Ok(())
 }
 
@@ -64,6 +69,11 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
         given.model.scenario.as_deref(),
         given.model.extension.as_deref(),
     )?;
+    // The --extension terms, written again with the discovered ones to DIR/extension.toml.
+    let given_terms = match given.model.extension.as_deref() {
+        Some(path) => sepval_common::extension::load_extension(path)?,
+        None => Vec::new(),
+    };
     let validation = inputs::validation_job(
         &args.validate,
         &given.data,
@@ -101,6 +111,8 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
             ..lm
         },
         validation,
+        given_terms,
+        strict_tables: args.tables.strict_tables,
     };
     Ok(DiagnoseConfig { job, options })
 }
@@ -108,6 +120,13 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
 /// The terminal summary: a few short lines.
 fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
     let mut s = String::new();
+    if !d.baseline_converged {
+        s.push_str(&format!(
+            "UNRELIABLE: the baseline fit failed (J_pos {:.0}, J_att {:.0} sigma): no cause below is reliable\n",
+            d.baseline.j_pos_m / d.sigma_pos_m,
+            d.baseline.j_att_deg / d.sigma_att_deg
+        ));
+    }
     let answer = if !d.discovered.is_empty() {
         "terms found beyond the catalogue"
     } else if !d.causes.is_empty() {

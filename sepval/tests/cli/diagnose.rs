@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use sepval_tests::{ok, sepval};
+use sepval_tests::{ok, refused, sepval};
 use serde_json::Value;
 
 /// Factors of the base model of these tests (not the default truth).
@@ -265,4 +265,191 @@ fn the_eglin_cfd_trajectory_is_diagnosed_honestly() {
         .as_f64()
         .unwrap();
     assert!((fwdfac - 0.2).abs() < 0.05, "fwdfac {fwdfac}");
+}
+
+/// Runs `sepval diagnose` on `data` in `dir` with the reduced budgets and `extra` flags.
+fn diagnose_in(dir: &Path, data: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "diagnose",
+        "--data",
+        data,
+        "--generations",
+        "20",
+        "--evaluator",
+        "inproc",
+        "--threads",
+        "2",
+        "--out",
+        "diag",
+    ];
+    args.extend(extra);
+    sepval(&args, dir)
+}
+
+fn diagnosis_in(dir: &Path) -> Value {
+    serde_json::from_slice(&std::fs::read(dir.join("diag/diagnosis.json")).unwrap()).unwrap()
+}
+
+/// Issue 21, item 4: a store 45 % lighter than the scenario's cannot be fitted by the 17
+/// factors (the baseline stays at about 140 sigma in position); the refits then reach the
+/// noise with nonsense terms. The diagnosis says first that its baseline failed, names nothing
+/// as explained, and marks the answer unreliable in diagnosis.json, the page and the summary.
+#[test]
+fn a_baseline_that_cannot_fit_makes_the_answer_unreliable() {
+    let dir = tempfile::tempdir().unwrap();
+    let light = sepval_scenario().replace("mass_kg = 907.18474", "mass_kg = 500.0");
+    std::fs::write(dir.path().join("light.toml"), light).unwrap();
+    ok(&sepval(
+        &[
+            "simulate",
+            "--scenario",
+            "light.toml",
+            "--noise-seed",
+            "3",
+            "--out",
+            "d.csv",
+        ],
+        dir.path(),
+    ));
+    let stdout = ok(&diagnose_in(dir.path(), "d.csv", &[]));
+    let d = diagnosis_in(dir.path());
+    let verdict = d["verdict"].as_str().unwrap();
+    assert!(
+        verdict.starts_with("unreliable: the baseline fit did not reach near the noise"),
+        "{verdict}"
+    );
+    assert_eq!(d["baseline_converged"], false);
+    assert!(
+        d["baseline_unreliable"]
+            .as_str()
+            .unwrap()
+            .contains("the limit is 20 sigma")
+    );
+    assert_eq!(d["explained"], false);
+    if d["extension"].is_object() {
+        assert_eq!(d["extension"]["explained"], false, "{}", d["extension"]);
+    }
+    assert!(
+        stdout.starts_with("UNRELIABLE: the baseline fit failed"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("explained: no"), "{stdout}");
+    let html = std::fs::read_to_string(dir.path().join("diag/report.html")).unwrap();
+    let (unreliable, verdict_at) = (
+        html.find("<b>Unreliable:</b>").unwrap(),
+        html.find("class=\"verdict\">unreliable").unwrap(),
+    );
+    assert!(unreliable < verdict_at);
+}
+
+/// Eight extension terms, the most a run can take, at zero (they change nothing).
+fn eight_terms() -> String {
+    let mut s = String::from("format = \"sepval-extension/1\"\n");
+    for (k, axis) in ["CA", "CY", "CZ", "Cl", "Cm", "Cn", "CY", "Cm"]
+        .iter()
+        .enumerate()
+    {
+        s.push_str(&format!(
+            "\n[[term]]\naxis = \"{axis}\"\nfamily = \"step\"\nregressor = \"step\"\nt_on_s = {}\ncoefficient = 0.0\n",
+            0.1 * (k + 1) as f64
+        ));
+    }
+    s
+}
+
+/// Issue 21, item 10: with the 8-term budget full, discovery cannot add a term; the notes and
+/// the verdict say so instead of blaming a cause outside both the catalogue and the library.
+#[test]
+fn a_full_term_budget_is_said_to_stop_discovery() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("eight.toml"), eight_terms()).unwrap();
+    // A side force step in the data: neither the catalogue nor the zero terms explain it.
+    let hidden = "format = \"sepval-extension/1\"\n\n[[term]]\naxis = \"CY\"\nfamily = \"step\"\nregressor = \"step\"\nt_on_s = 0.43\ncoefficient = 0.2\n";
+    std::fs::write(dir.path().join("hidden.toml"), hidden).unwrap();
+    std::fs::write(dir.path().join("base.json"), BASE).unwrap();
+    ok(&sepval(
+        &[
+            "simulate",
+            "--factors",
+            "base.json",
+            "--extension",
+            "hidden.toml",
+            "--noise-seed",
+            "4",
+            "--out",
+            "d.csv",
+        ],
+        dir.path(),
+    ));
+    ok(&diagnose_in(
+        dir.path(),
+        "d.csv",
+        &["--extension", "eight.toml"],
+    ));
+    let d = diagnosis_in(dir.path());
+    assert!(d["discovery_steps"].as_array().unwrap().is_empty());
+    let notes = d["discovery_notes"].to_string();
+    assert!(
+        notes.contains("discovery could not run: the term budget is full"),
+        "{notes}"
+    );
+    let verdict = d["verdict"].as_str().unwrap();
+    assert_eq!(d["explained"], false, "{verdict}");
+    assert!(
+        verdict.contains("the term budget is full") && verdict.contains("were not looked for"),
+        "{verdict}"
+    );
+    assert!(
+        !verdict.contains("the cause lies outside both"),
+        "{verdict}"
+    );
+}
+
+/// Issue 21, item 11: the tabulated store at Mach 5 leaves its Mach tables. `diagnose` reports
+/// it as simulate and fit do, and with `--strict-tables` refuses after the baseline fit,
+/// before any other work, writing no diagnosis.
+#[test]
+fn tables_left_are_reported_and_refused_with_strict_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let example =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/tabulated-store/scenario.toml");
+    let scenario = std::fs::read_to_string(&example)
+        .unwrap()
+        .replace("mach = 0.85", "mach = 5.0");
+    let tables = example.parent().unwrap().join("tables");
+    std::fs::write(
+        dir.path().join("s.toml"),
+        scenario.replace("\"tables/", &format!("\"{}/", tables.display())),
+    )
+    .unwrap();
+    let sim = [
+        "simulate",
+        "--scenario",
+        "s.toml",
+        "--noise-seed",
+        "3",
+        "--out",
+        "d.csv",
+    ];
+    ok(&sepval(&sim, dir.path()));
+    let out = diagnose_in(dir.path(), "d.csv", &["--scenario", "s.toml"]);
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("warning: baseline, d.csv: left table `aero.cm`"),
+        "{stderr}"
+    );
+    let d = diagnosis_in(dir.path());
+    assert!(d["tables_left"].to_string().contains("mach up to"), "{d}");
+    let out = diagnose_in(
+        dir.path(),
+        "d.csv",
+        &["--scenario", "s.toml", "--strict-tables", "--overwrite"],
+    );
+    refused(
+        &out,
+        "--strict-tables: the baseline fit d.csv: left table `aero.",
+    );
+    assert!(!dir.path().join("diag/diagnosis.json").exists());
+    assert!(!dir.path().join("diag/report.html").exists());
 }

@@ -360,3 +360,101 @@ fn small_mistakes_are_named() {
     );
     assert_eq!(stderr.matches("EOF while parsing").count(), 1, "{stderr}");
 }
+
+/// The goals `sepval goals` prints: J_pos \[m\], J_att \[deg\].
+fn goals_printed(stdout: &str) -> [f64; 2] {
+    let value = |key: &str| -> f64 {
+        let line = stdout.lines().find(|l| l.starts_with(key)).unwrap();
+        line.split_whitespace().nth(2).unwrap().parse().unwrap()
+    };
+    [value("J_pos"), value("J_att")]
+}
+
+/// Issue 21, item 5: DIR/extension.toml holds every term of the answer's model, the one given
+/// with `--extension` included, so that the README's recipe (`simulate --factors
+/// DIR/factors.json --extension DIR/extension.toml`) reproduces the answer's goals.
+#[test]
+fn the_extension_written_reproduces_the_answer_with_the_users_terms() {
+    let dir = tempfile::tempdir().unwrap();
+    let term = |axis: &str, regressor_lines: &str, c: f64| {
+        format!("\n[[term]]\naxis = \"{axis}\"\n{regressor_lines}coefficient = {c}\n")
+    };
+    let given = term("Cl", "family = \"rate\"\nregressor = \"p\"\n", -0.5);
+    let hidden = term(
+        "CY",
+        "family = \"step\"\nregressor = \"step\"\nt_on_s = 0.43\n",
+        0.2,
+    );
+    let head = "format = \"sepval-extension/1\"\n";
+    std::fs::write(dir.path().join("given.toml"), format!("{head}{given}")).unwrap();
+    std::fs::write(
+        dir.path().join("both.toml"),
+        format!("{head}{given}{hidden}"),
+    )
+    .unwrap();
+    ok(&sepval(
+        &[
+            "simulate",
+            "--extension",
+            "both.toml",
+            "--noise-seed",
+            "6",
+            "--out",
+            "d.csv",
+        ],
+        dir.path(),
+    ));
+    ok(&sepval(
+        &[
+            "diagnose",
+            "--data",
+            "d.csv",
+            "--extension",
+            "given.toml",
+            "--generations",
+            "20",
+            "--evaluator",
+            "inproc",
+            "--threads",
+            "2",
+            "--out",
+            "diag",
+        ],
+        dir.path(),
+    ));
+    let d: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("diag/diagnosis.json")).unwrap())
+            .unwrap();
+    assert_eq!(d["extension"]["answer"], true, "{}", d["verdict"]);
+    let written = std::fs::read_to_string(dir.path().join("diag/extension.toml")).unwrap();
+    assert!(written.contains("regressor = \"p\""), "{written}");
+    assert!(written.contains("given with --extension"), "{written}");
+    assert!(written.contains("family = \"step\""), "{written}");
+    ok(&sepval(
+        &[
+            "simulate",
+            "--factors",
+            "diag/factors.json",
+            "--extension",
+            "diag/extension.toml",
+            "--out",
+            "again.csv",
+        ],
+        dir.path(),
+    ));
+    let printed = ok(&sepval(
+        &["goals", "--data", "d.csv", "--sim", "again.csv"],
+        dir.path(),
+    ));
+    let [jp, ja] = goals_printed(&printed);
+    let model = &d["extension"]["model"];
+    let (ep, ea) = (
+        model["j_pos_m"].as_f64().unwrap(),
+        model["j_att_deg"].as_f64().unwrap(),
+    );
+    // The same model simulated again: equal to the printed digits (1e-9 m, 1e-9 deg).
+    assert!(
+        (jp - ep).abs() < 1e-8 && (ja - ea).abs() < 1e-8,
+        "{jp} {ja} vs {ep} {ea}"
+    );
+}
