@@ -26,7 +26,7 @@ use sepval_fit::space::{Noise, residual_vector};
 pub const PROBE_SAMPLES: usize = SAMPLE_BUDGET / 4;
 
 /// Most samples (over all events) the discovery's linear algebra uses.
-pub const MAX_ROWS_SAMPLES: usize = 20_000;
+pub const MAX_ROWS_SAMPLES: usize = 3_000;
 
 /// The residual rows the discovery uses: every k-th sample of every event (6 rows each).
 pub fn rows(job: &Job) -> Vec<usize> {
