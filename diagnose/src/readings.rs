@@ -170,7 +170,7 @@ fn gust(term: &Term) -> String {
         _ => ("gust", "building up over"),
     };
     format!(
-        "A {axis} {what} of {} m/s toward {toward} from t = {} s, {over} {} s: the air moved during the release (every coefficient sees it through the flow angles and the airspeed)",
+        "A {axis} {what} of {} m/s toward {toward} from t = {} s, {over} {} s: the air moved during the release",
         fmt_num(w.abs()),
         fmt_num(t_on_s),
         fmt_num(rise_s)
@@ -263,7 +263,7 @@ mod tests {
         };
         assert_eq!(
             reading(&gust(Axis::WindY, Regressor::WindStep, 2.1)),
-            "A lateral gust of 2.1 m/s toward +y (starboard) from t = 0.2 s, building up over 0.1 s: the air moved during the release (every coefficient sees it through the flow angles and the airspeed)"
+            "A lateral gust of 2.1 m/s toward +y (starboard) from t = 0.2 s, building up over 0.1 s: the air moved during the release"
         );
         let pulse = reading(&gust(Axis::WindZ, Regressor::WindPulse, -3.0));
         assert!(

@@ -74,15 +74,11 @@ fn a_steady_crosswind_flies_as_the_release_at_that_sideslip_and_airspeed() {
     let (a, b, calm) = (fly(&windy), fly(&turned), fly(&base));
     let mut worst_m: f64 = 0.0;
     let mut moved_m: f64 = 0.0;
-    for k in 0..times.len() {
+    for (k, t) in times.iter().enumerate() {
         for j in 0..3 {
             worst_m = worst_m.max((a.pos_m[k][j] - b.pos_m[k][j]).abs());
             moved_m = moved_m.max((a.pos_m[k][j] - calm.pos_m[k][j]).abs());
-            assert!(
-                (a.att_deg[k][j] - b.att_deg[k][j]).abs() < 1e-7,
-                "t = {}",
-                times[k]
-            );
+            assert!((a.att_deg[k][j] - b.att_deg[k][j]).abs() < 1e-7, "t = {t}");
         }
     }
     assert!(worst_m < 1e-7, "positions differ by {worst_m} m");
