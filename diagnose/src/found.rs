@@ -61,7 +61,7 @@ pub struct GroupMember {
 /// One discovered term (an oscillation: its sine-cosine pair as one amplitude and phase).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DiscoveredTerm {
-    /// `CA`, `CY`, `CZ`, `Cl`, `Cm`, `Cn` or `ejector`.
+    /// `CA`, `CY`, `CZ`, `Cl`, `Cm`, `Cn`, `ejector`, `wind_y` or `wind_z`.
     pub axis: String,
     /// The library family.
     pub family: String,
@@ -74,9 +74,12 @@ pub struct DiscoveredTerm {
     /// An oscillation's phase \[deg\]: A sin(2 pi f t + phase).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phase_deg: Option<f64>,
-    /// A step's time \[s\].
+    /// A step's or a gust's time \[s\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t_on_s: Option<f64>,
+    /// A gust's onset or pulse length \[s\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rise_s: Option<f64>,
     /// An oscillation's frequency \[Hz\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub f_hz: Option<f64>,

@@ -25,7 +25,7 @@ pub(super) fn model_increments(job: &Job, fitted: &Fitted) -> Result<Curves> {
     Ok(history
         .iter()
         .map(|samples| {
-            Axis::ALL
+            Axis::FORCE_AND_MOMENT
                 .iter()
                 .map(|&axis| {
                     let pick = |s: &Sample| -> Option<f64> {
@@ -72,7 +72,8 @@ fn axis_caption(axis: &str) -> String {
 }
 
 /// DIR/figures/increments.png: the reconstructed increments per axis with their bands, and
-/// what the discovered terms give (`model[event][axis]`, axes in `Axis::ALL` order).
+/// what the discovered terms give (`model[event][axis]`, axes in `Axis::FORCE_AND_MOMENT`
+/// order: a wind is no increment, it acts through the flow).
 pub(super) fn increment_figure(
     path: &Path,
     reconstruction: &[Reconstruction],

@@ -6,9 +6,12 @@
 //! lengths (0.3, 0.6, 1.2 m) for the interference-times-flow families; steps every 25 ms inside
 //! the record; oscillations every 0.5 Hz from 1 Hz to a quarter of the sample rate (at most
 //! 50 Hz), sine and cosine together; the Mach reference at the mean freestream Mach number of
-//! the events.
+//! the events; gusts (`wind`, on `wind_y` and `wind_z`) at the step times, a 1-cosine onset
+//! over 0.1 s and pulses of 0.1 and 0.2 s (the 1-cosine gust of 14 CFR 25.341 with gust
+//! gradients of about 30 to 60 m at the airspeeds of a release: docs/model-choices.md).
 
 use sepval_common::evaluation::{Candidate, Job};
+use sepval_common::extension::wind::DEFAULT_RISE_S;
 use sepval_common::extension::{Axis, Family, Regressor, Term, TermInput};
 use sepval_common::model::EquationsOfMotion;
 use sepval_common::model::StateVector;
@@ -24,6 +27,14 @@ pub const STEP_SPACING_S: f64 = 0.025;
 pub const FREQUENCY_SPACING_HZ: f64 = 0.5;
 /// Size of a probe: the largest coefficient increment (regressor times probe) it makes.
 const PROBE: f64 = 1e-3;
+/// Size of a wind probe: the largest air velocity it adds \[m/s\] (about 0.02 deg of flow
+/// angle at the airspeed of a release: small enough to stay linear, large enough that its
+/// column stands well above rounding).
+const WIND_PROBE_M_S: f64 = 0.1;
+/// Onset lengths of the library's gusts \[s\].
+pub const WIND_ONSETS_S: [f64; 1] = [DEFAULT_RISE_S];
+/// Lengths of the library's gust pulses \[s\].
+pub const WIND_PULSES_S: [f64; 2] = [0.1, 0.2];
 /// Width of a reconstruction window \[s\] (at least; at most 100 windows per axis).
 pub const WINDOW_S: f64 = 0.02;
 
@@ -148,7 +159,12 @@ fn probed(mut term: Term, history: &[Vec<Sample>]) -> Option<Term> {
     if m.is_nan() || m <= 1e-9 {
         return None;
     }
-    term.coefficient = PROBE / m;
+    let size = if term.axis.is_wind() {
+        WIND_PROBE_M_S
+    } else {
+        PROBE
+    };
+    term.coefficient = size / m;
     Some(term)
 }
 
@@ -198,11 +214,9 @@ pub fn library(job: &Job, history: &[Vec<Sample>], rate_hz: f64) -> Vec<Entry> {
         / job.events().len() as f64;
     plain.push((Regressor::Dm, mach0));
     plain.push((Regressor::Dm2, mach0));
-    let (t0, t1) = span(history);
-    let mut t_on = t0 + STEP_SPACING_S;
-    while t_on < t1 - STEP_SPACING_S + 1e-9 {
-        plain.push((Regressor::Step, (t_on * 1e6).round() / 1e6));
-        t_on += STEP_SPACING_S;
+    let t_ons = step_times(history);
+    for &t_on in &t_ons {
+        plain.push((Regressor::Step, t_on));
     }
     let mut entries = Vec::new();
     for axis in aero {
@@ -252,6 +266,45 @@ pub fn library(job: &Job, history: &[Vec<Sample>], rate_hz: f64) -> Vec<Entry> {
             }
         }
         f += FREQUENCY_SPACING_HZ;
+    }
+    entries.extend(gusts(&t_ons, history));
+    entries
+}
+
+/// The step times: every [`STEP_SPACING_S`] from the record's start plus one spacing to its end
+/// less one, to the microsecond.
+fn step_times(history: &[Vec<Sample>]) -> Vec<f64> {
+    let (t0, t1) = span(history);
+    let mut out = Vec::new();
+    let mut t_on = t0 + STEP_SPACING_S;
+    while t_on < t1 - STEP_SPACING_S + 1e-9 {
+        out.push((t_on * 1e6).round() / 1e6);
+        t_on += STEP_SPACING_S;
+    }
+    out
+}
+
+/// The `wind` entries: on each wind axis, an onset and the pulses at each step time.
+fn gusts(t_ons: &[f64], history: &[Vec<Sample>]) -> Vec<Entry> {
+    let shapes = WIND_ONSETS_S
+        .map(|t| (Regressor::WindStep, t))
+        .into_iter()
+        .chain(WIND_PULSES_S.map(|t| (Regressor::WindPulse, t)));
+    let mut entries = Vec::new();
+    for (regressor, rise_s) in shapes {
+        for axis in Axis::WIND {
+            for &t_on in t_ons {
+                let term = Term {
+                    axis,
+                    regressor,
+                    locator: [t_on, rise_s],
+                    coefficient: 0.0,
+                };
+                if let Some(t) = probed(term, history) {
+                    entries.push(Entry { terms: vec![t] });
+                }
+            }
+        }
     }
     entries
 }

@@ -14,6 +14,7 @@
 //! | `oscillation` | `<quantity> oscillating at f Hz: buffet (or a structural or flow oscillation)` |
 //! | `ejector_stroke` (`stroke`) | `ejector force falls (or rises) along the stroke` |
 //! | `ejector_stroke` (`stroke2`) | `ejector force peaks (or dips) mid-stroke` |
+//! | `wind` (`step`, `pulse`) | `a lateral (or vertical) gust (or gust pulse) of w m/s toward +y (starboard) / -y (port) / +z (down) / -z (up) from t = t_on s over T s: the air moved during the release` |
 
 use sepval_common::extension::{Axis, Family, Regressor, Term};
 use sepval_common::scenario::Interference;
@@ -28,6 +29,8 @@ pub fn quantity(axis: Axis) -> &'static str {
         Axis::Cm => "pitch moment",
         Axis::Cn => "yaw moment",
         Axis::Ejector => "ejector force",
+        Axis::WindY => "lateral wind",
+        Axis::WindZ => "vertical wind",
     }
 }
 
@@ -147,8 +150,31 @@ pub fn reading(term: &Term, interference: &Interference) -> String {
                 if c < 0.0 { "falls" } else { "rises" }
             ),
         },
+        Family::Wind => gust(term),
         Family::Window => format!("{} differs in a window of time", capitalised(q)),
     }
+}
+
+/// A `wind` term in words: which way the air moved, how fast, when and how long.
+fn gust(term: &Term) -> String {
+    let [t_on_s, rise_s] = term.locator;
+    let w = term.coefficient;
+    let (axis, toward) = match (term.axis, w < 0.0) {
+        (Axis::WindZ, false) => ("vertical", "+z (down)"),
+        (Axis::WindZ, true) => ("vertical", "-z (up)"),
+        (_, false) => ("lateral", "+y (starboard)"),
+        (_, true) => ("lateral", "-y (port)"),
+    };
+    let (what, over) = match term.regressor {
+        Regressor::WindPulse => ("gust pulse", "lasting"),
+        _ => ("gust", "building up over"),
+    };
+    format!(
+        "A {axis} {what} of {} m/s toward {toward} from t = {} s, {over} {} s: the air moved during the release",
+        fmt_num(w.abs()),
+        fmt_num(t_on_s),
+        fmt_num(rise_s)
+    )
 }
 
 /// A number with at most three decimals and no trailing zeros.
@@ -225,5 +251,26 @@ mod tests {
         );
         assert!(reading(&term(Axis::Cm, Regressor::P, 0.0, -0.5)).contains("cross derivative"));
         assert!(reading(&term(Axis::CA, Regressor::Dm, 0.9, 0.1)).contains("drag rise"));
+    }
+
+    #[test]
+    fn a_gust_reads_as_the_air_moving() {
+        let gust = |axis, regressor, w| Term {
+            axis,
+            regressor,
+            locator: [0.2, 0.1],
+            coefficient: w,
+        };
+        assert_eq!(
+            reading(&gust(Axis::WindY, Regressor::WindStep, 2.1)),
+            "A lateral gust of 2.1 m/s toward +y (starboard) from t = 0.2 s, building up over 0.1 s: the air moved during the release"
+        );
+        let pulse = reading(&gust(Axis::WindZ, Regressor::WindPulse, -3.0));
+        assert!(
+            pulse.starts_with(
+                "A vertical gust pulse of 3 m/s toward -z (up) from t = 0.2 s, lasting 0.1 s"
+            ),
+            "{pulse}"
+        );
     }
 }

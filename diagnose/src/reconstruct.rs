@@ -80,7 +80,7 @@ pub fn reconstruct(
     // The smoothness penalty: first differences within each axis, scaled by the axis's mean
     // information per window.
     let mut pen = DMatrix::zeros(n, n);
-    for axis in Axis::ALL {
+    for axis in Axis::FORCE_AND_MOMENT {
         let idx: Vec<usize> = (0..nw).filter(|&k| windows[k].axis == axis).collect();
         if idx.len() < 2 {
             continue;
@@ -128,7 +128,7 @@ pub fn reconstruct(
     };
     let res = r0 + &a * &beta;
     let mut increments = Vec::new();
-    for axis in Axis::ALL {
+    for axis in Axis::FORCE_AND_MOMENT {
         let idx: Vec<usize> = (0..nw).filter(|&k| windows[k].axis == axis).collect();
         if idx.is_empty() {
             continue;

@@ -4,15 +4,17 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::wind::DEFAULT_RISE_S;
 use super::{Axis, Family, MAX_TERMS, Regressor, Term, TermError};
 use crate::limits::MAX_EXTENSION_BYTES;
 
-/// A term as files write it: `axis`, `family`, `regressor`, the family's locator by name, and
+/// A term as files write it: `axis`, `family`, `regressor`, the family's locator by name (a
+/// wind's two: `t_on_s` and `rise_s`, the latter [`DEFAULT_RISE_S`] when not written), and
 /// `coefficient` (with `std_error` and `reading` kept as the diagnosis wrote them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TermRecord {
-    /// `CA`, `CY`, `CZ`, `Cl`, `Cm`, `Cn` or `ejector`.
+    /// `CA`, `CY`, `CZ`, `Cl`, `Cm`, `Cn`, `ejector`, `wind_y` or `wind_z`.
     pub axis: String,
     /// A family of the library.
     pub family: String,
@@ -24,9 +26,12 @@ pub struct TermRecord {
     /// Reference Mach number (`mach`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mach0: Option<f64>,
-    /// Step time (`step`) \[s\].
+    /// Step or gust time (`step`, `wind`) \[s\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t_on_s: Option<f64>,
+    /// Onset or pulse length (`wind`) \[s\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rise_s: Option<f64>,
     /// Frequency (`oscillation`) \[Hz\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub f_hz: Option<f64>,
@@ -53,6 +58,7 @@ impl TermRecord {
             lambda_m: pick("lambda_m"),
             mach0: pick("mach0"),
             t_on_s: pick("t_on_s"),
+            rise_s: (family == Family::Wind).then_some(term.locator[1]),
             f_hz: pick("f_hz"),
             coefficient: term.coefficient,
             std_error: None,
@@ -66,7 +72,7 @@ impl TermRecord {
             (
                 "axis",
                 format!(
-                    "`{}` is not an axis (expected CA, CY, CZ, Cl, Cm, Cn or ejector)",
+                    "`{}` is not an axis (expected CA, CY, CZ, Cl, Cm, Cn, ejector, wind_y or wind_z)",
                     self.axis
                 ),
             )
@@ -116,10 +122,17 @@ impl TermRecord {
                 (false, None) => {}
             }
         }
+        let rise_s = match (family, self.rise_s) {
+            (Family::Wind, v) => v.unwrap_or(DEFAULT_RISE_S),
+            (_, None) => 0.0,
+            (_, Some(_)) => {
+                return Err(("rise_s", format!("is not a locator of {}", family.name())));
+            }
+        };
         let term = Term {
             axis,
             regressor,
-            locator: [locator, 0.0],
+            locator: [locator, rise_s],
             coefficient: self.coefficient,
         };
         term.check().map_err(|e| {

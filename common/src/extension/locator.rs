@@ -14,13 +14,17 @@
 //!   reaches; the diagnosis's library uses the events' flight Mach number.
 //! - `t_on_s` in [-7200, 7200] s, twice the longest event (`limits::MAX_SPAN_S`): a step
 //!   further out is constant over any event; the library's steps lie inside the record.
+//! - `rise_s` in [0.001, 7200] s (the length T of a `wind` onset or pulse): the shapes divide
+//!   t - t_on by T, which stays finite for any positive T and any time of an event; below 1 ms
+//!   (two steps of the default 0.5 ms integrator) a gust is a jump the integrator cannot
+//!   resolve, and beyond twice the longest event it never completes.
 //! - `f_hz` in [0, 1e6] Hz: 2 pi f t stays finite for every time of an event (a frequency
 //!   beyond half the integration rate is aliased, but it still simulates); the library tries 1 to
 //!   50 Hz.
 //!
-//! The diagnosis's own locators (`coordinator/src/diagnose/library.rs` and the refits of
-//! `discover.rs`: decay lengths about 0.1 to 3.6 m, steps within the record, 1 to 50.5 Hz) lie
-//! well inside.
+//! The diagnosis's own locators (`diagnose/src/library.rs` and the refits of `discover/`:
+//! decay lengths about 0.1 to 3.6 m, steps and gusts within the record, gust lengths 0.05 to
+//! 0.2 s, 1 to 50.5 Hz) lie well inside.
 
 use crate::limits::MAX_SPAN_S;
 
@@ -84,6 +88,15 @@ pub const T_ON_S: LocatorDomain = LocatorDomain {
     expected: "expected a time in [-7200, 7200] s",
 };
 
+/// Onset or pulse length of `wind` \[s\].
+pub const RISE_S: LocatorDomain = LocatorDomain {
+    name: "rise_s",
+    min: 1e-3,
+    min_open: false,
+    max: 2.0 * MAX_SPAN_S,
+    expected: "expected a length in [0.001, 7200] s",
+};
+
 /// Frequency of `oscillation` \[Hz\].
 pub const F_HZ: LocatorDomain = LocatorDomain {
     name: "f_hz",
@@ -100,7 +113,7 @@ mod tests {
     /// Each message states the domain it checks.
     #[test]
     fn messages_state_the_bounds() {
-        for d in [LAMBDA_M, MACH0, T_ON_S, F_HZ] {
+        for d in [LAMBDA_M, MACH0, T_ON_S, RISE_S, F_HZ] {
             let (open, close) = (if d.min_open { '(' } else { '[' }, ']');
             let stated = format!("{open}{}, {}{close}", d.min, d.max);
             assert!(d.expected.contains(&stated), "{}: {stated}", d.expected);

@@ -5,8 +5,10 @@
 //! model is usable, not only reported.
 //!
 //! A term acts on one axis: an aerodynamic coefficient increment (`CA` positive aft, so
-//! `CX -= dCA`; `CY`, `CZ`, `Cl`, `Cm`, `Cn` added as they are), or the ejector force (`ejector`:
-//! a fraction of each foot's force, `F_i (1 + dE)`, while the foot pushes). Its regressor comes
+//! `CX -= dCA`; `CY`, `CZ`, `Cl`, `Cm`, `Cn` added as they are), the ejector force (`ejector`:
+//! a fraction of each foot's force, `F_i (1 + dE)`, while the foot pushes), or the air's
+//! velocity in the launch frame (`wind_y`, `wind_z` \[m/s\]: a gust, seen by every coefficient
+//! through the flow angles, the airspeed and the Mach number; [`wind`]). Its regressor comes
 //! from a documented library of families (the names are the ones the diagnosis reports):
 //!
 //! | family | regressors | locator |
@@ -19,6 +21,7 @@
 //! | `step` | `step`: (1 + tanh((t - t_on) / w)) / 2, w = 5 ms | `t_on_s` |
 //! | `oscillation` | `sin`, `cos`: sin(2 pi f t), cos(2 pi f t) | `f_hz` |
 //! | `ejector_stroke` | `stroke`, `stroke2`: sigma - 1/2 and (sigma - 1/2)^2 - 1/12, sigma = clamp(s_i, 0, stroke) / stroke (ejector axis only) | - |
+//! | `wind` | `step`, `pulse`: the 1-cosine onset and pulse of length T (wind axes only; the only family on them) | `t_on_s`, `rise_s` (T) |
 //!
 //! A diagnosis also uses time windows (`window`: 1 for t0 <= t < t1) to reconstruct the missing
 //! force and moment as time histories; they are not a family of the library and cannot be
@@ -31,9 +34,12 @@ use serde::{Deserialize, Serialize};
 
 mod file;
 pub mod locator;
+mod set;
+pub mod wind;
 pub use file::{
     EXTENSION_FORMAT, ExtensionError, TermRecord, extension_toml, load_extension, parse_extension,
 };
+pub use set::TermSet;
 
 /// Most terms one run carries (an extension's and a candidate's together).
 pub const MAX_TERMS: usize = 8;
@@ -58,11 +64,31 @@ pub enum Axis {
     /// The ejector force, as a fraction of each foot's force.
     #[serde(rename = "ejector")]
     Ejector,
+    /// The air's velocity along the launch frame's y (lateral) \[m/s\].
+    #[serde(rename = "wind_y")]
+    WindY,
+    /// The air's velocity along the launch frame's z (vertical, positive down) \[m/s\].
+    #[serde(rename = "wind_z")]
+    WindZ,
 }
 
 impl Axis {
-    /// Every axis, in this order.
-    pub const ALL: [Axis; 7] = [
+    /// Every axis, in this order (the wire's axis index is the position here).
+    pub const ALL: [Axis; 9] = [
+        Axis::CA,
+        Axis::CY,
+        Axis::CZ,
+        Axis::Cl,
+        Axis::Cm,
+        Axis::Cn,
+        Axis::Ejector,
+        Axis::WindY,
+        Axis::WindZ,
+    ];
+
+    /// The force and moment axes: the coefficient increments and the ejector's, in this order
+    /// (what a diagnosis reconstructs as time histories; the wind axes are not among them).
+    pub const FORCE_AND_MOMENT: [Axis; 7] = [
         Axis::CA,
         Axis::CY,
         Axis::CZ,
@@ -71,6 +97,9 @@ impl Axis {
         Axis::Cn,
         Axis::Ejector,
     ];
+
+    /// The wind axes.
+    pub const WIND: [Axis; 2] = [Axis::WindY, Axis::WindZ];
 
     /// Its name in files and reports.
     pub fn name(self) -> &'static str {
@@ -82,6 +111,8 @@ impl Axis {
             Axis::Cm => "Cm",
             Axis::Cn => "Cn",
             Axis::Ejector => "ejector",
+            Axis::WindY => "wind_y",
+            Axis::WindZ => "wind_z",
         }
     }
 
@@ -90,9 +121,19 @@ impl Axis {
         Axis::ALL.into_iter().find(|a| a.name() == name)
     }
 
-    /// Index 0..7.
+    /// Index 0..9, its position in [`Axis::ALL`] (0..6: the coefficients CA ... Cn).
     pub fn index(self) -> usize {
         self as usize
+    }
+
+    /// Whether it is an aerodynamic coefficient (CA ... Cn).
+    pub fn is_coefficient(self) -> bool {
+        self.index() < 6
+    }
+
+    /// Whether it is a wind axis.
+    pub fn is_wind(self) -> bool {
+        matches!(self, Axis::WindY | Axis::WindZ)
     }
 }
 
@@ -115,13 +156,15 @@ pub enum Family {
     Oscillation,
     /// The ejector force's shape along the stroke.
     EjectorStroke,
+    /// A gust: the air's velocity in time.
+    Wind,
     /// A time window (reconstruction only).
     Window,
 }
 
 impl Family {
     /// The families of the library, in report order.
-    pub const LIBRARY: [Family; 8] = [
+    pub const LIBRARY: [Family; 9] = [
         Family::FlowAngle,
         Family::Rate,
         Family::Interference,
@@ -130,6 +173,7 @@ impl Family {
         Family::Step,
         Family::Oscillation,
         Family::EjectorStroke,
+        Family::Wind,
     ];
 
     /// Its name in files and reports.
@@ -143,6 +187,7 @@ impl Family {
             Family::Step => "step",
             Family::Oscillation => "oscillation",
             Family::EjectorStroke => "ejector_stroke",
+            Family::Wind => "wind",
             Family::Window => "window",
         }
     }
@@ -152,12 +197,13 @@ impl Family {
         Family::LIBRARY.into_iter().find(|f| f.name() == name)
     }
 
-    /// The name of its locator in files, if it has one.
+    /// The name of its (first) locator in files, if it has one; `wind` has a second,
+    /// `rise_s` ([`wind`]).
     pub fn locator(self) -> Option<&'static str> {
         match self {
             Family::Interference | Family::InterferenceFlowAngle => Some("lambda_m"),
             Family::Mach => Some("mach0"),
-            Family::Step => Some("t_on_s"),
+            Family::Step | Family::Wind => Some("t_on_s"),
             Family::Oscillation => Some("f_hz"),
             Family::Window => Some("t0_s"),
             _ => None,
@@ -193,11 +239,13 @@ pub enum Regressor {
     Stroke,
     Stroke2,
     Window,
+    WindStep,
+    WindPulse,
 }
 
 impl Regressor {
     /// Every regressor, with its family and name.
-    pub const ALL: [(Regressor, Family, &'static str); 24] = [
+    pub const ALL: [(Regressor, Family, &'static str); 26] = [
         (Regressor::Alpha, Family::FlowAngle, "alpha"),
         (Regressor::Beta, Family::FlowAngle, "beta"),
         (Regressor::Alpha2, Family::FlowAngle, "alpha2"),
@@ -222,6 +270,8 @@ impl Regressor {
         (Regressor::Stroke, Family::EjectorStroke, "stroke"),
         (Regressor::Stroke2, Family::EjectorStroke, "stroke2"),
         (Regressor::Window, Family::Window, "window"),
+        (Regressor::WindStep, Family::Wind, "step"),
+        (Regressor::WindPulse, Family::Wind, "pulse"),
     ];
 
     /// Its family.
@@ -243,9 +293,12 @@ impl Regressor {
     }
 
     /// Whether it may act on `axis` (the stroke shapes act on the ejector only, the ejector
-    /// only through them, time windows and steps).
+    /// only through them, time windows and steps; the wind shapes act on the wind axes only,
+    /// and nothing else does).
     pub fn fits(self, axis: Axis) -> bool {
         match (self.family(), axis) {
+            (Family::Wind, a) => a.is_wind(),
+            (_, a) if a.is_wind() => false,
             (Family::EjectorStroke, a) => a == Axis::Ejector,
             (Family::Window | Family::Step, _) => true,
             (_, a) => a != Axis::Ejector,
@@ -279,9 +332,11 @@ pub struct Term {
     pub axis: Axis,
     /// The regressor.
     pub regressor: Regressor,
-    /// Its locator (`lambda_m`, `mach0`, `t_on_s`, `f_hz`; a window's `[t0_s, t1_s]`).
+    /// Its locator (`lambda_m`, `mach0`, `t_on_s`, `f_hz`; a window's `[t0_s, t1_s]`; a
+    /// wind's `[t_on_s, rise_s]`).
     pub locator: [f64; 2],
-    /// Its coefficient (dimensionless; for the ejector, a fraction of the force).
+    /// Its coefficient (dimensionless; for the ejector, a fraction of the force; for a wind
+    /// axis, the air's velocity \[m/s\]).
     pub coefficient: f64,
 }
 
@@ -350,6 +405,7 @@ impl Term {
             Family::Mach => domain(locator::MACH0, a),
             Family::Step => domain(locator::T_ON_S, a),
             Family::Oscillation => domain(locator::F_HZ, a),
+            Family::Wind => domain(locator::T_ON_S, a).and(domain(locator::RISE_S, b)),
             Family::Window => {
                 value("t0_s", a, true, "expected a finite time")?;
                 value("t1_s", b, b > a, "expected a time after t0_s")
@@ -358,7 +414,7 @@ impl Term {
         }
     }
 
-    /// The regressor's value (aerodynamic axes).
+    /// The regressor's value (aerodynamic axes; for a wind regressor, its shape in time).
     #[inline]
     pub fn regressor_value(&self, x: &TermInput) -> f64 {
         let [a, b] = self.locator;
@@ -387,6 +443,8 @@ impl Term {
             Regressor::Cos => crate::elementary::cos(std::f64::consts::TAU * a * x.t_s),
             Regressor::Window => f64::from(u8::from(x.t_s >= a && x.t_s < b)),
             Regressor::Stroke | Regressor::Stroke2 => 0.0,
+            Regressor::WindStep => wind::onset(x.t_s, a, b),
+            Regressor::WindPulse => wind::pulse(x.t_s, a, b),
         }
     }
 
@@ -432,6 +490,8 @@ impl Term {
             Regressor::Stroke => "(sigma - 1/2)".into(),
             Regressor::Stroke2 => "((sigma - 1/2)^2 - 1/12)".into(),
             Regressor::Window => format!("[{a} s <= t < {b} s]"),
+            Regressor::WindStep => format!("onset(t - {a} s; {b} s)"),
+            Regressor::WindPulse => format!("pulse(t - {a} s; {b} s)"),
         }
     }
 }
@@ -467,102 +527,6 @@ fn decay(s_m: f64, lambda_m: f64, s_end_m: f64) -> f64 {
 #[inline]
 fn step(t_s: f64, t_on_s: f64) -> f64 {
     1.0 / (1.0 + crate::elementary::exp(-2.0 * (t_s - t_on_s) / STEP_WIDTH_S))
-}
-
-/// The terms of one run (fixed capacity, `Copy`: no allocation).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TermSet {
-    len: usize,
-    items: [Option<Term>; MAX_TERMS],
-}
-
-impl Default for TermSet {
-    fn default() -> Self {
-        TermSet::NONE
-    }
-}
-
-impl TermSet {
-    /// No terms.
-    pub const NONE: TermSet = TermSet {
-        len: 0,
-        items: [None; MAX_TERMS],
-    };
-
-    /// Adds a (checked) term.
-    pub fn push(&mut self, term: Term) -> Result<(), TermError> {
-        term.check()?;
-        if self.len == MAX_TERMS {
-            return Err(TermError::TooMany);
-        }
-        self.items[self.len] = Some(term);
-        self.len += 1;
-        Ok(())
-    }
-
-    /// The terms of `terms` (checked).
-    pub fn of(terms: &[Term]) -> Result<TermSet, TermError> {
-        let mut s = TermSet::NONE;
-        for t in terms {
-            s.push(*t)?;
-        }
-        Ok(s)
-    }
-
-    /// Number of terms.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    /// The terms.
-    pub fn iter(&self) -> impl Iterator<Item = &Term> {
-        self.items[..self.len].iter().flatten()
-    }
-
-    /// These terms followed by `other`'s.
-    pub fn merged(&self, other: &TermSet) -> Result<TermSet, TermError> {
-        let mut s = *self;
-        for t in other.iter() {
-            s.push(*t)?;
-        }
-        Ok(s)
-    }
-
-    /// Whether any term acts on the ejector.
-    pub fn has_ejector(&self) -> bool {
-        self.iter().any(|t| t.axis == Axis::Ejector)
-    }
-
-    /// Whether any term acts on an aerodynamic coefficient.
-    pub fn has_aero(&self) -> bool {
-        self.iter().any(|t| t.axis != Axis::Ejector)
-    }
-
-    /// The increments of (CA, CY, CZ, Cl, Cm, Cn) at one force evaluation.
-    #[inline]
-    pub fn aero_increments(&self, x: &TermInput) -> [f64; 6] {
-        let mut d = [0.0; 6];
-        for t in self.iter().filter(|t| t.axis != Axis::Ejector) {
-            d[t.axis.index()] += t.coefficient * t.regressor_value(x);
-        }
-        d
-    }
-
-    /// The ejector force factor max(0, 1 + dE) of a foot at stroke fraction `sigma` at time
-    /// `t_s`: an ejector pushes, it never pulls, however large a negative term.
-    #[inline]
-    pub fn ejector_factor(&self, t_s: f64, sigma: f64) -> f64 {
-        let mut d = 0.0;
-        for t in self.iter().filter(|t| t.axis == Axis::Ejector) {
-            d += t.coefficient * t.ejector_value(t_s, sigma);
-        }
-        (1.0 + d).max(0.0)
-    }
 }
 
 #[cfg(test)]

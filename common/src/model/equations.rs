@@ -16,7 +16,9 @@
 //! catalogue's coefficient terms, the extension's terms: section 3, 7 and 11) runs lane by lane
 //! through the scalar code of each lane's run ([`Parts`]), and its result is put back into the
 //! lane; a lane whose feet do not push keeps its value by a select, never by arithmetic. Both
-//! keep the rule.
+//! keep the rule. A wind (section 11.2) is evaluated the same way, lane by lane, and subtracted
+//! from the air-relative velocity only when a lane has one (the others subtract +0.0, which
+//! changes no bit).
 
 use crate::elementary::atan2_asin;
 use crate::lanes::{F64x4, Real, gather, lane, mask};
@@ -111,6 +113,8 @@ pub(crate) struct Constants<R: Real> {
     any_diagonal: bool,
     /// Whether any lane has terms beyond the linear coefficients.
     extra_terms: bool,
+    /// Whether any lane has a wind (section 11.2: the air's velocity in L).
+    wind: bool,
 }
 
 impl<R: Real> Constants<R> {
@@ -145,6 +149,7 @@ impl<R: Real> Constants<R> {
             all_diagonal: parts.iter().all(|p| p.run.inertia_diagonal),
             any_diagonal: parts.iter().any(|p| p.run.inertia_diagonal),
             extra_terms: parts.iter().any(Parts::has_extra_terms),
+            wind: parts.iter().any(|p| p.run.terms.has_wind()),
         }
     }
 }
@@ -197,7 +202,7 @@ impl<'a> EquationsOfMotion<'a> {
     /// The flow the store sees in state `x` at time `t_s` (docs/model.md section 3): what the
     /// catalogue's and the extension's terms read, for reports and diagnoses.
     pub fn flow(&self, x: &StateVector, t_s: f64) -> Flow {
-        flow_frame(&self.constants, x, t_s).0
+        flow_frame(&self.constants, std::slice::from_ref(&self.parts), x, t_s).0
     }
 
     /// The state derivative with the ejector feet in the given modes (`on[i]`: foot i
@@ -250,9 +255,14 @@ impl<'a> LaneEquations<'a> {
 }
 
 /// The flow of a stage (section 3) with its direction cosines and V^2: the first half of
-/// [`derivative`], inlined there.
+/// [`derivative`], inlined there (`parts`: one per lane, for their winds).
 #[inline(always)]
-fn flow_frame<R: Real>(c: &Constants<R>, x: &[R; STATE_LEN], t_s: R) -> (Flow<R>, Dcm<R>, R) {
+fn flow_frame<R: Real>(
+    c: &Constants<R>,
+    parts: &[Parts],
+    x: &[R; STATE_LEN],
+    t_s: R,
+) -> (Flow<R>, Dcm<R>, R) {
     let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
     // Section 1: interference decay with s = |r|. First: its input is ready long before
     // the stage's velocity and attitude, so the exponential overlaps the rest.
@@ -266,7 +276,14 @@ fn flow_frame<R: Real>(c: &Constants<R>, x: &[R; STATE_LEN], t_s: R) -> (Flow<R>
     // Section 2: v_air = v + V_inf (cos a cos b, sin b, sin a cos b) in L;
     // (u, v, w) = C_BL v_air, here |q|^2 (u, v, w).
     let va = &c.v_aircraft_air_l_m_s;
-    let air = [vx + va[0], vy + va[1], vz + va[2]];
+    let mut air = [vx + va[0], vy + va[1], vz + va[2]];
+    // Section 11.2: a wind w_L moves the air, v_air -= w_L. Only when a lane has one (a lane
+    // without subtracts +0.0, which leaves every value's bits as they are), so a run without
+    // wind takes the contract's operations and no other.
+    if c.wind {
+        let w = wind_lanes(parts, t_s);
+        air = [air[0] - w[0], air[1] - w[1], air[2] - w[2]];
+    }
     let [u_s, v_s, w_s] = dcm.to_body_scaled(air);
     // Section 3: V = |v_air| (rotation-invariant, so taken in L), qbar = 0.5 rho V^2,
     // alpha = atan2(w, u) (the scale |q|^2 cancels), beta = asin(v / V) with
@@ -306,7 +323,7 @@ fn derivative<R: Real>(
     t_s: R,
     on: &[[bool; 2]],
 ) -> [R; STATE_LEN] {
-    let (flow, dcm, speed2) = flow_frame(c, x, t_s);
+    let (flow, dcm, speed2) = flow_frame(c, parts, x, t_s);
     let [_, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
     // Section 3: the six coefficients, then the tables' terms, the catalogue's extra terms
     // (section 7) and the extension's (section 11), lane by lane.
@@ -365,6 +382,23 @@ fn derivative<R: Real>(
     // Section 2: domega/dt = I^-1 (M_B - omega x (I omega)).
     let [dp, dq, dr] = angular_acceleration(c, [mx, my, mz], [p, q, r]);
     [vx, vy, vz, ax, ay, az, dq0, dq1, dq2, dq3, dp, dq, dr]
+}
+
+/// Each lane's wind in L at its time (section 11.2; +0.0 in lanes without one), from the
+/// scalar code of its run, as the extra terms below. Out of line: only runs with a wind call
+/// it.
+#[inline(never)]
+fn wind_lanes<R: Real>(parts: &[Parts], t_s: R) -> [R; 3] {
+    let mut w = [R::splat(0.0).to_array(); 3];
+    for (i, part) in parts.iter().enumerate() {
+        if part.run.terms.has_wind() {
+            let w_i = part.run.terms.wind_l_m_s(lane(t_s, i));
+            for (j, v) in w_i.into_iter().enumerate() {
+                w[j].as_mut()[i] = v;
+            }
+        }
+    }
+    w.map(R::from_array)
 }
 
 /// The extra terms of each lane's run ([`Parts::extra_terms`]) at that lane's flow, put back into

@@ -21,6 +21,10 @@
 //! an aerodynamic moment reference point away from the CG (`cg_offset`), an ejector force
 //! direction in L (`ejector_cant`), an ejector start time (`ejector_delay`), initial rates
 //! (`release_rates`), and the measurement knobs (time offset, attitude bias, tracked point).
+//! Model extensions (section 11) add coefficient increments and ejector factors, and a wind
+//! (the `wind` family, [`crate::extension::wind`]): the air's velocity in L, subtracted from
+//! the store's air-relative velocity before anything is read from it; a run without one takes
+//! exactly the contract's operations.
 
 pub mod aero;
 mod dcm;

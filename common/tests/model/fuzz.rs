@@ -24,7 +24,7 @@ use proptest::prelude::*;
 use proptest::sample::select;
 use proptest::test_runner::TestCaseError;
 use sepval_common::effects::{CATALOGUE, EffectSet};
-use sepval_common::extension::locator::{F_HZ, LAMBDA_M, LocatorDomain, MACH0, T_ON_S};
+use sepval_common::extension::locator::{F_HZ, LAMBDA_M, LocatorDomain, MACH0, RISE_S, T_ON_S};
 use sepval_common::extension::{
     Axis, EXTENSION_FORMAT, ExtensionError, Family, MAX_TERMS, Regressor, Term, TermRecord,
     extension_toml, parse_extension,
@@ -604,10 +604,19 @@ fn valid_term() -> BoxedStrategy<Term> {
             };
             (Just(regressor), select(axes), locator, finite())
         })
-        .prop_map(|(regressor, axis, locator, coefficient)| Term {
+        .prop_flat_map(|(regressor, axis, locator, coefficient)| {
+            // A wind's second locator, its onset or pulse length.
+            let rise_s = if regressor.family() == Family::Wind {
+                prop_oneof![2 => 0.01..1.0f64, 1 => in_domain(RISE_S)].boxed()
+            } else {
+                Just(0.0).boxed()
+            };
+            (Just((regressor, axis, locator, coefficient)), rise_s)
+        })
+        .prop_map(|((regressor, axis, locator, coefficient), rise_s)| Term {
             axis,
             regressor,
-            locator: [locator, 0.0],
+            locator: [locator, rise_s],
             coefficient,
         })
         .boxed()

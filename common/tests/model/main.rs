@@ -13,3 +13,4 @@ mod lanes;
 mod locators;
 mod tables;
 mod verification;
+mod wind;

@@ -1,5 +1,5 @@
 //! The locator zoom (`docs/model.md` section 11.5): each entry to verify has its locator (step
-//! time, frequency, decay length) refined on a grid eight times finer than the library's, around
+//! or gust time, frequency, decay length) refined on a grid eight times finer than the library's, around
 //! the one screened, and its linear coefficients estimated by the regression there.
 
 use nalgebra::{DMatrix, DVector};
@@ -33,7 +33,7 @@ struct ZoomProbe {
 fn fine_grid(term: &Term) -> Option<Vec<f64>> {
     let l = term.locator[0];
     let spacing = match term.regressor.family() {
-        Family::Step => library::STEP_SPACING_S,
+        Family::Step | Family::Wind => library::STEP_SPACING_S,
         Family::Oscillation => library::FREQUENCY_SPACING_HZ,
         Family::Interference | Family::InterferenceFlowAngle => {
             // sepval's own pow, not the C library's: these decay lengths are simulated (and may

@@ -92,7 +92,8 @@ fn named(
         coefficient,
         std_error,
         phase_deg,
-        t_on_s: (family == Family::Step).then_some(locator),
+        t_on_s: matches!(family, Family::Step | Family::Wind).then_some(locator),
+        rise_s: (family == Family::Wind).then_some(lead.locator[1]),
         f_hz: (family == Family::Oscillation).then_some(locator),
         lambda_m: matches!(family, Family::Interference | Family::InterferenceFlowAngle)
             .then_some(locator),

@@ -122,7 +122,8 @@ impl Picked {
     }
 
     /// The free terms of these entries: coefficients bounded to ten times their estimate, step
-    /// times and decay lengths free near their refined values.
+    /// and gust times and decay lengths free near their refined values (a gust's length stays
+    /// at the library's).
     pub fn free_terms(&self) -> Vec<FreeTerm> {
         self.entries
             .iter()
@@ -145,7 +146,7 @@ impl Picked {
 fn locator_bounds(term: &Term) -> Option<(f64, f64)> {
     let l = term.locator[0];
     match term.regressor.family() {
-        Family::Step => Some((
+        Family::Step | Family::Wind => Some((
             l - library::STEP_SPACING_S / 4.0,
             l + library::STEP_SPACING_S / 4.0,
         )),

@@ -11,6 +11,7 @@ mod diagnose;
 mod discover;
 mod fit;
 mod fuzz;
+mod gust;
 mod hardening;
 mod hardening_on_disk;
 mod plan;

@@ -1,12 +1,13 @@
 //! One wire protocol: every transport returns what the in-process evaluator returns, bit for
-//! bit, for finished, diverged and failed runs alike (failure reasons included), with and
-//! without samples, through real worker processes.
+//! bit, for finished, diverged and failed runs alike (failure reasons included), runs in a gust
+//! among them (wind terms travel), with and without samples, through real worker processes.
 
 use std::sync::Arc;
 use std::time::Duration;
 
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Candidate, Evaluation, Job, Outcome};
+use sepval_common::extension::{Axis, Regressor, Term, TermSet};
 use sepval_common::factors::Factors;
 use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
@@ -16,6 +17,21 @@ use sepval_transport::dispatch::DispatchOptions;
 use sepval_transport::ipc::{IpcOptions, Launch};
 use sepval_transport::link::quiet;
 use sepval_transport::spec::EvaluatorSpec;
+
+/// The truth in a gust: the air's velocity along `axis` \[m/s\] (docs/model.md section 11).
+fn gusty(axis: Axis, regressor: Regressor, locator: [f64; 2], w_m_s: f64) -> Candidate {
+    let term = Term {
+        axis,
+        regressor,
+        locator,
+        coefficient: w_m_s,
+    };
+    Candidate {
+        factors: Factors::TRUTH,
+        effects: EffectSet::NONE,
+        terms: TermSet::of(&[term]).unwrap(),
+    }
+}
 
 fn candidates() -> Vec<Candidate> {
     let with = |spec: &str| {
@@ -35,6 +51,8 @@ fn candidates() -> Vec<Candidate> {
         Candidate::with_effects(Factors::TRUTH, with("inertia_product_xz=1000")),
         Candidate::with_effects(Factors::TRUTH, with("release_rates=60,60,60")),
         Candidate::with_effects(Factors::NOMINAL, with("telemetry_time_offset=0.01")),
+        gusty(Axis::WindY, Regressor::WindStep, [0.2, 0.1], 3.0),
+        gusty(Axis::WindZ, Regressor::WindPulse, [0.1, 0.15], -4.0),
     ];
     // Enough for several chunks per worker.
     for k in 0..40 {
@@ -75,9 +93,16 @@ fn every_transport_returns_the_in_process_outcomes_bit_for_bit() {
         .into_iter()
         .map(|s| (s, inproc.evaluate(&candidates(), s).unwrap()))
         .collect();
-    // The batch exercises every kind of outcome.
+    // The batch exercises every kind of outcome, and gusts that simulate.
     let outcomes = &reference[0].1;
     assert!(matches!(outcomes[0].outcome, Outcome::Goals { .. }));
+    for k in [7, 8] {
+        assert!(
+            matches!(outcomes[k].outcome, Outcome::Goals { .. }) && outcomes[k] != outcomes[0],
+            "{k}: {:?}",
+            outcomes[k].outcome
+        );
+    }
     for k in [2, 3, 4] {
         assert!(
             matches!(outcomes[k].outcome, Outcome::Failed { .. }),

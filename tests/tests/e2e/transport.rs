@@ -281,7 +281,7 @@ fn a_version_mismatch_is_refused_on_both_sides() {
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("setup has protocol version 99, this process speaks version 4"),
+        stderr.contains("setup has protocol version 99, this process speaks version 5"),
         "{stderr}"
     );
     assert!(

@@ -29,7 +29,11 @@ use sepval_common::propagator::Observation;
 /// functions (`sepval_common::elementary`: no C library in the simulation, extension terms
 /// included, results changed in their last bits), so a version-3 worker, which computes with the
 /// C library, must not serve a version-4 fit whose results are to be bit-identical across hosts.
-pub const PROTOCOL_VERSION: u32 = 4;
+/// Version 5: the same layout, but a term may name the wind axes (`wind_y`, `wind_z`: axis
+/// indices 7 and 8) and the `wind` family's regressors (indices 24 and 25); a version-4 worker
+/// would fail such a candidate, which a diagnosis would read as a probe that does not simulate,
+/// so the handshake refuses it instead.
+pub const PROTOCOL_VERSION: u32 = 5;
 
 /// "SEPVAL01" as a little-endian integer: the first field of [`Hello`], [`SetupHeader`] and
 /// every byte-stream frame.
@@ -119,11 +123,12 @@ pub struct WireRequest {
 #[type_name("sepval.WireTerm")]
 #[repr(C)]
 pub struct WireTerm {
-    /// Index of its axis in `Axis::ALL`.
+    /// Index of its axis in `Axis::ALL` (7 and 8: the wind axes, since version 5).
     pub axis: u32,
     /// Index of its regressor in `Regressor::ALL`.
     pub regressor: u32,
-    /// Its locator.
+    /// Its locator pair (a window's `[t0_s, t1_s]`, a wind's `[t_on_s, rise_s]`; others use
+    /// the first).
     pub locator: [f64; 2],
     /// Its coefficient.
     pub coefficient: f64,

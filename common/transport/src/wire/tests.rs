@@ -17,6 +17,20 @@ fn requests_and_responses_round_trip_and_bad_ones_are_refused() {
             coefficient: -0.7,
         })
         .unwrap();
+    // A gust: the wind axes and regressors, and both locators, travel.
+    for (axis, regressor, locator, w_m_s) in [
+        (Axis::WindY, Regressor::WindStep, [0.2, 0.08], 2.1),
+        (Axis::WindZ, Regressor::WindPulse, [0.45, 0.2], -1.3),
+    ] {
+        terms
+            .push(Term {
+                axis,
+                regressor,
+                locator,
+                coefficient: w_m_s,
+            })
+            .unwrap();
+    }
     let c = Candidate {
         factors: Factors::TRUTH,
         effects,
@@ -53,6 +67,24 @@ fn requests_and_responses_round_trip_and_bad_ones_are_refused() {
             .unwrap_err()
             .to_string()
             .contains("cannot act on axis ejector")
+    );
+    let mut bad = w;
+    bad.terms[1].axis = 1; // CY: a wind shape acts on the wind axes only
+    assert_eq!(
+        bad.candidate().unwrap_err().to_string(),
+        "extension term 1: the wind regressor `step` cannot act on axis CY"
+    );
+    let mut bad = w;
+    bad.terms[2].locator[1] = 0.0;
+    assert_eq!(
+        bad.candidate().unwrap_err().to_string(),
+        "extension term 2: rise_s = 0: expected a length in [0.001, 7200] s"
+    );
+    let mut bad = w;
+    bad.terms[0].axis = 9;
+    assert_eq!(
+        bad.candidate().unwrap_err().to_string(),
+        "extension term 0: axis index 9 is not an axis"
     );
     let mut bad = w;
     bad.effect_params[0][1] = f64::INFINITY;
