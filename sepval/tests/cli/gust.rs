@@ -92,3 +92,4 @@ fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
         dir,
     ));
 }
+
