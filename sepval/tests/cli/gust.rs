@@ -92,4 +92,3 @@ fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
         dir,
     ));
 }
-
