@@ -186,7 +186,7 @@ fn rates_at_release_are_named_after_the_planned_release() {
         .find(|r| r["kind"] == "discovered")
         .unwrap_or_else(|| panic!("no term rivals: {}", shown(&l.first)));
     let top = &l.plan["conditions"][0];
-    assert!(top["separates"].as_array().unwrap().len() >= 1, "{top}");
+    assert!(!top["separates"].as_array().unwrap().is_empty(), "{top}");
     // Both releases: release_rates is named and no term is left as a rival.
     assert_eq!(open(&l.both), ["release_rates"], "{}", shown(&l.both));
     assert!(
