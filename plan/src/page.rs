@@ -168,7 +168,8 @@ fn headline(file: &PlanFile) -> (String, String) {
                 best.separates.len()
             ),
             format!(
-                "The releases flown cannot tell the answer ({answer}) from its rivals, and no condition in the ranges separates every pair by more than {threshold} in BIC: here the hardest pair is left at {separation}. Widen the ranges, or plan again after this release; {information}."
+                "The releases flown cannot tell the answer ({answer}) from its rivals, and no condition in the ranges separates every pair by more than {threshold} in BIC. This one separates the most pairs ({} of {pairs}; any of the models may be the true one, so every pair counts), and of those that separate as many its hardest pair is left the furthest apart, at {separation}. Widen the ranges, or plan again after this release; {information}.",
+                best.separates.len()
             ),
         )
     }
@@ -237,8 +238,15 @@ fn method(file: &PlanFile) -> String {
          is refitted (linearised, its parameters held to their ranges) to the other's noise-free \
          trajectories at the releases flown and the new one, in units of the noise; a pair is \
          separated above {}. The information gain is the growth of ln det of the answer's Fisher \
-         information (parameters in units of their ranges, a unit prior on each). \
+         information (parameters in units of their ranges, a unit prior on each). {} \
          See docs/model.md section 12.",
-        number(file.threshold)
+        number(file.threshold),
+        if file.ranked_by == "separation" {
+            "The conditions are ranked by the number of pairs they separate (any model may be \
+             the true one, so every pair counts), then by their separation (the hardest pair's), \
+             then by information gain."
+        } else {
+            "With no rivals, the conditions are ranked by information gain."
+        }
     )
 }

@@ -1,6 +1,10 @@
-//! The ranking of the conditions (docs/model.md section 12.4): with rivals, by separation
-//! (largest first), the information gain deciding between equal separations; without, by
-//! information gain alone. Conditions where a model leaves a table come after every condition
+//! The ranking of the conditions (docs/model.md section 12.4): with rivals, by the number of
+//! pairs of models a release there separates (most first), then by its separation (the hardest
+//! pair's, largest first), then by information gain; without rivals, by information gain alone.
+//! Every model, the answer or a rival, may be the true one, so every pair counts alike: with
+//! many rivals the hardest pair (often two rivals, neither the answer) may be inseparable
+//! everywhere in the ranges, and the smallest separation alone would then rank by a pair no
+//! release settles. Conditions where a model leaves a table come after every condition
 //! that stays inside them, and conditions where a model diverges (or a step of its
 //! sensitivities does) come last, in grid order: they are reported, never recommended first.
 
@@ -39,6 +43,8 @@ impl Standing {
 pub struct RankedCondition {
     /// Its index in the grid.
     pub index: usize,
+    /// The number of pairs of models a release there separates.
+    pub separated_pairs: usize,
     /// Its separation (none without rivals or where a model did not run).
     pub separation: Option<f64>,
     /// Its information gain (none where the answer's sensitivities are missing).
@@ -93,11 +99,13 @@ pub fn rank(
             } else {
                 Standing::Ranked
             };
+            let pairs = pairs.unwrap_or_default();
             RankedCondition {
                 index: k,
+                separated_pairs: pairs.iter().filter(|p| p.separated()).count(),
                 separation: separations.of(k),
                 information_gain: gain.ok(),
-                pairs: pairs.unwrap_or_default(),
+                pairs,
                 standing,
             }
         })
@@ -110,7 +118,9 @@ pub fn rank(
             return by_class.then(a.index.cmp(&b.index));
         }
         let by_separation = if rivals {
-            key(b.separation).total_cmp(&key(a.separation))
+            b.separated_pairs
+                .cmp(&a.separated_pairs)
+                .then(key(b.separation).total_cmp(&key(a.separation)))
         } else {
             Ordering::Equal
         };

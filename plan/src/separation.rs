@@ -14,7 +14,7 @@
 //! smaller of its two margins (whichever is true, the other must lose), and a release
 //! separates the pair when it is above [`SEPARATION_THRESHOLD`], the strong evidence of Kass
 //! and Raftery that the diagnosis names rivals by. A condition's separation is the smallest
-//! over its pairs: the pair hardest to separate decides.
+//! over its pairs, the hardest pair's ([`crate::ranking`] counts the pairs separated first).
 
 use serde::{Deserialize, Serialize};
 

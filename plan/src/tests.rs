@@ -1,6 +1,7 @@
 //! The plan's stages on the embedded default release: what a factor absorbs does not separate,
 //! the top condition is the argmax of an independent brute-force computation of the same
-//! separation, and the information gain is positive and larger where the trajectory is more
+//! separation, the ranking rule with rivals (pairs separated, then the hardest pair, then
+//! information), and the information gain is positive and larger where the trajectory is more
 //! sensitive.
 
 use std::sync::Arc;
@@ -17,7 +18,7 @@ use sepval_solve::run::NoProgress;
 
 use super::*;
 use crate::models::PlanModel;
-use crate::separation::SEPARATION_THRESHOLD;
+use crate::separation::{PairSeparation, SEPARATION_THRESHOLD};
 
 const NOISE: Noise = Noise {
     pos_m: 0.003,
@@ -249,4 +250,56 @@ fn with_no_rivals_the_information_gain_is_positive_and_larger_where_the_release_
     let best = gains.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let top = r.ranking.conditions[0].information_gain.unwrap();
     assert!((top - best).abs() < 1e-12, "{top} against {gains:?}");
+}
+
+#[test]
+fn with_rivals_the_pairs_separated_rank_first_then_the_hardest_pair_then_information() {
+    // Three models (three pairs) at three conditions: the first two separate two pairs and
+    // leave the third at 1, the last separates none but leaves its hardest pair at 2. The
+    // smallest separation alone would recommend the last; the count puts it last, and the
+    // information gain decides between the equal first two.
+    let pairs = |seps: [f64; 3]| -> Result<Vec<PairSeparation>, String> {
+        let models = [[0, 1], [0, 2], [1, 2]];
+        Ok(models
+            .iter()
+            .zip(seps)
+            .map(|(&models, s)| PairSeparation {
+                models,
+                chi2: [s, s],
+                margins: [s, s],
+                separation: s,
+            })
+            .collect())
+    };
+    let separations = separation::Separations {
+        flown: Vec::new(),
+        conditions: vec![
+            pairs([50.0, 50.0, 1.0]),
+            pairs([50.0, 1.0, 50.0]),
+            pairs([5.0, 5.0, 2.0]),
+        ],
+    };
+    let information = information::Information {
+        flown_log_det: 0.0,
+        gains: vec![Ok(1.0), Ok(2.0), Ok(3.0)],
+    };
+    let flown = flown();
+    let conditions = Conditions::grid(
+        flown.events()[0].simulator.scenario(),
+        &[beta(-6.0, 6.0)],
+        3,
+    )
+    .unwrap();
+    let left = vec![Vec::new(); 3];
+    let r = ranking::rank(&conditions, &separations, &information, &left, true);
+    let order: Vec<(usize, usize)> = r
+        .conditions
+        .iter()
+        .map(|c| (c.index, c.separated_pairs))
+        .collect();
+    assert_eq!(order, [(1, 2), (0, 2), (2, 0)]);
+    // Without rivals the information gain alone ranks.
+    let r = ranking::rank(&conditions, &separations, &information, &left, false);
+    let order: Vec<usize> = r.conditions.iter().map(|c| c.index).collect();
+    assert_eq!(order, [2, 1, 0]);
 }

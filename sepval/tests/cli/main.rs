@@ -7,6 +7,7 @@
 
 mod checkpoint;
 mod cli;
+mod closing;
 mod diagnose;
 mod discover;
 mod fit;
