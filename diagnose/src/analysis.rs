@@ -50,6 +50,8 @@ pub(super) struct Decided {
     pub skipped: Vec<SkippedRefit>,
     /// The tables the baseline's runs left.
     pub tables_left: Vec<String>,
+    /// Why the first baseline was replaced, when the catalogue showed it in a local optimum.
+    pub baseline_restart: Option<String>,
     /// Simulations run.
     pub evaluations: u64,
 }
@@ -148,11 +150,7 @@ pub(super) fn analyse(
     if let Some(c) = &caution {
         verdict.push_str(&format!("; caution: {c}"));
     }
-    let mut tables_left = d.tables_left;
-    if let Answer::Catalogue { selected, .. } = &d.answer {
-        let answer = tables::tables_left(job, &selected.fitted.candidate(job)?);
-        tables_left.extend(answer.iter().map(|l| format!("answer, {l}")));
-    }
+    let tables_left = with_answers_tables(job, d.tables_left, &d.answer)?;
     let diagnosis = Diagnosis {
         format: DIAGNOSIS_FORMAT.to_string(),
         causes,
@@ -160,6 +158,7 @@ pub(super) fn analyse(
         verdict,
         baseline_converged: unreliable.is_none(),
         baseline_unreliable: unreliable,
+        baseline_restart: d.baseline_restart,
         caution,
         discovered,
         ambiguous: !rivals.is_empty(),
@@ -193,6 +192,15 @@ pub(super) fn analyse(
         curves,
         extension,
     })
+}
+
+/// The baseline's tables left, then a catalogue answer's.
+fn with_answers_tables(job: &Job, mut left: Vec<String>, answer: &Answer) -> Result<Vec<String>> {
+    if let Answer::Catalogue { selected, .. } = answer {
+        let answer = tables::tables_left(job, &selected.fitted.candidate(job)?);
+        left.extend(answer.iter().map(|l| format!("answer, {l}")));
+    }
+    Ok(left)
 }
 
 /// Whether the model that lost the answer's decision is a rival: it is then listed once, as

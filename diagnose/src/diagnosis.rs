@@ -189,6 +189,11 @@ pub struct Diagnosis {
     /// Why the baseline counts as not converged (its goals against the limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub baseline_unreliable: Option<String>,
+    /// Why the first baseline fit was replaced: the catalogue's refits showed it in a local
+    /// optimum of the factors, and the baseline refined again from theirs fits better
+    /// (`docs/model.md` section 11.5, step 2a).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline_restart: Option<String>,
     /// Why the answer may not name the cause: an alternative predicts the `--validate` events
     /// clearly better.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -128,6 +128,7 @@ mod probe;
 pub mod readings;
 mod reconstruct;
 mod residuals;
+mod restart;
 mod rivals;
 mod stepwise;
 mod tables;
@@ -144,6 +145,7 @@ pub use residuals::{
     CHANNELS, ChannelReport, LAGS, ResidualReport, SegmentRms, WHITENESS_P, physical_residuals,
     residual_report,
 };
+pub use restart::RESTART_BIC;
 pub use rivals::rival_name;
 pub use validation::{AlternativePrediction, ValidationReport};
 pub use verdict::fmt_discovered;
@@ -235,10 +237,14 @@ pub fn diagnose(
         .iter()
         .map(|l| format!("baseline, {l}"))
         .collect();
-    let cat = catalogue::select(
+    let restart::Catalogued {
+        baseline,
+        outcome: cat,
+        restart: baseline_restart,
+    } = restart::catalogue(
         evaluator,
         job,
-        &baseline,
+        baseline,
         setting.noise,
         &options.candidate_lm,
         &mut evaluations,
@@ -287,6 +293,7 @@ pub fn diagnose(
         blocked: disc.blocked,
         skipped,
         tables_left,
+        baseline_restart,
         evaluations,
     };
     sepval_common::cancel::check().map_err(RunError::from)?;

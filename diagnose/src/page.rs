@@ -22,6 +22,8 @@ struct Page<'a> {
     verdict: &'a str,
     /// Why the answer is unreliable (the baseline fit failed), shown before everything else.
     unreliable: Option<&'a str>,
+    /// Why the first baseline fit was replaced (a local optimum the catalogue showed).
+    baseline_restart: Option<&'a str>,
     /// Refits that did not simulate, left out.
     skipped: Vec<String>,
     /// Tables the fitted runs left.
@@ -189,6 +191,7 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> Result<String, H
     let page = Page {
         verdict: &d.verdict,
         unreliable: d.baseline_unreliable.as_deref(),
+        baseline_restart: d.baseline_restart.as_deref(),
         skipped: d
             .skipped
             .iter()
