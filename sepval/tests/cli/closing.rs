@@ -3,7 +3,8 @@
 //! condition with the same hidden cause; both releases diagnosed together. The true cause must
 //! be named and the mimic dropped. The data come from `discover`'s generator (the scenario's
 //! own aerodynamics or initial state changed, on a base that is not the default truth, with the
-//! generator's own noise), never from the catalogue's or the extension's code.
+//! generator's own noise), never from the catalogue's or the extension's code; a gust, which no
+//! coefficient function can make, comes from `gust`'s releases (the extension's wind).
 
 use std::path::Path;
 
@@ -12,6 +13,7 @@ use sepval_tests::{ok, sepval};
 use serde_json::Value;
 
 use super::discover::{default_scenario, diagnose, release};
+use super::gust::{PULSE, gust_release, terms};
 
 /// The three runs of a closed loop.
 struct Loop {
@@ -21,6 +23,19 @@ struct Loop {
     plan: Value,
     /// The diagnosis of both releases.
     both: Value,
+}
+
+/// `truth`'s flight condition set to the top condition of `plan`.
+fn at_top(truth: &Scenario, plan: &Value) -> Scenario {
+    let top = &plan["conditions"][0];
+    let mut next = truth.clone();
+    let f = &mut next.flight;
+    f.mach = top["mach"].as_f64().unwrap();
+    f.altitude_m = top["altitude_m"].as_f64().unwrap();
+    f.alpha_deg = top["alpha_deg"].as_f64().unwrap();
+    f.beta_deg = top["beta_deg"].as_f64().unwrap();
+    f.gamma_deg = top["gamma_deg"].as_f64().unwrap();
+    next
 }
 
 /// Diagnoses one release of `truth` (modelled by `model`), plans over `ranges` from it, flies
@@ -34,14 +49,7 @@ fn close_loop(model: &Scenario, truth: &Scenario, seeds: [u64; 2], ranges: &[&st
         Some(model),
     );
     let plan = plan(one.path(), ranges);
-    let top = &plan["conditions"][0];
-    let mut next = truth.clone();
-    let f = &mut next.flight;
-    f.mach = top["mach"].as_f64().unwrap();
-    f.altitude_m = top["altitude_m"].as_f64().unwrap();
-    f.alpha_deg = top["alpha_deg"].as_f64().unwrap();
-    f.beta_deg = top["beta_deg"].as_f64().unwrap();
-    f.gamma_deg = top["gamma_deg"].as_f64().unwrap();
+    let next = at_top(truth, &plan);
     let two = tempfile::tempdir().unwrap();
     let releases = [
         release(truth, None, seeds[0]),
@@ -197,4 +205,49 @@ fn rates_at_release_are_named_after_the_planned_release() {
         "{} (the mimic was {mimic})",
         shown(&l.both)
     );
+}
+
+#[test]
+fn a_gust_is_named_and_its_coefficient_mimics_dropped_after_the_planned_release() {
+    // A short lateral gust: on one release coefficient terms (a side-force step among them) fit
+    // about as well. The same gust on a release at the plan's top condition settles it.
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    gust_release(dir, PULSE, None, 7, "gust.csv");
+    let first = super::gust::diagnose(dir, &["gust.csv"], "diag");
+    let wind = vec![("wind_y".to_string(), "wind".to_string())];
+    assert_eq!(terms(&first["model"]), wind, "{}", shown(&first));
+    let coefficient_rival = |d: &Value| {
+        d["rivals"].as_array().unwrap().iter().any(|r| {
+            terms(&r["model"])
+                .iter()
+                .any(|(axis, _)| !axis.starts_with("wind"))
+        })
+    };
+    assert!(coefficient_rival(&first), "{}", shown(&first));
+    let plan = plan(
+        dir,
+        &["--mach", "0.6:0.95", "--beta-deg", "-6:6", "--points", "5"],
+    );
+    assert!(
+        !plan["conditions"][0]["separates"]
+            .as_array()
+            .unwrap()
+            .is_empty(),
+        "{}",
+        plan["conditions"][0]
+    );
+    let next = at_top(&default_scenario(), &plan);
+    std::fs::write(dir.join("next.toml"), next.to_toml_string()).unwrap();
+    gust_release(dir, PULSE, Some("next.toml"), 8, "next.csv");
+    let both = super::gust::diagnose(dir, &["gust.csv", "next.csv"], "both");
+    eprintln!(
+        "wall_s: first diagnosis {}, plan {}, both {}",
+        first["wall_s"], plan["wall_s"], both["wall_s"]
+    );
+    // Both releases: the gust is named, at its time, and no coefficient is left as a rival.
+    assert_eq!(terms(&both["model"]), wind, "{}", shown(&both));
+    let t_on = both["discovered"][0]["t_on_s"].as_f64().unwrap();
+    assert!((t_on - 0.3).abs() < 0.025, "t_on {t_on} s");
+    assert!(!coefficient_rival(&both), "{}", shown(&both));
 }
