@@ -39,6 +39,18 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     }
     traj.comments
         .insert(0, format!("sepval simulate --factors {}", args.factors));
+    if let Some(path) = &args.model.extension {
+        // The extension's terms as the model held them (the scenario's own terms included),
+        // so that the file says what made it.
+        traj.push_metadata("extension", &path.display().to_string());
+        let terms: Vec<String> = sim
+            .model()
+            .extension
+            .iter()
+            .map(|t| format!("{} {} = {}", t.axis.name(), t.formula(), t.coefficient))
+            .collect();
+        traj.push_metadata("extension_terms", &terms.join("; "));
+    }
     traj.write(&args.out)?;
     eprintln!(
         "wrote {} ({} samples, t = 0 to {} s)",

@@ -126,6 +126,14 @@ fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
         ],
         dir,
     ));
+    // The file says what made it: the extension and its terms.
+    let csv = std::fs::read_to_string(dir.join("gust.csv")).unwrap();
+    assert!(
+        csv.contains("# extension = gust.toml")
+            && csv.contains("# extension_terms = wind_y onset(t - 0.3 s; 0.1 s) = 3"),
+        "{}",
+        &csv[..600]
+    );
     let out = sepval(
         &[
             "diagnose",
