@@ -169,9 +169,9 @@ impl RunDir {
                 }
             }
             Claim::Overwrite => {
-                let ours = others
-                    .iter()
-                    .any(|e| e == MARKER_FILE || SEPVAL_OUTPUTS.contains(&e.as_str()));
+                // `entries` leaves the marker out: it is looked for on its own.
+                let ours = path.join(MARKER_FILE).is_file()
+                    || others.iter().any(|e| SEPVAL_OUTPUTS.contains(&e.as_str()));
                 if !others.is_empty() && !ours {
                     return Err(OutDirError::NotOurs {
                         path: path.to_path_buf(),
@@ -364,6 +364,12 @@ mod tests {
         assert_eq!(again.prepare().unwrap(), Vec::<PathBuf>::new());
         assert!(!d.join("result.json").exists() && d.join(MARKER_FILE).exists());
         drop(again);
+        // The marker alone makes a directory ours (a plan's holds no result.json).
+        std::fs::write(d.join("plan.json"), "{}").unwrap();
+        let marked = RunDir::claim(&d, Claim::Overwrite, "plan").unwrap();
+        marked.prepare().unwrap();
+        assert!(!d.join("plan.json").exists());
+        drop(marked);
         // A directory sepval did not make is never cleared.
         let other = tmp.path().join("mine");
         std::fs::create_dir(&other).unwrap();

@@ -189,6 +189,8 @@ pub struct PlanArgs {
     /// Output directory (plan.json, plan.html, figures/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub overwrite: OverwriteArgs,
 }
 
 #[derive(Subcommand)]
@@ -291,7 +293,7 @@ pub struct TablesArgs {
     pub strict_tables: bool,
 }
 
-/// Whether an earlier run in `--out` may be cleared (fit, diagnose).
+/// Whether an earlier run in `--out` may be cleared (fit, diagnose, plan).
 #[derive(clap::Args)]
 pub struct OverwriteArgs {
     /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).

@@ -33,8 +33,17 @@ pub fn run(args: PlanArgs) -> Result<()> {
         )
     })?;
     let prepared = prepare(diagnosis, &flown, &ranges, args.points)?;
-    let run_dir = RunDir::claim(&args.out, Claim::Fresh, "plan")
-        .with_context(|| format!("--out {}", args.out.display()))?;
+    let claim = if args.overwrite.overwrite {
+        Claim::Overwrite
+    } else {
+        Claim::Fresh
+    };
+    let run_dir = RunDir::claim(&args.out, claim, "plan").with_context(|| {
+        format!(
+            "--out {} (--overwrite clears an earlier run)",
+            args.out.display()
+        )
+    })?;
     let start = Instant::now();
     let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
     run_dir.prepare()?;

@@ -130,6 +130,29 @@ fn without_rivals_the_plan_ranks_by_information() {
     }
     let html = std::fs::read_to_string(fixture().join("info/plan.html")).unwrap();
     assert!(html.contains("Fly the next release at Mach"), "{html}");
+    // A second plan into the same directory is refused, and nothing of the first is touched;
+    // with --overwrite it replaces the first.
+    let again = [
+        "plan", "--from", "diag", "--out", "info", "--mach", "0.6:0.95",
+    ];
+    let before = std::fs::read(fixture().join("info/plan.json")).unwrap();
+    let refused = sepval(
+        &[&again[..], &["--points", "3", "--evaluator", "inproc"]].concat(),
+        fixture(),
+    );
+    assert_eq!(refused.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(stderr.contains("--overwrite"), "{stderr}");
+    assert_eq!(
+        std::fs::read(fixture().join("info/plan.json")).unwrap(),
+        before
+    );
+    let p = plan(
+        "diag",
+        "info",
+        &["--mach", "0.6:0.95", "--points", "3", "--overwrite"],
+    );
+    assert_eq!(p["conditions"].as_array().unwrap().len(), 3);
 }
 
 #[test]
