@@ -27,6 +27,7 @@ use crate::{
     Result, RivalReport, SkippedRefit, ValidationReport, catalogue, readings, tables,
 };
 use sepval_fit::space::Noise;
+use sepval_solve::identifiability::identifiability;
 
 /// Everything the stages before the analysis produced.
 pub(super) struct Decided {
@@ -177,6 +178,13 @@ pub(super) fn analyse(
         model,
         inputs: options.fit.inputs.clone(),
         parameters,
+        identifiability: Some(identifiability(
+            &answer_fit.space(job).params,
+            &answer_fit.lm.x,
+            &answer_fit.lm.residuals,
+            &answer_fit.lm.jacobian,
+            &setting.events,
+        )),
         candidates: d.candidates,
         residuals: before_after(setting, &d.baseline, answer_fit)?,
         reconstruction: d.reconstruction,

@@ -13,6 +13,7 @@ use sepval_common::extension::TermRecord;
 use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::results::ChannelRms;
+use sepval_solve::identifiability::Identifiability;
 
 /// One parameter's estimate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -235,6 +236,12 @@ pub struct Diagnosis {
     pub inputs: InputsRecord,
     /// Each named effect's parameters with standard errors.
     pub parameters: BTreeMap<String, Vec<ParamValue>>,
+    /// How sure every parameter of the answer's model is (factors, effects' parameters, terms'
+    /// coefficients): standard errors and the correlation matrix of its refit, from which
+    /// `sepval predict` draws it (covariance std_i std_j rho_ij). Absent in files written before
+    /// it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub identifiability: Option<Identifiability>,
     /// Every candidate tried, every round.
     pub candidates: Vec<CandidateReport>,
     /// Residual analysis before and after.

@@ -9,6 +9,8 @@ use sepval_common::propagator::Observation;
 use sepval_solve::best::BestSoFar;
 use serde::{Deserialize, Serialize};
 
+use crate::checkpoint::InputsRecord;
+
 /// Format tag of result files.
 pub const RESULT_FORMAT: &str = "sepval-fit-result/1";
 
@@ -40,6 +42,11 @@ pub struct FitResult {
     pub identifiability: Option<sepval_solve::identifiability::Identifiability>,
     /// What one grid step of each factor does at the best fit.
     pub resolution: Vec<ResolutionRow>,
+    /// Where the inputs came from: data, scenario and extension file (absent in files written
+    /// before it was recorded), so that `sepval predict --from DIR` rebuilds the releases
+    /// fitted, as diagnosis.json's `inputs` does.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inputs: Option<InputsRecord>,
     /// How this run was executed (not part of the deterministic result).
     pub run: RunInfo,
 }

@@ -311,6 +311,7 @@ fn fit_result(cx: &Context, found: Found, describe: String, start: Instant) -> F
         methods: found.methods,
         identifiability: found.identifiability,
         resolution: found.resolution,
+        inputs: Some(options.inputs.clone()),
         run: RunInfo {
             evaluator: describe,
             wall_s: start.elapsed().as_secs_f64(),
