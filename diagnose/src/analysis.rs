@@ -27,7 +27,7 @@ use crate::{
     Result, RivalReport, SkippedRefit, ValidationReport, catalogue, readings, tables,
 };
 use sepval_fit::space::Noise;
-use sepval_solve::identifiability::identifiability;
+use sepval_solve::identifiability::{Identifiability, identifiability};
 
 /// Everything the stages before the analysis produced.
 pub(super) struct Decided {
@@ -112,11 +112,7 @@ pub(super) fn analyse(
     let cat_report = residual_report(job, &cat_fit.lm, &cat_fit.candidate(job)?, noise, floor);
     let explained = cat_report.white && cat_report.at_noise_floor && unreliable.is_none();
     let (causes, discovered) = d.answer.named();
-    let parameters = d
-        .answer
-        .selected()
-        .map(|s| effect_parameters(setting, &s.fitted))
-        .unwrap_or_default();
+    let (parameters, identifiability) = answer_estimates(setting, &d.answer, answer_fit);
     let rivals: Vec<RivalReport> = d.rivals.iter().map(|(_, r)| r.clone()).collect();
     let alternatives = if loser_is_rival(job, &d) {
         Vec::new()
@@ -178,13 +174,7 @@ pub(super) fn analyse(
         model,
         inputs: options.fit.inputs.clone(),
         parameters,
-        identifiability: Some(identifiability(
-            &answer_fit.space(job).params,
-            &answer_fit.lm.x,
-            &answer_fit.lm.residuals,
-            &answer_fit.lm.jacobian,
-            &setting.events,
-        )),
+        identifiability: Some(identifiability),
         candidates: d.candidates,
         residuals: before_after(setting, &d.baseline, answer_fit)?,
         reconstruction: d.reconstruction,
@@ -289,6 +279,29 @@ fn summary(setting: &Setting, fitted: &Fitted) -> ModelSummary {
         )),
         factors: fitted.candidate(job).ok().map(|c| c.factors),
     }
+}
+
+/// The chosen effects' parameters with standard errors (by effect id), and how sure every
+/// parameter of the answer's model `answer_fit` is (the covariance `sepval predict` draws from).
+fn answer_estimates(
+    setting: &Setting,
+    answer: &Answer,
+    answer_fit: &Fitted,
+) -> (BTreeMap<String, Vec<ParamValue>>, Identifiability) {
+    let parameters = answer
+        .selected()
+        .map(|s| effect_parameters(setting, &s.fitted))
+        .unwrap_or_default();
+    let lm = &answer_fit.lm;
+    let space = answer_fit.space(&setting.job);
+    let id = identifiability(
+        &space.params,
+        &lm.x,
+        &lm.residuals,
+        &lm.jacobian,
+        &setting.events,
+    );
+    (parameters, id)
 }
 
 /// Each chosen effect's parameters with standard errors, by effect id.

@@ -1,6 +1,7 @@
 //! The fit's results file, DIR/result.json, and the per-channel residual summary.
 
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 
 use sepval_common::evaluation::Job;
 use sepval_common::factors::Factors;
@@ -8,8 +9,6 @@ use sepval_common::goals::residual;
 use sepval_common::propagator::Observation;
 use sepval_solve::best::BestSoFar;
 use serde::{Deserialize, Serialize};
-
-use crate::checkpoint::InputsRecord;
 
 /// Format tag of result files.
 pub const RESULT_FORMAT: &str = "sepval-fit-result/1";
@@ -49,6 +48,19 @@ pub struct FitResult {
     pub inputs: Option<InputsRecord>,
     /// How this run was executed (not part of the deterministic result).
     pub run: RunInfo,
+}
+
+/// Where the fit's inputs came from (so that `rerun` and `--resume` can find them again, and
+/// `sepval predict` the releases fitted); checkpoints, result.json and diagnosis.json hold it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InputsRecord {
+    /// Data files (absolute paths); empty for the embedded default flight test.
+    pub data: Vec<PathBuf>,
+    /// Scenario file (absolute path); none for the embedded default.
+    pub scenario: Option<PathBuf>,
+    /// Model-extension file (absolute path), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extension: Option<PathBuf>,
 }
 
 /// The noise floor.

@@ -137,17 +137,7 @@ pub const CHECKPOINT_FORMAT: &str = "sepval-ga-checkpoint/2";
 /// Format tag of the checkpoints written before the digest (refused).
 pub const CHECKPOINT_FORMAT_1: &str = "sepval-ga-checkpoint/1";
 
-/// Where the fit's inputs came from (so that `rerun` and `--resume` can find them again).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct InputsRecord {
-    /// Data files (absolute paths); empty for the embedded default flight test.
-    pub data: Vec<PathBuf>,
-    /// Scenario file (absolute path); none for the embedded default.
-    pub scenario: Option<PathBuf>,
-    /// Model-extension file (absolute path), if any.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extension: Option<PathBuf>,
-}
+pub use crate::results::InputsRecord;
 
 /// One generation's checkpoint.
 ///
