@@ -30,8 +30,10 @@ MAY_USE = {
     "sepval-diagnose": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-report"},
     "sepval-plan": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-diagnose",
                     "sepval-report"},
+    "sepval-predict": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-diagnose",
+                       "sepval-report"},
     "sepval": {"sepval-common", "sepval-transport", "sepval-solve", "sepval-fit",
-               "sepval-diagnose", "sepval-plan", "sepval-report"},
+               "sepval-diagnose", "sepval-plan", "sepval-predict", "sepval-report"},
     "sepval-worker": {"sepval-common", "sepval-transport"},
     "sepval-tests": set(),
 }

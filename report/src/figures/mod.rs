@@ -20,6 +20,8 @@
 //! - [`throughput_figure`]: simulations per second against worker count, per transport.
 //! - [`condition_map`]: a score over a grid of conditions (a plan's separation), the best cell
 //!   outlined; [`channel_figure`]: several models' predicted trajectories, six channels.
+//! - [`band_figure`]: a predicted release with its bands, six channels, a flown release over
+//!   them.
 //!
 //! Choices made here:
 //! - Rendering needs no system library and no installed font: `plotters` draws into an in-memory
@@ -48,6 +50,7 @@ use std::path::{Path, PathBuf};
 
 use sepval_common::telemetry::Trajectory;
 
+mod bands;
 mod channels;
 mod condition_map;
 mod convergence;
@@ -62,6 +65,7 @@ mod testing;
 mod throughput;
 mod trajectory;
 
+pub use bands::{Band, band_figure};
 pub use channels::channel_figure;
 pub use condition_map::{MapAxis, condition_map};
 pub use convergence::convergence_figure;

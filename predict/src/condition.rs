@@ -1,0 +1,123 @@
+//! The condition predicted and the prediction's settings, checked before anything runs: the
+//! scenario of `--scenario COND.toml` must fly the store that was fitted (the same store,
+//! ejector, aerodynamics, interference, factor table and extension terms as the releases
+//! fitted: only `[flight]`, the name and the integrator may differ), `--level` lies in (0, 1),
+//! and `--samples` is at least 1, at most [`MAX_SAMPLES`], and their trajectories at the
+//! band's points fit [`MAX_VALUE_BYTES`].
+
+use sepval_common::scenario::Scenario;
+
+/// The most samples of one prediction.
+pub const MAX_SAMPLES: usize = 100_000;
+/// The samples' trajectories held at once (samples x points x 6 doubles) are refused beyond
+/// this \[bytes\].
+pub const MAX_VALUE_BYTES: usize = 1 << 30;
+
+/// A condition, flown release or setting that cannot be predicted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ConditionError {
+    /// `--level` outside (0, 1).
+    #[error("--level {0}: expected a number between 0 and 1 (exclusive), e.g. 0.95")]
+    Level(f64),
+    /// `--samples` 0 or too many.
+    #[error("--samples {samples}: {message}")]
+    Samples {
+        /// The number given.
+        samples: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A scenario of another store.
+    #[error(
+        "--scenario {scenario}: its {part} differs from that of the releases fitted ({fitted}): a prediction flies the store that was fitted; change only [flight]"
+    )]
+    OtherStore {
+        /// The scenario's name.
+        scenario: String,
+        /// The part that differs.
+        part: &'static str,
+        /// The fitted scenario's name.
+        fitted: String,
+    },
+}
+
+/// How a prediction is made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// Samples.
+    pub samples: usize,
+    /// The bands' level (0.95: 95 % bands).
+    pub level: f64,
+    /// The seed of every draw.
+    pub seed: u64,
+    /// Whether the measurement noise is a source (always with a flown release to check).
+    pub with_noise: bool,
+    /// Threads of the calibration's in-process refits.
+    pub threads: usize,
+}
+
+impl Settings {
+    /// Checks the level and the number of samples.
+    pub fn check(&self) -> Result<(), ConditionError> {
+        if !(self.level > 0.0 && self.level < 1.0) {
+            return Err(ConditionError::Level(self.level));
+        }
+        if self.samples == 0 {
+            return Err(ConditionError::Samples {
+                samples: 0,
+                message: "expected at least 1 (1000 gives 95 % bands to about +-1 % in level)"
+                    .into(),
+            });
+        }
+        if self.samples > MAX_SAMPLES {
+            return Err(ConditionError::Samples {
+                samples: self.samples,
+                message: format!("expected at most {MAX_SAMPLES}"),
+            });
+        }
+        Ok(())
+    }
+
+    /// Checks that the samples' trajectories at `points` band points fit [`MAX_VALUE_BYTES`].
+    pub fn check_size(&self, points: usize) -> Result<(), ConditionError> {
+        let bytes = self.samples.saturating_mul(points).saturating_mul(6 * 8);
+        if bytes > MAX_VALUE_BYTES {
+            return Err(ConditionError::Samples {
+                samples: self.samples,
+                message: format!(
+                    "{} samples of {points} band points need {bytes} bytes, above {MAX_VALUE_BYTES}: give fewer samples",
+                    self.samples
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Checks that `condition` flies the store of `fitted`.
+pub fn check_condition(fitted: &Scenario, condition: &Scenario) -> Result<(), ConditionError> {
+    let differs: Option<&'static str> = if fitted.store != condition.store {
+        Some("store (mass properties, ejector geometry)")
+    } else if fitted.ejector != condition.ejector {
+        Some("ejector force curve")
+    } else if fitted.aero != condition.aero {
+        Some("aerodynamic database")
+    } else if fitted.interference != condition.interference {
+        Some("interference model")
+    } else if fitted.factors != condition.factors {
+        Some("factor table")
+    } else if fitted.extension != condition.extension {
+        Some("extension terms")
+    } else {
+        None
+    };
+    match differs {
+        Some(part) => Err(ConditionError::OtherStore {
+            scenario: condition.name.clone(),
+            part,
+            fitted: fitted.name.clone(),
+        }),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,483 @@
+//! The model-form discrepancy (docs/model.md section 13.4): what the answer gets wrong beyond
+//! its factor bands and the noise, calibrated on releases held out of its fit, carried to the
+//! release predicted as a standard deviation per channel and time, delta_c(t).
+//!
+//! The rule, exactly:
+//! 1. *Held-out releases.* With R >= 2 releases fitted, each release j is left out in turn:
+//!    the answer is refitted (Levenberg-Marquardt from its estimate, the same parameters,
+//!    [`LOO_BUDGET`] simulations at most) to the other R - 1, and that refit predicts release
+//!    j. Releases given with `--validate` (and a diagnosis's own `--validate` releases whose
+//!    files still open) are held out as they are: the answer fitted to all R predicts them.
+//! 2. *Errors beyond the factor band.* At each sample of release j and channel c: e the data
+//!    minus the held-out fit's trajectory, v the variance of [`HELD_OUT_SAMPLES`] trajectories
+//!    drawn from that fit's covariance ([`crate::sampling`]), sigma_c the noise; the excess is
+//!    e^2 - v - sigma_c^2 (signed: noise alone gives it a mean of zero), averaged over a
+//!    moving window of +-10 % of the release's samples (W samples).
+//! 3. *Departures at the release predicted.* Each refit without release j also predicts the
+//!    release asked for, with [`HELD_OUT_SAMPLES`] draws of its own covariance; its departure
+//!    is (y_-j - y)^2 - v_-j, y the answer's trajectory there, v_-j the variance of the draws,
+//!    smoothed alike: refits that agree where they were fitted but part where nothing was
+//!    flown say that the model's form, not its factors, decides the prediction there.
+//! 4. *Carried to the release predicted.* M_c(t) is the mean over the J held-out releases of
+//!    their excess at the same time after release (linear between samples, held beyond a
+//!    release's end), less what noise alone gives a window's mean, [`SIGNIFICANCE`] sigma_c^2
+//!    sqrt(2 / W) / sqrt(J) (e^2 - sigma^2 has variance 2 sigma^4 for white noise); D_c(t)
+//!    the mean of the departures. delta_c(t)^2 = [`KAPPA`] max(0, M_c(t), D_c(t)).
+//! 5. *The releases fitted.* Whatever the held-out releases say, delta_c^2 is at least the
+//!    answer's own misfit on the releases fitted beyond the noise, max(0, rms_c^2 -
+//!    sigma_c^2 (1 + [`SIGNIFICANCE`] sqrt(2 / N))) (N the samples fitted), constant in time:
+//!    the only evidence when one release was fitted and none held out (it understates the
+//!    error at another condition, which the page says).
+//!
+//! [`KAPPA`] = 2 was chosen on the calibration cases of the README's table (1 gave a mean
+//! coverage of 0.88 there, 2 gives 0.90); the CI test runs other seeds.
+//!
+//! The refits and the held-out predictions are small (a few hundred simulations each) and run
+//! in this process ([`InProcess`], on the threads given), whose results are the same bits
+//! whatever the thread count.
+
+use std::sync::Arc;
+
+use sepval_common::evaluation::{Event, InProcess, Job};
+use sepval_fit::problem::Evaluate;
+use sepval_fit::refine::ModelLm;
+use sepval_fit::space::Noise;
+use sepval_solve::identifiability::{Identifiability, identifiability};
+use sepval_solve::lm::LmSettings;
+use sepval_solve::run::{NoProgress, RunError, run};
+use serde::{Deserialize, Serialize};
+
+use crate::ensemble::Member;
+use crate::sampling::{ParameterDistribution, sample_rng};
+use crate::simulate::{Grid, GridTrajectory, SimulateError, data_on_grid, run_candidates};
+
+/// Trajectories drawn from a held-out fit's covariance to measure its factor band.
+pub const HELD_OUT_SAMPLES: usize = 100;
+/// The factor on the squared discrepancy carried from the held-out releases (1: carried as
+/// measured; see the module docs for why 2).
+pub const KAPPA: f64 = 2.0;
+/// Simulation budget of each leave-one-out refit.
+pub const LOO_BUDGET: u64 = 3_000;
+/// The generator streams of held-out release j's draws start here (the prediction's own use
+/// streams 0 and 1).
+const STREAM_HELD_OUT: u64 = 16;
+/// The streams of the draws at the release predicted of the refit without release j start here
+/// (offset from [`STREAM_HELD_OUT`]).
+const TARGET_STREAM: usize = 1 << 20;
+
+/// A calibration that could not be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DiscrepancyError {
+    /// A simulation.
+    #[error(transparent)]
+    Simulate(#[from] SimulateError),
+    /// A refit interrupted or whose evaluator failed.
+    #[error("the refit without release {release}")]
+    Refit {
+        /// The release left out.
+        release: String,
+        /// Why.
+        #[source]
+        source: RunError,
+    },
+}
+
+/// How one release held out was predicted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HeldOutRecord {
+    /// The release.
+    pub release: String,
+    /// `left out` (refitted without it) or `validate` (given to predict, never fitted).
+    pub how: String,
+    /// RMS error of the held-out fit's trajectory per channel (x, y, z \[m\], roll, pitch,
+    /// yaw \[deg\]).
+    pub rms_error: [f64; 6],
+    /// RMS standard deviation of its factor band per channel.
+    pub rms_factor_sd: [f64; 6],
+    /// RMS of the smoothed excess's square root per channel: the error beyond the factor band
+    /// and the noise.
+    pub rms_excess: [f64; 6],
+    /// Why it could not be used, when it could not (the refit or the prediction did not run).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub note: String,
+}
+
+/// The discrepancy carried to the release predicted.
+#[derive(Debug, Clone)]
+pub struct Discrepancy {
+    /// delta_c at each grid point.
+    pub sd: Vec<[f64; 6]>,
+    /// The releases held out.
+    pub held_out: Vec<HeldOutRecord>,
+    /// The floor from the releases fitted: sqrt(max(0, rms_c^2 - sigma_c^2)).
+    pub fitted_floor: [f64; 6],
+    /// Simulations run.
+    pub evaluations: u64,
+}
+
+/// What the calibration needs.
+pub struct Calibration<'a> {
+    /// The answer.
+    pub answer: &'a Member,
+    /// Its covariance record (for `--validate` releases).
+    pub identifiability: &'a Identifiability,
+    /// The releases fitted.
+    pub fitted: &'a Job,
+    /// Releases held out as they are.
+    pub held_out: &'a [Event],
+    /// The release predicted (its data unused), sampled at the grid's release times.
+    pub target: &'a Event,
+    /// The noise.
+    pub noise: Noise,
+    /// The answer's residual RMS per channel on the releases fitted.
+    pub fitted_rms: [f64; 6],
+    /// Threads of the in-process evaluator.
+    pub threads: usize,
+    /// The seed.
+    pub seed: u64,
+}
+
+/// The excess of one release, smoothed, on its own times, with what noise alone would give it.
+struct Excess {
+    t_s: Vec<f64>,
+    value: Vec<[f64; 6]>,
+    /// [`SIGNIFICANCE`] standard deviations of a window's mean of e^2 - sigma^2 under noise
+    /// alone: SIGNIFICANCE sigma^2 sqrt(2 / W), W the window's samples.
+    threshold: [f64; 6],
+}
+
+/// How many standard deviations of noise alone the smoothed excess must exceed to count.
+pub const SIGNIFICANCE: f64 = 2.0;
+
+/// The noise of channel `c`.
+pub fn sigma(noise: Noise, c: usize) -> f64 {
+    if c < 3 { noise.pos_m } else { noise.att_deg }
+}
+
+/// Calibrates the discrepancy and carries it to `grid`.
+pub fn calibrate(cal: &Calibration, grid: &Grid) -> Result<Discrepancy, DiscrepancyError> {
+    let mut excesses = Vec::new();
+    let mut departures = Vec::new();
+    let mut held_out = Vec::new();
+    let mut evaluations = 0;
+    let events = cal.fitted.events();
+    let full = if events.len() >= 2 {
+        let b = factor_band(cal, cal.target, &cal.answer.x, None, 0)?;
+        evaluations += b.evaluations;
+        b.nominal.ok()
+    } else {
+        None
+    };
+    if events.len() >= 2 {
+        for j in 0..events.len() {
+            let rest: Vec<Event> = (0..events.len())
+                .filter(|&i| i != j)
+                .map(|i| events[i].clone())
+                .collect();
+            let name = events[j].name.clone();
+            match refit(cal, rest, &name)? {
+                Ok((x, id, n)) => {
+                    evaluations += n;
+                    let (record, excess, n) = predict_held_out(cal, &events[j], &x, &id, j)?;
+                    evaluations += n;
+                    held_out.push(HeldOutRecord {
+                        how: "left out".into(),
+                        ..record
+                    });
+                    excesses.extend(excess);
+                    if let Some(full) = &full {
+                        let b = factor_band(cal, cal.target, &x, Some(&id), TARGET_STREAM + j)?;
+                        evaluations += b.evaluations;
+                        departures.extend(departure(&b, full, grid));
+                    }
+                }
+                Err(reason) => held_out.push(unusable(&name, "left out", reason)),
+            }
+        }
+    }
+    for (k, e) in cal.held_out.iter().enumerate() {
+        let (record, excess, n) =
+            predict_held_out(cal, e, &cal.answer.x, cal.identifiability, events.len() + k)?;
+        evaluations += n;
+        held_out.push(HeldOutRecord {
+            how: "validate".into(),
+            ..record
+        });
+        excesses.extend(excess);
+    }
+    // What noise alone gives rms^2 - sigma^2 over the samples fitted: sigma^2 sqrt(2 / N).
+    let n = cal.fitted.sample_count().max(1) as f64;
+    let fitted_floor: [f64; 6] = std::array::from_fn(|c| {
+        let s2 = sigma(cal.noise, c).powi(2);
+        let noise_alone = SIGNIFICANCE * s2 * (2.0 / n).sqrt();
+        (cal.fitted_rms[c].powi(2) - s2 - noise_alone)
+            .max(0.0)
+            .sqrt()
+    });
+    let sd = grid
+        .t_s
+        .iter()
+        .map(|&t| {
+            std::array::from_fn(|c| {
+                let beyond = if excesses.is_empty() {
+                    0.0
+                } else {
+                    let j = excesses.len() as f64;
+                    let mean = excesses.iter().map(|e| at_time(e, t, c)).sum::<f64>() / j;
+                    let tau = excesses.iter().map(|e| e.threshold[c]).sum::<f64>() / j;
+                    (mean - tau / j.sqrt()).max(0.0)
+                };
+                let departed = if departures.is_empty() {
+                    0.0
+                } else {
+                    let j = departures.len() as f64;
+                    (departures.iter().map(|e| at_time(e, t, c)).sum::<f64>() / j).max(0.0)
+                };
+                let beyond = beyond.max(departed);
+                (KAPPA * beyond).max(fitted_floor[c].powi(2)).sqrt()
+            })
+        })
+        .collect();
+    Ok(Discrepancy {
+        sd,
+        held_out,
+        fitted_floor,
+        evaluations,
+    })
+}
+
+fn unusable(release: &str, how: &str, note: String) -> HeldOutRecord {
+    HeldOutRecord {
+        release: release.to_string(),
+        how: how.to_string(),
+        rms_error: [f64::NAN; 6],
+        rms_factor_sd: [f64::NAN; 6],
+        rms_excess: [f64::NAN; 6],
+        note,
+    }
+}
+
+/// The answer refitted to `events`: its parameters, their identifiability and the simulations
+/// run; `Err` with the reason when the refit cannot run on its own (its start does not
+/// simulate).
+#[allow(clippy::type_complexity)]
+fn refit(
+    cal: &Calibration,
+    events: Vec<Event>,
+    left_out: &str,
+) -> Result<Result<(Vec<f64>, Identifiability, u64), String>, DiscrepancyError> {
+    let job = Arc::new(Job::new(events).map_err(SimulateError::from)?);
+    let settings = LmSettings {
+        budget: LOO_BUDGET,
+        ..LmSettings::default()
+    };
+    let space = cal.answer.space.clone();
+    let mut lm = ModelLm::new(
+        space.clone(),
+        Arc::clone(&job),
+        &cal.answer.x,
+        cal.noise,
+        settings,
+    );
+    let mut evaluator = InProcess::new(Arc::clone(&job), cal.threads);
+    match run(&mut lm, &mut Evaluate(&mut evaluator), &mut []) {
+        Ok(()) => {}
+        Err(RunError::Search(reason)) => return Ok(Err(reason)),
+        Err(source) => {
+            return Err(DiscrepancyError::Refit {
+                release: left_out.to_string(),
+                source,
+            });
+        }
+    }
+    let r = lm.finish();
+    let samples: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
+    let id = identifiability(&space.params, &r.x, &r.residuals, &r.jacobian, &samples);
+    Ok(Ok((r.x, id, r.evaluations)))
+}
+
+/// A fit's trajectory at one release and the variance of its factor band there.
+struct FactorBand {
+    /// The fit's trajectory at the release's grid, or why it does not run.
+    nominal: Result<GridTrajectory, String>,
+    /// The variance of the draws at each grid point (zeros without draws).
+    var: Vec<[f64; 6]>,
+    /// The grid.
+    grid: Grid,
+    /// Simulations run.
+    evaluations: u64,
+}
+
+/// The fit at `x` at release `event`, with [`HELD_OUT_SAMPLES`] draws from `id` (none when
+/// `id` is `None`) on generator stream `stream`.
+fn factor_band(
+    cal: &Calibration,
+    event: &Event,
+    x: &[f64],
+    id: Option<&Identifiability>,
+    stream: usize,
+) -> Result<FactorBand, DiscrepancyError> {
+    let space = &cal.answer.space;
+    let dist = id.map(|id| ParameterDistribution::of(space, x, id));
+    let job = Arc::new(Job::new(vec![event.clone()]).map_err(SimulateError::from)?);
+    let grid = Grid::of(&event.data.times_s);
+    let mut evaluator = InProcess::new(Arc::clone(&job), cal.threads);
+    let (seed, fallback) = (cal.seed, cal.answer.candidate);
+    let candidate = |i: usize| {
+        let x = match (&dist, i) {
+            (Some(d), 1..) => d.draw(&mut sample_rng(
+                seed,
+                i as u64,
+                STREAM_HELD_OUT + stream as u64,
+            )),
+            _ => x.to_vec(),
+        };
+        space.candidate(&x).unwrap_or(fallback)
+    };
+    let n = if dist.is_some() {
+        HELD_OUT_SAMPLES + 1
+    } else {
+        1
+    };
+    let runs = run_candidates(&mut evaluator, n, &candidate, &grid, &mut NoProgress)?;
+    let evaluations = runs.evaluations;
+    let mut runs = runs.trajectories.into_iter();
+    let nominal = runs.next().unwrap_or_else(|| Err("no run".into()));
+    let drawn: Vec<GridTrajectory> = runs.filter_map(Result::ok).collect();
+    let var = (0..grid.len())
+        .map(|k| std::array::from_fn(|c| variance(drawn.iter().map(|d| d[k][c]))))
+        .collect();
+    Ok(FactorBand {
+        nominal,
+        var,
+        grid,
+        evaluations,
+    })
+}
+
+/// How far a refit without one release departs at the release predicted from the answer's
+/// trajectory `full` beyond its own factor band: (y_-j - y)^2 - v_-j, smoothed like the
+/// excess (no noise: nothing to subtract for it). `None` when the refit does not simulate it.
+fn departure(b: &FactorBand, full: &GridTrajectory, grid: &Grid) -> Option<Excess> {
+    let nominal = b.nominal.as_ref().ok()?;
+    let raw: Vec<[f64; 6]> = (0..grid.len())
+        .map(|k| std::array::from_fn(|c| (nominal[k][c] - full[k][c]).powi(2) - b.var[k][c]))
+        .collect();
+    let (value, _) = smooth(&raw);
+    Some(Excess {
+        t_s: grid.t_s.clone(),
+        value,
+        threshold: [0.0; 6],
+    })
+}
+
+/// Release `event` predicted by the fit at `x` with covariance `id`: its record, its smoothed
+/// excess (none when the fit's trajectory does not run) and the simulations run.
+fn predict_held_out(
+    cal: &Calibration,
+    event: &Event,
+    x: &[f64],
+    id: &Identifiability,
+    stream: usize,
+) -> Result<(HeldOutRecord, Option<Excess>, u64), DiscrepancyError> {
+    let b = factor_band(cal, event, x, Some(id), stream)?;
+    let n = b.evaluations;
+    let nominal = match &b.nominal {
+        Ok(t) => t,
+        Err(reason) => {
+            let note = format!("the held-out fit does not simulate it: {reason}");
+            return Ok((unusable(&event.name, "", note), None, n));
+        }
+    };
+    let grid = &b.grid;
+    let data = data_on_grid(&event.data, grid);
+    let mut record = unusable(&event.name, "", String::new());
+    let mut raw = Vec::with_capacity(grid.len());
+    let (mut err2, mut var2, mut exc2) = ([0.0; 6], [0.0; 6], [0.0; 6]);
+    for k in 0..grid.len() {
+        let point: [f64; 6] = std::array::from_fn(|c| {
+            let e = data[k][c] - nominal[k][c];
+            let v = b.var[k][c];
+            let s = sigma(cal.noise, c);
+            err2[c] += e * e;
+            var2[c] += v;
+            e * e - v - s * s
+        });
+        raw.push(point);
+    }
+    let (value, window) = smooth(&raw);
+    let threshold =
+        std::array::from_fn(|c| SIGNIFICANCE * sigma(cal.noise, c).powi(2) * (2.0 / window).sqrt());
+    for p in &value {
+        for c in 0..6 {
+            exc2[c] += p[c].max(0.0);
+        }
+    }
+    let m = grid.len().max(1) as f64;
+    record.rms_error = err2.map(|v| (v / m).sqrt());
+    record.rms_factor_sd = var2.map(|v| (v / m).sqrt());
+    record.rms_excess = exc2.map(|v| (v / m).sqrt());
+    Ok((
+        record,
+        Some(Excess {
+            t_s: grid.t_s.clone(),
+            value,
+            threshold,
+        }),
+        n,
+    ))
+}
+
+/// The variance of `values` (0 for fewer than two).
+pub fn variance(values: impl Iterator<Item = f64>) -> f64 {
+    let (mut n, mut sum, mut sq) = (0.0, 0.0, 0.0);
+    for v in values {
+        n += 1.0;
+        sum += v;
+        sq += v * v;
+    }
+    if n < 2.0 {
+        return 0.0;
+    }
+    let mean = sum / n;
+    ((sq - n * mean * mean) / (n - 1.0)).max(0.0)
+}
+
+/// The moving average of each channel over +-10 % of the points (at least one), and the
+/// window's full width in points.
+fn smooth(raw: &[[f64; 6]]) -> (Vec<[f64; 6]>, f64) {
+    let n = raw.len();
+    let h = (n / 10).max(1);
+    let mut prefix = vec![[0.0; 6]; n + 1];
+    for k in 0..n {
+        for c in 0..6 {
+            prefix[k + 1][c] = prefix[k][c] + raw[k][c];
+        }
+    }
+    let smoothed = (0..n)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(h), (k + h + 1).min(n));
+            std::array::from_fn(|c| (prefix[b][c] - prefix[a][c]) / (b - a) as f64)
+        })
+        .collect();
+    (smoothed, (2 * h + 1).min(n.max(1)) as f64)
+}
+
+/// The excess of channel `c` at time `t` (linear between points, held beyond the ends).
+fn at_time(e: &Excess, t: f64, c: usize) -> f64 {
+    let n = e.t_s.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let k = e.t_s.partition_point(|&s| s < t);
+    if k == 0 {
+        return e.value[0][c];
+    }
+    if k >= n {
+        return e.value[n - 1][c];
+    }
+    let (t0, t1) = (e.t_s[k - 1], e.t_s[k]);
+    let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+    e.value[k - 1][c] * (1.0 - w) + e.value[k][c] * w
+}

@@ -1,0 +1,190 @@
+//! The models a prediction draws from and their weights (docs/model.md section 13.2): the
+//! source's answer and each of its rivals, rebuilt from their model records
+//! (`sepval_fit::model_spec`) with the free parameters their refits move (the 17 factors, the
+//! effects' parameters, the terms' coefficients, as `sepval plan` rebuilds them), weighted by
+//! their evidence: w_m = exp(-delta_BIC_m / 2), normalised to sum 1 (the BIC approximation of
+//! the posterior probability of each model with equal prior odds: R. E. Kass and A. E.
+//! Raftery, JASA 90, 1995, section 4.1; A. E. Raftery, Sociological Methodology 25, 1995).
+//!
+//! The answer's parameters are drawn from the source's covariance ([`crate::sampling`]); a
+//! rival has no covariance of its own in the files, so its 17 factors take the answer's draws
+//! of the factors as deviations from its own values (the factors mean the same thing in every
+//! model) and its other parameters stay at their values.
+
+use sepval_common::evaluation::Candidate;
+use sepval_common::factors::{FACTOR_COUNT, FactorTable};
+use sepval_fit::model_spec::ModelSpecError;
+use sepval_fit::space::{FreeTerm, ParamSpace};
+
+use crate::source::Source;
+
+/// A term's coefficient may move within this many times its estimate either way (the bounds
+/// of the diagnosis's refits of discovered terms, as `sepval plan` holds them).
+pub const TERM_COEFFICIENT_SPAN: f64 = 10.0;
+
+/// A model of the source that cannot be rebuilt.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum EnsembleError {
+    /// A model record that names no model.
+    #[error("{which}: {source}")]
+    Spec {
+        /// `the answer` or `rival N`.
+        which: String,
+        /// Why.
+        #[source]
+        source: ModelSpecError,
+    },
+    /// A model whose factors are outside the factor table of the inputs.
+    #[error("{which}: its factors do not fit the scenario's factor table: {message}")]
+    Factors {
+        /// `the answer` or `rival N`.
+        which: String,
+        /// Why.
+        message: String,
+    },
+}
+
+/// One model with its weight and free parameters.
+#[derive(Debug, Clone)]
+pub struct Member {
+    /// Its name in reports: its effects and terms (`baseline` when it has none).
+    pub name: String,
+    /// Whether it is the source's answer.
+    pub answer: bool,
+    /// Its BIC minus the answer's on the releases fitted.
+    pub delta_bic: f64,
+    /// Its weight (the weights sum to 1).
+    pub weight: f64,
+    /// Its candidate at its estimate.
+    pub candidate: Candidate,
+    /// Its free parameters (names, bounds).
+    pub space: ParamSpace,
+    /// Their values at its estimate.
+    pub x: Vec<f64>,
+}
+
+/// The answer and its rivals.
+#[derive(Debug, Clone)]
+pub struct Ensemble {
+    /// The answer first, then the rivals.
+    pub members: Vec<Member>,
+}
+
+impl Ensemble {
+    /// The models of `source`, their factors checked against `table` (the factor table of the
+    /// releases fitted). The answer's estimate is the source's identifiability record's values
+    /// where it names a parameter.
+    pub fn of(source: &Source, table: &FactorTable) -> Result<Ensemble, EnsembleError> {
+        let raw: Vec<f64> = source
+            .models
+            .iter()
+            .map(|m| (-0.5 * m.delta_bic).exp())
+            .collect();
+        let total: f64 = raw.iter().sum();
+        let mut members = Vec::with_capacity(raw.len());
+        for (i, (m, w)) in source.models.iter().zip(&raw).enumerate() {
+            let which = if i == 0 {
+                "the answer".to_string()
+            } else {
+                format!("rival {i}")
+            };
+            let candidate = m.spec.candidate().map_err(|source| EnsembleError::Spec {
+                which: which.clone(),
+                source,
+            })?;
+            table
+                .check(&candidate.factors)
+                .map_err(|e| EnsembleError::Factors {
+                    which: which.clone(),
+                    message: e.to_string(),
+                })?;
+            let space = space_of(&candidate, table);
+            let mut x = space.start(&candidate.factors);
+            if i == 0 {
+                let id = &source.identifiability;
+                for (j, name) in space.params.names.iter().enumerate() {
+                    if let Some(k) = id.names.iter().position(|n| n == name) {
+                        let v = id.parameters[k].value;
+                        if v.is_finite() {
+                            x[j] = v.clamp(space.params.lo[j], space.params.hi[j]);
+                        }
+                    }
+                }
+            }
+            let candidate = space.candidate(&x).map_err(|e| EnsembleError::Factors {
+                which: which.clone(),
+                message: e.to_string(),
+            })?;
+            members.push(Member {
+                name: describe(&candidate, i),
+                answer: i == 0,
+                delta_bic: m.delta_bic,
+                weight: if total > 0.0 && total.is_finite() {
+                    w / total
+                } else {
+                    f64::from(u8::from(i == 0))
+                },
+                candidate,
+                space,
+                x,
+            });
+        }
+        Ok(Ensemble { members })
+    }
+
+    /// The answer.
+    pub fn answer(&self) -> &Member {
+        &self.members[0]
+    }
+
+    /// Whether there are rivals.
+    pub fn has_rivals(&self) -> bool {
+        self.members.len() > 1
+    }
+}
+
+/// The free parameters of `candidate`'s model: its factors, its effects' parameters and its
+/// terms' coefficients within [`TERM_COEFFICIENT_SPAN`] times their estimates (locators held).
+pub fn space_of(candidate: &Candidate, table: &FactorTable) -> ParamSpace {
+    let free: Vec<FreeTerm> = candidate
+        .terms
+        .iter()
+        .map(|t| {
+            let b = TERM_COEFFICIENT_SPAN * t.coefficient.abs().max(1e-12);
+            FreeTerm {
+                term: *t,
+                coefficient: (-b, b),
+                locator: None,
+            }
+        })
+        .collect();
+    ParamSpace::with_terms(table, &candidate.effects, &free)
+}
+
+/// A model in words: its effects and terms (`baseline` when none), `(rival N)` after a rival.
+fn describe(c: &Candidate, i: usize) -> String {
+    let mut parts: Vec<String> = c
+        .effects
+        .iter()
+        .map(|a| a.effect().id().to_string())
+        .collect();
+    parts.extend(
+        c.terms
+            .iter()
+            .map(|t| format!("{}: {}", t.axis.name(), t.formula())),
+    );
+    let name = if parts.is_empty() {
+        "baseline".to_string()
+    } else {
+        parts.join(" + ")
+    };
+    if i == 0 {
+        name
+    } else {
+        format!("{name} (rival {i})")
+    }
+}
+
+/// The number of factors every model shares (the first parameters of every space).
+pub const SHARED: usize = FACTOR_COUNT;

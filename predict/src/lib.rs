@@ -1,0 +1,270 @@
+//! The trajectory of a release that was not flown (`sepval predict`), with bands that say how
+//! sure it is, and the post-flight check of a flown release against them. What is computed is
+//! specified in docs/model.md section 13. The bands have three sources, each reported with its
+//! share of the width: the factors (drawn from the covariance of the fit), the model's form
+//! (the diagnosis's rivals weighted by their evidence, and a discrepancy calibrated on releases
+//! held out of the fit), and the measurement. The field's warning is NASA's X-43A: flight
+//! results left the Monte Carlo bounds of the parameters in several instances because the
+//! model's form was uncertain too (J. T. Karlgaard et al., "Hyper-X post-flight trajectory
+//! reconstruction", J. Spacecraft and Rockets 43(1), 2006; L. Baumann et al., AIAA 2005-3247).
+//!
+//! The prediction is a pipeline of named stages ([`prepare`] and [`predict`] show it whole):
+//! 1. [`source`]: the `--from` directory read and checked ([`Source`]);
+//! 2. [`ensemble`]: the answer and its rivals rebuilt, with their weights ([`Ensemble`]);
+//! 3. [`sampling`]: the answer's parameters drawn from their covariance, each sample from its
+//!    own seeded generator ([`Sampler`]);
+//! 4. [`simulate`]: every sample at the condition through any [`Evaluator`], in parts, reduced
+//!    to the band's time points ([`simulate::Runs`]);
+//! 5. [`discrepancy`]: the model-form discrepancy calibrated on held-out releases
+//!    ([`Discrepancy`]);
+//! 6. [`bands`]: pointwise quantiles and the shares of the sources ([`Bands`]);
+//! 7. [`check`]: the post-flight check of a flown release ([`Check`]);
+//! 8. [`record`] and [`outputs`]: DIR/prediction.json, DIR/bands.csv, DIR/report.html and
+//!    DIR/figures/prediction.png, written atomically.
+
+#![warn(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod bands;
+pub mod check;
+pub mod condition;
+pub mod discrepancy;
+pub mod ensemble;
+pub mod outputs;
+mod page;
+pub mod record;
+pub mod sampling;
+pub mod simulate;
+pub mod source;
+
+use sepval_common::evaluation::{Evaluator, Event, Job};
+use sepval_common::scenario::Scenario;
+use sepval_common::telemetry::Trajectory;
+use sepval_solve::run::ProgressObserver;
+
+pub use bands::{Bands, ChannelBand, Shares};
+pub use check::Check;
+pub use condition::{ConditionError, Settings, check_condition};
+pub use discrepancy::Discrepancy;
+pub use ensemble::Ensemble;
+pub use outputs::write_outputs;
+pub use record::{PREDICTION_FORMAT, PredictionFile, prediction_file};
+pub use sampling::Sampler;
+pub use source::{Source, SourceError, SourceKind, read_source};
+
+use simulate::{Grid, GridTrajectory, Runs};
+
+/// A prediction that cannot be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PredictError {
+    /// The `--from` directory.
+    #[error(transparent)]
+    Source(#[from] SourceError),
+    /// A model of the source that cannot be rebuilt.
+    #[error("the models of --from")]
+    Ensemble(#[from] ensemble::EnsembleError),
+    /// The condition, the flown release or the settings.
+    #[error(transparent)]
+    Condition(#[from] ConditionError),
+    /// The simulations.
+    #[error(transparent)]
+    Simulate(#[from] simulate::SimulateError),
+    /// The calibration of the discrepancy.
+    #[error("the calibration of the model-form discrepancy")]
+    Discrepancy(#[from] discrepancy::DiscrepancyError),
+    /// Every sample diverged or failed.
+    #[error(
+        "every one of the {samples} samples diverged or failed at this condition (the first: {first}): the models do not fly it; predict a condition nearer those fitted"
+    )]
+    AllDiverged {
+        /// Samples.
+        samples: usize,
+        /// The first one's reason.
+        first: String,
+    },
+    /// The outputs.
+    #[error(transparent)]
+    Outputs(#[from] outputs::OutputError),
+}
+
+/// A release flown at the condition, to check against the bands.
+#[derive(Debug, Clone)]
+pub struct Flown {
+    /// Its name (the file).
+    pub name: String,
+    /// Its data.
+    pub data: Trajectory,
+}
+
+/// A prediction's inputs, checked, before anything is simulated.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The source.
+    pub source: Source,
+    /// Its models and their weights.
+    pub ensemble: Ensemble,
+    /// The draws.
+    pub sampler: Sampler,
+    /// The condition's scenario.
+    pub condition: Scenario,
+    /// The evaluator's job: one release at the condition.
+    pub job: Job,
+    /// The band's time points.
+    pub grid: Grid,
+    /// The releases fitted.
+    pub fitted: Job,
+    /// Releases held out as they are (`--validate`).
+    pub held_out: Vec<Event>,
+    /// The flown release to check, if any.
+    pub flown: Option<Flown>,
+    /// The settings.
+    pub settings: Settings,
+}
+
+/// Rebuilds the models of `source`, fitted to `fitted` (the job of its `inputs`), and the job
+/// of the release at `condition` (sampled at the flown release's times, else the first fitted
+/// release's): everything checked before any simulation.
+pub fn prepare(
+    source: Source,
+    fitted: Job,
+    condition: Scenario,
+    held_out: Vec<Event>,
+    flown: Option<Flown>,
+    settings: Settings,
+) -> Result<Prepared, PredictError> {
+    settings.check()?;
+    let first = &fitted.events()[0];
+    check_condition(first.simulator.scenario(), &condition)?;
+    let times = match &flown {
+        Some(f) => f.data.times_s.clone(),
+        None => first.data.times_s.clone(),
+    };
+    let grid = Grid::of(&times);
+    settings.check_size(grid.len())?;
+    let ensemble = Ensemble::of(&source, fitted.factor_table())?;
+    let answer = ensemble.answer();
+    let sampler = Sampler {
+        answer: sampling::ParameterDistribution::of(
+            &answer.space,
+            &answer.x,
+            &source.identifiability,
+        ),
+        seed: settings.seed,
+    };
+    let job = simulate::release_job(&condition, &times, "prediction")
+        .map_err(simulate::SimulateError::from)?;
+    Ok(Prepared {
+        source,
+        ensemble,
+        sampler,
+        condition,
+        job,
+        grid,
+        fitted,
+        held_out,
+        flown,
+        settings,
+    })
+}
+
+/// What a prediction found.
+#[derive(Debug, Clone)]
+pub struct Prediction {
+    /// Each sample's model.
+    pub models: Vec<usize>,
+    /// The samples' runs.
+    pub runs: Runs,
+    /// The discrepancy.
+    pub discrepancy: Discrepancy,
+    /// The bands.
+    pub bands: Bands,
+    /// The flown release at the grid, when given.
+    pub flown: Option<GridTrajectory>,
+    /// The post-flight check, when a flown release was given.
+    pub check: Option<Check>,
+    /// Simulations run (the calibration's included).
+    pub evaluations: u64,
+}
+
+/// The prediction's stages from the samples on. `evaluator` must have been started with
+/// `prepared.job`.
+pub fn predict(
+    prepared: &Prepared,
+    evaluator: &mut dyn Evaluator,
+    progress: &mut dyn ProgressObserver,
+) -> Result<Prediction, PredictError> {
+    let (ens, n) = (&prepared.ensemble, prepared.settings.samples);
+    let samples: Vec<sampling::Sample> = (0..n)
+        .map(|i| prepared.sampler.sample(ens, i as u64))
+        .collect();
+    progress.start("predict", Some(n.div_ceil(part_size(&prepared.job))));
+    let runs = simulate::run_candidates(
+        evaluator,
+        n,
+        &|i| samples[i].candidate,
+        &prepared.grid,
+        progress,
+    )?;
+    progress.finish();
+    if runs.failed() == n {
+        let first = runs.trajectories[0].clone().err().unwrap_or_default();
+        return Err(PredictError::AllDiverged { samples: n, first });
+    }
+    let calibration = discrepancy::Calibration {
+        answer: ens.answer(),
+        identifiability: &prepared.source.identifiability,
+        fitted: &prepared.fitted,
+        held_out: &prepared.held_out,
+        target: &prepared.job.events()[0],
+        noise: prepared.source.noise,
+        fitted_rms: prepared.source.fitted_rms,
+        threads: prepared.settings.threads,
+        seed: prepared.settings.seed,
+    };
+    let discrepancy = discrepancy::calibrate(&calibration, &prepared.grid)?;
+    let flown = prepared
+        .flown
+        .as_ref()
+        .map(|f| simulate::data_on_grid(&f.data, &prepared.grid));
+    let with_noise = prepared.settings.with_noise || flown.is_some();
+    let models: Vec<usize> = samples.iter().map(|s| s.model).collect();
+    let per_sample: Vec<(usize, Option<&GridTrajectory>)> = models
+        .iter()
+        .zip(&runs.trajectories)
+        .map(|(m, t)| (*m, t.as_ref().ok()))
+        .collect();
+    let weights: Vec<f64> = ens.members.iter().map(|m| m.weight).collect();
+    let bands = bands::bands(&bands::BandInputs {
+        samples: &per_sample,
+        weights: &weights,
+        discrepancy: &discrepancy.sd,
+        noise: with_noise.then_some(prepared.source.noise),
+        level: prepared.settings.level,
+        seed: prepared.settings.seed,
+        points: prepared.grid.len(),
+    });
+    let check = prepared
+        .flown
+        .as_ref()
+        .zip(flown.as_ref())
+        .map(|(f, d)| check::check(&f.name, d, &prepared.grid.t_s, &bands.channels));
+    let evaluations = runs.evaluations + discrepancy.evaluations;
+    Ok(Prediction {
+        models,
+        runs,
+        discrepancy,
+        bands,
+        flown,
+        check,
+        evaluations,
+    })
+}
+
+/// Candidates per part of the evaluator's job.
+fn part_size(job: &Job) -> usize {
+    (sepval_fit::problem::SAMPLE_BUDGET / job.sample_count().max(1)).max(1)
+}
+
+#[cfg(test)]
+mod tests;

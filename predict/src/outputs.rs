@@ -1,0 +1,105 @@
+//! The prediction's outputs: DIR/figures/prediction.png (the six channels with their bands and
+//! the flown release over them), DIR/report.html (the answer first, the private module
+//! `page`), DIR/bands.csv and DIR/prediction.json (its record, [`crate::record`]), in that
+//! order, prediction.json last. Each file is written atomically and the cancellation flag is
+//! checked before each: a failed or interrupted prediction leaves no partial file.
+
+use std::path::{Path, PathBuf};
+
+use sepval_common::atomic_file::write_atomically;
+use sepval_report::figures::{Band, FigureError, band_figure};
+use sepval_report::html::HtmlError;
+
+use crate::Prediction;
+use crate::record::{PredictionFile, bands_csv};
+
+/// Outputs that could not be written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OutputError {
+    /// A file.
+    #[error("cannot write {}", .0.path.display())]
+    Write(#[source] sepval_common::atomic_file::WriteError),
+    /// A directory.
+    #[error("cannot create {}: {source}", path.display())]
+    Dir {
+        /// The directory.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A figure.
+    #[error(transparent)]
+    Figure(#[from] FigureError),
+    /// The page.
+    #[error(transparent)]
+    Page(#[from] HtmlError),
+    /// A signal asked the process to stop.
+    #[error("interrupted by a signal")]
+    Interrupted,
+}
+
+fn check_cancel() -> Result<(), OutputError> {
+    sepval_common::cancel::check().map_err(|_| OutputError::Interrupted)
+}
+
+/// Writes the figure, the page, bands.csv and prediction.json into `out`; returns the files
+/// written.
+pub fn write_outputs(
+    prediction: &Prediction,
+    file: &PredictionFile,
+    out: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let figures = out.join("figures");
+    std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
+        path: figures.clone(),
+        source,
+    })?;
+    check_cancel()?;
+    let figure = figures.join("prediction.png");
+    let ch = file.channels();
+    let bands: [Band; 6] = std::array::from_fn(|c| Band {
+        lo: &ch[c].lo,
+        mid: &ch[c].mid,
+        hi: &ch[c].hi,
+    });
+    let label = match &file.check {
+        Some(c) => format!("flown: {}", c.data),
+        None => String::new(),
+    };
+    let data = prediction.flown.as_deref().map(|d| (label.as_str(), d));
+    let title = format!(
+        "Predicted release at {} ({:.0} % bands{})",
+        crate::page::condition_words(file),
+        100.0 * file.level,
+        match &file.check {
+            Some(c) => format!("; {}", c.verdict),
+            None => String::new(),
+        }
+    );
+    band_figure(
+        &figure,
+        &file.t_s,
+        &bands,
+        data,
+        &format!("{:.0} % band", 100.0 * file.level),
+        &title,
+    )?;
+    let mut written = vec![figure];
+    check_cancel()?;
+    let html = crate::page::render(file, "figures/prediction.png")?;
+    let page = out.join("report.html");
+    write_atomically(&page, html.as_bytes()).map_err(OutputError::Write)?;
+    written.push(page);
+    check_cancel()?;
+    let csv = out.join("bands.csv");
+    write_atomically(&csv, bands_csv(file).as_bytes()).map_err(OutputError::Write)?;
+    written.push(csv);
+    check_cancel()?;
+    let json = serde_json::to_string_pretty(file).expect("a prediction serialises") + "\n";
+    let path = out.join("prediction.json");
+    write_atomically(&path, json.as_bytes()).map_err(OutputError::Write)?;
+    written.push(path);
+    Ok(written)
+}

@@ -1,0 +1,238 @@
+//! The source of a prediction: the `--out` directory of `sepval fit` (DIR/result.json, format
+//! [`sepval_fit::results::RESULT_FORMAT`]) or of `sepval diagnose` (DIR/diagnosis.json, format
+//! [`sepval_diagnose::DIAGNOSIS_FORMAT`]), read and checked. What a prediction needs from it
+//! (docs/model.md section 13.1): the fitted models (a fit's best refined factors; a diagnosis's
+//! answer and its rivals with their BIC against the answer), the covariance of the answer's
+//! parameters (`identifiability`: standard errors and correlations of the `+lm` refinement or
+//! of the diagnosis's refit of its answer), the noise, the answer's residual RMS per channel on
+//! the releases fitted, and where the releases fitted came from (`inputs`).
+
+use std::path::{Path, PathBuf};
+
+use sepval_fit::checkpoint::InputsRecord;
+use sepval_fit::model_spec::ModelSpec;
+use sepval_fit::results::{FitResult, RESULT_FORMAT};
+use sepval_fit::space::Noise;
+use sepval_solve::identifiability::Identifiability;
+
+/// A `--from` directory that cannot be predicted from.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SourceError {
+    /// Not a directory, or holding neither result.json nor diagnosis.json.
+    #[error("--from {}: {message}", path.display())]
+    NotASepvalOutput {
+        /// The directory.
+        path: PathBuf,
+        /// What is missing.
+        message: String,
+    },
+    /// A file that cannot be read or parsed, or of another format.
+    #[error("--from {}: {file}: {message}", path.display())]
+    File {
+        /// The directory.
+        path: PathBuf,
+        /// `result.json` or `diagnosis.json`.
+        file: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// A fit without a covariance of its factors (`--method ga` or `hill`).
+    #[error(
+        "--from {}: the fit ran --method {methods}, which estimates no covariance of the factors; fit with --method ga+lm (or hill+lm) to predict from it",
+        path.display()
+    )]
+    NoCovariance {
+        /// The directory.
+        path: PathBuf,
+        /// The methods it ran.
+        methods: String,
+    },
+}
+
+/// Which command wrote the source.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SourceKind {
+    /// `sepval fit` (DIR/result.json).
+    Fit,
+    /// `sepval diagnose` (DIR/diagnosis.json).
+    Diagnosis,
+}
+
+impl SourceKind {
+    /// Its name in files: `fit` or `diagnosis`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SourceKind::Fit => "fit",
+            SourceKind::Diagnosis => "diagnosis",
+        }
+    }
+}
+
+/// One fitted model of the source.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceModel {
+    /// The model as files hold it.
+    pub spec: ModelSpec,
+    /// Its BIC minus the answer's on the releases fitted (0 for the answer).
+    pub delta_bic: f64,
+}
+
+/// What a prediction takes from its `--from` directory.
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// Which command wrote it.
+    pub kind: SourceKind,
+    /// The directory.
+    pub dir: PathBuf,
+    /// The answer first, then the rivals (a fit has none).
+    pub models: Vec<SourceModel>,
+    /// Standard errors and correlations of the answer's parameters.
+    pub identifiability: Identifiability,
+    /// The measurement noise of the source.
+    pub noise: Noise,
+    /// The answer's RMS residual per channel on the releases fitted (x, y, z \[m\], roll,
+    /// pitch, yaw \[deg\]).
+    pub fitted_rms: [f64; 6],
+    /// Where the releases fitted came from.
+    pub inputs: InputsRecord,
+    /// Releases the source held out of its fits (a diagnosis's `--validate`) whose files still
+    /// open.
+    pub held_out: Vec<PathBuf>,
+}
+
+/// Reads the source in `dir`: diagnosis.json when it holds one, else result.json.
+pub fn read_source(dir: &Path) -> Result<Source, SourceError> {
+    let not = |message: &str| SourceError::NotASepvalOutput {
+        path: dir.to_path_buf(),
+        message: message.to_string(),
+    };
+    if !dir.is_dir() {
+        return Err(not(
+            "not a directory (give the --out directory of `sepval fit` or `sepval diagnose`)",
+        ));
+    }
+    if dir.join("diagnosis.json").exists() {
+        return diagnosis_source(dir);
+    }
+    if dir.join("result.json").exists() {
+        return fit_source(dir);
+    }
+    Err(not(
+        "holds neither result.json nor diagnosis.json: not the output of `sepval fit` or `sepval diagnose`",
+    ))
+}
+
+/// The text of `dir/file` whose `format` is `format`.
+fn read_json(dir: &Path, file: &'static str, format: &str) -> Result<String, SourceError> {
+    let bad = |message: String| SourceError::File {
+        path: dir.to_path_buf(),
+        file,
+        message,
+    };
+    let text = sepval_common::input_file::read_string(
+        &dir.join(file),
+        file,
+        sepval_common::limits::MAX_JSON_BYTES,
+    )
+    .map_err(|e| bad(e.to_string()))?;
+    let found: Option<String> = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_string));
+    if found.as_deref() != Some(format) {
+        return Err(bad(format!(
+            "format {}, expected {format} (run it again with this sepval)",
+            found.unwrap_or_else(|| "none".into())
+        )));
+    }
+    Ok(text)
+}
+
+fn diagnosis_source(dir: &Path) -> Result<Source, SourceError> {
+    let file = "diagnosis.json";
+    let text = read_json(dir, file, sepval_diagnose::DIAGNOSIS_FORMAT)?;
+    let bad = |message: String| SourceError::File {
+        path: dir.to_path_buf(),
+        file,
+        message,
+    };
+    let d: sepval_diagnose::Diagnosis =
+        serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    let identifiability = d.identifiability.clone().ok_or_else(|| {
+        bad("records no covariance of the answer's parameters (`identifiability`, written by sepval since predict): diagnose again with this sepval".into())
+    })?;
+    let mut models = vec![SourceModel {
+        spec: d.model.clone(),
+        delta_bic: 0.0,
+    }];
+    models.extend(d.rivals.iter().map(|r| SourceModel {
+        spec: r.model.clone(),
+        delta_bic: r.delta_bic,
+    }));
+    let held_out = d
+        .validation
+        .iter()
+        .map(|v| PathBuf::from(&v.event))
+        .filter(|p| p.is_file())
+        .collect();
+    Ok(Source {
+        kind: SourceKind::Diagnosis,
+        dir: dir.to_path_buf(),
+        models,
+        identifiability,
+        noise: Noise {
+            pos_m: d.sigma_pos_m,
+            att_deg: d.sigma_att_deg,
+        },
+        fitted_rms: d.extended.channel_rms.as_array(),
+        inputs: d.inputs,
+        held_out,
+    })
+}
+
+fn fit_source(dir: &Path) -> Result<Source, SourceError> {
+    let file = "result.json";
+    let text = read_json(dir, file, RESULT_FORMAT)?;
+    let bad = |message: String| SourceError::File {
+        path: dir.to_path_buf(),
+        file,
+        message,
+    };
+    let r: FitResult = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    // The refined methods; the identifiability is that of the best of them.
+    let best = r
+        .methods
+        .values()
+        .filter(|m| m.refinement.is_some())
+        .min_by(|a, b| a.best.weighted.total_cmp(&b.best.weighted));
+    let (Some(identifiability), Some(best)) = (r.identifiability.clone(), best) else {
+        let methods: Vec<&str> = r.methods.keys().map(String::as_str).collect();
+        return Err(SourceError::NoCovariance {
+            path: dir.to_path_buf(),
+            methods: methods.join(", "),
+        });
+    };
+    let inputs = r.inputs.clone().ok_or_else(|| {
+        bad("records no `inputs` (written by an older sepval): fit again with this sepval".into())
+    })?;
+    Ok(Source {
+        kind: SourceKind::Fit,
+        dir: dir.to_path_buf(),
+        models: vec![SourceModel {
+            spec: ModelSpec {
+                factors: best.best.factors,
+                effects: Vec::new(),
+                terms: Vec::new(),
+            },
+            delta_bic: 0.0,
+        }],
+        identifiability,
+        noise: Noise {
+            pos_m: r.sigma_pos_m,
+            att_deg: r.sigma_att_deg,
+        },
+        fitted_rms: best.best.channel_rms.as_array(),
+        inputs,
+        held_out: Vec::new(),
+    })
+}
