@@ -74,8 +74,6 @@ pub struct Bands {
 
 /// What the bands are made of.
 pub struct BandInputs<'a> {
-    /// Per sample, its model and trajectory (`None`: it did not run).
-    pub samples: &'a [(usize, Option<&'a GridTrajectory>)],
     /// The models' weights.
     pub weights: &'a [f64],
     /// The discrepancy's standard deviation per grid point.
@@ -90,20 +88,21 @@ pub struct BandInputs<'a> {
     pub points: usize,
 }
 
-/// The bands and the shares.
-pub fn bands(inp: &BandInputs) -> Bands {
-    let ran: Vec<(u64, usize, &GridTrajectory)> = inp
-        .samples
-        .iter()
+/// The bands and the shares of `samples` (per sample, its model and its trajectory, `None`
+/// when it did not run), taken and turned into the values in place: the trajectories are held
+/// once.
+pub fn bands(inp: &BandInputs, samples: Vec<(usize, Option<GridTrajectory>)>) -> Bands {
+    let ran: Vec<(u64, usize, GridTrajectory)> = samples
+        .into_iter()
         .enumerate()
-        .filter_map(|(s, (m, t))| t.map(|t| (s as u64, *m, t)))
+        .filter_map(|(s, (m, t))| t.map(|t| (s as u64, m, t)))
         .collect();
     let shares = shares(inp, &ran);
-    let mut values: Vec<Vec<[f64; 6]>> = Vec::with_capacity(ran.len());
-    for (s, _, t) in &ran {
-        let mut rng = sample_rng(inp.seed, *s, STREAM_BANDS);
+    let used = ran.len();
+    let mut values: Vec<GridTrajectory> = Vec::with_capacity(used);
+    for (s, _, mut v) in ran {
+        let mut rng = sample_rng(inp.seed, s, STREAM_BANDS);
         let a: [f64; 6] = std::array::from_fn(|_| normal(&mut rng));
-        let mut v = (*t).clone();
         for (k, p) in v.iter_mut().enumerate() {
             for c in 0..6 {
                 p[c] += a[c] * inp.discrepancy[k][c];
@@ -130,7 +129,7 @@ pub fn bands(inp: &BandInputs) -> Bands {
     Bands {
         channels,
         shares,
-        used: ran.len(),
+        used,
     }
 }
 
@@ -148,7 +147,7 @@ pub fn quantile(v: &[f64], q: f64) -> f64 {
 }
 
 /// The shares of the sources (module docs).
-fn shares(inp: &BandInputs, ran: &[(u64, usize, &GridTrajectory)]) -> Shares {
+fn shares(inp: &BandInputs, ran: &[(u64, usize, GridTrajectory)]) -> Shares {
     let models = inp.weights.len();
     let mut sums = [[0.0; 6]; 4];
     for k in 0..inp.points {

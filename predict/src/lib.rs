@@ -52,7 +52,7 @@ pub use record::{PREDICTION_FORMAT, PredictionFile, prediction_file};
 pub use sampling::Sampler;
 pub use source::{Source, SourceError, SourceKind, read_source};
 
-use simulate::{Grid, GridTrajectory, Runs};
+use simulate::{Grid, GridTrajectory};
 
 /// A prediction that cannot be made.
 #[derive(Debug, thiserror::Error)]
@@ -173,8 +173,8 @@ pub fn prepare(
 pub struct Prediction {
     /// Each sample's model.
     pub models: Vec<usize>,
-    /// The samples' runs.
-    pub runs: Runs,
+    /// Samples that diverged or failed.
+    pub failed: usize,
     /// The discrepancy.
     pub discrepancy: Discrepancy,
     /// The bands.
@@ -229,21 +229,22 @@ pub fn predict(
         .map(|f| simulate::data_on_grid(&f.data, &prepared.grid));
     let with_noise = prepared.settings.with_noise || flown.is_some();
     let models: Vec<usize> = samples.iter().map(|s| s.model).collect();
-    let per_sample: Vec<(usize, Option<&GridTrajectory>)> = models
+    let failed = runs.failed();
+    let per_sample: Vec<(usize, Option<GridTrajectory>)> = models
         .iter()
-        .zip(&runs.trajectories)
-        .map(|(m, t)| (*m, t.as_ref().ok()))
+        .zip(runs.trajectories)
+        .map(|(m, t)| (*m, t.ok()))
         .collect();
     let weights: Vec<f64> = ens.members.iter().map(|m| m.weight).collect();
-    let bands = bands::bands(&bands::BandInputs {
-        samples: &per_sample,
+    let inputs = bands::BandInputs {
         weights: &weights,
         discrepancy: &discrepancy.sd,
         noise: with_noise.then_some(prepared.source.noise),
         level: prepared.settings.level,
         seed: prepared.settings.seed,
         points: prepared.grid.len(),
-    });
+    };
+    let bands = bands::bands(&inputs, per_sample);
     let check = prepared
         .flown
         .as_ref()
@@ -252,7 +253,7 @@ pub fn predict(
     let evaluations = runs.evaluations + discrepancy.evaluations;
     Ok(Prediction {
         models,
-        runs,
+        failed,
         discrepancy,
         bands,
         flown,

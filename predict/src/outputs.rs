@@ -69,14 +69,14 @@ pub fn write_outputs(
         None => String::new(),
     };
     let data = prediction.flown.as_deref().map(|d| (label.as_str(), d));
+    let c = &file.condition;
     let title = format!(
-        "Predicted release at {} ({:.0} % bands{})",
-        crate::page::condition_words(file),
-        100.0 * file.level,
-        match &file.check {
-            Some(c) => format!("; {}", c.verdict),
-            None => String::new(),
-        }
+        "Predicted release at Mach {}, {} m, alpha {} deg, beta {} deg: {:.0} % bands",
+        crate::page::number(c.mach),
+        crate::page::number(c.altitude_m),
+        crate::page::number(c.alpha_deg),
+        crate::page::number(c.beta_deg),
+        100.0 * file.level
     );
     band_figure(
         &figure,

@@ -215,7 +215,15 @@ pub fn render(file: &PredictionFile, figure: &str) -> Result<String, HtmlError> 
         samples: format!("{} samples, {} ran", file.samples, file.samples_used),
         evaluations: file.evaluations,
         wall_s: number(file.wall_s),
-        from: format!("{} ({})", file.from, file.from_kind),
+        from: format!(
+            "{} (the output of sepval {})",
+            file.from,
+            if file.from_kind == "fit" {
+                "fit"
+            } else {
+                "diagnose"
+            }
+        ),
     };
     render_page(&PREDICTION, &page)
 }

@@ -39,6 +39,9 @@ pub enum Command {
     /// Plan the next release: the flight condition that would best tell a diagnosis's answer
     /// from its rivals, or (with no rivals) most shrink the uncertainty of its parameters.
     Plan(Box<PlanArgs>),
+    /// Predict a release not flown, with bands from the factors, the model's form and the
+    /// measurement; with --data, check a flown release against them.
+    Predict(Box<PredictArgs>),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
     /// Check the Pareto machinery on problems with known fronts.
@@ -187,6 +190,47 @@ pub struct PlanArgs {
     #[command(flatten)]
     pub eval: EvalArgs,
     /// Output directory (plan.json, plan.html, figures/).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub overwrite: OverwriteArgs,
+}
+
+#[derive(clap::Args)]
+pub struct PredictArgs {
+    /// The output directory of `sepval fit` (with --method ga+lm or hill+lm) or of `sepval
+    /// diagnose` to predict from (its result.json or diagnosis.json).
+    #[arg(long, value_name = "DIR")]
+    pub from: PathBuf,
+    /// The release to predict: a scenario of the store fitted with the flight condition to
+    /// predict in [flight] (Mach, altitude, alpha, beta, gamma).
+    #[arg(long, value_name = "COND.toml")]
+    pub scenario: PathBuf,
+    /// Model extension (TOML) the source was fitted with [default: the one its inputs record].
+    #[arg(long, value_name = "FILE")]
+    pub extension: Option<PathBuf>,
+    /// Samples drawn.
+    #[arg(long, default_value_t = 1000, value_name = "N")]
+    pub samples: usize,
+    /// Level of the bands, in (0, 1).
+    #[arg(long, default_value_t = 0.95, allow_hyphen_values = true)]
+    pub level: f64,
+    /// Seed of every draw.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Include the measurement noise of the source in the bands (to compare with telemetry
+    /// rather than the truth; always with --data).
+    #[arg(long)]
+    pub with_noise: bool,
+    /// A release flown at the condition (CSV): the post-flight check against the bands.
+    #[arg(long, value_name = "FLOWN.csv")]
+    pub data: Option<PathBuf>,
+    /// A release held out of the fit (CSV; repeatable): calibrates the model-form discrepancy.
+    #[arg(long, value_name = "FILE.csv")]
+    pub validate: Vec<PathBuf>,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// Output directory (prediction.json, bands.csv, report.html, figures/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     #[command(flatten)]

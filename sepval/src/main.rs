@@ -73,6 +73,7 @@ fn main() -> ExitCode {
         Command::Rerun(args) => command::rerun::run(args),
         Command::Diagnose(args) => command::diagnose::run(*args),
         Command::Plan(args) => command::plan::run(*args),
+        Command::Predict(args) => command::predict::run(*args),
         Command::Bench(args) => command::bench::run(args),
         Command::Gateway(args) => command::gateway::run(args),
         Command::Selftest(c) => command::selftest::run(c),

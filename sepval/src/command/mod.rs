@@ -12,6 +12,7 @@ pub mod gateway;
 pub mod goals;
 pub mod inputs;
 pub mod plan;
+pub mod predict;
 pub mod rerun;
 pub mod scenario;
 pub mod selftest;

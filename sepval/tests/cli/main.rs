@@ -1,5 +1,5 @@
 //! The `sepval` command line end to end, in one test binary: the commands as a user runs them,
-//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, `diagnose`, `plan`, and
+//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, `diagnose`, `plan`, `predict`, and
 //! property-based hardening of the checkpoint reader on arbitrary and mutated files. The binary
 //! is run through the shared support of the end-to-end tests (`sepval-tests`). Keep this the
 //! package's only integration test: it is also what makes `cargo test --workspace` build
@@ -16,6 +16,7 @@ mod gust;
 mod hardening;
 mod hardening_on_disk;
 mod plan;
+mod predict;
 mod refine;
 mod rivals;
 mod tables;

@@ -20,7 +20,7 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
 
 /// A directory holding `diag/` (a diagnosis with no rivals) and `damping/diag/` (a diagnosis
 /// with real rivals), made once for every test here.
-fn fixture() -> &'static Path {
+pub(crate) fn fixture() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();

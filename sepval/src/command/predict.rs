@@ -1,0 +1,157 @@
+//! `sepval predict`: a release not flown, with its bands, from a fit or a diagnosis; with
+//! `--data`, the post-flight check of a flown release against them.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use sepval_common::evaluation::Event;
+use sepval_common::telemetry::Trajectory;
+use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_predict::{
+    Flown, PredictionFile, Settings, predict, prediction_file, prepare, read_source, write_outputs,
+};
+
+use super::{Bar, count, evaluator_spec, inputs, notices};
+use crate::cli::PredictArgs;
+
+/// Runs `sepval predict`. Every input (the flags, the source, its releases, the condition, the
+/// flown release) is checked before the output directory is claimed or a worker started, so a
+/// refusal writes nothing.
+pub fn run(args: PredictArgs) -> Result<()> {
+    let spec = evaluator_spec(&args.eval)?;
+    let settings = Settings {
+        samples: args.samples,
+        level: args.level,
+        seed: args.seed,
+        with_noise: args.with_noise,
+        threads: count("--threads", args.eval.threads)?,
+    };
+    settings.check()?;
+    let source = read_source(&args.from)?;
+    let record = source.inputs.clone();
+    let extension = args.extension.clone().or(record.extension.clone());
+    let (fitted, _) = inputs::job(
+        &record.data,
+        record.scenario.as_deref(),
+        extension.as_deref(),
+    )
+    .with_context(|| {
+        format!(
+            "--from {}: the releases it was fitted to",
+            args.from.display()
+        )
+    })?;
+    let condition = inputs::scenario(Some(&args.scenario), extension.as_deref())
+        .with_context(|| format!("--scenario {}", args.scenario.display()))?;
+    let mut held: Vec<PathBuf> = args.validate.clone();
+    let recorded = source
+        .held_out
+        .iter()
+        .filter(|p| !held.contains(p))
+        .cloned();
+    held.extend(recorded.collect::<Vec<_>>());
+    let held_out: Vec<Event> = inputs::validation_job(
+        &held,
+        &record.data,
+        &fitted,
+        record.scenario.as_deref(),
+        extension.as_deref(),
+    )?
+    .map(|j| j.events().to_vec())
+    .unwrap_or_default();
+    let flown = match &args.data {
+        Some(path) => Some(flown(path, &condition)?),
+        None => None,
+    };
+    let prepared = prepare(source, fitted, condition, held_out, flown, settings)?;
+    let claim = if args.overwrite.overwrite {
+        Claim::Overwrite
+    } else {
+        Claim::Fresh
+    };
+    let run_dir = RunDir::claim(&args.out, claim, "predict")
+        .with_context(|| format!("--out {}", args.out.display()))?;
+    let start = Instant::now();
+    let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
+    run_dir.prepare()?;
+    let found = predict(&prepared, evaluator.as_mut(), &mut Bar::new())?;
+    drop(evaluator);
+    let file = prediction_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
+    write_outputs(&found, &file, &args.out)?;
+    print!("{}", summary_lines(&file, &args.out));
+    drop(run_dir);
+    Ok(())
+}
+
+/// The flown release of `--data`, whose metadata (when it names one) must give the condition
+/// of `--scenario`.
+fn flown(path: &Path, condition: &sepval_common::scenario::Scenario) -> Result<Flown> {
+    let name = path.display().to_string();
+    let data = Trajectory::read(path).with_context(|| format!("--data {name}"))?;
+    let named = inputs::event_scenario(condition, &data, &name)?;
+    let (a, b) = (&named.flight, &condition.flight);
+    let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + x.abs().max(y.abs()));
+    if !(same(a.mach, b.mach)
+        && same(a.altitude_m, b.altitude_m)
+        && same(a.alpha_deg, b.alpha_deg)
+        && same(a.beta_deg, b.beta_deg)
+        && same(a.gamma_deg, b.gamma_deg))
+    {
+        bail!(
+            "--data {name}: its metadata says it was flown at Mach {}, altitude {} m, alpha {} deg, beta {} deg, gamma {} deg, not at the condition of --scenario (Mach {}, altitude {} m, alpha {} deg, beta {} deg, gamma {} deg)",
+            a.mach,
+            a.altitude_m,
+            a.alpha_deg,
+            a.beta_deg,
+            a.gamma_deg,
+            b.mach,
+            b.altitude_m,
+            b.alpha_deg,
+            b.beta_deg,
+            b.gamma_deg
+        );
+    }
+    Ok(Flown { name, data })
+}
+
+/// The terminal summary: a few short lines.
+fn summary_lines(file: &PredictionFile, out: &Path) -> String {
+    let k = file.t_s.len().saturating_sub(1);
+    let ch = file.channels();
+    let mut s = format!(
+        "predict:   t = {:.3} s: x {:.3} m [{:.3}, {:.3}], z {:.3} m [{:.3}, {:.3}], pitch {:.2} deg [{:.2}, {:.2}] ({:.0} % bands)\n",
+        file.t_s.get(k).copied().unwrap_or(f64::NAN),
+        ch[0].mid[k],
+        ch[0].lo[k],
+        ch[0].hi[k],
+        ch[2].mid[k],
+        ch[2].lo[k],
+        ch[2].hi[k],
+        ch[4].mid[k],
+        ch[4].lo[k],
+        ch[4].hi[k],
+        100.0 * file.level
+    );
+    let src = &file.sources;
+    s.push_str(&format!(
+        "sources:   factors {:.0} %, model form {:.0} %, measurement {:.0} % (most: {})\n",
+        100.0 * src.factors.share,
+        100.0 * src.model_form.share,
+        100.0 * src.measurement.share,
+        src.dominant.replace('_', " ")
+    ));
+    if let Some(c) = &file.check {
+        s.push_str(&format!("check:     {}\n", c.verdict));
+    }
+    s.push_str(&format!(
+        "samples:   {} ({} ran), {} simulations, {:.1} s\n",
+        file.samples, file.samples_used, file.evaluations, file.wall_s
+    ));
+    s.push_str(&format!(
+        "report:    {}\n",
+        out.join("report.html").display()
+    ));
+    s
+}
