@@ -314,6 +314,19 @@ fn bad_inputs_are_refused_naming_what_and_nothing_is_written() {
         ],
         "differs from that of the releases fitted",
     );
+    // A store spinning at 10 000 deg/s at release tumbles at once: every sample diverges.
+    let mut spin = Scenario::embedded_default();
+    spin.initial.rates_deg_s = [10_000.0, 0.0, 0.0];
+    std::fs::write(p.join("spin.toml"), spin.to_toml_string()).unwrap();
+    run(
+        vec![
+            "--from".into(),
+            "fit".into(),
+            "--scenario".into(),
+            "spin.toml".into(),
+        ],
+        "every one of the 1000 samples diverged or failed at this condition",
+    );
     run(
         with(&["--data", "a.csv"]),
         "--data a.csv: its metadata says it was flown at Mach 0.8",
