@@ -78,8 +78,9 @@ impl TermSet {
         self.iter().any(|t| t.axis.is_coefficient())
     }
 
-    /// The increments of (CA, CY, CZ, Cl, Cm, Cn) at one force evaluation.
-    #[inline]
+    /// The increments of (CA, CY, CZ, Cl, Cm, Cn) at one force evaluation (inlined always, as
+    /// [`Term::regressor_value`]).
+    #[inline(always)]
     pub fn aero_increments(&self, x: &TermInput) -> [f64; 6] {
         let mut d = [0.0; 6];
         for t in self.iter().filter(|t| t.axis.is_coefficient()) {
@@ -90,7 +91,7 @@ impl TermSet {
 
     /// The ejector force factor max(0, 1 + dE) of a foot at stroke fraction `sigma` at time
     /// `t_s`: an ejector pushes, it never pulls, however large a negative term.
-    #[inline]
+    #[inline(always)]
     pub fn ejector_factor(&self, t_s: f64, sigma: f64) -> f64 {
         let mut d = 0.0;
         for t in self.iter().filter(|t| t.axis == Axis::Ejector) {
