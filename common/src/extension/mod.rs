@@ -448,13 +448,19 @@ impl Term {
             Regressor::Dm => x.mach - a,
             Regressor::Dm2 => (x.mach - a) * (x.mach - a),
             Regressor::Step => step(x.t_s, a),
-            Regressor::Sin => crate::elementary::sin(std::f64::consts::TAU * a * x.t_s),
-            Regressor::Cos => crate::elementary::cos(std::f64::consts::TAU * a * x.t_s),
+            Regressor::Sin => crate::elementary::sin(self.oscillation_argument(x.t_s)),
+            Regressor::Cos => crate::elementary::cos(self.oscillation_argument(x.t_s)),
             Regressor::Window => f64::from(u8::from(x.t_s >= a && x.t_s < b)),
             Regressor::Stroke | Regressor::Stroke2 => 0.0,
             Regressor::WindStep => wind::onset(x.t_s, a, b),
             Regressor::WindPulse => wind::pulse(x.t_s, a, b),
         }
+    }
+
+    /// The argument 2 pi f t of an oscillation's sine or cosine at time `t_s` (f its locator).
+    #[inline(always)]
+    pub(crate) fn oscillation_argument(&self, t_s: f64) -> f64 {
+        std::f64::consts::TAU * self.locator[0] * t_s
     }
 
     /// The regressor's value on the ejector axis, for a foot at stroke fraction `sigma`.
