@@ -415,10 +415,19 @@ impl Term {
     }
 
     /// The regressor's value (aerodynamic axes; for a wind regressor, its shape in time).
-    #[inline]
+    /// Inlined always, as the kernels it calls: the simulation calls it from a copy compiled
+    /// for FMA units (`model::RunSetup::add_extension_terms`), and only code inlined there uses
+    /// them.
+    #[inline(always)]
     pub fn regressor_value(&self, x: &TermInput) -> f64 {
         let [a, b] = self.locator;
-        let f = || decay(x.distance_m, a, x.s_end_m);
+        // A macro, not a closure: a closure is a function of its own that the compiler may
+        // leave out of line, compiled without the caller's FMA units.
+        macro_rules! f {
+            () => {
+                decay(x.distance_m, a, x.s_end_m)
+            };
+        }
         match self.regressor {
             Regressor::Alpha => x.alpha_rad,
             Regressor::Beta => x.beta_rad,
@@ -430,17 +439,17 @@ impl Term {
             Regressor::P => x.rates_hat[0],
             Regressor::Q => x.rates_hat[1],
             Regressor::R => x.rates_hat[2],
-            Regressor::F => f(),
-            Regressor::FAlpha => f() * x.alpha_rad,
-            Regressor::FBeta => f() * x.beta_rad,
-            Regressor::FP => f() * x.rates_hat[0],
-            Regressor::FQ => f() * x.rates_hat[1],
-            Regressor::FR => f() * x.rates_hat[2],
+            Regressor::F => f!(),
+            Regressor::FAlpha => f!() * x.alpha_rad,
+            Regressor::FBeta => f!() * x.beta_rad,
+            Regressor::FP => f!() * x.rates_hat[0],
+            Regressor::FQ => f!() * x.rates_hat[1],
+            Regressor::FR => f!() * x.rates_hat[2],
             Regressor::Dm => x.mach - a,
             Regressor::Dm2 => (x.mach - a) * (x.mach - a),
             Regressor::Step => step(x.t_s, a),
-            Regressor::Sin => crate::elementary::sin(std::f64::consts::TAU * a * x.t_s),
-            Regressor::Cos => crate::elementary::cos(std::f64::consts::TAU * a * x.t_s),
+            Regressor::Sin => crate::elementary::sin(self.oscillation_argument(x.t_s)),
+            Regressor::Cos => crate::elementary::cos(self.oscillation_argument(x.t_s)),
             Regressor::Window => f64::from(u8::from(x.t_s >= a && x.t_s < b)),
             Regressor::Stroke | Regressor::Stroke2 => 0.0,
             Regressor::WindStep => wind::onset(x.t_s, a, b),
@@ -448,8 +457,14 @@ impl Term {
         }
     }
 
+    /// The argument 2 pi f t of an oscillation's sine or cosine at time `t_s` (f its locator).
+    #[inline(always)]
+    pub(crate) fn oscillation_argument(&self, t_s: f64) -> f64 {
+        std::f64::consts::TAU * self.locator[0] * t_s
+    }
+
     /// The regressor's value on the ejector axis, for a foot at stroke fraction `sigma`.
-    #[inline]
+    #[inline(always)]
     pub fn ejector_value(&self, t_s: f64, sigma: f64) -> f64 {
         let [a, b] = self.locator;
         match self.regressor {
@@ -514,7 +529,7 @@ fn short(v: f64) -> String {
 }
 
 /// f_lambda(s) of docs/model.md section 3 for decay length `lambda_m`.
-#[inline]
+#[inline(always)]
 fn decay(s_m: f64, lambda_m: f64, s_end_m: f64) -> f64 {
     if s_m >= s_end_m {
         return 0.0;
@@ -524,7 +539,7 @@ fn decay(s_m: f64, lambda_m: f64, s_end_m: f64) -> f64 {
 }
 
 /// The smooth step (1 + tanh((t - t_on) / w)) / 2 = 1 / (1 + exp(-2 (t - t_on) / w)).
-#[inline]
+#[inline(always)]
 fn step(t_s: f64, t_on_s: f64) -> f64 {
     1.0 / (1.0 + crate::elementary::exp(-2.0 * (t_s - t_on_s) / STEP_WIDTH_S))
 }

@@ -39,7 +39,7 @@ pub const DEFAULT_RISE_S: f64 = 0.1;
 
 /// The 1-cosine onset: 0 before `t_on_s`, 1 after `t_on_s + rise_s`, (1 - cos(pi x)) / 2 in
 /// between, x = (t - t_on) / T.
-#[inline]
+#[inline(always)]
 pub fn onset(t_s: f64, t_on_s: f64, rise_s: f64) -> f64 {
     let x = (t_s - t_on_s) / rise_s;
     if x <= 0.0 {
@@ -52,7 +52,7 @@ pub fn onset(t_s: f64, t_on_s: f64, rise_s: f64) -> f64 {
 }
 
 /// The 1-cosine pulse: (1 - cos(2 pi x)) / 2 for x = (t - t_on) / T in (0, 1), 0 outside.
-#[inline]
+#[inline(always)]
 pub fn pulse(t_s: f64, t_on_s: f64, rise_s: f64) -> f64 {
     let x = (t_s - t_on_s) / rise_s;
     if x <= 0.0 || x >= 1.0 {
@@ -70,7 +70,7 @@ impl TermSet {
 
     /// The air's velocity in the launch frame at time `t_s` \[m/s\]: (0, sum of the `wind_y`
     /// terms, sum of the `wind_z` terms).
-    #[inline]
+    #[inline(always)]
     pub fn wind_l_m_s(&self, t_s: f64) -> [f64; 3] {
         let mut w = [0.0; 3];
         for t in self.iter().filter(|t| t.axis.is_wind()) {

@@ -392,7 +392,7 @@ fn wind_lanes<R: Real>(parts: &[Parts], t_s: R) -> [R; 3] {
     let mut w = [R::splat(0.0).to_array(); 3];
     for (i, part) in parts.iter().enumerate() {
         if part.run.terms.has_wind() {
-            let w_i = part.run.terms.wind_l_m_s(lane(t_s, i));
+            let w_i = super::wind_l_m_s(&part.run.terms, lane(t_s, i));
             for (j, v) in w_i.into_iter().enumerate() {
                 w[j].as_mut()[i] = v;
             }

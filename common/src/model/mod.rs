@@ -431,12 +431,37 @@ impl RunSetup {
     }
 
     /// Adds the extension's coefficient increments (section 11; CA is positive aft, so
-    /// `CX -= dCA`). Out of line, as the catalogue's terms.
+    /// `CX -= dCA`). Out of line, as the catalogue's terms; on x86-64 hosts with AVX2 and FMA,
+    /// a copy compiled for them (as `frames::euler_321_deg`): the regressors' `exp`, `sin` and
+    /// `cos` are Horner chains of fused multiply-adds, each otherwise a call to the C library's
+    /// `fma` (the same bits either way, fma being correctly rounded; three quarters of a
+    /// simulation's time with a few terms went to those calls).
     #[inline(never)]
-    fn add_extension_terms(&self, flow: &Flow, mut k: Coefficients) -> Coefficients {
+    fn add_extension_terms(&self, flow: &Flow, k: Coefficients) -> Coefficients {
         if !self.terms.has_aero() {
             return k;
         }
+        #[cfg(target_arch = "x86_64")]
+        if host_has_fma() {
+            // SAFETY: the CPU supports the features `add_extension_terms_fma` is compiled for.
+            return unsafe { self.add_extension_terms_fma(flow, k) };
+        }
+        self.add_extension_terms_inline(flow, k)
+    }
+
+    /// [`RunSetup::add_extension_terms`] compiled for x86-64 hosts with AVX2 and FMA.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn add_extension_terms_fma(&self, flow: &Flow, k: Coefficients) -> Coefficients {
+        self.add_extension_terms_inline(flow, k)
+    }
+
+    /// The body of [`RunSetup::add_extension_terms`].
+    #[inline(always)]
+    fn add_extension_terms_inline(&self, flow: &Flow, mut k: Coefficients) -> Coefficients {
         let d = self.terms.aero_increments(&TermInput {
             t_s: flow.t_s,
             alpha_rad: flow.alpha_rad,
@@ -455,15 +480,60 @@ impl RunSetup {
         k
     }
 
-    /// The extension's factor on a foot's force at displacement `s_i` (section 11).
+    /// The extension's factor on a foot's force at displacement `s_i` (section 11); compiled
+    /// for AVX2 and FMA where the host has them, as [`RunSetup::add_extension_terms`].
     #[inline(never)]
     fn ejector_factor(&self, t_s: f64, s_i: f64) -> f64 {
         if !self.terms.has_ejector() {
             return 1.0;
         }
         let sigma = s_i.clamp(0.0, self.stroke_m) / self.stroke_m;
+        #[cfg(target_arch = "x86_64")]
+        if host_has_fma() {
+            // SAFETY: the CPU supports the features `ejector_factor_fma` is compiled for.
+            return unsafe { ejector_factor_fma(&self.terms, t_s, sigma) };
+        }
         self.terms.ejector_factor(t_s, sigma)
     }
+}
+
+/// Whether this x86-64 host has AVX2 and FMA units (detected once, then a cached flag).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+pub(crate) fn host_has_fma() -> bool {
+    std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// The extension's wind in L at `t_s` ([`TermSet::wind_l_m_s`]), compiled for AVX2 and FMA
+/// where the host has them, as [`RunSetup::add_extension_terms`].
+#[inline(never)]
+pub(crate) fn wind_l_m_s(terms: &TermSet, t_s: f64) -> [f64; 3] {
+    #[cfg(target_arch = "x86_64")]
+    if host_has_fma() {
+        // SAFETY: the CPU supports the features `wind_l_m_s_fma` is compiled for.
+        return unsafe { wind_l_m_s_fma(terms, t_s) };
+    }
+    terms.wind_l_m_s(t_s)
+}
+
+/// [`TermSet::wind_l_m_s`] compiled for x86-64 hosts with AVX2 and FMA.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn wind_l_m_s_fma(terms: &TermSet, t_s: f64) -> [f64; 3] {
+    terms.wind_l_m_s(t_s)
+}
+
+/// [`TermSet::ejector_factor`] compiled for x86-64 hosts with AVX2 and FMA.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn ejector_factor_fma(terms: &TermSet, t_s: f64, sigma: f64) -> f64 {
+    terms.ejector_factor(t_s, sigma)
 }
 
 /// Inverse of a symmetric inertia tensor, refusing one that is not positive definite.

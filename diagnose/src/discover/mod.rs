@@ -93,6 +93,7 @@ pub(super) fn discover(
         current: baseline.clone(),
         picked: Picked::default(),
         groups: Vec::new(),
+        without: None,
     };
     for step in 0..stepwise::MAX_ENTRIES {
         let Some(entered) = enter(
@@ -216,6 +217,7 @@ fn enter(
         current: fitted,
         picked,
         groups,
+        without: None,
     }))
 }
 
@@ -242,7 +244,15 @@ fn conclude(
         p_with,
         search.m,
     );
-    let gains = remove::entry_gains(evaluator, search, &fitted, &picked, &gain, trail)?;
+    let gains = remove::entry_gains(
+        evaluator,
+        search,
+        &fitted,
+        &picked,
+        &gain,
+        sel.without,
+        trail,
+    )?;
     let terms = naming::name_terms(job, &fitted, &picked, &gains, &gain, &sel.groups);
     Ok(Some(Found {
         fitted,

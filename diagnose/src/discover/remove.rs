@@ -87,7 +87,7 @@ pub(super) fn f_to_remove(
         return Ok(sel);
     }
     let job = search.job;
-    let without = leave_one_out(evaluator, search, &sel.current, &sel.picked, trail)?;
+    let mut without = leave_one_out(evaluator, search, &sel.current, &sel.picked, trail)?;
     let p_with = sel.current.space(job).len();
     let mut weakest: Option<(usize, f64)> = None;
     for (k, f) in without.iter().enumerate() {
@@ -108,22 +108,25 @@ pub(super) fn f_to_remove(
         sel.picked.remove(k);
         sel.groups.remove(k);
         sel.current = without
-            .into_iter()
-            .nth(k)
-            .flatten()
+            .swap_remove(k)
             .ok_or_else(|| DiagnoseError::Model("a leave-one-out refit is missing".into()))?;
+        sel.without = None;
+    } else {
+        sel.without = Some(without);
     }
     Ok(sel)
 }
 
 /// Each entry's gain in `fitted` (made of `picked`): with several, what removing it costs; with
-/// one, `total`, the extension's gain over the baseline.
+/// one, `total`, the extension's gain over the baseline. `made`: the refits of `fitted` without
+/// each entry when F-to-remove already made them (otherwise they are made here).
 pub(super) fn entry_gains(
     evaluator: &mut dyn Evaluator,
     search: &Search,
     fitted: &Fitted,
     picked: &Picked,
     total: &Gain,
+    made: Option<Vec<Option<Fitted>>>,
     trail: &mut Trail,
 ) -> Result<Vec<Gain>> {
     if picked.len() <= 1 {
@@ -131,7 +134,10 @@ pub(super) fn entry_gains(
     }
     let job = search.job;
     let p_with = fitted.space(job).len();
-    let without = leave_one_out(evaluator, search, fitted, picked, trail)?;
+    let without = match made {
+        Some(without) if without.len() == picked.len() => without,
+        _ => leave_one_out(evaluator, search, fitted, picked, trail)?,
+    };
     Ok(without
         .iter()
         .map(|f| match f {

@@ -85,6 +85,10 @@ pub(super) struct Selection {
     pub picked: Picked,
     /// Per entry, the entries the data cannot tell from it.
     pub groups: Vec<Vec<crate::GroupMember>>,
+    /// The refits of `current` without each of its entries, when F-to-remove made them and
+    /// kept every entry: the gains of the entries of the final model are read from them rather
+    /// than refitted again (the same refits from the same optimum).
+    pub without: Option<Vec<Option<Fitted>>>,
 }
 
 /// What discovery records as it goes.
