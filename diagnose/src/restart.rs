@@ -61,12 +61,15 @@ pub(super) fn catalogue(
         evaluations,
         skipped,
     )?;
-    if outcome.chosen.is_empty() {
-        return Ok(Catalogued {
+    let kept = |baseline, outcome| {
+        Ok(Catalogued {
             baseline,
             outcome,
             restart: None,
-        });
+        })
+    };
+    if outcome.chosen.is_empty() {
+        return kept(baseline, outcome);
     }
     let lm = match refit(evaluator, job, &baseline, &outcome.fitted, noise, settings)? {
         Ok(lm) => lm,
@@ -76,22 +79,14 @@ pub(super) fn catalogue(
                 model: "baseline".into(),
                 reason,
             });
-            return Ok(Catalogued {
-                baseline,
-                outcome,
-                restart: None,
-            });
+            return kept(baseline, outcome);
         }
     };
     *evaluations += lm.evaluations;
     let (k, m) = (baseline.lm.x.len(), 6 * job.sample_count());
     let drop = bic(baseline.lm.cost, k, m) - bic(lm.cost, k, m);
     if drop.is_nan() || drop <= RESTART_BIC {
-        return Ok(Catalogued {
-            baseline,
-            outcome,
-            restart: None,
-        });
+        return kept(baseline, outcome);
     }
     let restart = format!(
         "the first baseline fit sat in a local optimum: refined again from the factors of the \

@@ -67,6 +67,17 @@ pub fn spawn_worker(run: &str, extra: &[&str]) -> Child {
         .expect("start sepval-worker")
 }
 
+/// The CLI tests' reduced search budget for `fit` and `diagnose`: 20 generations, in process on
+/// two threads (the study's 500 generations over workers are for users, not for CI).
+pub const REDUCED_BUDGET: [&str; 6] = [
+    "--generations",
+    "20",
+    "--evaluator",
+    "inproc",
+    "--threads",
+    "2",
+];
+
 /// Fails the test with sepval's stderr unless it exited successfully; returns its stdout.
 pub fn ok(out: &Output) -> String {
     assert!(

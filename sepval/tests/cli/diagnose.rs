@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use sepval_tests::{ok, refused, sepval};
+use sepval_tests::{REDUCED_BUDGET, ok, refused, sepval};
 use serde_json::Value;
 
 /// Factors of the base model of these tests (not the default truth).
@@ -35,22 +35,9 @@ fn diagnose_hidden(effects: &[&str], seed: &str, scenario: Option<&str>) -> Valu
         sim.extend(["--scenario", "s.toml"]);
     }
     ok(&sepval(&sim, dir.path()));
-    ok(&sepval(
-        &[
-            "diagnose",
-            "--data",
-            "d.csv",
-            "--generations",
-            "20",
-            "--evaluator",
-            "inproc",
-            "--threads",
-            "2",
-            "--out",
-            "diag",
-        ],
-        dir.path(),
-    ));
+    let head = ["diagnose", "--data", "d.csv"];
+    let args = [&head[..], &REDUCED_BUDGET, &["--out", "diag"]].concat();
+    ok(&sepval(&args, dir.path()));
     let d: Value = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("diag/diagnosis.json")).unwrap(),
     )
@@ -269,19 +256,9 @@ fn the_eglin_cfd_trajectory_is_diagnosed_honestly() {
 
 /// Runs `sepval diagnose` on `data` in `dir` with the reduced budgets and `extra` flags.
 fn diagnose_in(dir: &Path, data: &str, extra: &[&str]) -> std::process::Output {
-    let mut args = vec![
-        "diagnose",
-        "--data",
-        data,
-        "--generations",
-        "20",
-        "--evaluator",
-        "inproc",
-        "--threads",
-        "2",
-        "--out",
-        "diag",
-    ];
+    let mut args = vec!["diagnose", "--data", data];
+    args.extend(REDUCED_BUDGET);
+    args.extend(["--out", "diag"]);
     args.extend(extra);
     sepval(&args, dir)
 }

@@ -15,7 +15,7 @@ use sepval_common::propagator::{Observation, propagate};
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
-use sepval_tests::{Gauss, ok, sepval};
+use sepval_tests::{Gauss, REDUCED_BUDGET, ok, sepval};
 use serde_json::Value;
 
 /// Factors of the base model (not the default truth).
@@ -81,16 +81,7 @@ pub(crate) fn diagnose(
         args.push(if k < fit { "--data" } else { "--validate" }.into());
         args.push(name);
     }
-    for a in [
-        "--generations",
-        "20",
-        "--evaluator",
-        "inproc",
-        "--threads",
-        "2",
-        "--out",
-        "diag",
-    ] {
+    for a in REDUCED_BUDGET.into_iter().chain(["--out", "diag"]) {
         args.push(a.into());
     }
     let args: Vec<&str> = args.iter().map(String::as_str).collect();

@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use sepval_tests::{ok, sepval};
+use sepval_tests::{REDUCED_BUDGET, ok, sepval};
 use serde_json::Value;
 
 /// Factors of the base model (not the default truth).
@@ -57,16 +57,8 @@ pub(crate) fn diagnose(dir: &Path, data: &[&str], out: &str) -> Value {
     for d in data {
         args.extend(["--data", d]);
     }
-    args.extend([
-        "--generations",
-        "20",
-        "--evaluator",
-        "inproc",
-        "--threads",
-        "2",
-        "--out",
-        out,
-    ]);
+    args.extend(REDUCED_BUDGET);
+    args.extend(["--out", out]);
     ok(&sepval(&args, dir));
     serde_json::from_slice(&std::fs::read(dir.join(out).join("diagnosis.json")).unwrap()).unwrap()
 }
@@ -134,20 +126,9 @@ fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
         "{}",
         &csv[..600]
     );
+    let head = ["diagnose", "--data", "gust.csv"];
     let out = sepval(
-        &[
-            "diagnose",
-            "--data",
-            "gust.csv",
-            "--generations",
-            "20",
-            "--evaluator",
-            "inproc",
-            "--threads",
-            "2",
-            "--out",
-            "diag",
-        ],
+        &[&head[..], &REDUCED_BUDGET, &["--out", "diag"]].concat(),
         dir,
     );
     ok(&out);

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use sepval_tests::{ok, refused, sepval};
+use sepval_tests::{REDUCED_BUDGET, ok, refused, sepval};
 use serde_json::{Value, json};
 
 use super::discover::{default_scenario, diagnose, release};
@@ -40,20 +40,9 @@ pub(crate) fn fixture() -> &'static Path {
             ],
             p,
         ));
+        let head = ["diagnose", "--data", "d.csv"];
         ok(&sepval(
-            &[
-                "diagnose",
-                "--data",
-                "d.csv",
-                "--generations",
-                "20",
-                "--evaluator",
-                "inproc",
-                "--threads",
-                "2",
-                "--out",
-                "diag",
-            ],
+            &[&head[..], &REDUCED_BUDGET, &["--out", "diag"]].concat(),
             p,
         ));
         let d: Value =
