@@ -30,6 +30,7 @@ pub mod model_spec;
 pub mod out_dir;
 pub mod pipeline;
 pub mod problem;
+pub mod rebuild;
 pub mod refine;
 pub mod rerun;
 pub mod results;

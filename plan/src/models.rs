@@ -7,38 +7,15 @@
 use sepval_common::evaluation::Candidate;
 use sepval_common::factors::FactorTable;
 use sepval_diagnose::Diagnosis;
-use sepval_fit::model_spec::{ModelSpec, ModelSpecError};
-use sepval_fit::space::{FreeTerm, ParamSpace};
+use sepval_fit::model_spec::ModelSpec;
+use sepval_fit::rebuild::{Rebuilt, rebuild};
+use sepval_fit::space::ParamSpace;
 
 /// Forward-difference step of a sensitivity, as a fraction of the parameter's range (the
 /// refinement's own, `sepval_solve::lm::LmSettings::fd_step`).
 pub const FD_STEP: f64 = 1e-6;
-/// A term's coefficient may move within this many times its estimate either way (the bounds
-/// of the diagnosis's refits of discovered terms).
-pub const TERM_COEFFICIENT_SPAN: f64 = 10.0;
-
 /// A model of a diagnosis that cannot be rebuilt.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum ModelsError {
-    /// A model spec that names no model.
-    #[error("{which}: {source}")]
-    Spec {
-        /// `the answer` or `rival N`.
-        which: String,
-        /// Why.
-        #[source]
-        source: ModelSpecError,
-    },
-    /// A model whose factors are outside the factor table of the inputs.
-    #[error("{which}: its factors do not fit the scenario's factor table: {message}")]
-    Factors {
-        /// `the answer` or `rival N`.
-        which: String,
-        /// Why.
-        message: String,
-    },
-}
+pub use sepval_fit::rebuild::RebuildError as ModelsError;
 
 /// One model with what its refit may move.
 #[derive(Debug, Clone)]
@@ -69,30 +46,12 @@ impl PlanModel {
         answer: bool,
         delta_bic: f64,
     ) -> Result<PlanModel, ModelsError> {
-        let candidate = spec.candidate().map_err(|source| ModelsError::Spec {
-            which: which.clone(),
-            source,
-        })?;
-        table
-            .check(&candidate.factors)
-            .map_err(|e| ModelsError::Factors {
-                which: which.clone(),
-                message: e.to_string(),
-            })?;
-        let free: Vec<FreeTerm> = candidate
-            .terms
-            .iter()
-            .map(|t| {
-                let b = TERM_COEFFICIENT_SPAN * t.coefficient.abs().max(1e-12);
-                FreeTerm {
-                    term: *t,
-                    coefficient: (-b, b),
-                    locator: None,
-                }
-            })
-            .collect();
-        let space = ParamSpace::with_terms(table, &candidate.effects, &free);
-        let x = space.start(&candidate.factors);
+        let Rebuilt {
+            name,
+            candidate,
+            space,
+            x,
+        } = rebuild(spec, &which, table)?;
         let steps = (0..x.len())
             .map(|i| {
                 let h = FD_STEP * space.params.range(i);
@@ -101,7 +60,7 @@ impl PlanModel {
             })
             .collect();
         Ok(PlanModel {
-            name: describe(spec),
+            name,
             answer,
             delta_bic,
             spec: spec.clone(),
@@ -178,22 +137,5 @@ impl Models {
     /// Whether there is anything to separate.
     pub fn has_rivals(&self) -> bool {
         self.list.len() > 1
-    }
-}
-
-/// A model's effects and terms in words: `roll_due_to_sideslip + Cl: p`.
-pub fn describe(spec: &ModelSpec) -> String {
-    let mut parts = spec.effect_ids();
-    if let Ok(c) = spec.candidate() {
-        parts.extend(
-            c.terms
-                .iter()
-                .map(|t| format!("{}: {}", t.axis.name(), t.formula())),
-        );
-    }
-    if parts.is_empty() {
-        "baseline".into()
-    } else {
-        parts.join(" + ")
     }
 }

@@ -13,37 +13,13 @@
 
 use sepval_common::evaluation::Candidate;
 use sepval_common::factors::{FACTOR_COUNT, FactorTable};
-use sepval_fit::model_spec::ModelSpecError;
-use sepval_fit::space::{FreeTerm, ParamSpace};
+use sepval_fit::rebuild::{Rebuilt, rebuild};
+use sepval_fit::space::ParamSpace;
 
 use crate::source::Source;
 
-/// A term's coefficient may move within this many times its estimate either way (the bounds
-/// of the diagnosis's refits of discovered terms, as `sepval plan` holds them).
-pub const TERM_COEFFICIENT_SPAN: f64 = 10.0;
-
 /// A model of the source that cannot be rebuilt.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum EnsembleError {
-    /// A model record that names no model.
-    #[error("{which}: {source}")]
-    Spec {
-        /// `the answer` or `rival N`.
-        which: String,
-        /// Why.
-        #[source]
-        source: ModelSpecError,
-    },
-    /// A model whose factors are outside the factor table of the inputs.
-    #[error("{which}: its factors do not fit the scenario's factor table: {message}")]
-    Factors {
-        /// `the answer` or `rival N`.
-        which: String,
-        /// Why.
-        message: String,
-    },
-}
+pub use sepval_fit::rebuild::RebuildError as EnsembleError;
 
 /// One model with its weight and free parameters.
 #[derive(Debug, Clone)]
@@ -89,18 +65,9 @@ impl Ensemble {
             } else {
                 format!("rival {i}")
             };
-            let candidate = m.spec.candidate().map_err(|source| EnsembleError::Spec {
-                which: which.clone(),
-                source,
-            })?;
-            table
-                .check(&candidate.factors)
-                .map_err(|e| EnsembleError::Factors {
-                    which: which.clone(),
-                    message: e.to_string(),
-                })?;
-            let space = space_of(&candidate, table);
-            let mut x = space.start(&candidate.factors);
+            let Rebuilt {
+                name, space, mut x, ..
+            } = rebuild(&m.spec, &which, table)?;
             if i == 0 {
                 let id = &source.identifiability;
                 for (j, name) in space.params.names.iter().enumerate() {
@@ -117,7 +84,11 @@ impl Ensemble {
                 message: e.to_string(),
             })?;
             members.push(Member {
-                name: describe(&candidate, i),
+                name: if i == 0 {
+                    name
+                } else {
+                    format!("{name} (rival {i})")
+                },
                 answer: i == 0,
                 delta_bic: m.delta_bic,
                 weight: if total > 0.0 && total.is_finite() {
@@ -141,48 +112,6 @@ impl Ensemble {
     /// Whether there are rivals.
     pub fn has_rivals(&self) -> bool {
         self.members.len() > 1
-    }
-}
-
-/// The free parameters of `candidate`'s model: its factors, its effects' parameters and its
-/// terms' coefficients within [`TERM_COEFFICIENT_SPAN`] times their estimates (locators held).
-pub fn space_of(candidate: &Candidate, table: &FactorTable) -> ParamSpace {
-    let free: Vec<FreeTerm> = candidate
-        .terms
-        .iter()
-        .map(|t| {
-            let b = TERM_COEFFICIENT_SPAN * t.coefficient.abs().max(1e-12);
-            FreeTerm {
-                term: *t,
-                coefficient: (-b, b),
-                locator: None,
-            }
-        })
-        .collect();
-    ParamSpace::with_terms(table, &candidate.effects, &free)
-}
-
-/// A model in words: its effects and terms (`baseline` when none), `(rival N)` after a rival.
-fn describe(c: &Candidate, i: usize) -> String {
-    let mut parts: Vec<String> = c
-        .effects
-        .iter()
-        .map(|a| a.effect().id().to_string())
-        .collect();
-    parts.extend(
-        c.terms
-            .iter()
-            .map(|t| format!("{}: {}", t.axis.name(), t.formula())),
-    );
-    let name = if parts.is_empty() {
-        "baseline".to_string()
-    } else {
-        parts.join(" + ")
-    };
-    if i == 0 {
-        name
-    } else {
-        format!("{name} (rival {i})")
     }
 }
 
