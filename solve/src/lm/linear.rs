@@ -7,12 +7,19 @@ use nalgebra::{DMatrix, DVector};
 
 use super::Params;
 
-/// Forward-difference steps at `x`: `fd_step` of each range, inward at the upper bound.
-pub(super) fn fd_steps(params: &Params, x: &[f64], fd_step: f64) -> Vec<f64> {
+/// One-sided difference steps at `x`: `fd_step` of each range, forward (backward when
+/// `backward`), turned inward at the bound the step would cross.
+pub(super) fn fd_steps(params: &Params, x: &[f64], fd_step: f64, backward: bool) -> Vec<f64> {
     (0..params.len())
         .map(|i| {
             let h = fd_step * params.range(i);
-            if x[i] + h <= params.hi[i] { h } else { -h }
+            if backward {
+                if x[i] - h >= params.lo[i] { -h } else { h }
+            } else if x[i] + h <= params.hi[i] {
+                h
+            } else {
+                -h
+            }
         })
         .collect()
 }

@@ -9,7 +9,13 @@
 //! (as in bounded variants such as Kanzow, Yamashita and Fukushima, 2004). The Jacobian is a
 //! forward difference, one batch per iteration; each iteration also tries four damping values in
 //! one batch (mu/100, mu/10, mu, 10 mu) and keeps the best as the next mu, so the evaluators stay
-//! busy and the damping adapts in one iteration. Each step carries Transtrum and Sethna's
+//! busy and the damping adapts in one iteration. When every trial from a forward-difference
+//! Jacobian raises the cost although that Jacobian predicted a drop above the tolerance, the
+//! Jacobian is made again at the same point by backward differences (once per point, the damping
+//! unchanged): a forward probe that steps across a jump of the residuals (a simulation whose
+//! response to a parameter is discontinuous there) gives a column of jump / step, thousands of
+//! times the true slope, that spoils every damped step and, the damping grown, leaves only gains
+//! below the tolerance (sepval's own rule, 2026-11-25; seen in discovery's refits). Each step carries Transtrum and Sethna's
 //! geodesic acceleration (one probe per step), which follows the narrow curved valleys of
 //! strongly compensating parameters.
 //!
@@ -103,6 +109,9 @@ struct Position {
     stop: String,
     /// Consecutive accepted steps that lowered the cost by less than the tolerance.
     small_gains: usize,
+    /// The Jacobian at `x` is made of backward differences: its forward one's damped steps
+    /// all failed while it predicted a drop (a probe that crossed a jump of the residuals).
+    backward: bool,
 }
 
 /// One refinement as a sequence of batches: [`LmRun::request`] gives the next parameter
@@ -138,6 +147,7 @@ impl<M: Measure> LmRun<M> {
                 history: Vec::new(),
                 stop: String::new(),
                 small_gains: 0,
+                backward: false,
             },
             stage: Stage::Start,
             part: part.max(1),
@@ -213,7 +223,12 @@ impl<M: Measure> LmRun<M> {
         // samples x parameters doubles each, 1.6 GB at 2 million samples and 17 parameters).
         self.at.jac = DMatrix::zeros(0, 0);
         Stage::Jacobian(Differencing {
-            steps: fd_steps(&self.params, &self.at.x, self.settings.fd_step),
+            steps: fd_steps(
+                &self.params,
+                &self.at.x,
+                self.settings.fd_step,
+                self.at.backward,
+            ),
             last,
             parts: Parts::new(self.params.len()),
             jac: DMatrix::zeros(self.at.r.len(), self.params.len()),
@@ -329,6 +344,39 @@ mod tests {
         let r = lm.finish();
         assert!(r.x[0] <= 0.5 && (r.x[0] - 0.5).abs() < 1e-9, "{:?}", r.x);
         assert!((r.x[1] - 0.25).abs() < 1e-6, "{:?}", r.x);
+    }
+
+    /// One residual, b - 1 plus a jump of 3 once a exceeds 0.5 + 1e-9: the optimum is b = 1
+    /// with a anywhere below the jump, and a starts just below it.
+    struct JumpAbove;
+
+    impl Problem<Vec<f64>, Option<Vec<f64>>> for JumpAbove {
+        fn evaluate(&mut self, p: &[Vec<f64>], _: bool) -> Result<Vec<Option<Vec<f64>>>> {
+            Ok(p.iter()
+                .map(|x| {
+                    let jump = if x[0] > 0.5 + 1e-9 { 3.0 } else { 0.0 };
+                    Some(vec![x[1] - 1.0 + jump])
+                })
+                .collect())
+        }
+    }
+
+    #[test]
+    fn a_forward_probe_across_a_jump_does_not_stop_the_refinement() {
+        // The forward probe of a (4e-6 of its range) crosses the jump: its column is 3 / 4e-6,
+        // every damped step then crosses it too. Without the backward Jacobian the damping
+        // grows until the steps are too small to gain and b stays near its start (b = 7.5e-4
+        // after 32 iterations), as discovery's step-2 refits on two gust releases did.
+        let settings = LmSettings {
+            max_iterations: 40,
+            ..LmSettings::default()
+        };
+        let mut lm = LmRun::new(params(), &[0.5, 0.0], Rms, settings, 100);
+        run(&mut lm, &mut JumpAbove, &mut []).unwrap();
+        let r = lm.finish();
+        assert!((r.x[1] - 1.0).abs() < 1e-6, "{r:?}");
+        assert!(r.x[0] <= 0.5 + 1e-9, "{:?}", r.x);
+        assert!(r.cost < 1e-12, "{}", r.cost);
     }
 
     #[test]

@@ -67,14 +67,17 @@ pub(super) struct Curving {
     jtj: DMatrix<f64>,
     pub(super) parts: Parts,
     points: Vec<Vec<f64>>,
+    predicted: f64,
 }
 
-/// Trials under way: `best` is the lowest cost of the trials told so far.
+/// Trials under way: `best` is the lowest cost of the trials told so far; `predicted` is the
+/// largest drop of the cost the Jacobian's linear model predicts for the damped steps.
 pub(super) struct Trying {
     pub(super) points: Vec<Vec<f64>>,
     mus: [f64; 4],
     pub(super) parts: Parts,
     best: Option<BestTrial>,
+    predicted: f64,
 }
 
 /// The best trial so far.
@@ -149,6 +152,14 @@ impl<M: Measure> LmRun<M> {
             .iter()
             .map(|&m| solve_damped(&jtj, &free, m, &minus_g))
             .collect();
+        // The linear model's drop for step d: -(2 g.d + d^T J^T J d).
+        let predicted = deltas
+            .iter()
+            .map(|d| {
+                let d = DVector::from_column_slice(d);
+                -(2.0 * g.dot(&d) + d.dot(&(&jtj * &d)))
+            })
+            .fold(0.0, f64::max);
         let probes: Vec<Vec<f64>> = deltas
             .iter()
             .map(|d| (0..n).map(|i| x[i] + CURVATURE_H * d[i]).collect())
@@ -161,6 +172,7 @@ impl<M: Measure> LmRun<M> {
             free,
             jtj,
             points: Vec::with_capacity(4),
+            predicted,
         })
     }
 
@@ -178,6 +190,7 @@ impl<M: Measure> LmRun<M> {
             points: c.points,
             mus: c.mus,
             best: None,
+            predicted: c.predicted,
         })
     }
 
@@ -230,7 +243,9 @@ impl<M: Measure> LmRun<M> {
     }
 
     /// Trials told: the best so far kept; once complete, the best trial accepted when it
-    /// lowers the cost (then the next Jacobian), else a larger damping.
+    /// lowers the cost (then the next Jacobian), else the Jacobian made again by backward
+    /// differences when the forward one predicted a drop above the tolerance (a probe that
+    /// crossed a jump, module documentation), else a larger damping.
     pub(super) fn tried(&mut self, mut t: Trying, out: Vec<Option<Vec<f64>>>) -> Stage {
         for (k, rk) in t.parts.range(self.part).zip(out) {
             if let Some(rk) = rk {
@@ -247,8 +262,13 @@ impl<M: Measure> LmRun<M> {
         if t.parts.advance(self.part) {
             return Stage::Trials(t);
         }
+        let suspect = t.predicted > self.settings.rel_tolerance * self.at.cost;
         match t.best {
             Some(b) if b.cost < self.at.cost => self.accept(b, &t.points, &t.mus),
+            _ if suspect && !self.at.backward => {
+                self.at.backward = true;
+                self.begin_jacobian(false)
+            }
             _ => {
                 self.at.mu *= 100.0;
                 if self.at.mu > 1e12 {
@@ -270,6 +290,7 @@ impl<M: Measure> LmRun<M> {
         at.cost = b.cost;
         at.r = b.residuals;
         at.mu = mus[b.index].max(1e-12);
+        at.backward = false;
         self.record();
         let at = &mut self.at;
         at.small_gains = if gain < self.settings.rel_tolerance {
