@@ -19,7 +19,7 @@ use super::{ALPHA, CandidateReport, DiagnoseError, Fitted, ParamValue, Result, S
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_solve::identifiability::identifiability;
-use sepval_solve::lm::LmSettings;
+use sepval_solve::lm::{LmResult, LmSettings};
 use sepval_solve::stats::f_test;
 
 /// Refines a model again from its optimum until it converges (a reference model must be
@@ -34,17 +34,7 @@ pub(super) fn converge(
     evaluations: &mut u64,
     skipped: &mut Vec<SkippedRefit>,
 ) -> Result<Fitted> {
-    let mut run = [ModelLm::new(
-        fitted.space(job),
-        Arc::clone(job),
-        &fitted.lm.x,
-        noise,
-        settings.clone(),
-    )];
-    refine_together(evaluator, &mut run)?;
-    let [run] = run;
-    let failure = run.failure().map(str::to_string);
-    let lm = run.finish();
+    let (lm, failure) = refine_from(evaluator, job, &fitted, &fitted.lm.x, noise, settings)?;
     *evaluations += lm.evaluations;
     if let Some(reason) = failure {
         skipped.push(SkippedRefit {
@@ -59,6 +49,29 @@ pub(super) fn converge(
     } else {
         fitted
     })
+}
+
+/// The model of `fitted` (its space) refined from `x0`, with the reason when the refinement
+/// did not simulate (its result then counts the simulations only).
+pub(super) fn refine_from(
+    evaluator: &mut dyn Evaluator,
+    job: &Arc<Job>,
+    fitted: &Fitted,
+    x0: &[f64],
+    noise: Noise,
+    settings: &LmSettings,
+) -> Result<(LmResult, Option<String>)> {
+    let mut run = [ModelLm::new(
+        fitted.space(job),
+        Arc::clone(job),
+        x0,
+        noise,
+        settings.clone(),
+    )];
+    refine_together(evaluator, &mut run)?;
+    let [run] = run;
+    let failure = run.failure().map(str::to_string);
+    Ok((run.finish(), failure))
 }
 
 /// How a skipped refit names its model: its effects and terms, or `baseline`.

@@ -18,9 +18,8 @@
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Evaluator, Job};
-use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::Noise;
-use sepval_solve::lm::{LmResult, LmSettings};
+use sepval_solve::lm::LmSettings;
 
 use super::catalogue::{self, CatalogueOutcome};
 use super::{Fitted, Result, SkippedRefit, bic};
@@ -71,18 +70,18 @@ pub(super) fn catalogue(
     if outcome.chosen.is_empty() {
         return kept(baseline, outcome);
     }
-    let lm = match refit(evaluator, job, &baseline, &outcome.fitted, noise, settings)? {
-        Ok(lm) => lm,
-        Err(reason) => {
-            skipped.push(SkippedRefit {
-                stage: "baseline restart".into(),
-                model: "baseline".into(),
-                reason,
-            });
-            return kept(baseline, outcome);
-        }
-    };
+    // The extension's parameters follow the baseline's in its vector (catalogue.rs).
+    let from = &outcome.fitted.lm.x[..baseline.lm.x.len()];
+    let (lm, failure) = catalogue::refine_from(evaluator, job, &baseline, from, noise, settings)?;
     *evaluations += lm.evaluations;
+    if let Some(reason) = failure {
+        skipped.push(SkippedRefit {
+            stage: "baseline restart".into(),
+            model: "baseline".into(),
+            reason,
+        });
+        return kept(baseline, outcome);
+    }
     let (k, m) = (baseline.lm.x.len(), 6 * job.sample_count());
     let drop = bic(baseline.lm.cost, k, m) - bic(lm.cost, k, m);
     if drop.is_nan() || drop <= RESTART_BIC {
@@ -108,32 +107,5 @@ pub(super) fn catalogue(
         baseline,
         outcome,
         restart: Some(restart),
-    })
-}
-
-/// The baseline refined again from the factors of `from` (a model that extends it: its
-/// parameters follow the baseline's in its vector, as `catalogue.rs` builds them); `Err` with
-/// the reason when the refinement did not simulate.
-fn refit(
-    evaluator: &mut dyn Evaluator,
-    job: &Arc<Job>,
-    baseline: &Fitted,
-    from: &Fitted,
-    noise: Noise,
-    settings: &LmSettings,
-) -> Result<std::result::Result<LmResult, String>> {
-    let k = baseline.lm.x.len();
-    let mut run = [ModelLm::new(
-        baseline.space(job),
-        Arc::clone(job),
-        &from.lm.x[..k],
-        noise,
-        settings.clone(),
-    )];
-    refine_together(evaluator, &mut run)?;
-    let [run] = run;
-    Ok(match run.failure() {
-        Some(reason) => Err(reason.to_string()),
-        None => Ok(run.finish()),
     })
 }
