@@ -7,37 +7,14 @@
 use std::path::{Path, PathBuf};
 
 use sepval_common::atomic_file::write_atomically;
-use sepval_report::figures::{FigureError, MapAxis, channel_figure, condition_map};
-use sepval_report::html::HtmlError;
+use sepval_report::figures::{MapAxis, channel_figure, condition_map};
 
 use crate::conditions::Quantity;
 use crate::ranking::{RankedCondition, Standing};
 use crate::record::PlanFile;
 use crate::{Plan, Prepared};
 
-/// Outputs that could not be written.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum OutputError {
-    /// A file.
-    #[error("cannot write {}", .0.path.display())]
-    Write(#[source] sepval_common::atomic_file::WriteError),
-    /// A directory.
-    #[error("cannot create {}: {source}", path.display())]
-    Dir {
-        /// The directory.
-        path: PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
-    },
-    /// A figure.
-    #[error(transparent)]
-    Figure(#[from] FigureError),
-    /// The page.
-    #[error(transparent)]
-    Page(#[from] HtmlError),
-}
+pub use sepval_report::OutputError;
 
 /// Writes the figures, the page and plan.json into `out` (plan.json last); returns the files
 /// written.

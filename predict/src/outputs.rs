@@ -7,38 +7,12 @@
 use std::path::{Path, PathBuf};
 
 use sepval_common::atomic_file::write_atomically;
-use sepval_report::figures::{Band, FigureError, band_figure};
-use sepval_report::html::HtmlError;
+use sepval_report::figures::{Band, band_figure};
 
 use crate::Prediction;
 use crate::record::{PredictionFile, bands_csv};
 
-/// Outputs that could not be written.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum OutputError {
-    /// A file.
-    #[error("cannot write {}", .0.path.display())]
-    Write(#[source] sepval_common::atomic_file::WriteError),
-    /// A directory.
-    #[error("cannot create {}: {source}", path.display())]
-    Dir {
-        /// The directory.
-        path: PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
-    },
-    /// A figure.
-    #[error(transparent)]
-    Figure(#[from] FigureError),
-    /// The page.
-    #[error(transparent)]
-    Page(#[from] HtmlError),
-    /// A signal asked the process to stop.
-    #[error("interrupted by a signal")]
-    Interrupted,
-}
+pub use sepval_report::OutputError;
 
 fn check_cancel() -> Result<(), OutputError> {
     sepval_common::cancel::check().map_err(|_| OutputError::Interrupted)

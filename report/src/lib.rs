@@ -8,3 +8,6 @@
 
 pub mod figures;
 pub mod html;
+mod output_error;
+
+pub use output_error::OutputError;
