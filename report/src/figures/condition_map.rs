@@ -17,6 +17,9 @@ pub struct MapAxis<'a> {
     pub values: &'a [f64],
 }
 
+/// The colour of a cell without a value.
+pub(super) const NO_VALUE_GREY: RGBColor = RGBColor(170, 170, 170);
+
 /// The sequential colour of `f` in \[0, 1\] (viridis at five stops); grey when not finite.
 fn sequential(f: f64) -> RGBColor {
     const STOPS: [[f64; 3]; 5] = [
@@ -27,7 +30,7 @@ fn sequential(f: f64) -> RGBColor {
         [253.0, 231.0, 37.0],
     ];
     if !f.is_finite() {
-        return RGBColor(170, 170, 170);
+        return NO_VALUE_GREY;
     }
     let s = f.clamp(0.0, 1.0) * 4.0;
     let k = (s.floor() as usize).min(3);
@@ -38,7 +41,7 @@ fn sequential(f: f64) -> RGBColor {
 
 /// The cell edges around `values`: midway between neighbours, half a step beyond the ends (a
 /// single value gets a cell of width 1, or 10 % of the value).
-fn edges(values: &[f64]) -> Vec<f64> {
+pub(super) fn edges(values: &[f64]) -> Vec<f64> {
     match values {
         [] => vec![0.0, 1.0],
         [v] => {

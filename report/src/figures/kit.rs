@@ -369,6 +369,17 @@ pub(super) enum LegendMark {
     Band(RGBColor),
     /// A dashed line in the colour.
     Dashed(RGBColor),
+    /// A ring in the colour (a marked point, for example a release flown, hollow so that what
+    /// is under it stays readable).
+    Ring(RGBColor),
+}
+
+/// The radius of a marked point ([`LegendMark::Ring`]), in pixels.
+pub(super) const RING_RADIUS_PX: i32 = 13;
+
+/// The style of a ring of colour `c`.
+pub(super) fn ring_style(c: RGBColor) -> ShapeStyle {
+    c.stroke_width(4)
 }
 
 /// Draws a one-row legend centred in `area`.
@@ -400,6 +411,10 @@ pub(super) fn draw_legend_strip(area: &Root<'_>, entries: &[(String, LegendMark)
                 4,
                 c.stroke_width(2),
             ))?,
+            LegendMark::Ring(c) => {
+                let centre = (x + mark / 2, y);
+                area.draw(&Circle::new(centre, RING_RADIUS_PX, ring_style(*c)))?;
+            }
         }
         let style = style.pos(Pos::new(HPos::Left, VPos::Center));
         area.draw(&Text::new(label.as_str(), (x + mark + 8, y), style))?;

@@ -22,6 +22,10 @@
 //!   outlined; [`channel_figure`]: several models' predicted trajectories, six channels.
 //! - [`band_figure`]: a predicted release with its bands, six channels, a flown release over
 //!   them.
+//! - [`envelope_map`]: a per-condition value over a grid of flight conditions (the probability
+//!   of too small a clearance, or a low percentile of it) coloured by which side of the
+//!   criterion is [`Safety`], the criterion's contour ([`contour_segments`], marching squares)
+//!   over it and the releases flown marked.
 //!
 //! Choices made here:
 //! - Rendering needs no system library and no installed font: `plotters` draws into an in-memory
@@ -43,8 +47,9 @@
 //! Layout: the plotting kit every figure is drawn with (font, rendering and PNG encoding,
 //! ranges, ticks, palette, legends, lines and marks) is the private submodule `kit`; each
 //! figure family has a submodule of its own (`trajectory`, `factors`, `pareto`,
-//! `convergence`, `residuals`, `increments`, `correlation`, `throughput`) whose function is
-//! re-exported here.
+//! `convergence`, `residuals`, `increments`, `correlation`, `throughput`, `condition_map`,
+//! `channels`, `bands`, `envelope_map` with its colour scale `envelope_scale`) whose function is
+//! re-exported here; `contour` computes contours for the maps.
 
 use std::path::{Path, PathBuf};
 
@@ -56,6 +61,8 @@ mod condition_map;
 mod contour;
 mod convergence;
 mod correlation;
+mod envelope_map;
+mod envelope_scale;
 mod factors;
 mod increments;
 mod kit;
@@ -72,6 +79,8 @@ pub use condition_map::{MapAxis, condition_map};
 pub use contour::{GridError, Segment, contour_segments, row_crossings};
 pub use convergence::convergence_figure;
 pub use correlation::correlation_figure;
+pub use envelope_map::{EnvelopeMap, envelope_map};
+pub use envelope_scale::Safety;
 pub use factors::factor_figure;
 pub use increments::{IncrementPanel, IncrementSeries, increment_figure};
 pub use pareto::pareto_figure;

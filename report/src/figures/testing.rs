@@ -54,6 +54,18 @@ pub(super) fn dark_pixels(path: &Path, rows: std::ops::Range<usize>) -> usize {
         .count()
 }
 
+/// The pixels of a figure that are exactly `colour`.
+pub(super) fn count_colour(path: &Path, colour: plotters::style::RGBColor) -> usize {
+    let file = File::open(path).unwrap();
+    let mut reader = png::Decoder::new(BufReader::new(file)).read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let frame = reader.next_frame(&mut buf).unwrap();
+    buf[..frame.buffer_size()]
+        .chunks_exact(3)
+        .filter(|p| p == &[colour.0, colour.1, colour.2])
+        .count()
+}
+
 /// A trajectory over 1.2 s at 50 Hz, shaped by `k`.
 pub(super) fn trajectory(k: f64) -> Trajectory {
     let times_s: Vec<f64> = (0..60).map(|i| f64::from(i) * 0.02).collect();
