@@ -35,6 +35,7 @@ MAY_USE = {
     "sepval": {"sepval-common", "sepval-transport", "sepval-solve", "sepval-fit",
                "sepval-diagnose", "sepval-plan", "sepval-predict", "sepval-report"},
     "sepval-worker": {"sepval-common", "sepval-transport"},
+    "sepval-geometry": set(),
     "sepval-tests": set(),
 }
 # Intended cycle: the effect catalogue's plug-ins and the model that runs them.
