@@ -163,15 +163,36 @@ impl Conditions {
                 message: "expected at least 1 point per axis".into(),
             });
         }
+        let per_axis: Vec<(Range, usize)> = ranges.iter().map(|&r| (r, points)).collect();
+        Conditions::grid_per_axis(base, &per_axis)
+    }
+
+    /// The grid over `ranges`, each with its own number of points (at least 1; a range of one
+    /// point, or with LO = HI, is held at LO), around `base`.
+    pub fn grid_per_axis(
+        base: &Scenario,
+        ranges: &[(Range, usize)],
+    ) -> Result<Conditions, ConditionError> {
         let mut axes: Vec<(Quantity, Vec<f64>)> = Vec::new();
+        let mut points = 0;
         for q in Quantity::ALL {
-            let given: Vec<&Range> = ranges.iter().filter(|r| r.quantity == q).collect();
-            let Some(&r) = given.first() else { continue };
+            let given: Vec<&(Range, usize)> =
+                ranges.iter().filter(|(r, _)| r.quantity == q).collect();
+            let Some(&&(r, n)) = given.first() else {
+                continue;
+            };
             if given.len() > 1 {
                 return Err(ConditionError::Repeated { flag: q.flag() });
             }
-            check_range(base, r)?;
-            let n = if r.hi > r.lo { points } else { 1 };
+            if n == 0 {
+                return Err(ConditionError::Points {
+                    points: n,
+                    message: format!("{}: expected at least 1 point", q.flag()),
+                });
+            }
+            check_range(base, &r)?;
+            let n = if r.hi > r.lo { n } else { 1 };
+            points = points.max(n);
             let values = (0..n)
                 .map(|i| {
                     if n == 1 {
