@@ -156,20 +156,42 @@ pub fn sigma(noise: Noise, c: usize) -> f64 {
     if c < 3 { noise.pos_m } else { noise.att_deg }
 }
 
+/// What the held-out releases say, whatever the release predicted: their smoothed excesses,
+/// the leave-one-out refits (to carry to a release predicted, [`carry`]) and their records.
+/// Computed once, it serves every condition of an envelope.
+pub struct Evidence {
+    excesses: Vec<Excess>,
+    /// Per release left out: its index, the refit's parameters and identifiability.
+    refits: Vec<(usize, Vec<f64>, Identifiability)>,
+    held_out: Vec<HeldOutRecord>,
+    evaluations: u64,
+}
+
 /// Calibrates the discrepancy and carries it to `grid`.
 pub fn calibrate(cal: &Calibration, grid: &Grid) -> Result<Discrepancy, DiscrepancyError> {
-    let mut excesses = Vec::new();
-    let mut departures = Vec::new();
-    let mut held_out = Vec::new();
-    let mut evaluations = 0;
-    let events = cal.fitted.events();
-    let full = if events.len() >= 2 {
-        let b = factor_band(cal, cal.target, &cal.answer.x, None, 0)?;
-        evaluations += b.evaluations;
-        b.nominal.ok()
-    } else {
-        None
+    let ev = evidence(cal)?;
+    let mut d = carry(cal, &ev, grid)?;
+    d.evaluations += ev.evaluations;
+    Ok(d)
+}
+
+impl Evidence {
+    /// Simulations its refits and held-out predictions ran.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+}
+
+/// Steps 1 and 2 of the rule (module docs): the refits without each release and every
+/// held-out release's excess. `cal.target` is not used.
+pub fn evidence(cal: &Calibration) -> Result<Evidence, DiscrepancyError> {
+    let mut ev = Evidence {
+        excesses: Vec::new(),
+        refits: Vec::new(),
+        held_out: Vec::new(),
+        evaluations: 0,
     };
+    let events = cal.fitted.events();
     if events.len() >= 2 {
         for j in 0..events.len() {
             let rest: Vec<Event> = (0..events.len())
@@ -179,34 +201,55 @@ pub fn calibrate(cal: &Calibration, grid: &Grid) -> Result<Discrepancy, Discrepa
             let name = events[j].name.clone();
             match refit(cal, rest, &name)? {
                 Ok((x, id, n)) => {
-                    evaluations += n;
+                    ev.evaluations += n;
                     let (record, excess, n) = predict_held_out(cal, &events[j], &x, &id, j)?;
-                    evaluations += n;
-                    held_out.push(HeldOutRecord {
+                    ev.evaluations += n;
+                    ev.held_out.push(HeldOutRecord {
                         how: "left out".into(),
                         ..record
                     });
-                    excesses.extend(excess);
-                    if let Some(full) = &full {
-                        let b = factor_band(cal, cal.target, &x, Some(&id), TARGET_STREAM + j)?;
-                        evaluations += b.evaluations;
-                        departures.extend(departure(&b, full, grid));
-                    }
+                    ev.excesses.extend(excess);
+                    ev.refits.push((j, x, id));
                 }
-                Err(reason) => held_out.push(unusable(&name, "left out", reason)),
+                Err(reason) => ev.held_out.push(unusable(&name, "left out", reason)),
             }
         }
     }
     for (k, e) in cal.held_out.iter().enumerate() {
         let (record, excess, n) =
             predict_held_out(cal, e, &cal.answer.x, cal.identifiability, events.len() + k)?;
-        evaluations += n;
-        held_out.push(HeldOutRecord {
+        ev.evaluations += n;
+        ev.held_out.push(HeldOutRecord {
             how: "validate".into(),
             ..record
         });
-        excesses.extend(excess);
+        ev.excesses.extend(excess);
     }
+    Ok(ev)
+}
+
+/// Steps 3 to 5 of the rule (module docs): the refits' departures at `cal.target` and the
+/// discrepancy carried to `grid` (the target's band points). Its `evaluations` are those of
+/// this step only.
+pub fn carry(
+    cal: &Calibration,
+    ev: &Evidence,
+    grid: &Grid,
+) -> Result<Discrepancy, DiscrepancyError> {
+    let mut evaluations = 0;
+    let mut departures = Vec::new();
+    if cal.fitted.events().len() >= 2 {
+        let b = factor_band(cal, cal.target, &cal.answer.x, None, 0)?;
+        evaluations += b.evaluations;
+        if let Ok(full) = &b.nominal {
+            for (j, x, id) in &ev.refits {
+                let b = factor_band(cal, cal.target, x, Some(id), TARGET_STREAM + j)?;
+                evaluations += b.evaluations;
+                departures.extend(departure(&b, full, grid));
+            }
+        }
+    }
+    let (excesses, held_out) = (&ev.excesses, ev.held_out.clone());
     // What noise alone gives rms^2 - sigma^2 over the samples fitted: sigma^2 sqrt(2 / N).
     let n = cal.fitted.sample_count().max(1) as f64;
     let fitted_floor: [f64; 6] = std::array::from_fn(|c| {

@@ -27,6 +27,7 @@
 
 pub mod bands;
 pub mod check;
+pub mod clearance;
 pub mod condition;
 pub mod discrepancy;
 pub mod ensemble;
@@ -44,6 +45,7 @@ use sepval_solve::run::ProgressObserver;
 
 pub use bands::{Bands, ChannelBand, Shares};
 pub use check::Check;
+pub use clearance::{ClearanceSettings, ClearanceStats};
 pub use condition::{ConditionError, Settings, check_condition};
 pub use discrepancy::Discrepancy;
 pub use ensemble::Ensemble;
@@ -120,6 +122,33 @@ pub struct Prepared {
     pub flown: Option<Flown>,
     /// The settings.
     pub settings: Settings,
+    /// The clearance to assess, if any ([`Prepared::with_clearance`]).
+    pub clearance: Option<ClearanceSettings>,
+}
+
+impl Prepared {
+    /// The same prediction with the clearance of every sample assessed.
+    pub fn with_clearance(self, clearance: ClearanceSettings) -> Prepared {
+        Prepared {
+            clearance: Some(clearance),
+            ..self
+        }
+    }
+
+    /// What the discrepancy's calibration needs, at this prediction's condition.
+    pub fn calibration(&self) -> discrepancy::Calibration<'_> {
+        discrepancy::Calibration {
+            answer: self.ensemble.answer(),
+            identifiability: &self.source.identifiability,
+            fitted: &self.fitted,
+            held_out: &self.held_out,
+            target: &self.job.events()[0],
+            noise: self.source.noise,
+            fitted_rms: self.source.fitted_rms,
+            threads: self.settings.threads,
+            seed: self.settings.seed,
+        }
+    }
 }
 
 /// Rebuilds the models of `source`, fitted to `fitted` (the job of its `inputs`), and the job
@@ -165,6 +194,7 @@ pub fn prepare(
         held_out,
         flown,
         settings,
+        clearance: None,
     })
 }
 
@@ -183,6 +213,8 @@ pub struct Prediction {
     pub flown: Option<GridTrajectory>,
     /// The post-flight check, when a flown release was given.
     pub check: Option<Check>,
+    /// The clearance, when a geometry was given.
+    pub clearance: Option<ClearanceStats>,
     /// Simulations run (the calibration's included).
     pub evaluations: u64,
 }
@@ -193,6 +225,18 @@ pub fn predict(
     prepared: &Prepared,
     evaluator: &mut dyn Evaluator,
     progress: &mut dyn ProgressObserver,
+) -> Result<Prediction, PredictError> {
+    predict_with(prepared, evaluator, progress, None)
+}
+
+/// [`predict`] with the held-out releases' evidence already computed
+/// ([`discrepancy::evidence`] of [`Prepared::calibration`]), as an envelope does once for all
+/// its conditions; `None` computes it.
+pub fn predict_with(
+    prepared: &Prepared,
+    evaluator: &mut dyn Evaluator,
+    progress: &mut dyn ProgressObserver,
+    evidence: Option<&discrepancy::Evidence>,
 ) -> Result<Prediction, PredictError> {
     let (ens, n) = (&prepared.ensemble, prepared.settings.samples);
     let samples: Vec<sampling::Sample> = (0..n)
@@ -211,18 +255,24 @@ pub fn predict(
         let first = runs.trajectories[0].clone().err().unwrap_or_default();
         return Err(PredictError::AllDiverged { samples: n, first });
     }
-    let calibration = discrepancy::Calibration {
-        answer: ens.answer(),
-        identifiability: &prepared.source.identifiability,
-        fitted: &prepared.fitted,
-        held_out: &prepared.held_out,
-        target: &prepared.job.events()[0],
-        noise: prepared.source.noise,
-        fitted_rms: prepared.source.fitted_rms,
-        threads: prepared.settings.threads,
-        seed: prepared.settings.seed,
+    let calibration = prepared.calibration();
+    let discrepancy = match evidence {
+        Some(ev) => discrepancy::carry(&calibration, ev, &prepared.grid)?,
+        None => discrepancy::calibrate(&calibration, &prepared.grid)?,
     };
-    let discrepancy = discrepancy::calibrate(&calibration, &prepared.grid)?;
+    let clearance = prepared.clearance.as_ref().map(|c| {
+        let trajectories: Vec<Option<&GridTrajectory>> =
+            runs.trajectories.iter().map(|t| t.as_ref().ok()).collect();
+        let s = &prepared.settings;
+        clearance::assess(
+            c,
+            &trajectories,
+            &discrepancy.sd,
+            &prepared.grid,
+            s.seed,
+            s.threads,
+        )
+    });
     let flown = prepared
         .flown
         .as_ref()
@@ -258,6 +308,7 @@ pub fn predict(
         bands,
         flown,
         check,
+        clearance,
         evaluations,
     })
 }

@@ -19,6 +19,7 @@ const PREDICTION: PageTemplate = PageTemplate {
 #[derive(Serialize)]
 struct Page {
     headline: String,
+    clearance: String,
     check: String,
     check_data: String,
     sources_words: String,
@@ -151,6 +152,10 @@ pub fn render(file: &PredictionFile, figure: &str) -> Result<String, HtmlError> 
     };
     let page = Page {
         headline: headline(file),
+        clearance: file
+            .clearance
+            .as_ref()
+            .map_or(String::new(), crate::clearance::words),
         check: file
             .check
             .as_ref()

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::bands::{ChannelBand, Shares};
 use crate::check::{CHANNEL_NAMES, CHANNEL_WORDS, Check};
+use crate::clearance::ClearanceStats;
 use crate::discrepancy::HeldOutRecord;
 use crate::{Prediction, Prepared};
 
@@ -123,6 +124,9 @@ pub struct PredictionFile {
     /// The post-flight check, when a flown release was given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub check: Option<Check>,
+    /// The clearance to the aircraft, when a geometry was given (docs/model.md section 14.3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<ClearanceStats>,
     /// `fit` or `diagnosis`.
     pub from_kind: String,
     /// The source directory.
@@ -274,6 +278,7 @@ pub fn prediction_file(
             })
             .collect(),
         check: p.check.clone(),
+        clearance: p.clearance.clone(),
         from_kind: prepared.source.kind.name().into(),
         from: from.display().to_string(),
         sigma_pos_m: prepared.source.noise.pos_m,

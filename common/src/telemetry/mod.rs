@@ -257,6 +257,37 @@ impl Trajectory {
         write_atomically(path, self.to_csv_string().as_bytes())
     }
 
+    /// Writes the trajectory atomically with `extra` columns after the seven (each a header
+    /// whose quantity readers ignore, such as `clearance_m`, and one value per sample).
+    pub fn write_with_columns(
+        &self,
+        path: &Path,
+        extra: &[(&str, &[f64])],
+    ) -> Result<(), WriteError> {
+        let mut s = String::with_capacity(64 * (self.len() + 8));
+        for c in &self.comments {
+            let _ = writeln!(s, "# {c}");
+        }
+        s.push_str("t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg");
+        for (h, _) in extra {
+            let _ = write!(s, ",{h}");
+        }
+        s.push('\n');
+        for k in 0..self.len() {
+            let (p, a) = (self.pos_m[k], self.att_deg[k]);
+            let _ = write!(
+                s,
+                "{},{},{},{},{},{},{}",
+                self.times_s[k], p[0], p[1], p[2], a[0], a[1], a[2]
+            );
+            for (_, v) in extra {
+                let _ = write!(s, ",{}", v.get(k).copied().unwrap_or(f64::NAN));
+            }
+            s.push('\n');
+        }
+        write_atomically(path, s.as_bytes())
+    }
+
     /// Adds a `# key = value` comment (and metadata entry).
     pub fn push_metadata(&mut self, key: &str, value: &str) {
         self.comments.push(format!("{key} = {value}"));
