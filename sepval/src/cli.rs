@@ -42,6 +42,9 @@ pub enum Command {
     /// Predict a release not flown, with bands from the factors, the model's form and the
     /// measurement; with --data, check a flown release against them.
     Predict(Box<PredictArgs>),
+    /// Map the separation envelope: the store's clearance to the aircraft predicted over a grid
+    /// of flight conditions, and where it holds with confidence.
+    Envelope(Box<EnvelopeArgs>),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
     /// Check the Pareto machinery on problems with known fronts.
@@ -229,6 +232,8 @@ pub struct PredictArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub validate: Vec<PathBuf>,
     #[command(flatten)]
+    pub geometry: GeometryArgs,
+    #[command(flatten)]
     pub eval: EvalArgs,
     /// Output directory (prediction.json, bands.csv, report.html, figures/).
     #[arg(long, value_name = "DIR")]
@@ -337,6 +342,69 @@ pub struct TablesArgs {
     pub strict_tables: bool,
 }
 
+/// The store and the aircraft whose clearance is assessed (docs/geometry.md).
+#[derive(clap::Args)]
+pub struct GeometryArgs {
+    /// The aircraft's geometry in the launch frame: STL (ASCII or binary) or TOML of
+    /// primitives, e.g. examples/geometry/aircraft.toml.
+    #[arg(long, value_name = "FILE")]
+    pub aircraft: Option<PathBuf>,
+    /// The store's shape in body axes about its CG (STL or TOML) [default: the scenario's
+    /// store of revolution with four fins].
+    #[arg(long, value_name = "FILE", requires = "aircraft")]
+    pub store_shape: Option<PathBuf>,
+    /// The smallest clearance allowed [mm] (MIL-STD-1289D: 25.4).
+    #[arg(long, default_value_t = 25.4, value_name = "MM", allow_hyphen_values = true)]
+    pub clearance_mm: f64,
+}
+
+#[derive(clap::Args)]
+pub struct EnvelopeArgs {
+    /// The output directory of `sepval fit` (with --method ga+lm or hill+lm) or of `sepval
+    /// diagnose` to predict from.
+    #[arg(long, value_name = "DIR")]
+    pub from: PathBuf,
+    /// Mach values: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub mach: Option<String>,
+    /// Altitudes [m]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub altitude_m: Option<String>,
+    /// Aircraft angles of attack [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub alpha_deg: Option<String>,
+    /// Aircraft sideslip angles [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub beta_deg: Option<String>,
+    /// Flight-path angles [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub gamma_deg: Option<String>,
+    /// Model extension (TOML) the source was fitted with [default: the one its inputs record].
+    #[arg(long, value_name = "FILE")]
+    pub extension: Option<PathBuf>,
+    /// Samples per condition.
+    #[arg(long, default_value_t = 1000, value_name = "N")]
+    pub samples: usize,
+    /// Seed of every draw (the same samples at every condition).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// A release held out of the fit (CSV; repeatable): calibrates the model-form discrepancy.
+    #[arg(long, value_name = "FILE.csv")]
+    pub validate: Vec<PathBuf>,
+    #[command(flatten)]
+    pub geometry: GeometryArgs,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// Output directory (envelope.csv, envelope.json, report.html, figures/).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Go on with the interrupted sweep in --out (same inputs) instead of starting anew.
+    #[arg(long, conflicts_with = "overwrite")]
+    pub resume: bool,
+    #[command(flatten)]
+    pub overwrite: OverwriteArgs,
+}
+
 /// Whether an earlier run in `--out` may be cleared (fit, diagnose, plan).
 #[derive(clap::Args)]
 pub struct OverwriteArgs {
@@ -417,6 +485,8 @@ pub struct SimulateArgs {
     pub rate: Option<f64>,
     #[command(flatten)]
     pub tables: TablesArgs,
+    #[command(flatten)]
+    pub geometry: GeometryArgs,
     /// Output CSV file (written atomically).
     #[arg(long, value_name = "FILE.csv")]
     pub out: PathBuf,

@@ -74,6 +74,7 @@ fn main() -> ExitCode {
         Command::Diagnose(args) => command::diagnose::run(*args),
         Command::Plan(args) => command::plan::run(*args),
         Command::Predict(args) => command::predict::run(*args),
+        Command::Envelope(args) => command::envelope::run(*args),
         Command::Bench(args) => command::bench::run(args),
         Command::Gateway(args) => command::gateway::run(args),
         Command::Selftest(c) => command::selftest::run(c),

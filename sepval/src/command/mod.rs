@@ -5,8 +5,10 @@
 
 pub mod bench;
 pub mod clean_ipc;
+pub mod clearance;
 pub mod diagnose;
 pub mod effects;
+pub mod envelope;
 pub mod fit;
 pub mod gateway;
 pub mod goals;

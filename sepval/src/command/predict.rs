@@ -6,14 +6,15 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use sepval_common::evaluation::Event;
+use sepval_common::evaluation::{Event, Job};
 use sepval_common::telemetry::Trajectory;
 use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_predict::{
-    Flown, PredictionFile, Settings, predict, prediction_file, prepare, read_source, write_outputs,
+    Flown, PredictionFile, Settings, Source, predict, prediction_file, prepare, read_source,
+    write_outputs,
 };
 
-use super::{Bar, count, evaluator_spec, inputs, notices};
+use super::{Bar, clearance, count, evaluator_spec, inputs, notices};
 use crate::cli::PredictArgs;
 
 /// Runs `sepval predict`. Every input (the flags, the source, its releases, the condition, the
@@ -29,43 +30,21 @@ pub fn run(args: PredictArgs) -> Result<()> {
         threads: count("--threads", args.eval.threads)?,
     };
     settings.check()?;
-    let source = read_source(&args.from)?;
-    let record = source.inputs.clone();
-    let extension = args.extension.clone().or(record.extension.clone());
-    let (fitted, _) = inputs::job(
-        &record.data,
-        record.scenario.as_deref(),
-        extension.as_deref(),
-    )
-    .with_context(|| {
-        format!(
-            "--from {}: the releases it was fitted to",
-            args.from.display()
-        )
-    })?;
+    let (source, fitted, held_out) =
+        source_inputs(&args.from, args.extension.as_deref(), &args.validate)?;
+    let extension = args.extension.clone().or(source.inputs.extension.clone());
     let condition = inputs::scenario(Some(&args.scenario), extension.as_deref())
         .with_context(|| format!("--scenario {}", args.scenario.display()))?;
-    let mut held: Vec<PathBuf> = args.validate.clone();
-    let recorded = source
-        .held_out
-        .iter()
-        .filter(|p| !held.contains(p))
-        .cloned();
-    held.extend(recorded.collect::<Vec<_>>());
-    let held_out: Vec<Event> = inputs::validation_job(
-        &held,
-        &record.data,
-        &fitted,
-        record.scenario.as_deref(),
-        extension.as_deref(),
-    )?
-    .map(|j| j.events().to_vec())
-    .unwrap_or_default();
     let flown = match &args.data {
         Some(path) => Some(flown(path, &condition)?),
         None => None,
     };
+    let clearance = clearance::settings(&args.geometry, &condition)?;
     let prepared = prepare(source, fitted, condition, held_out, flown, settings)?;
+    let prepared = match clearance {
+        Some(c) => prepared.with_clearance(c),
+        None => prepared,
+    };
     let claim = if args.overwrite.overwrite {
         Claim::Overwrite
     } else {
@@ -83,6 +62,43 @@ pub fn run(args: PredictArgs) -> Result<()> {
     print!("{}", summary_lines(&file, &args.out));
     drop(run_dir);
     Ok(())
+}
+
+/// The source of `--from` read and checked, the releases it was fitted to, and the releases held
+/// out (`--validate`, then those the source records).
+pub fn source_inputs(
+    from: &Path,
+    extension: Option<&Path>,
+    validate: &[PathBuf],
+) -> Result<(Source, Job, Vec<Event>)> {
+    let source = read_source(from)?;
+    let record = source.inputs.clone();
+    let extension = extension
+        .map(Path::to_path_buf)
+        .or(record.extension.clone());
+    let (fitted, _) = inputs::job(
+        &record.data,
+        record.scenario.as_deref(),
+        extension.as_deref(),
+    )
+    .with_context(|| format!("--from {}: the releases it was fitted to", from.display()))?;
+    let mut held: Vec<PathBuf> = validate.to_vec();
+    let recorded = source
+        .held_out
+        .iter()
+        .filter(|p| !held.contains(p))
+        .cloned();
+    held.extend(recorded.collect::<Vec<_>>());
+    let held_out: Vec<Event> = inputs::validation_job(
+        &held,
+        &record.data,
+        &fitted,
+        record.scenario.as_deref(),
+        extension.as_deref(),
+    )?
+    .map(|j| j.events().to_vec())
+    .unwrap_or_default();
+    Ok((source, fitted, held_out))
 }
 
 /// The flown release of `--data`, whose metadata (when it names one) must give the condition
@@ -144,6 +160,12 @@ fn summary_lines(file: &PredictionFile, out: &Path) -> String {
     ));
     if let Some(c) = &file.check {
         s.push_str(&format!("check:     {}\n", c.verdict));
+    }
+    if let Some(c) = &file.clearance {
+        s.push_str(&format!(
+            "clearance: {}\n",
+            sepval_predict::clearance::words(c)
+        ));
     }
     s.push_str(&format!(
         "samples:   {} ({} ran), {} simulations, {:.1} s\n",

@@ -5,7 +5,7 @@ use sepval_common::limits::{check_sampling, check_steps};
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test_logged;
 
-use super::{inputs, positive};
+use super::{clearance, inputs, positive};
 use crate::cli::SimulateArgs;
 
 /// Runs `sepval simulate`.
@@ -18,6 +18,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         args.model.extension.as_deref(),
     )?;
     let factors = inputs::factors(&args.factors, &scenario.factors)?;
+    let clearance = clearance::settings(&args.geometry, &scenario)?;
     let t_end = t_end.unwrap_or(scenario.integrator.t_end_s);
     let rate = rate.unwrap_or(scenario.integrator.rate_hz);
     // The work of the run, refused before the sample times are made.
@@ -51,7 +52,17 @@ pub fn run(args: SimulateArgs) -> Result<()> {
             .collect();
         traj.push_metadata("extension_terms", &terms.join("; "));
     }
-    traj.write(&args.out)?;
+    match &clearance {
+        Some(c) => {
+            // The clearance of the trajectory written (its noise included, with --noise-seed).
+            let trace = clearance::trace(c, &traj)?;
+            let line = clearance::words(c, &trace);
+            traj.push_metadata("clearance", &line);
+            traj.write_with_columns(&args.out, &[("clearance_m", &trace.distance_m)])?;
+            eprintln!("clearance: {line}");
+        }
+        None => traj.write(&args.out)?,
+    }
     eprintln!(
         "wrote {} ({} samples, t = 0 to {} s)",
         args.out.display(),

@@ -10,6 +10,7 @@ mod cli;
 mod closing;
 mod diagnose;
 mod discover;
+mod envelope;
 mod fit;
 mod fuzz;
 mod gust;

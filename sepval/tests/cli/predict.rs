@@ -46,7 +46,7 @@ fn release(dir: &Path, scenario: &str, seed: &str, out: &str) {
 
 /// A directory holding two releases, `fit/` (their `ga+lm` fit), `ga/` (a fit without
 /// covariance), `cond.toml` (the condition to predict) and `flown.csv` (a release flown there).
-fn fixture() -> &'static Path {
+pub(crate) fn fixture() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();

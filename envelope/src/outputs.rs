@@ -1,0 +1,102 @@
+//! The envelope's outputs: DIR/figures/envelope.png (the probability of failing to clear over
+//! the map's two axes, with the allowed probability's contour and the releases flown),
+//! DIR/report.html (the answer first, the private module `page`), DIR/envelope.csv (one row
+//! per condition, [`crate::row`]) and DIR/envelope.json (the record), in that order,
+//! envelope.json last. Each file is written atomically and the cancellation flag is checked
+//! before each: a failed or interrupted envelope leaves no partial file.
+
+use std::path::{Path, PathBuf};
+
+use sepval_common::atomic_file::write_atomically;
+use sepval_plan::conditions::Quantity;
+use sepval_report::figures::{EnvelopeMap, MapAxis, Safety, envelope_map};
+
+use crate::grid::Grid;
+use crate::record::EnvelopeFile;
+use crate::row::csv;
+
+pub use sepval_report::OutputError;
+
+fn check_cancel() -> Result<(), OutputError> {
+    sepval_common::cancel::check().map_err(|_| OutputError::Interrupted)
+}
+
+/// Writes the figure, the page, envelope.csv and envelope.json into `out`; returns the files
+/// written.
+pub fn write_outputs(
+    grid: &Grid,
+    file: &EnvelopeFile,
+    out: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let figures = out.join("figures");
+    std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
+        path: figures.clone(),
+        source,
+    })?;
+    check_cancel()?;
+    let figure = figures.join("envelope.png");
+    map(grid, file, &figure)?;
+    let mut written = vec![figure];
+    check_cancel()?;
+    let html = crate::page::render(file, "figures/envelope.png")?;
+    let page = out.join("report.html");
+    write_atomically(&page, html.as_bytes()).map_err(OutputError::Write)?;
+    written.push(page);
+    check_cancel()?;
+    let path = out.join("envelope.csv");
+    write_atomically(&path, csv(&file.rows).as_bytes()).map_err(OutputError::Write)?;
+    written.push(path);
+    check_cancel()?;
+    let json = serde_json::to_string_pretty(file).expect("an envelope serialises") + "\n";
+    let path = out.join("envelope.json");
+    write_atomically(&path, json.as_bytes()).map_err(OutputError::Write)?;
+    written.push(path);
+    Ok(written)
+}
+
+/// DIR/figures/envelope.png: the worst probability of failing to clear in each cell.
+fn map(grid: &Grid, file: &EnvelopeFile, path: &Path) -> Result<(), OutputError> {
+    let axes = grid.map_axes();
+    let one = [grid.flight(0).mach];
+    let (xq, xv) = axes.first().copied().unwrap_or((Quantity::Mach, &one));
+    let ny = axes.get(1).map_or(1, |(_, v)| v.len());
+    let mut cells = vec![vec![f64::NAN; xv.len()]; ny];
+    for r in &file.rows {
+        let (ix, iy) = grid.cell(r.index);
+        let cell = &mut cells[iy][ix];
+        if !(cell.is_finite() && *cell >= r.p_fail) {
+            *cell = r.p_fail;
+        }
+    }
+    let title = format!(
+        "Probability of coming within {} mm of the aircraft or diverging",
+        file.criterion_mm
+    );
+    let criterion_label = format!(
+        "{:.0} % allowed (cleared inside)",
+        100.0 * file.allowed_probability
+    );
+    let x = MapAxis {
+        label: xq.label(),
+        values: xv,
+    };
+    let y = axes.get(1).map(|(q, v)| MapAxis {
+        label: q.label(),
+        values: v,
+    });
+    envelope_map(
+        path,
+        &EnvelopeMap {
+            title: &title,
+            x,
+            y,
+            cells: &cells,
+            value_label: "probability of failing to clear",
+            safety: Safety::LowIsSafe,
+            criterion: file.allowed_probability,
+            criterion_label: &criterion_label,
+            flown: &file.flown,
+        },
+    )?;
+    Ok(())
+}

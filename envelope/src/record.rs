@@ -1,0 +1,100 @@
+//! DIR/envelope.json: the envelope's record (format [`ENVELOPE_FORMAT`]).
+
+use serde::{Deserialize, Serialize};
+
+use sepval_plan::conditions::Quantity;
+use sepval_predict::clearance::ALLOWED_PROBABILITY;
+
+use crate::grid::Grid;
+use crate::row::Row;
+use crate::summary::Summary;
+
+/// The format of DIR/envelope.json.
+pub const ENVELOPE_FORMAT: &str = "sepval-envelope/1";
+
+/// One axis of the grid as recorded.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AxisRecord {
+    /// The quantity.
+    pub quantity: Quantity,
+    /// Its values.
+    pub values: Vec<f64>,
+}
+
+/// DIR/envelope.json.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnvelopeFile {
+    /// [`ENVELOPE_FORMAT`].
+    pub format: String,
+    /// The answer in words.
+    pub headline: String,
+    /// Per value of the map's second axis, the runs cleared and not.
+    pub summary: Vec<String>,
+    /// Conditions cleared.
+    pub cleared: usize,
+    /// Conditions.
+    pub conditions: usize,
+    /// The criterion \[mm\].
+    pub criterion_mm: f64,
+    /// The largest share of samples failing to clear at a cleared condition.
+    pub allowed_probability: f64,
+    /// The axes varied.
+    pub axes: Vec<AxisRecord>,
+    /// One row per condition, in grid order.
+    pub rows: Vec<Row>,
+    /// Samples per condition.
+    pub samples: usize,
+    /// The seed.
+    pub seed: u64,
+    /// The SHA-256 of the sweep's inputs ([`crate::progress::inputs_digest`]).
+    pub inputs_sha256: String,
+    /// The fit or diagnosis predicted from.
+    pub from: String,
+    /// The aircraft's geometry.
+    pub aircraft: String,
+    /// The store's shape (`default` for the scenario's store of revolution).
+    pub store_shape: String,
+    /// The releases flown (their conditions), marked on the map.
+    pub flown: Vec<(f64, f64)>,
+    /// Simulations run by this process (conditions resumed from not counted).
+    pub evaluations: u64,
+    /// Conditions taken from an interrupted sweep.
+    pub resumed: usize,
+    /// Wall time of this process \[s\].
+    pub wall_s: f64,
+}
+
+impl EnvelopeFile {
+    /// The record of a sweep.
+    pub fn new(grid: &Grid, rows: Vec<Row>, summary: &Summary, criterion_mm: f64) -> Self {
+        EnvelopeFile {
+            format: ENVELOPE_FORMAT.into(),
+            headline: summary.headline.clone(),
+            summary: summary.lines.clone(),
+            cleared: summary.cleared,
+            conditions: summary.total,
+            criterion_mm,
+            allowed_probability: ALLOWED_PROBABILITY,
+            axes: grid
+                .conditions
+                .axes
+                .iter()
+                .map(|(q, v)| AxisRecord {
+                    quantity: *q,
+                    values: v.clone(),
+                })
+                .collect(),
+            rows,
+            samples: 0,
+            seed: 0,
+            inputs_sha256: String::new(),
+            from: String::new(),
+            aircraft: String::new(),
+            store_shape: String::new(),
+            flown: Vec::new(),
+            evaluations: 0,
+            resumed: 0,
+            wall_s: f64::NAN,
+        }
+    }
+}

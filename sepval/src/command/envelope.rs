@@ -1,0 +1,226 @@
+//! `sepval envelope`: the store's clearance to the aircraft predicted over a grid of flight
+//! conditions from a fit or a diagnosis, mapped as a separation envelope; `--resume` goes on
+//! with an interrupted sweep.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use sepval_common::evaluation::EvalError;
+use sepval_envelope::grid::{Axis, Grid};
+use sepval_envelope::progress::{Progress, inputs_digest, progress_path};
+use sepval_envelope::summary::summarise;
+use sepval_envelope::{EnvelopeFile, Sweep, sweep, write_outputs};
+use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_plan::conditions::Quantity;
+use sepval_predict::Settings;
+
+use super::predict::source_inputs;
+use super::{Bar, clearance, count, evaluator_spec, notices};
+use crate::cli::EnvelopeArgs;
+
+/// Runs `sepval envelope`. Every input (the flags, the source, the geometry, the grid) is
+/// checked before the output directory is claimed or a worker started.
+pub fn run(args: EnvelopeArgs) -> Result<()> {
+    let spec = evaluator_spec(&args.eval)?;
+    let settings = Settings {
+        samples: args.samples,
+        level: 0.95,
+        seed: args.seed,
+        with_noise: false,
+        threads: count("--threads", args.eval.threads)?,
+    };
+    settings.check()?;
+    let Some(aircraft) = args.geometry.aircraft.clone() else {
+        bail!(
+            "--aircraft FILE is required: the aircraft's geometry (e.g. examples/geometry/aircraft.toml)"
+        );
+    };
+    let given = axes_given(&args);
+    if given.is_empty() {
+        bail!(
+            "give at least one axis to sweep: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N"
+        );
+    }
+    let axes: Vec<Axis> = given
+        .iter()
+        .map(|(q, text)| Axis::parse(*q, text))
+        .collect::<Result<_, _>>()?;
+    let (source, fitted, held_out) =
+        source_inputs(&args.from, args.extension.as_deref(), &args.validate)?;
+    let base = fitted.events()[0].simulator.scenario().clone();
+    let grid = Grid::of(&base, &axes)?;
+    let Some(clearance) = clearance::settings(&args.geometry, &base)? else {
+        bail!("--aircraft FILE is required");
+    };
+    let digest = digest(&args, &source.dir, &aircraft, &given)?;
+    let inputs_sha256 = digest.clone();
+    let (run_dir, progress) = claim(&args, digest, grid.len())?;
+    run_dir.prepare()?;
+    let start = Instant::now();
+    let sweep_inputs = Sweep {
+        source,
+        fitted,
+        held_out,
+        settings,
+        grid,
+        clearance,
+        progress_path: progress_path(&args.out),
+    };
+    let mut start_evaluator = |job| spec.start(job, notices()).map_err(EvalError::transport);
+    let swept = sweep(
+        &sweep_inputs,
+        progress,
+        &mut start_evaluator,
+        &mut Bar::new(),
+    )?;
+    let criterion_mm = args.geometry.clearance_mm;
+    let summary = summarise(&sweep_inputs.grid, &swept.rows, criterion_mm);
+    let mut file = EnvelopeFile::new(&sweep_inputs.grid, swept.rows, &summary, criterion_mm);
+    file.samples = args.samples;
+    file.seed = args.seed;
+    file.inputs_sha256 = inputs_sha256;
+    file.from = args.from.display().to_string();
+    file.aircraft = aircraft.display().to_string();
+    file.store_shape = args
+        .geometry
+        .store_shape
+        .as_ref()
+        .map_or("default".into(), |p| p.display().to_string());
+    file.flown = flown(&sweep_inputs);
+    file.evaluations = swept.evaluations;
+    file.resumed = swept.resumed;
+    file.wall_s = start.elapsed().as_secs_f64();
+    write_outputs(&sweep_inputs.grid, &file, &args.out)?;
+    let progress_file = progress_path(&args.out);
+    let _ = std::fs::remove_file(&progress_file);
+    if let Some(dir) = progress_file.parent() {
+        let _ = std::fs::remove_dir(dir);
+    }
+    println!("envelope:  {}", summary.headline);
+    for l in &summary.lines {
+        println!("           {l}");
+    }
+    println!(
+        "conditions: {} ({} resumed), {} samples each, {} simulations, {:.1} s",
+        file.conditions, file.resumed, file.samples, file.evaluations, file.wall_s
+    );
+    println!("report:    {}", args.out.join("report.html").display());
+    drop(run_dir);
+    Ok(())
+}
+
+/// Claims `--out` (fresh, cleared with --overwrite, or the interrupted sweep's with --resume,
+/// whose progress must record the same inputs) and returns the progress to go on from.
+fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunDir, Progress)> {
+    let progress_file = progress_path(&args.out);
+    let (claim, progress) = if args.resume {
+        let p = Progress::read(&progress_file, &digest, conditions).with_context(|| {
+            format!(
+                "--resume: the sweep in {} (run without --resume to start anew)",
+                args.out.display()
+            )
+        })?;
+        let checkpoint = progress_file.clone();
+        (
+            Claim::Resume {
+                checkpoint,
+                generation: 0,
+            },
+            p,
+        )
+    } else if args.overwrite.overwrite {
+        (Claim::Overwrite, Progress::new(digest, conditions))
+    } else {
+        (Claim::Fresh, Progress::new(digest, conditions))
+    };
+    let run_dir = RunDir::claim(&args.out, claim, "envelope").with_context(|| {
+        let hint = if progress_file.is_file() {
+            " (it holds an interrupted sweep: --resume goes on with it)"
+        } else {
+            ""
+        };
+        format!("--out {}{hint}", args.out.display())
+    })?;
+    Ok((run_dir, progress))
+}
+
+/// The axes given, in the order of `[flight]`.
+fn axes_given(args: &EnvelopeArgs) -> Vec<(Quantity, String)> {
+    [
+        (Quantity::Mach, &args.mach),
+        (Quantity::AltitudeM, &args.altitude_m),
+        (Quantity::AlphaDeg, &args.alpha_deg),
+        (Quantity::BetaDeg, &args.beta_deg),
+        (Quantity::GammaDeg, &args.gamma_deg),
+    ]
+    .into_iter()
+    .filter_map(|(q, v)| v.clone().map(|v| (q, v)))
+    .collect()
+}
+
+/// The releases flown, on the map's axes.
+fn flown(s: &Sweep) -> Vec<(f64, f64)> {
+    let axes = s.grid.map_axes();
+    s.fitted
+        .events()
+        .iter()
+        .map(|e| {
+            let f = &e.simulator.scenario().flight;
+            (
+                axes.first().map_or(f.mach, |(q, _)| q.get(f)),
+                axes.get(1).map_or(0.0, |(q, _)| q.get(f)),
+            )
+        })
+        .collect()
+}
+
+/// The digest of what decides the envelope: the source's records, the geometry files, the
+/// extension, the held-out files named, the axes and the settings.
+fn digest(
+    args: &EnvelopeArgs,
+    from: &Path,
+    aircraft: &Path,
+    axes: &[(Quantity, String)],
+) -> Result<String> {
+    let read = |p: &Path| -> Result<Vec<u8>> {
+        std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))
+    };
+    let mut parts: Vec<(String, Vec<u8>)> = Vec::new();
+    for name in ["result.json", "diagnosis.json"] {
+        let p = from.join(name);
+        if p.is_file() {
+            parts.push((name.into(), read(&p)?));
+        }
+    }
+    parts.push(("aircraft".into(), read(aircraft)?));
+    if let Some(p) = &args.geometry.store_shape {
+        parts.push(("store".into(), read(p)?));
+    }
+    if let Some(p) = &args.extension {
+        parts.push(("extension".into(), read(p)?));
+    }
+    let validate: Vec<String> = args
+        .validate
+        .iter()
+        .map(|p: &PathBuf| p.display().to_string())
+        .collect();
+    let axes: Vec<String> = axes
+        .iter()
+        .map(|(q, t)| format!("{}={t}", q.flag()))
+        .collect();
+    let settings = format!(
+        "samples={} seed={} clearance_mm={} validate={} axes={}",
+        args.samples,
+        args.seed,
+        args.geometry.clearance_mm,
+        validate.join(";"),
+        axes.join(";")
+    );
+    parts.push(("settings".into(), settings.into_bytes()));
+    let refs: Vec<(&str, &[u8])> = parts
+        .iter()
+        .map(|(l, b)| (l.as_str(), b.as_slice()))
+        .collect();
+    Ok(inputs_digest(&refs))
+}
