@@ -114,6 +114,13 @@ fn an_envelope_maps_every_condition_and_a_resumed_sweep_is_the_same_bits() {
 fn bad_envelope_input_is_refused_with_nothing_written() {
     let p = fixture();
     let aircraft = example("aircraft.toml");
+    // A pylon that reaches into the store at carriage.
+    std::fs::write(
+        p.join("deep-pylon.toml"),
+        "[[box]]\nname = \"pylon\"\ncentre_m = [0.0, 0.0, -0.3]\nhalf_extents_m = [0.5, 0.05, 0.1]\n",
+    )
+    .unwrap();
+    std::fs::write(p.join("empty.stl"), "").unwrap();
     let run = |out: &str, extra: &[&str]| {
         let mut args = vec!["envelope", "--from", "fit", "--out", out, "--samples", "10"];
         args.extend(extra);
@@ -137,6 +144,14 @@ fn bad_envelope_input_is_refused_with_nothing_written() {
         (
             vec!["--aircraft", &aircraft, "--mach", "0.7:0.9:3", "--resume"],
             "progress.json",
+        ),
+        (
+            vec!["--aircraft", "deep-pylon.toml", "--mach", "0.7:0.9:3"],
+            "intersects the aircraft (deep-pylon.toml) at carriage",
+        ),
+        (
+            vec!["--aircraft", "empty.stl", "--mach", "0.7:0.9:3"],
+            "empty.stl",
         ),
         (
             vec![
@@ -222,4 +237,102 @@ fn simulate_and_predict_report_the_clearance() {
     assert!(m["p5"].as_f64().unwrap() <= m["p50"].as_f64().unwrap());
     assert!(m["p50"].as_f64().unwrap() <= m["p95"].as_f64().unwrap());
     assert!(!c["closest_parts"].as_array().unwrap().is_empty());
+}
+
+/// A made-up aircraft: a block behind and below the carriage (a tail) that a store falling
+/// far enough aft before it has fallen deep enough strikes: at low altitude and high Mach
+/// (high dynamic pressure, high drag) it does, high and slow it does not.
+const TAIL: &str = r#"
+[[box]]
+name = "tail"
+centre_m = [-12.5, 0.0, 8.0]
+half_extents_m = [7.5, 10.0, 4.0]
+"#;
+
+/// The smallest clearance [mm] that `sepval simulate --aircraft` gives the base model at
+/// `mach` and `altitude_m` (its `# clearance = smallest clearance X mm ...` line).
+fn true_clearance_mm(dir: &Path, mach: f64, altitude_m: f64) -> f64 {
+    let mut s = sepval_common::scenario::Scenario::embedded_default();
+    s.flight.mach = mach;
+    s.flight.altitude_m = altitude_m;
+    let name = format!("truth-{mach}-{altitude_m}");
+    std::fs::write(dir.join(format!("{name}.toml")), s.to_toml_string()).unwrap();
+    let scenario = format!("{name}.toml");
+    let out = format!("{name}.csv");
+    ok(&sepval(
+        &[
+            "simulate",
+            "--scenario",
+            &scenario,
+            "--factors",
+            "base.json",
+            "--aircraft",
+            "tail.toml",
+            "--out",
+            &out,
+        ],
+        dir,
+    ));
+    let text = std::fs::read_to_string(dir.join(&out)).unwrap();
+    let line = text
+        .lines()
+        .find_map(|l| l.strip_prefix("# clearance = smallest clearance "))
+        .unwrap();
+    line.split(' ').next().unwrap().parse().unwrap()
+}
+
+#[test]
+fn the_envelope_clears_where_the_true_store_misses_a_tail_and_not_where_it_strikes() {
+    let p = fixture();
+    std::fs::write(p.join("tail.toml"), TAIL).unwrap();
+    ok(&sepval(
+        &[
+            "envelope",
+            "--from",
+            "fit",
+            "--aircraft",
+            "tail.toml",
+            "--mach",
+            "0.6:0.95:4",
+            "--altitude-m",
+            "1000:9000:3",
+            "--samples",
+            "40",
+            "--evaluator",
+            "inproc",
+            "--out",
+            "env-tail",
+        ],
+        p,
+    ));
+    let j: Value =
+        serde_json::from_str(&std::fs::read_to_string(p.join("env-tail/envelope.json")).unwrap())
+            .unwrap();
+    let (mut clear, mut strike) = (0, 0);
+    for r in j["rows"].as_array().unwrap() {
+        let c = &r["condition"];
+        let (mach, alt) = (
+            c["mach"].as_f64().unwrap(),
+            c["altitude_m"].as_f64().unwrap(),
+        );
+        let truth = true_clearance_mm(p, mach, alt);
+        let cleared = r["cleared"].as_bool().unwrap();
+        if truth >= 150.0 {
+            clear += 1;
+            assert!(
+                cleared,
+                "Mach {mach}, {alt} m: the store misses by {truth} mm: {r}"
+            );
+        } else if truth <= 0.0 {
+            strike += 1;
+            assert!(
+                !cleared,
+                "Mach {mach}, {alt} m: the store strikes the tail: {r}"
+            );
+        }
+    }
+    assert!(
+        clear >= 3 && strike >= 3,
+        "{clear} clear and {strike} strikes"
+    );
 }
