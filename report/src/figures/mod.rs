@@ -26,6 +26,10 @@
 //!   of too small a clearance, or a low percentile of it) coloured by which side of the
 //!   criterion is [`Safety`], the criterion's contour ([`contour_segments`], marching squares)
 //!   over it and the releases flown marked.
+//! - [`clearance_figure`]: the clearance between a store and the aircraft against time, one
+//!   line per release, the criterion, each release's smallest clearance counted, the time the
+//!   ejector holds the store shaded, and a panel near the criterion when the clearances span
+//!   metres.
 //!
 //! Choices made here:
 //! - Rendering needs no system library and no installed font: `plotters` draws into an in-memory
@@ -48,8 +52,8 @@
 //! ranges, ticks, palette, legends, lines and marks) is the private submodule `kit`; each
 //! figure family has a submodule of its own (`trajectory`, `factors`, `pareto`,
 //! `convergence`, `residuals`, `increments`, `correlation`, `throughput`, `condition_map`,
-//! `channels`, `bands`, `envelope_map` with its colour scale `envelope_scale`) whose function is
-//! re-exported here; `contour` computes contours for the maps.
+//! `channels`, `bands`, `envelope_map` with its colour scale `envelope_scale`, `clearance`)
+//! whose function is re-exported here; `contour` computes contours for the maps.
 
 use std::path::{Path, PathBuf};
 
@@ -57,6 +61,7 @@ use sepval_common::telemetry::Trajectory;
 
 mod bands;
 mod channels;
+mod clearance;
 mod condition_map;
 mod contour;
 mod convergence;
@@ -75,6 +80,7 @@ mod trajectory;
 
 pub use bands::{Band, band_figure};
 pub use channels::channel_figure;
+pub use clearance::{ClearanceSeries, clearance_figure};
 pub use condition_map::{MapAxis, condition_map};
 pub use contour::{GridError, Segment, contour_segments, row_crossings};
 pub use convergence::convergence_figure;
