@@ -61,7 +61,7 @@ const CRITERION_RED: RGBColor = RGBColor(190, 0, 0);
 /// The range that matters reaches at least this many times the criterion (which so lies in
 /// its lower part)...
 const CRITERION_HEADROOM: f64 = 2.5;
-/// ... and this many times the largest minimum (room for its value above its dot).
+/// ... and this many times the largest minimum (so that no dot sits on the top edge).
 const MINIMUM_HEADROOM: f64 = 1.3;
 /// A panel near the criterion is added when the whole range is more than this many times the
 /// range that matters (which would then fill less than a fifth of the one panel).
