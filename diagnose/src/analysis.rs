@@ -160,6 +160,7 @@ pub(super) fn analyse(
         discovered,
         ambiguous: !rivals.is_empty(),
         rivals,
+        clearance: None,
         alternatives,
         extension,
         discovery_notes: d.notes,

@@ -205,6 +205,10 @@ pub struct Diagnosis {
     pub ambiguous: bool,
     /// Explanations the data cannot tell from the answer, best first.
     pub rivals: Vec<RivalReport>,
+    /// The clearance to the aircraft of the answer's trajectory of each release, when the
+    /// diagnosis was given `--aircraft` (docs/model.md section 14.2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<Vec<sepval_fit::results::ReleaseClearance>>,
     /// Models that explain part of the data but not as well as the answer (mimics).
     pub alternatives: Vec<Alternative>,
     /// The discovered extension and its gain, when discovery verified one.

@@ -46,8 +46,34 @@ pub struct FitResult {
     /// fitted, as diagnosis.json's `inputs` does.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inputs: Option<InputsRecord>,
+    /// The clearance to the aircraft of the best fit's trajectory of each release, when the
+    /// fit was given `--aircraft` (docs/model.md section 14.2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<Vec<ReleaseClearance>>,
     /// How this run was executed (not part of the deterministic result).
     pub run: RunInfo,
+}
+
+/// The clearance of one release's trajectory (docs/model.md section 14.2), as result.json and
+/// diagnosis.json record it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReleaseClearance {
+    /// The release.
+    pub release: String,
+    /// The criterion \[mm\].
+    pub criterion_mm: f64,
+    /// The smallest clearance once the store has moved the ejector's stroke \[mm\].
+    pub min_clearance_mm: f64,
+    /// Its time \[s\].
+    pub t_min_s: f64,
+    /// The store's part that comes closest.
+    pub store_part: String,
+    /// The aircraft's part it comes closest to.
+    pub aircraft_part: String,
+    /// Whether the smallest clearance keeps the criterion.
+    pub clears: bool,
+    /// Whether the store moved the stroke within the record (else every sample counts).
+    pub free_flight_reached: bool,
 }
 
 /// Where the fit's inputs came from (so that `rerun` and `--resume` can find them again, and

@@ -114,6 +114,8 @@ pub struct FitArgs {
     #[command(flatten)]
     pub eval: EvalArgs,
     #[command(flatten)]
+    pub geometry: GeometryArgs,
+    #[command(flatten)]
     pub noise: NoiseArgs,
     /// The true factors (JSON), for Figure 7; the embedded truth is used with the default data.
     #[arg(long, value_name = "FILE.json")]
@@ -156,6 +158,8 @@ pub struct DiagnoseArgs {
     pub lm_budget: u64,
     #[command(flatten)]
     pub eval: EvalArgs,
+    #[command(flatten)]
+    pub geometry: GeometryArgs,
     #[command(flatten)]
     pub noise: NoiseArgs,
     #[command(flatten)]
@@ -354,7 +358,12 @@ pub struct GeometryArgs {
     #[arg(long, value_name = "FILE", requires = "aircraft")]
     pub store_shape: Option<PathBuf>,
     /// The smallest clearance allowed [mm] (MIL-STD-1289D: 25.4).
-    #[arg(long, default_value_t = 25.4, value_name = "MM", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        default_value_t = 25.4,
+        value_name = "MM",
+        allow_hyphen_values = true
+    )]
     pub clearance_mm: f64,
 }
 

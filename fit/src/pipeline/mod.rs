@@ -312,6 +312,7 @@ fn fit_result(cx: &Context, found: Found, describe: String, start: Instant) -> F
         identifiability: found.identifiability,
         resolution: found.resolution,
         inputs: Some(options.inputs.clone()),
+        clearance: None,
         run: RunInfo {
             evaluator: describe,
             wall_s: start.elapsed().as_secs_f64(),

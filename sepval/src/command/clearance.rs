@@ -5,10 +5,14 @@ use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
+use sepval_common::atomic_file::write_atomically;
+use sepval_common::evaluation::{Candidate, Evaluator, InProcess, Job};
 use sepval_common::scenario::Scenario;
 use sepval_common::telemetry::Trajectory;
+use sepval_fit::results::ReleaseClearance;
 use sepval_geometry::{Body, Geometry, Pose, Role, Trace};
 use sepval_predict::ClearanceSettings;
+use sepval_report::figures::{ClearanceSeries, clearance_figure};
 
 use crate::cli::GeometryArgs;
 
@@ -93,4 +97,125 @@ pub fn words(c: &ClearanceSettings, t: &Trace) -> String {
         g.store_part(t.min.store_part),
         g.aircraft_part(t.min.aircraft_part)
     )
+}
+
+/// The clearance of each release's trajectory (`releases`: name, sample times and samples),
+/// written to `out/clearance.csv` (`release, t_s, clearance_m`, one row per sample) and
+/// `out/figures/clearance.png`, and returned as the records of result.json and diagnosis.json.
+pub fn of_releases(
+    c: &ClearanceSettings,
+    releases: &[(String, Trajectory)],
+    out: &Path,
+) -> Result<Vec<ReleaseClearance>> {
+    let mut records = Vec::with_capacity(releases.len());
+    let mut traces = Vec::with_capacity(releases.len());
+    let mut csv = String::from("release,t_s,clearance_m\n");
+    for (name, traj) in releases {
+        let t = trace(c, traj).with_context(|| format!("release {name}"))?;
+        let quoted = if name.contains([',', '"']) {
+            format!("\"{}\"", name.replace('"', "\"\""))
+        } else {
+            name.clone()
+        };
+        for (ts, d) in traj.times_s.iter().zip(&t.distance_m) {
+            csv.push_str(&format!("{quoted},{ts},{d}\n"));
+        }
+        records.push(ReleaseClearance {
+            release: name.clone(),
+            criterion_mm: 1e3 * c.criterion_m,
+            min_clearance_mm: 1e3 * t.min.distance_m,
+            t_min_s: t.t_min_s,
+            store_part: c.geometry.store_part(t.min.store_part).to_string(),
+            aircraft_part: c.geometry.aircraft_part(t.min.aircraft_part).to_string(),
+            clears: t.min.distance_m >= c.criterion_m,
+            free_flight_reached: t.free_flight_reached,
+        });
+        traces.push(t);
+    }
+    write_atomically(&out.join("clearance.csv"), csv.as_bytes())?;
+    let figures = out.join("figures");
+    std::fs::create_dir_all(&figures)
+        .with_context(|| format!("cannot create {}", figures.display()))?;
+    let series: Vec<ClearanceSeries> = releases
+        .iter()
+        .zip(&traces)
+        .map(|((name, traj), t)| ClearanceSeries {
+            label: name,
+            t_s: &traj.times_s,
+            clearance_m: &t.distance_m,
+            free_from_s: traj.times_s.get(t.assessed_from).copied().unwrap_or(0.0),
+            min_t_s: t.t_min_s,
+            min_m: t.min.distance_m,
+        })
+        .collect();
+    clearance_figure(
+        &figures.join("clearance.png"),
+        "Clearance to the aircraft along each release",
+        &series,
+        c.criterion_m,
+    )?;
+    Ok(records)
+}
+
+/// Each release of `job` simulated by `candidate` in this process, as trajectories.
+pub fn simulate_releases(
+    job: &Arc<Job>,
+    candidate: Candidate,
+    threads: usize,
+) -> Result<Vec<(String, Trajectory)>> {
+    let mut evaluator = InProcess::new(Arc::clone(job), threads);
+    let e = evaluator
+        .evaluate(&[candidate], true)
+        .context("the best trajectories")?
+        .pop()
+        .context("no evaluation")?;
+    let Some(samples) = e.samples else {
+        bail!(
+            "the best model does not simulate every release: {:?}",
+            e.outcome
+        );
+    };
+    Ok(job
+        .events()
+        .iter()
+        .zip(samples)
+        .map(|(ev, s)| {
+            let traj = Trajectory {
+                times_s: ev.data.times_s.clone(),
+                pos_m: s.iter().map(|o| o.pos_m).collect(),
+                att_deg: s.iter().map(|o| o.att_deg).collect(),
+                ..Trajectory::default()
+            };
+            (ev.name.clone(), traj)
+        })
+        .collect())
+}
+
+/// The clearance of the best trajectories of a fit or diagnosis in `out`, for `--aircraft`
+/// given: rewrites `record` (result.json or diagnosis.json) with its `clearance` and prints
+/// one line per release.
+pub fn record_releases<T: serde::Serialize>(
+    c: &ClearanceSettings,
+    releases: &[(String, Trajectory)],
+    out: &Path,
+    file: &str,
+    record: &mut T,
+    set: impl FnOnce(&mut T, Vec<ReleaseClearance>),
+) -> Result<()> {
+    let records = of_releases(c, releases, out)?;
+    for r in &records {
+        println!(
+            "clearance: {}: smallest {:.1} mm at t = {:.3} s ({} / {}): {}",
+            r.release,
+            r.min_clearance_mm,
+            r.t_min_s,
+            r.store_part,
+            r.aircraft_part,
+            if r.clears { "clears" } else { "does not clear" }
+        );
+    }
+    set(record, records);
+    let json = serde_json::to_vec_pretty(record).context("a record serialises")?;
+    write_atomically(&out.join(file), &json)?;
+    Ok(())
 }

@@ -12,7 +12,7 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 
-use super::{Bar, evaluator_spec, inputs, notices};
+use super::{Bar, clearance, evaluator_spec, inputs, notices};
 use crate::cli::DiagnoseArgs;
 
 /// Runs `sepval diagnose`. The output directory is claimed (locked and checked) before anything
@@ -33,9 +33,23 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
         )
     })?;
     let DiagnoseConfig { job, options } = configure(&args)?;
+    let base = job.events()[0].simulator.scenario().clone();
+    let geometry = clearance::settings(&args.geometry, &base)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;
     run_dir.prepare()?;
-    let d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
+    let mut d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
+    if let Some(c) = &geometry {
+        // The answer's trajectories: the model diagnosis.json records, rebuilt as predict does.
+        let source = sepval_predict::read_source(&args.out)?;
+        let ensemble = sepval_predict::Ensemble::of(&source, evaluator.job().factor_table())
+            .context("the answer of the diagnosis")?;
+        let threads = super::count("--threads", args.eval.threads)?;
+        let releases =
+            clearance::simulate_releases(evaluator.job(), ensemble.answer().candidate, threads)?;
+        clearance::record_releases(c, &releases, &args.out, "diagnosis.json", &mut d, |d, v| {
+            d.clearance = Some(v)
+        })?;
+    }
     print!("{}", summary_lines(&d, &args.out));
     drop(run_dir);
     // Tables left by the fitted runs, as simulate and fit report them (--strict-tables refused

@@ -13,7 +13,7 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 
-use super::{Bar, evaluator_spec, inputs, notices};
+use super::{Bar, clearance, evaluator_spec, inputs, notices};
 use crate::cli::{FitArgs, MethodArg};
 
 /// The library's method of `--method`.
@@ -36,6 +36,8 @@ pub fn run(args: FitArgs) -> Result<()> {
     let resume = args.resume.as_deref().map(Checkpoint::load).transpose()?;
     let run_dir = claim(&args, resume.as_ref())?;
     let FitConfig { job, options } = configure(&args, resume)?;
+    let base = job.events()[0].simulator.scenario().clone();
+    let geometry = clearance::settings(&args.geometry, &base)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;
     if let (Some(c), Some(path)) = (&options.resume, args.resume.as_deref()) {
         // Its members re-evaluated and its generation replayed before going on from it.
@@ -52,7 +54,10 @@ pub fn run(args: FitArgs) -> Result<()> {
             removed.display()
         );
     }
-    let output = run_fit(&options, evaluator.as_mut(), &mut Bar::new())?;
+    let mut output = run_fit(&options, evaluator.as_mut(), &mut Bar::new())?;
+    if let Some(c) = &geometry {
+        best_clearance(c, &args, evaluator.job(), &mut output)?;
+    }
     render(&args, evaluator.job(), &output)?;
     drop(run_dir);
     // Tables left by the best fit: reported, or an error with --strict-tables.
@@ -207,6 +212,35 @@ fn searches(args: &FitArgs, resume: Option<&Checkpoint>, job: &Job) -> Result<Se
     let sigma = Sigma::resolve(job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
         .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
     Ok(Searches { ga, hill, sigma })
+}
+
+/// The clearance of the best fit's trajectories (`--aircraft`): clearance.csv, the figure and
+/// result.json's `clearance`.
+fn best_clearance(
+    c: &sepval_predict::ClearanceSettings,
+    args: &FitArgs,
+    job: &Arc<Job>,
+    output: &mut FitOutput,
+) -> Result<()> {
+    let Some(best) = output
+        .result
+        .methods
+        .values()
+        .min_by(|a, b| a.best.weighted.total_cmp(&b.best.weighted))
+    else {
+        return Ok(());
+    };
+    let candidate = sepval_common::evaluation::Candidate::baseline(best.best.factors);
+    let threads = super::count("--threads", args.eval.threads)?;
+    let releases = clearance::simulate_releases(job, candidate, threads)?;
+    clearance::record_releases(
+        c,
+        &releases,
+        &args.out,
+        "result.json",
+        &mut output.result,
+        |r, v| r.clearance = Some(v),
+    )
 }
 
 /// The summary on stdout, the figures (unless --no-figures), and where the result is.

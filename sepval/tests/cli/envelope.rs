@@ -336,3 +336,60 @@ fn the_envelope_clears_where_the_true_store_misses_a_tail_and_not_where_it_strik
         "{clear} clear and {strike} strikes"
     );
 }
+
+#[test]
+fn fit_and_diagnose_record_the_clearance_of_their_best_trajectories() {
+    let p = fixture();
+    let aircraft = example("aircraft.toml");
+    let common = [
+        "--data",
+        "a.csv",
+        "--evaluator",
+        "inproc",
+        "--threads",
+        "2",
+        "--aircraft",
+        aircraft.as_str(),
+    ];
+    let mut fit = vec![
+        "fit",
+        "--method",
+        "ga+lm",
+        "--generations",
+        "3",
+        "--population",
+        "20",
+        "--out",
+        "fit-clear",
+    ];
+    fit.extend(common);
+    let stdout = ok(&sepval(&fit, p));
+    assert!(stdout.contains("clearance: a.csv: smallest"), "{stdout}");
+    let mut diagnose = vec!["diagnose", "--out", "diag-clear"];
+    diagnose.extend(common);
+    ok(&sepval(&diagnose, p));
+    for (dir, file) in [
+        ("fit-clear", "result.json"),
+        ("diag-clear", "diagnosis.json"),
+    ] {
+        let j: Value =
+            serde_json::from_str(&std::fs::read_to_string(p.join(dir).join(file)).unwrap())
+                .unwrap();
+        let c = &j["clearance"][0];
+        assert_eq!(c["release"], "a.csv", "{dir}: {j:.300}");
+        let mm = c["min_clearance_mm"].as_f64().unwrap();
+        assert!(
+            mm > 25.4,
+            "{dir}: the benchmark store clears the pylon: {c}"
+        );
+        assert_eq!(c["clears"], true);
+        assert_eq!(c["free_flight_reached"], true);
+        let csv = std::fs::read_to_string(p.join(dir).join("clearance.csv")).unwrap();
+        assert!(
+            csv.starts_with("release,t_s,clearance_m\na.csv,0,"),
+            "{csv:.80}"
+        );
+        assert_eq!(csv.lines().count(), 202, "{dir}: one row per sample");
+        assert!(p.join(dir).join("figures/clearance.png").is_file());
+    }
+}
