@@ -65,6 +65,27 @@ pub fn summarise(grid: &Grid, rows: &[Row], criterion_mm: f64) -> Summary {
             total,
         };
     };
+    if cleared == total || cleared == 0 {
+        // One verdict over the whole grid: one line.
+        let word = if cleared == total {
+            "cleared"
+        } else {
+            "not cleared"
+        };
+        let ranges: Vec<String> = axes
+            .iter()
+            .map(|(q, v)| match v {
+                [one] => value(*q, *one),
+                _ => span(*q, v[0], v[v.len() - 1]),
+            })
+            .collect();
+        return Summary {
+            headline,
+            lines: vec![format!("{word} everywhere swept: {}", ranges.join(", "))],
+            cleared,
+            total,
+        };
+    }
     let ny = axes.get(1).map_or(1, |(_, v)| v.len());
     let mut ok = vec![vec![true; xv.len()]; ny];
     for r in rows {
@@ -135,5 +156,13 @@ mod tests {
             ]
         );
         assert!(sum.headline.starts_with("Cleared at 6 of 8 conditions"));
+        let all: Vec<Row> = rows
+            .into_iter()
+            .map(|r| Row { cleared: true, ..r })
+            .collect();
+        assert_eq!(
+            summarise(&g, &all, 25.4).lines,
+            vec!["cleared everywhere swept: Mach 0.60-0.90, altitude 1000-5000 m"]
+        );
     }
 }

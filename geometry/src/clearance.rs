@@ -184,6 +184,17 @@ impl Geometry {
         best
     }
 
+    /// A lower bound on the clearance at `pose` (the smallest of the part pairs' bounds; minus
+    /// infinity when a part has none): a pose whose bound is at least a clearance already
+    /// found cannot come closer, and need not be measured.
+    pub(crate) fn pose_lower_bound(&self, pose: &Pose) -> f64 {
+        let body = body_pose(pose.position_m, pose.euler_deg);
+        let n_air = self.aircraft.parts.len();
+        (0..self.store.parts.len() * n_air)
+            .map(|k| self.lower_bound(k / n_air, k % n_air, &body))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// A lower bound on the distance between store part `i` (body at `body`) and aircraft part
     /// `j`, from bounding spheres, boxes and planes.
     fn lower_bound(&self, i: usize, j: usize, body: &PPose) -> f64 {

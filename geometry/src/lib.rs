@@ -37,7 +37,7 @@ pub use body::{Body, Role};
 pub use clearance::{CARRIAGE_TOLERANCE_M, Closest, Geometry, Pose};
 pub use error::{CarriageOverlap, GeometryError};
 pub use input::{MAX_FILE_BYTES, MAX_TRIANGLES};
-pub use trace::Trace;
+pub use trace::{Smallest, Trace};
 
 /// The smallest clearance between store and aircraft that MIL-STD-1289D (Department of Defense
 /// Interface Standard, "Airborne stores ejection clearance", 2003) asks for: 1 inch.

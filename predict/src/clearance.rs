@@ -6,8 +6,8 @@
 //! Each sample's trajectory is the one its bands are made of without the measurement noise
 //! (the noise is the instrument's, not the store's): y_s(t) + a_s delta(t), a_s the sample's
 //! six standard normals on stream [`STREAM_BANDS`] (the first six draws of that stream, the
-//! same as the bands'), delta the discrepancy. Its clearance is traced at the band's points
-//! by [`sepval_geometry::Geometry::trace`]; the smallest is taken once the store's CG has
+//! same as the bands'), delta the discrepancy. Its smallest clearance at the band's points is
+//! [`sepval_geometry::Geometry::smallest`]; the smallest is taken once the store's CG has
 //! moved the ejector stroke from carriage (docs/geometry.md). The samples are shared among
 //! threads, each result in its sample's place, so the statistics are the same bits whatever
 //! the thread count.
@@ -166,7 +166,7 @@ fn sample_closest(
         .collect();
     let trace = settings
         .geometry
-        .trace(&grid.t_s, &poses, settings.free_after_m)
+        .smallest(&grid.t_s, &poses, settings.free_after_m)
         .ok()?;
     Some(SampleClosest {
         distance_m: trace.min.distance_m,

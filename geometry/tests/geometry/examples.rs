@@ -94,3 +94,64 @@ fn a_trace_takes_its_minimum_after_the_stroke() {
     );
     assert!(g.clearance(&bad[3]).distance_m.is_nan());
 }
+
+#[test]
+fn the_smallest_clearance_is_the_traces_minimum_bit_for_bit() {
+    let g = example_pair();
+    // Trajectories (u from 0 to 1 over the record) that fall away, come back up to the pylon,
+    // bob under it while pitching, and tumble: the minimum at the stroke's end, at the end and
+    // in between.
+    type Path = fn(f64) -> ([f64; 3], [f64; 3]);
+    let paths: [Path; 4] = [
+        |u| {
+            (
+                [-3.0 * u * u, 0.0, 6.0 * u * u + 0.12 * u],
+                [0.0, 10.0 * u, 0.0],
+            )
+        },
+        |u| {
+            (
+                [0.0, 0.0, 0.6 * (std::f64::consts::PI * u).sin() + 0.03 * u],
+                [0.0; 3],
+            )
+        },
+        |u| {
+            let w = 2.0 * std::f64::consts::PI * u;
+            (
+                [0.1 * u, 0.0, 0.25 + 0.13 * (2.0 * w).cos()],
+                [0.0, 20.0 * w.sin(), 0.0],
+            )
+        },
+        |u| ([-u, 0.5 * u, 1.5 * u], [360.0 * u, 90.0 * u, -45.0 * u]),
+    ];
+    let mut late = 0;
+    for (k, path) in paths.into_iter().enumerate() {
+        let n = 201;
+        let t_s: Vec<f64> = (0..n).map(|i| 0.005 * i as f64).collect();
+        let poses: Vec<Pose> = t_s
+            .iter()
+            .map(|&t| {
+                let (r, a) = path(t / t_s[n - 1]);
+                pose(r, a)
+            })
+            .collect();
+        let trace = g.trace(&t_s, &poses, 0.1).unwrap();
+        let s = g.smallest(&t_s, &poses, 0.1).unwrap();
+        assert_eq!(s.min, trace.min, "case {k}");
+        assert_eq!(
+            (s.index_min, s.assessed_from, s.free_flight_reached),
+            (
+                trace.index_min,
+                trace.assessed_from,
+                trace.free_flight_reached
+            ),
+            "case {k}"
+        );
+        assert_eq!(s.t_min_s.to_bits(), trace.t_min_s.to_bits(), "case {k}");
+        late += usize::from(s.index_min > s.assessed_from + 1);
+    }
+    assert!(
+        late >= 2,
+        "cases whose minimum is not at the stroke's end: {late}"
+    );
+}
