@@ -8,7 +8,7 @@
 //! The sweep is a pipeline of named stages:
 //! 1. [`grid`]: the axes `LO:HI:N` and the conditions, checked before anything runs
 //!    ([`Grid`]);
-//! 2. [`sweep`]: the held-out evidence of the model form computed once ([`Evidence`]), then
+//! 2. [`mod@sweep`]: the held-out evidence of the model form computed once ([`Evidence`]), then
 //!    every condition predicted through any evaluator with its clearance, one row each
 //!    ([`Row`]), the rows saved after each condition so an interrupted sweep resumes
 //!    ([`progress`]);

@@ -3,10 +3,11 @@
 //! with an interrupted sweep.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use sepval_common::evaluation::EvalError;
+use sepval_common::evaluation::{EvalError, Evaluator, Job};
 use sepval_envelope::grid::{Axis, Grid};
 use sepval_envelope::progress::{Progress, inputs_digest, progress_path};
 use sepval_envelope::summary::summarise;
@@ -14,6 +15,8 @@ use sepval_envelope::{EnvelopeFile, Sweep, sweep, write_outputs};
 use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_plan::conditions::Quantity;
 use sepval_predict::Settings;
+use sepval_transport::link::{Notice, Notices};
+use sepval_transport::spec::EvaluatorSpec;
 
 use super::predict::source_inputs;
 use super::{Bar, clearance, count, evaluator_spec, notices};
@@ -67,7 +70,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         clearance,
         progress_path: progress_path(&args.out),
     };
-    let mut start_evaluator = |job| spec.start(job, notices()).map_err(EvalError::transport);
+    let mut start_evaluator = starter(&spec);
     let swept = sweep(
         &sweep_inputs,
         progress,
@@ -143,6 +146,27 @@ fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunD
         format!("--out {}{hint}", args.out.display())
     })?;
     Ok((run_dir, progress))
+}
+
+/// Starts each condition's evaluator: its workers' joining is told once, the rest of what the
+/// transport says (a worker lost, refused) every time.
+fn starter(
+    spec: &EvaluatorSpec,
+) -> impl FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + '_ {
+    let mut started = false;
+    move |job| {
+        let told: Notices = if started {
+            Arc::new(|n: Notice| {
+                if !matches!(n, Notice::Joined { .. }) {
+                    eprintln!("sepval: {n}");
+                }
+            })
+        } else {
+            notices()
+        };
+        started = true;
+        spec.start(job, told).map_err(EvalError::transport)
+    }
 }
 
 /// The axes given, in the order of `[flight]`.
