@@ -12,7 +12,9 @@ use sepval_transport::RunId;
     version,
     about = "Post-flight validation of store-separation simulations",
     long_about = "sepval compares a 6DOF store-separation simulation with measured trajectories, \
-                  fits the model factors that make it match, and diagnoses what it still gets wrong."
+                  fits the model factors that make it match, diagnoses what it still gets wrong, \
+                  plans the next release, predicts releases not flown with bands that hold, and \
+                  maps where the store clears the aircraft."
 )]
 pub struct Cli {
     #[command(subcommand)]
