@@ -130,6 +130,7 @@ mod reconstruct;
 mod residuals;
 mod restart;
 mod rivals;
+mod stage_clock;
 mod stepwise;
 mod tables;
 mod validation;
@@ -217,6 +218,7 @@ pub fn diagnose(
     progress: &mut dyn ProgressObserver,
 ) -> Result<Diagnosis> {
     let t0 = Instant::now();
+    stage_clock::start();
     let figures = options.out.join("figures");
     std::fs::create_dir_all(&figures).map_err(|source| DiagnoseError::Dir {
         path: figures,
@@ -229,6 +231,7 @@ pub fn diagnose(
         mut evaluations,
         mut skipped,
     } = baseline_fit(options, &setting, evaluator, progress)?;
+    stage_clock::lap("baseline converged");
     let tables_left = tables::tables_left(job, &baseline.candidate(job)?);
     if options.strict_tables && !tables_left.is_empty() {
         return Err(DiagnoseError::TablesLeft(tables_left));
@@ -250,6 +253,7 @@ pub fn diagnose(
         &mut evaluations,
         &mut skipped,
     )?;
+    stage_clock::lap("catalogue");
     // What the catalogue's answer changes in the residuals: discovery looks for its mimics.
     let signature: Option<Vec<f64>> = (!cat.chosen.is_empty()).then(|| {
         let (b, c) = (&baseline.lm.residuals, &cat.fitted.lm.residuals);
@@ -264,6 +268,7 @@ pub fn diagnose(
         signature.as_deref(),
     )?;
     evaluations += disc.evaluations;
+    stage_clock::lap("discovery");
     skipped.extend(disc.skipped);
     let selected = (!cat.chosen.is_empty()).then_some(Selected {
         fitted: cat.fitted,
@@ -282,6 +287,7 @@ pub fn diagnose(
         &options.candidate_lm,
         &mut evaluations,
     )?;
+    stage_clock::lap("rivals");
     let decided = Decided {
         baseline,
         answer,
@@ -298,7 +304,9 @@ pub fn diagnose(
     };
     sepval_common::cancel::check().map_err(RunError::from)?;
     let analysis = analyse(options, &setting, decided, t0)?;
+    stage_clock::lap("analysis");
     write_outputs(&options.out, &setting, &analysis, progress)?;
+    stage_clock::lap("outputs");
     Ok(analysis.diagnosis)
 }
 
@@ -326,7 +334,9 @@ fn baseline_fit(
         resume: None,
         ..options.fit.clone()
     };
-    let out = run_fit(&fit, evaluator, progress).map_err(|e| match e {
+    let out = run_fit(&fit, evaluator, progress);
+    stage_clock::lap("baseline fit");
+    let out = out.map_err(|e| match e {
         FitError::Run(RunError::Interrupted) => DiagnoseError::Run(RunError::Interrupted),
         other => DiagnoseError::Baseline(other),
     })?;
