@@ -110,9 +110,12 @@ pub(super) fn discover(
         else {
             break;
         };
+        crate::stage_clock::lap(&format!("discovery step {}: the rest", step + 1));
         sel = remove::f_to_remove(evaluator, &search, entered, &mut trail)?;
+        crate::stage_clock::lap(&format!("discovery step {} F-to-remove", step + 1));
     }
     let found = conclude(evaluator, &search, baseline, sel, &mut trail)?;
+    crate::stage_clock::lap("discovery's gains");
     Ok(Discovery {
         reconstruction,
         found,
@@ -150,6 +153,7 @@ fn enter(
     let Some(mut s) = screen::screen(evaluator, search, sel, step, trail)? else {
         return Ok(None);
     };
+    crate::stage_clock::lap("  screening");
     if let Some(signature) = at.signature {
         let exclude = s.to_verify();
         mimic::mimics(
@@ -162,6 +166,7 @@ fn enter(
             trail,
         )?;
     }
+    crate::stage_clock::lap("  mimics");
     if let Some(r) = s.reconstruction.take() {
         *reconstruction = r;
     }
@@ -180,8 +185,10 @@ fn enter(
         &best,
         &mut trail.evaluations,
     )?;
+    crate::stage_clock::lap("  locators");
     let now = sel.picked.at(search.job, &sel.current)?;
     let refits = verify::refit_candidates(evaluator, search, &sel.current, &now, located, trail)?;
+    crate::stage_clock::lap(&format!("  verification ({} refits)", refits.len()));
     record.verified = refits.iter().map(Refit::verified).collect();
     if step == 0 {
         mimic::from_refits(&s, &refits, trail);
@@ -200,6 +207,7 @@ fn enter(
         &mut trail.evaluations,
         &mut trail.skipped,
     )?;
+    crate::stage_clock::lap("  the winner converged");
     let gain = verify::gain_over(search, &sel.current, &fitted);
     if !(gain.p_value < s.threshold && gain.delta_bic < 0.0) {
         trail

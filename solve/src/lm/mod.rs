@@ -53,6 +53,22 @@ pub struct LmSettings {
     pub fd_step: f64,
     /// Stop when an accepted step lowers the cost by less than this fraction.
     pub rel_tolerance: f64,
+    /// Stop when the refinement stalls (none: run to the tolerance or a limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stall: Option<Stall>,
+}
+
+/// When a refinement has stalled: its last `iterations` iterations (accepted or not) together
+/// lowered the cost by less than the fraction `rel_drop` of the cost they started from. A
+/// refinement that creeps (each accepted step a gain just above the tolerance, hundreds of
+/// iterations) stops there, at the resolution its user needs: the diagnosis sets `rel_drop` to
+/// a tenth of a unit of its BIC (docs/model.md section 11.5).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Stall {
+    /// The iterations looked back over.
+    pub iterations: usize,
+    /// The smallest fraction of the cost they must lower it by for the refinement to go on.
+    pub rel_drop: f64,
 }
 
 impl Default for LmSettings {
@@ -62,6 +78,7 @@ impl Default for LmSettings {
             budget: 5_000,
             fd_step: 1e-6,
             rel_tolerance: 1e-7,
+            stall: None,
         }
     }
 }
@@ -109,6 +126,9 @@ struct Position {
     stop: String,
     /// Consecutive accepted steps that lowered the cost by less than the tolerance.
     small_gains: usize,
+    /// The cost at the start of each of the last iterations, oldest first (at most the stall
+    /// rule's iterations plus one).
+    recent: std::collections::VecDeque<f64>,
     /// The Jacobian at `x` is made of backward differences: its forward one's damped steps
     /// all failed while it predicted a drop (a probe that crossed a jump of the residuals).
     backward: bool,
@@ -147,6 +167,7 @@ impl<M: Measure> LmRun<M> {
                 history: Vec::new(),
                 stop: String::new(),
                 small_gains: 0,
+                recent: std::collections::VecDeque::new(),
                 backward: false,
             },
             stage: Stage::Start,
@@ -344,6 +365,48 @@ mod tests {
         let r = lm.finish();
         assert!(r.x[0] <= 0.5 && (r.x[0] - 0.5).abs() < 1e-9, "{:?}", r.x);
         assert!((r.x[1] - 0.25).abs() < 1e-6, "{:?}", r.x);
+    }
+
+    #[test]
+    fn a_stalled_refinement_stops_with_its_jacobian_current() {
+        let plain = {
+            let mut lm = LmRun::new(params(), &[-1.2, 1.0], Rms, LmSettings::default(), 100);
+            run(&mut lm, &mut Rosenbrock, &mut []).unwrap();
+            lm.finish()
+        };
+        // A drop of nothing is always enough to go on: the same refinement, bit for bit.
+        let never = LmSettings {
+            stall: Some(Stall {
+                iterations: 3,
+                rel_drop: 0.0,
+            }),
+            ..LmSettings::default()
+        };
+        let mut lm = LmRun::new(params(), &[-1.2, 1.0], Rms, never, 100);
+        run(&mut lm, &mut Rosenbrock, &mut []).unwrap();
+        let same = lm.finish();
+        assert_eq!(
+            (same.x, same.cost.to_bits()),
+            (plain.x, plain.cost.to_bits())
+        );
+        // Three iterations that must halve the cost: the valley's slow stretch stops it early.
+        let halve = LmSettings {
+            stall: Some(Stall {
+                iterations: 3,
+                rel_drop: 0.5,
+            }),
+            ..LmSettings::default()
+        };
+        let mut lm = LmRun::new(params(), &[-1.2, 1.0], Rms, halve, 100);
+        run(&mut lm, &mut Rosenbrock, &mut []).unwrap();
+        let r = lm.finish();
+        assert!(r.stop.starts_with("stalled"), "{}", r.stop);
+        assert!(
+            r.iterations < plain.iterations && r.cost > plain.cost,
+            "{r:?}"
+        );
+        assert_eq!(r.jacobian.shape(), (2, 2));
+        assert_eq!(r.residuals.len(), 2);
     }
 
     /// One residual, b - 1 plus a jump of 3 once a exceeds 0.5 + 1e-9: the optimum is b = 1

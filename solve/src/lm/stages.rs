@@ -133,6 +133,20 @@ impl<M: Measure> LmRun<M> {
             at.stop = "simulation budget".into();
             return Stage::Done;
         }
+        if let Some(stall) = self.settings.stall {
+            at.recent.push_back(at.cost);
+            if at.recent.len() > stall.iterations + 1 {
+                at.recent.pop_front();
+            }
+            let then = at.recent[0];
+            if at.recent.len() == stall.iterations + 1 && then - at.cost < stall.rel_drop * then {
+                at.stop = format!(
+                    "stalled (the last {} iterations lowered the cost by less than {:.2e} of it)",
+                    stall.iterations, stall.rel_drop
+                );
+                return Stage::Done;
+            }
+        }
         at.iterations += 1;
         let (x, params, mu) = (&at.x, &self.params, at.mu);
         let jtj = at.jac.tr_mul(&at.jac);
