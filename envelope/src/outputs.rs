@@ -17,10 +17,6 @@ use crate::row::csv;
 
 pub use sepval_report::OutputError;
 
-fn check_cancel() -> Result<(), OutputError> {
-    sepval_common::cancel::check().map_err(|_| OutputError::Interrupted)
-}
-
 /// Writes the figure, the page, envelope.csv and envelope.json into `out`; returns the files
 /// written.
 pub fn write_outputs(
@@ -28,25 +24,21 @@ pub fn write_outputs(
     file: &EnvelopeFile,
     out: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
-    let figures = out.join("figures");
-    std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
-        path: figures.clone(),
-        source,
-    })?;
-    check_cancel()?;
+    let figures = OutputError::figures_dir(out)?;
+    OutputError::check_cancel()?;
     let figure = figures.join("envelope.png");
     map(grid, file, &figure)?;
     let mut written = vec![figure];
-    check_cancel()?;
+    OutputError::check_cancel()?;
     let html = crate::page::render(file, "figures/envelope.png")?;
     let page = out.join("report.html");
     write_atomically(&page, html.as_bytes()).map_err(OutputError::Write)?;
     written.push(page);
-    check_cancel()?;
+    OutputError::check_cancel()?;
     let path = out.join("envelope.csv");
     write_atomically(&path, csv(&file.rows).as_bytes()).map_err(OutputError::Write)?;
     written.push(path);
-    check_cancel()?;
+    OutputError::check_cancel()?;
     let json = serde_json::to_string_pretty(file).expect("an envelope serialises") + "\n";
     let path = out.join("envelope.json");
     write_atomically(&path, json.as_bytes()).map_err(OutputError::Write)?;

@@ -24,11 +24,7 @@ pub fn write_outputs(
     file: &PlanFile,
     out: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
-    let figures = out.join("figures");
-    std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
-        path: figures.clone(),
-        source,
-    })?;
+    let figures = OutputError::figures_dir(out)?;
     let mut written = vec![separation_map(
         prepared,
         plan,

@@ -14,10 +14,6 @@ use crate::record::{PredictionFile, bands_csv};
 
 pub use sepval_report::OutputError;
 
-fn check_cancel() -> Result<(), OutputError> {
-    sepval_common::cancel::check().map_err(|_| OutputError::Interrupted)
-}
-
 /// Writes the figure, the page, bands.csv and prediction.json into `out`; returns the files
 /// written.
 pub fn write_outputs(
@@ -25,12 +21,8 @@ pub fn write_outputs(
     file: &PredictionFile,
     out: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
-    let figures = out.join("figures");
-    std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
-        path: figures.clone(),
-        source,
-    })?;
-    check_cancel()?;
+    let figures = OutputError::figures_dir(out)?;
+    OutputError::check_cancel()?;
     let figure = figures.join("prediction.png");
     let ch = file.channels();
     let bands: [Band; 6] = std::array::from_fn(|c| Band {
@@ -61,16 +53,16 @@ pub fn write_outputs(
         &title,
     )?;
     let mut written = vec![figure];
-    check_cancel()?;
+    OutputError::check_cancel()?;
     let html = crate::page::render(file, "figures/prediction.png")?;
     let page = out.join("report.html");
     write_atomically(&page, html.as_bytes()).map_err(OutputError::Write)?;
     written.push(page);
-    check_cancel()?;
+    OutputError::check_cancel()?;
     let csv = out.join("bands.csv");
     write_atomically(&csv, bands_csv(file).as_bytes()).map_err(OutputError::Write)?;
     written.push(csv);
-    check_cancel()?;
+    OutputError::check_cancel()?;
     let json = serde_json::to_string_pretty(file).expect("a prediction serialises") + "\n";
     let path = out.join("prediction.json");
     write_atomically(&path, json.as_bytes()).map_err(OutputError::Write)?;

@@ -32,3 +32,22 @@ pub enum OutputError {
     #[error("interrupted by a signal")]
     Interrupted,
 }
+
+impl OutputError {
+    /// Creates `out/figures` (and `out`) and returns it: the first step of every command that
+    /// writes figures.
+    pub fn figures_dir(out: &std::path::Path) -> Result<PathBuf, OutputError> {
+        let figures = out.join("figures");
+        std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
+            path: figures.clone(),
+            source,
+        })?;
+        Ok(figures)
+    }
+
+    /// [`OutputError::Interrupted`] once a signal asked the process to stop (checked before
+    /// each file, so an interrupted command stops between files, never inside one).
+    pub fn check_cancel() -> Result<(), OutputError> {
+        sepval_common::cancel::check().map_err(|_| OutputError::Interrupted)
+    }
+}
