@@ -9,8 +9,6 @@
 //! with more than two varied, a cell shows the worst of the conditions it covers (the
 //! highest probability of failing to clear).
 
-use serde::{Deserialize, Serialize};
-
 use sepval_common::scenario::{Flight, Scenario};
 use sepval_plan::conditions::{ConditionError, Conditions, Quantity, Range};
 
@@ -164,34 +162,6 @@ impl Grid {
             self.shown.first().map_or(0, |&a| at[a]),
             self.shown.get(1).map_or(0, |&a| at[a]),
         )
-    }
-}
-
-/// A condition's coordinates as written in a row.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ConditionRecord {
-    /// Mach.
-    pub mach: f64,
-    /// Altitude \[m\].
-    pub altitude_m: f64,
-    /// Aircraft alpha \[deg\].
-    pub alpha_deg: f64,
-    /// Aircraft beta \[deg\].
-    pub beta_deg: f64,
-    /// Flight-path angle \[deg\].
-    pub gamma_deg: f64,
-}
-
-impl ConditionRecord {
-    /// The record of `f`.
-    pub fn of(f: &Flight) -> ConditionRecord {
-        ConditionRecord {
-            mach: f.mach,
-            altitude_m: f.altitude_m,
-            alpha_deg: f.alpha_deg,
-            beta_deg: f.beta_deg,
-            gamma_deg: f.gamma_deg,
-        }
     }
 }
 

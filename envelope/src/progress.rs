@@ -145,7 +145,7 @@ pub fn inputs_digest(parts: &[(&str, &[u8])]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::ConditionRecord;
+    use sepval_predict::record::ConditionRecord;
 
     fn row(index: usize) -> Row {
         let c = ConditionRecord {

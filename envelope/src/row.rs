@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use sepval_predict::ClearanceStats;
 
-use crate::grid::ConditionRecord;
+use sepval_predict::record::ConditionRecord;
 
 /// One condition's row.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

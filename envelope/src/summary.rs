@@ -127,8 +127,9 @@ pub fn summarise(grid: &Grid, rows: &[Row], criterion_mm: f64) -> Summary {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::{Axis, ConditionRecord};
+    use crate::grid::Axis;
     use sepval_common::scenario::Scenario;
+    use sepval_predict::record::ConditionRecord;
 
     #[test]
     fn the_summary_names_the_runs_cleared_and_not_per_altitude() {

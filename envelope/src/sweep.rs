@@ -15,9 +15,10 @@ use sepval_predict::discrepancy::{self, Evidence};
 use sepval_predict::{ClearanceSettings, PredictError, Settings, Source, predict_with, prepare};
 use sepval_solve::run::{NoProgress, Progress as Step, ProgressObserver};
 
-use crate::grid::{ConditionRecord, Grid};
+use crate::grid::Grid;
 use crate::progress::{Progress, ProgressError};
 use crate::row::Row;
+use sepval_predict::record::ConditionRecord;
 
 /// A sweep that could not be completed.
 #[derive(Debug, thiserror::Error)]

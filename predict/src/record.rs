@@ -15,8 +15,8 @@ use crate::{Prediction, Prepared};
 /// The format of DIR/prediction.json.
 pub const PREDICTION_FORMAT: &str = "sepval-prediction/1";
 
-/// The flight condition predicted.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// The flight condition predicted (prediction.json, and each row of an envelope).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ConditionRecord {
     /// Mach.
     pub mach: f64,
@@ -28,6 +28,19 @@ pub struct ConditionRecord {
     pub beta_deg: f64,
     /// Flight-path angle \[deg\].
     pub gamma_deg: f64,
+}
+
+impl ConditionRecord {
+    /// The record of `f`.
+    pub fn of(f: &sepval_common::scenario::Flight) -> ConditionRecord {
+        ConditionRecord {
+            mach: f.mach,
+            altitude_m: f.altitude_m,
+            alpha_deg: f.alpha_deg,
+            beta_deg: f.beta_deg,
+            gamma_deg: f.gamma_deg,
+        }
+    }
 }
 
 /// One source's share of the band.
@@ -235,13 +248,7 @@ pub fn prediction_file(
         samples: prepared.settings.samples,
         samples_used: p.bands.used,
         seed: prepared.settings.seed,
-        condition: ConditionRecord {
-            mach: f.mach,
-            altitude_m: f.altitude_m,
-            alpha_deg: f.alpha_deg,
-            beta_deg: f.beta_deg,
-            gamma_deg: f.gamma_deg,
-        },
+        condition: ConditionRecord::of(f),
         t_s: prepared.grid.t_s.clone(),
         x_m,
         y_m,
