@@ -13,6 +13,9 @@
 //!
 //! `simulate_lanes_tables`: `simulate_lanes` with the default written as tables.
 //!
+//! `simulate_lanes_corrections`: `simulate_lanes` with an update's corrections (one over
+//! distance, one over alpha, one over Mach).
+//!
 //! `simulate_default_event_tables`: the same with the default written as tables
 //! (`sepval scenario --tables --interference-tables`: static coefficients over Mach, alpha and
 //! beta, damping over Mach, interference over distance); issue 15 asks for at most 20 % more time than the constant form.
@@ -44,14 +47,22 @@ fn simulate_default_event(c: &mut Criterion) {
 }
 
 fn simulate_lanes(c: &mut Criterion) {
-    bench_lanes(c, "simulate_lanes", &Simulator::embedded_default());
+    let sim = Simulator::embedded_default();
+    bench_lanes(c, "simulate_lanes", &sim, &|f| {
+        sim.run_setup(f, &EffectSet::NONE).expect("valid factors")
+    });
 }
 
 /// Times one run of `sim` in a batch of 100 candidates around the truth (factor j of candidate
 /// k moved by a fixed fraction of its range: a deterministic spread, no generator needed), four
 /// at a time through the lane propagator, goals accumulated against the nominal run; reports
 /// the time per run.
-fn bench_lanes(c: &mut Criterion, name: &str, sim: &Simulator) {
+fn bench_lanes(
+    c: &mut Criterion,
+    name: &str,
+    sim: &Simulator,
+    setup: &dyn Fn(&Factors) -> sepval_common::model::RunSetup,
+) {
     use sepval_common::goals::GoalAccumulator;
     use sepval_common::propagator::{LANES, propagate_lanes};
     let measured = sim
@@ -66,7 +77,7 @@ fn bench_lanes(c: &mut Criterion, name: &str, sim: &Simulator) {
                 let u = ((k * 17 + j * 31) % 101) as f64 / 100.0 - 0.5;
                 *v = (*v + 0.04 * u * (row.max - row.min)).clamp(row.min, row.max);
             }
-            sim.run_setup(&f, &EffectSet::NONE).expect("valid factors")
+            setup(&f)
         })
         .collect();
     c.bench_function(name, |b| {
@@ -116,7 +127,46 @@ fn simulate_default_event_tables(c: &mut Criterion) {
 }
 
 fn simulate_lanes_tables(c: &mut Criterion) {
-    bench_lanes(c, "simulate_lanes_tables", &tables_simulator());
+    let sim = tables_simulator();
+    bench_lanes(c, "simulate_lanes_tables", &sim, &|f| {
+        sim.run_setup(f, &EffectSet::NONE).expect("valid factors")
+    });
+}
+
+/// The default with the corrections of an update (docs/model.md section 15): the interference
+/// dCZ over distance (7 breakpoints and s_end), Cm over local alpha (5) and Cm_alpha over Mach
+/// (1), values small and not zero.
+fn simulate_lanes_corrections(c: &mut Criterion) {
+    use sepval_common::correction::{CorrectionRecord, CorrectionValues};
+    let mut s = sepval_common::Scenario::embedded_default();
+    let record = |field: &str, variable: &str, b: &[f64]| CorrectionRecord {
+        field: field.into(),
+        variable: variable.into(),
+        breakpoints: b.to_vec(),
+    };
+    s.correction = vec![
+        record(
+            "interference.dcz0",
+            "distance_m",
+            &[0.0, 0.05, 0.2, 0.45, 0.8, 1.25, 1.8, 9.144],
+        ),
+        record("aero.cm", "alpha_deg", &[-4.0, -1.0, 2.0, 5.0, 8.0]),
+        record("aero.cm_alpha_per_rad", "mach", &[0.95]),
+    ];
+    s.validate("bench").expect("valid corrections");
+    let sim = Simulator::new(&s);
+    let values: Vec<f64> = (0..14).map(|k| 0.001 * (k as f64 - 6.0)).collect();
+    let values = CorrectionValues::of(&values).expect("14 values");
+    bench_lanes(c, "simulate_lanes_corrections", &sim, &|f| {
+        sepval_common::model::RunSetup::with_corrections(
+            sim.model(),
+            f,
+            &EffectSet::NONE,
+            &sepval_common::extension::TermSet::NONE,
+            &values,
+        )
+        .expect("valid factors")
+    });
 }
 
 criterion_group!(
@@ -124,6 +174,7 @@ criterion_group!(
     simulate_default_event,
     simulate_lanes,
     simulate_default_event_tables,
-    simulate_lanes_tables
+    simulate_lanes_tables,
+    simulate_lanes_corrections
 );
 criterion_main!(benches);

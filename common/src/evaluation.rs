@@ -16,11 +16,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use crate::correction::CorrectionValues;
 use crate::effects::EffectSet;
 use crate::extension::TermSet;
 use crate::factors::{FactorTable, Factors};
 use crate::goals::{GoalAccumulator, GoalSums, Goals};
-use crate::model::RunSetup;
+use crate::model::{ModelError, RunSetup};
 use crate::propagator::{LANES, Observation, propagate_lanes};
 use crate::scenario::{Scenario, hex_sha256};
 use crate::simulation::Simulator;
@@ -196,10 +197,7 @@ impl Job {
                 if ended[i].is_some() {
                     continue;
                 }
-                match event
-                    .simulator
-                    .run_setup_with(&c.factors, &c.effects, &c.terms)
-                {
+                match c.run_setup(&event.simulator) {
                     Ok(run) => {
                         live.push(i);
                         live_runs.push(run);
@@ -290,6 +288,9 @@ pub struct Candidate {
     pub effects: EffectSet,
     /// Extension terms of this candidate (the scenario's own apply too).
     pub terms: TermSet,
+    /// The values of the scenario's corrections (docs/model.md section 15; none: every
+    /// correction 0).
+    pub corrections: CorrectionValues,
 }
 
 impl Candidate {
@@ -299,6 +300,7 @@ impl Candidate {
             factors,
             effects: EffectSet::NONE,
             terms: TermSet::NONE,
+            corrections: CorrectionValues::NONE,
         }
     }
 
@@ -308,7 +310,19 @@ impl Candidate {
             factors,
             effects,
             terms: TermSet::NONE,
+            corrections: CorrectionValues::NONE,
         }
+    }
+
+    /// Its run of `sim`'s scenario: factors, effects, terms and correction values applied.
+    pub fn run_setup(&self, sim: &Simulator) -> Result<RunSetup, ModelError> {
+        RunSetup::with_corrections(
+            sim.model(),
+            &self.factors,
+            &self.effects,
+            &self.terms,
+            &self.corrections,
+        )
     }
 }
 

@@ -13,6 +13,7 @@
 //! - [`telemetry`]: section 6;
 //! - [`effects`]: section 7, the effect catalogue;
 //! - [`table`], [`table_form`]: sections 1 and 3, tabulated coefficients and interference;
+//! - [`correction`]: section 15, corrections of the data whose values a search estimates;
 //! - [`noise`]: the measurement noise of the synthetic flight test (section 4);
 //! - [`input_file`]: how every input file is opened and read (regular files only, within the
 //!   byte limits of [`limits`]);
@@ -25,6 +26,7 @@
 pub mod atmosphere;
 pub mod atomic_file;
 pub mod cancel;
+pub mod correction;
 pub mod effects;
 pub mod elementary;
 pub mod encoding;
@@ -42,6 +44,7 @@ pub mod nonfinite;
 pub mod propagator;
 pub mod scenario;
 pub mod simulation;
+pub mod stage_clock;
 pub mod synthetic;
 pub mod table;
 pub mod table_form;

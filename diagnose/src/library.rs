@@ -53,7 +53,7 @@ pub fn flow_history(job: &Job, base: &Candidate) -> Vec<Vec<Sample>> {
         .iter()
         .map(|e| {
             let sim = &e.simulator;
-            let Ok(run) = sim.run_setup_with(&base.factors, &base.effects, &base.terms) else {
+            let Ok(run) = base.run_setup(sim) else {
                 return Vec::new();
             };
             let mut states: Vec<(Observation, StateVector)> = Vec::new();

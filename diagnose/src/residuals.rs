@@ -138,7 +138,7 @@ pub fn segments(job: &Job, c: &Candidate) -> Vec<(String, f64, f64)> {
     // The fitted model's own positions (it simulated when it was fitted; none, and the zone
     // runs to the end, if it does not now).
     let mut positions: Vec<Observation> = Vec::with_capacity(times.len());
-    if let Ok(run) = e.simulator.run_setup_with(&c.factors, &c.effects, &c.terms) {
+    if let Ok(run) = c.run_setup(&e.simulator) {
         if propagate(e.simulator.model(), &run, times, &mut positions).is_err() {
             positions.clear();
         }

@@ -108,6 +108,7 @@ impl ModelSpec {
             factors: self.factors,
             effects,
             terms,
+            corrections: sepval_common::correction::CorrectionValues::NONE,
         })
     }
 
@@ -137,9 +138,9 @@ mod tests {
             })
             .unwrap();
         let c = Candidate {
-            factors: Factors([1.0 + 1e-12; FACTOR_COUNT]),
             effects,
             terms,
+            ..Candidate::baseline(Factors([1.0 + 1e-12; FACTOR_COUNT]))
         };
         let text = serde_json::to_string(&ModelSpec::of(&c)).unwrap();
         let back: ModelSpec = serde_json::from_str(&text).unwrap();

@@ -151,6 +151,7 @@ impl ParamSpace {
             factors: Factors(f),
             effects,
             terms,
+            corrections: sepval_common::correction::CorrectionValues::NONE,
         })
     }
 

@@ -21,7 +21,7 @@ pub fn tables_left(job: &Job, flown: usize, models: &Models) -> Vec<Vec<String>>
             let mut left: Vec<String> = Vec::new();
             for m in &models.list {
                 let c = &m.candidate;
-                let Ok(run) = sim.run_setup_with(&c.factors, &c.effects, &c.terms) else {
+                let Ok(run) = c.run_setup(sim) else {
                     continue;
                 };
                 let mut sink: Vec<Observation> = Vec::with_capacity(e.data.len());

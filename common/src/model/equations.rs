@@ -41,7 +41,10 @@ impl Parts<'_> {
     /// Whether the run has terms beyond the linear coefficients (tables, catalogue terms,
     /// extension terms).
     fn has_extra_terms(&self) -> bool {
-        self.tables.is_some() || self.run.coefficient_term_count > 0 || !self.run.terms.is_empty()
+        self.tables.is_some()
+            || self.run.coefficient_term_count > 0
+            || !self.run.terms.is_empty()
+            || !self.run.corrections.is_empty()
     }
 
     /// The tables' terms (section 3), then the catalogue's extra terms (section 7) and the
@@ -54,6 +57,9 @@ impl Parts<'_> {
             if tables.runtime() {
                 k = add_table_terms(run, tables, state, flow, lateral_m, k);
             }
+        }
+        if !run.corrections.is_empty() {
+            k = add_corrections(run, flow, k);
         }
         if run.coefficient_term_count > 0 {
             k = run.add_coefficient_terms(*flow, k);
@@ -545,6 +551,25 @@ fn add_table_terms(
     k.cl = m[3].mul_add(d[3], k.cl + c[3]) + s[3];
     k.cm = m[4].mul_add(d[4], k.cm + c[4]) + s[4];
     k.cn = m[5].mul_add(d[5], k.cn + c[5]) + s[5];
+    k
+}
+
+/// Adds the corrections evaluated at each force evaluation (docs/model.md section 15): a static
+/// coefficient's as its table's (CX = -CA), an interference increment's times its multiplier,
+/// at the stage's local alpha and beta and distance from carriage. Out of line: only runs of
+/// an update have them.
+#[inline(never)]
+fn add_corrections(run: &RunSetup, flow: &Flow, mut k: Coefficients) -> Coefficients {
+    let d = run
+        .corrections
+        .evaluate(flow.alpha_rad, flow.beta_rad, flow.distance_m);
+    let m = &run.interference_multipliers;
+    k.cx = m[0].mul_add(d[6], k.cx) - d[0];
+    k.cy = m[1].mul_add(d[7], k.cy) + d[1];
+    k.cz = m[2].mul_add(d[8], k.cz) + d[2];
+    k.cl = m[3].mul_add(d[9], k.cl) + d[3];
+    k.cm = m[4].mul_add(d[10], k.cm) + d[4];
+    k.cn = m[5].mul_add(d[11], k.cn) + d[5];
     k
 }
 

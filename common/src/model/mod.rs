@@ -27,6 +27,7 @@
 //! exactly the contract's operations.
 
 pub mod aero;
+mod corrected;
 mod dcm;
 pub mod ejector;
 mod equations;
@@ -40,6 +41,7 @@ pub(crate) use equations::{LaneEquations, dot};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::atmosphere::isa_troposphere;
+use crate::correction::{Correction, CorrectionError, CorrectionRun};
 use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
 use crate::elementary::{cos, sin};
 use crate::extension::{TermError, TermInput, TermSet};
@@ -74,6 +76,9 @@ pub enum ModelError {
     /// Extension terms that cannot be run.
     #[error(transparent)]
     Term(#[from] TermError),
+    /// Correction values that do not fit the scenario's corrections.
+    #[error(transparent)]
+    Correction(#[from] CorrectionError),
     /// The resulting inertia tensor is not positive definite.
     #[error("inertia tensor is not positive definite (xz block determinant {det_kg2_m4} <= 0)")]
     InertiaNotPositiveDefinite {
@@ -125,6 +130,8 @@ pub struct Model {
     pub interference_at_carriage: [f64; 6],
     /// The scenario's tables, ready for the force evaluation (docs/model.md section 3).
     pub tables: PreparedTables,
+    /// The scenario's corrections (docs/model.md section 15), whose values candidates carry.
+    pub corrections: Vec<Correction>,
 }
 
 impl Model {
@@ -162,6 +169,7 @@ impl Model {
             aero_at_mach,
             interference_at_carriage,
             tables,
+            corrections: scenario.corrections(),
         }
     }
 
@@ -252,6 +260,9 @@ pub struct RunSetup {
     pub terms: TermSet,
     /// 1 / a, the speed of sound's reciprocal [s/m] (the store's Mach number is V / a).
     pub inv_speed_of_sound_s_m: f64,
+    /// The corrections evaluated at each force evaluation (docs/model.md section 15; none
+    /// without correction values).
+    pub corrections: CorrectionRun,
 }
 
 fn no_term(_: &[f64; MAX_EFFECT_PARAMS], _: &Flow, _: &mut Coefficients) {}
@@ -357,6 +368,7 @@ impl RunSetup {
             tracked_point_b_m: Vector3::zeros(),
             terms: model.extension,
             inv_speed_of_sound_s_m: 1.0 / model.speed_of_sound_m_s,
+            corrections: CorrectionRun::NONE,
         };
         effects.apply(&mut run)?;
         run.inertia_inv = invert_inertia(&run.inertia_kg_m2)?;

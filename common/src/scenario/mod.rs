@@ -301,6 +301,10 @@ pub struct Scenario {
     /// Model-extension terms (docs/model.md section 11), written as `[[extension]]` tables.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub extension: Vec<crate::extension::TermRecord>,
+    /// Corrections whose values each candidate carries (docs/model.md section 15), written as
+    /// `[[correction]]` tables; `sepval update` sets them, and the store it writes has none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub correction: Vec<crate::correction::CorrectionRecord>,
 }
 
 fn is_default_initial(i: &Initial) -> bool {
@@ -469,6 +473,11 @@ impl Scenario {
             .filter_map(|r| r.term().ok())
             .collect();
         crate::extension::TermSet::of(&terms).unwrap_or_default()
+    }
+
+    /// The corrections (checked by [`Scenario::validate`]).
+    pub fn corrections(&self) -> Vec<crate::correction::Correction> {
+        crate::correction::check_all(&self.correction).unwrap_or_default()
     }
 
     /// SHA-256 of the scenario's canonical form (its JSON serialisation), hex. Two scenarios

@@ -21,6 +21,8 @@ impl Scenario {
         c.integrator(&self.integrator)?;
         c.initial(&self.initial)?;
         c.extension(&self.extension)?;
+        crate::correction::check_all(&self.correction)
+            .map_err(|(k, e)| c.bad(&format!("correction[{k}]"), e.to_string()))?;
         self.factors
             .validate()
             .map_err(|e| c.bad("factors", e.to_string()))

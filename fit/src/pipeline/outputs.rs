@@ -114,10 +114,7 @@ fn simulate_locally(
         }
     }
     for (k, event) in job.events().iter().enumerate() {
-        let run = event
-            .simulator
-            .run_setup_with(&c.factors, &c.effects, &c.terms)
-            .map_err(|e| e.to_string())?;
+        let run = c.run_setup(&event.simulator).map_err(|e| e.to_string())?;
         propagate(
             event.simulator.model(),
             &run,

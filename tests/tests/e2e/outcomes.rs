@@ -30,6 +30,7 @@ fn gusty(axis: Axis, regressor: Regressor, locator: [f64; 2], w_m_s: f64) -> Can
         factors: Factors::TRUTH,
         effects: EffectSet::NONE,
         terms: TermSet::of(&[term]).unwrap(),
+        corrections: sepval_common::correction::CorrectionValues::NONE,
     }
 }
 

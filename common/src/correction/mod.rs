@@ -1,0 +1,344 @@
+//! Corrections of a store's aerodynamic data whose values a search estimates (docs/model.md
+//! section 15): piecewise-linear tables added to a scenario field, over one variable, with their
+//! breakpoints in the scenario (`[[correction]]`) and their values in each candidate.
+//!
+//! `sepval update` fits them by output error together with the factors, then writes the store
+//! with each correction merged into the field it corrects; a scenario written by it holds no
+//! `[[correction]]`. The value of a correction with breakpoints b_0 < ... < b_{n-1} and values
+//! v_0, ..., v_{n-1} at x is the linear interpolation of section 1 ("Tables"),
+//!
+//! ```text
+//! c(x) = v_i + t (v_{i+1} - v_i),   t = (x - b_i) / (b_{i+1} - b_i),   x held in [b_0, b_{n-1}]
+//! ```
+//!
+//! (a single breakpoint: the constant v_0), so that a correction merged into a table of the
+//! field on the union of the two grids is the same function (Press et al., *Numerical Recipes*,
+//! 3rd ed., section 3.6: a sum of piecewise-linear functions is linear on every cell of the
+//! union grid). It adds to the field exactly as a table of that field would (section 3,
+//! "Tabulated coefficients"):
+//!
+//! | field | variables | enters as |
+//! |---|---|---|
+//! | `aero.ca0` | `mach`, `alpha_deg`, `beta_deg` | CX -= c |
+//! | `aero.cy` ... `aero.cn` | `mach`, `alpha_deg`, `beta_deg` | CY += c, ... |
+//! | `aero.cz_alpha_per_rad` ... `aero.cn_r_per_rad` | `mach` | the derivative += c |
+//! | `interference.dcx0` ... `interference.dcn0` | `distance_m` | the increment += c, times its multiplier |
+//!
+//! Mach is the flight condition's, fixed for a run, so a correction over Mach is folded into the
+//! run's constants when it is set up ([`CorrectionRun::fold`]); the others are evaluated at every
+//! force evaluation at the stage's local alpha, beta and distance from carriage
+//! ([`CorrectionRun::add`]). A run without correction values takes none of these paths.
+
+mod run;
+
+use serde::{Deserialize, Serialize};
+
+use crate::table::Variable;
+
+pub use run::{CorrectionRun, CorrectionValues, Folded};
+
+/// Most correction values one run carries (over all its corrections): a candidate holds them
+/// in a fixed array, so that it travels to the workers without allocation.
+pub const MAX_CORRECTION_VALUES: usize = 64;
+
+/// Most corrections one scenario holds.
+pub const MAX_CORRECTIONS: usize = 16;
+
+/// The derivatives a correction may change, in the scenario's order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum Derivative {
+    CzAlpha,
+    CyBeta,
+    CmAlpha,
+    CnBeta,
+    ClP,
+    CmQ,
+    CnR,
+}
+
+impl Derivative {
+    /// Every derivative, in the scenario's order.
+    pub const ALL: [Derivative; 7] = [
+        Derivative::CzAlpha,
+        Derivative::CyBeta,
+        Derivative::CmAlpha,
+        Derivative::CnBeta,
+        Derivative::ClP,
+        Derivative::CmQ,
+        Derivative::CnR,
+    ];
+
+    /// Its scenario field's name within `[aero]`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Derivative::CzAlpha => "cz_alpha_per_rad",
+            Derivative::CyBeta => "cy_beta_per_rad",
+            Derivative::CmAlpha => "cm_alpha_per_rad",
+            Derivative::CnBeta => "cn_beta_per_rad",
+            Derivative::ClP => "cl_p_per_rad",
+            Derivative::CmQ => "cm_q_per_rad",
+            Derivative::CnR => "cn_r_per_rad",
+        }
+    }
+}
+
+/// The scenario field a correction adds to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    /// A static coefficient: 0 CA, 1 CY, 2 CZ, 3 Cl, 4 Cm, 5 Cn.
+    Static(usize),
+    /// A derivative.
+    Derivative(Derivative),
+    /// An interference increment: 0 dCX, ..., 5 dCn.
+    Interference(usize),
+}
+
+/// Names of the static coefficients' fields within `[aero]`, CA first.
+const STATIC_KEYS: [&str; 6] = ["ca0", "cy", "cz", "cl", "cm", "cn"];
+/// Names of the interference increments' fields within `[interference]`.
+const INTERFERENCE_KEYS: [&str; 6] = ["dcx0", "dcy0", "dcz0", "dcl0", "dcm0", "dcn0"];
+
+impl Target {
+    /// Every target, in the order of the scenario's fields.
+    pub fn all() -> Vec<Target> {
+        (0..6)
+            .map(Target::Static)
+            .chain(Derivative::ALL.into_iter().map(Target::Derivative))
+            .chain((0..6).map(Target::Interference))
+            .collect()
+    }
+
+    /// The field's TOML path, e.g. `aero.cm` or `interference.dcz0`.
+    pub fn field(self) -> String {
+        match self {
+            Target::Static(k) => format!("aero.{}", STATIC_KEYS[k]),
+            Target::Derivative(d) => format!("aero.{}", d.key()),
+            Target::Interference(k) => format!("interference.{}", INTERFERENCE_KEYS[k]),
+        }
+    }
+
+    /// The target of a field's TOML path.
+    pub fn of_field(field: &str) -> Option<Target> {
+        Target::all().into_iter().find(|t| t.field() == field)
+    }
+
+    /// The variables a correction of this field may span.
+    pub fn variables(self) -> &'static [Variable] {
+        match self {
+            Target::Static(_) => &[Variable::Mach, Variable::Alpha, Variable::Beta],
+            Target::Derivative(_) => &[Variable::Mach],
+            Target::Interference(_) => &[Variable::Distance],
+        }
+    }
+
+    /// The coefficient axis it acts on: 0 CA (or dCX), ..., 5 Cn; for a derivative, the axis of
+    /// its coefficient (CZ for CZ_alpha, ...).
+    pub fn axis(self) -> usize {
+        match self {
+            Target::Static(k) | Target::Interference(k) => k,
+            Target::Derivative(d) => match d {
+                Derivative::CzAlpha => 2,
+                Derivative::CyBeta => 1,
+                Derivative::CmAlpha | Derivative::CmQ => 4,
+                Derivative::CnBeta | Derivative::CnR => 5,
+                Derivative::ClP => 3,
+            },
+        }
+    }
+}
+
+/// A correction as a scenario file writes it: `[[correction]]` with `field`, `variable` and
+/// `breakpoints` (in the variable's unit: `mach` -, `alpha_deg` and `beta_deg` deg,
+/// `distance_m` m).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CorrectionRecord {
+    /// The field corrected, as a TOML path (`aero.cm`, `aero.cm_alpha_per_rad`,
+    /// `interference.dcz0`, ...).
+    pub field: String,
+    /// The variable: `mach`, `alpha_deg`, `beta_deg` or `distance_m`.
+    pub variable: String,
+    /// Its breakpoints, strictly increasing (one: a constant correction).
+    pub breakpoints: Vec<f64>,
+}
+
+/// A checked correction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Correction {
+    /// The field it adds to.
+    pub target: Target,
+    /// Its variable.
+    pub variable: Variable,
+    /// Its breakpoints, strictly increasing, in the variable's unit.
+    pub breakpoints: Vec<f64>,
+}
+
+/// What makes a correction or its values unusable (the caller says where).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CorrectionError {
+    /// A field no correction can change.
+    #[error(
+        "`field` `{0}` is not a field a correction can change (expected aero.ca0, aero.cy ... aero.cn, a derivative such as aero.cm_alpha_per_rad, or interference.dcx0 ... interference.dcn0)"
+    )]
+    Field(String),
+    /// A variable the field cannot be corrected over.
+    #[error("`variable` `{variable}`: {field} may be corrected over {allowed} only")]
+    Variable {
+        /// The field.
+        field: String,
+        /// The variable given.
+        variable: String,
+        /// The variables allowed.
+        allowed: String,
+    },
+    /// Breakpoints that are not finite and strictly increasing, or none.
+    #[error("`breakpoints` {0}")]
+    Breakpoints(String),
+    /// More corrections or values than a run carries.
+    #[error("{0}")]
+    TooMany(String),
+    /// A candidate whose values do not fit the scenario's corrections.
+    #[error("{0}")]
+    Values(String),
+}
+
+impl CorrectionRecord {
+    /// The record of `c`.
+    pub fn of(c: &Correction) -> CorrectionRecord {
+        CorrectionRecord {
+            field: c.target.field(),
+            variable: c.variable.key().to_string(),
+            breakpoints: c.breakpoints.clone(),
+        }
+    }
+
+    /// The correction it describes, checked.
+    pub fn correction(&self) -> Result<Correction, CorrectionError> {
+        let target = Target::of_field(&self.field)
+            .ok_or_else(|| CorrectionError::Field(self.field.clone()))?;
+        let allowed = target.variables();
+        let variable = allowed
+            .iter()
+            .copied()
+            .find(|v| v.key() == self.variable)
+            .ok_or_else(|| CorrectionError::Variable {
+                field: self.field.clone(),
+                variable: self.variable.clone(),
+                allowed: allowed
+                    .iter()
+                    .map(|v| v.key())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        let b = &self.breakpoints;
+        if b.is_empty() {
+            return Err(CorrectionError::Breakpoints(
+                "is empty: expected at least one".into(),
+            ));
+        }
+        if let Some(x) = b.iter().find(|x| !x.is_finite()) {
+            return Err(CorrectionError::Breakpoints(format!(
+                "holds {x}: expected finite numbers"
+            )));
+        }
+        if let Some(k) = (1..b.len()).find(|&k| b[k] <= b[k - 1]) {
+            return Err(CorrectionError::Breakpoints(format!(
+                "are not strictly increasing ({} then {})",
+                b[k - 1],
+                b[k]
+            )));
+        }
+        if b.len() > MAX_CORRECTION_VALUES {
+            return Err(CorrectionError::TooMany(format!(
+                "{} breakpoints: a run carries at most {MAX_CORRECTION_VALUES} correction values",
+                b.len()
+            )));
+        }
+        Ok(Correction {
+            target,
+            variable,
+            breakpoints: b.clone(),
+        })
+    }
+}
+
+/// Checks a scenario's corrections together: each on its own, at most [`MAX_CORRECTIONS`] of
+/// them and [`MAX_CORRECTION_VALUES`] values in all; returns them with the index of the first
+/// that is wrong on error.
+pub fn check_all(
+    records: &[CorrectionRecord],
+) -> Result<Vec<Correction>, (usize, CorrectionError)> {
+    if records.len() > MAX_CORRECTIONS {
+        return Err((
+            MAX_CORRECTIONS,
+            CorrectionError::TooMany(format!(
+                "{} corrections: at most {MAX_CORRECTIONS}",
+                records.len()
+            )),
+        ));
+    }
+    let mut out = Vec::with_capacity(records.len());
+    let mut values = 0;
+    for (k, r) in records.iter().enumerate() {
+        let c = r.correction().map_err(|e| (k, e))?;
+        values += c.breakpoints.len();
+        if values > MAX_CORRECTION_VALUES {
+            return Err((
+                k,
+                CorrectionError::TooMany(format!(
+                    "{values} correction values up to this one: a run carries at most {MAX_CORRECTION_VALUES}"
+                )),
+            ));
+        }
+        out.push(c);
+    }
+    Ok(out)
+}
+
+/// The value at `x` of the piecewise-linear function through (`b_i`, `v_i`), held at the ends
+/// (the interpolation of section 1, "Tables"; one breakpoint: `v_0`).
+#[inline(always)]
+pub fn interpolate(b: &[f64], v: &[f64], x: f64) -> f64 {
+    let n = b.len();
+    if n == 1 || x <= b[0] {
+        return v[0];
+    }
+    if x >= b[n - 1] {
+        return v[n - 1];
+    }
+    // Few breakpoints (a correction has a handful): a linear scan.
+    let mut i = 0;
+    while x > b[i + 1] {
+        i += 1;
+    }
+    let t = (x - b[i]) / (b[i + 1] - b[i]);
+    t.mul_add(v[i + 1] - v[i], v[i])
+}
+
+/// The weights of each breakpoint's value at `x`: `interpolate(b, v, x)` is their dot product
+/// with `v` (to rounding); for reports and the linear algebra of an update.
+pub fn weights(b: &[f64], x: f64) -> Vec<f64> {
+    let n = b.len();
+    let mut w = vec![0.0; n];
+    if n == 1 || x <= b[0] {
+        w[0] = 1.0;
+        return w;
+    }
+    if x >= b[n - 1] {
+        w[n - 1] = 1.0;
+        return w;
+    }
+    let mut i = 0;
+    while x > b[i + 1] {
+        i += 1;
+    }
+    let t = (x - b[i]) / (b[i + 1] - b[i]);
+    w[i] = 1.0 - t;
+    w[i + 1] = t;
+    w
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,125 @@
+use super::*;
+
+fn record(field: &str, variable: &str, breakpoints: &[f64]) -> CorrectionRecord {
+    CorrectionRecord {
+        field: field.into(),
+        variable: variable.into(),
+        breakpoints: breakpoints.to_vec(),
+    }
+}
+
+#[test]
+fn interpolation_is_linear_between_breakpoints_and_held_beyond_them() {
+    let b = [0.0, 1.0, 3.0];
+    let v = [2.0, 4.0, 0.0];
+    for (x, want) in [
+        (-5.0, 2.0),
+        (0.0, 2.0),
+        (0.5, 3.0),
+        (1.0, 4.0),
+        (2.0, 2.0),
+        (3.0, 0.0),
+        (9.0, 0.0),
+    ] {
+        assert!((interpolate(&b, &v, x) - want).abs() < 1e-15, "{x}");
+        let w = weights(&b, x);
+        let dot: f64 = w.iter().zip(v).map(|(w, v)| w * v).sum();
+        assert!((dot - want).abs() < 1e-15, "{x}");
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+    }
+    assert!((interpolate(&[0.7], &[1.5], 100.0) - 1.5).abs() < 1e-15);
+}
+
+#[test]
+fn every_field_names_itself_and_back() {
+    for t in Target::all() {
+        assert_eq!(Target::of_field(&t.field()), Some(t));
+    }
+    assert_eq!(Target::all().len(), 19);
+    assert_eq!(
+        Target::of_field("aero.cm_q_per_rad").map(Target::axis),
+        Some(4)
+    );
+}
+
+#[test]
+fn records_are_checked_with_a_message_naming_what_is_wrong() {
+    let c = record("aero.cm", "alpha_deg", &[-2.0, 0.0, 4.0])
+        .correction()
+        .unwrap();
+    assert_eq!(c.target, Target::Static(4));
+    assert_eq!(c.variable, Variable::Alpha);
+    let e = record("aero.cmm", "alpha_deg", &[0.0])
+        .correction()
+        .unwrap_err();
+    assert!(e.to_string().contains("`aero.cmm` is not a field"), "{e}");
+    let e = record("interference.dcz0", "alpha_deg", &[0.0, 1.0])
+        .correction()
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "`variable` `alpha_deg`: interference.dcz0 may be corrected over distance_m only"
+    );
+    let e = record("aero.cm_alpha_per_rad", "mach", &[0.9, 0.8])
+        .correction()
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "`breakpoints` are not strictly increasing (0.9 then 0.8)"
+    );
+    let e = record("aero.cz", "beta_deg", &[0.0, f64::NAN])
+        .correction()
+        .unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+    let e = record("aero.cz", "beta_deg", &[]).correction().unwrap_err();
+    assert!(e.to_string().contains("empty"), "{e}");
+    let many: Vec<CorrectionRecord> = (0..5)
+        .map(|_| {
+            record(
+                "aero.cm",
+                "alpha_deg",
+                &(0..20).map(f64::from).collect::<Vec<_>>(),
+            )
+        })
+        .collect();
+    let (at, e) = check_all(&many).unwrap_err();
+    assert_eq!(at, 3);
+    assert!(e.to_string().contains("at most 64"), "{e}");
+}
+
+#[test]
+fn a_run_folds_mach_corrections_and_keeps_the_others_for_the_force_evaluation() {
+    let corrections = check_all(&[
+        record("aero.ca0", "mach", &[0.8, 1.0]),
+        record("aero.cm_alpha_per_rad", "mach", &[0.9]),
+        record("aero.cm", "alpha_deg", &[0.0, 10.0]),
+        record("interference.dcz0", "distance_m", &[0.0, 1.0, 2.0]),
+    ])
+    .unwrap();
+    let values = CorrectionValues::of(&[0.1, 0.3, -0.5, 0.0, 0.2, 1.0, 0.5, 0.0]).unwrap();
+    let (run, folded) = CorrectionRun::new(&corrections, &values, 0.9).unwrap();
+    assert!((folded.statics[0] - 0.2).abs() < 1e-15);
+    assert!((folded.derivatives[2] + 0.5).abs() < 1e-15);
+    assert!(!run.is_empty());
+    let d = run.evaluate(5f64.to_radians(), 0.0, 0.5);
+    assert!((d[4] - 0.1).abs() < 1e-15, "{d:?}");
+    assert!((d[6 + 2] - 0.75).abs() < 1e-15, "{d:?}");
+    assert_eq!(d.iter().filter(|x| **x != 0.0).count(), 2);
+    // No values: nothing at all.
+    let (none, folded) = CorrectionRun::new(&corrections, &CorrectionValues::NONE, 0.9).unwrap();
+    assert!(none.is_empty());
+    assert_eq!(folded, Folded::default());
+    // The wrong number of values, or one not finite, is refused.
+    let e = CorrectionRun::new(&corrections, &CorrectionValues::of(&[0.0; 7]).unwrap(), 0.9)
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "the candidate carries 7 correction values, the scenario's corrections have 8 breakpoints"
+    );
+    let mut bad = [0.0; 8];
+    bad[5] = f64::INFINITY;
+    let e =
+        CorrectionRun::new(&corrections, &CorrectionValues::of(&bad).unwrap(), 0.9).unwrap_err();
+    assert!(e.to_string().contains("correction value 5 is inf"), "{e}");
+    assert!(CorrectionValues::of(&[0.0; 65]).is_err());
+}
