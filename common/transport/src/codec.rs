@@ -13,6 +13,7 @@ use crate::wire::{
     Answer, Chunk, ChunkHeader, MAGIC, MAX_CHUNK, PROTOCOL_VERSION, REASON_CAPACITY, SetupHeader,
     WireObservation, WireRequest, WireResponse,
 };
+use sepval_common::correction::MAX_CORRECTION_VALUES;
 use sepval_common::effects::{MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::extension::MAX_TERMS;
 use sepval_common::factors::FACTOR_COUNT;
@@ -236,7 +237,13 @@ const REQUEST_SIZE: usize = 8
     + 4
     + 4 * MAX_ACTIVE_EFFECTS
     + 4
-    + 8 * MAX_EFFECT_PARAMS * MAX_ACTIVE_EFFECTS;
+    + 8 * MAX_EFFECT_PARAMS * MAX_ACTIVE_EFFECTS
+    + 4
+    + 4
+    + 32 * MAX_TERMS
+    + 4
+    + 4
+    + 8 * MAX_CORRECTION_VALUES;
 const RESPONSE_SIZE: usize = 8 + 4 + 4 + 8 * 3 + 4 + 4 + REASON_CAPACITY;
 const OBSERVATION_SIZE: usize = 8 * 6;
 
@@ -256,6 +263,9 @@ fn put_request(w: &mut Writer, r: &WireRequest) {
         w.f64(t.locator[1]);
         w.f64(t.coefficient);
     }
+    w.u32(r.correction_count);
+    w.u32(r.reserved_corrections);
+    r.corrections.iter().for_each(|&v| w.f64(v));
 }
 
 fn get_request(r: &mut Reader) -> Result<WireRequest, CodecError> {
@@ -285,6 +295,12 @@ fn get_request(r: &mut Reader) -> Result<WireRequest, CodecError> {
             coefficient: r.f64()?,
         };
     }
+    let correction_count = r.u32()?;
+    let reserved_corrections = r.u32()?;
+    let mut corrections = [0.0; MAX_CORRECTION_VALUES];
+    for v in &mut corrections {
+        *v = r.f64()?;
+    }
     Ok(WireRequest {
         index,
         factors,
@@ -295,6 +311,9 @@ fn get_request(r: &mut Reader) -> Result<WireRequest, CodecError> {
         term_count,
         reserved_terms,
         terms,
+        correction_count,
+        reserved_corrections,
+        corrections,
     })
 }
 

@@ -25,6 +25,7 @@ use std::sync::LazyLock;
 use proptest::prelude::*;
 use proptest::sample::select;
 use proptest::test_runner::TestCaseError;
+use sepval_common::correction::MAX_CORRECTION_VALUES;
 use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::evaluation::{Candidate, Event, Job, Outcome};
 use sepval_common::extension::{Axis, MAX_TERMS, Regressor, Term, TermSet};
@@ -85,6 +86,7 @@ static FRAMES: LazyLock<Vec<Frame>> = LazyLock::new(|| {
                 coefficient: -0.8,
             }])
             .unwrap(),
+            corrections: sepval_common::correction::CorrectionValues::NONE,
         },
         Candidate::baseline(Factors([9.0; FACTOR_COUNT])),
     ];
@@ -416,16 +418,27 @@ fn wire_request() -> BoxedStrategy<WireRequest> {
             prop::array::uniform4(prop::array::uniform3(param)),
         ),
         (term_count, any::<u32>(), prop::array::uniform8(term)),
+        (
+            prop_oneof![3 => 0..=(MAX_CORRECTION_VALUES as u32 + 1), 1 => any::<u32>()],
+            any::<u32>(),
+            prop::collection::vec(
+                prop_oneof![3 => -1.0..1.0f64, 1 => hostile_f64()],
+                MAX_CORRECTION_VALUES,
+            ),
+        ),
     )
         .prop_map(
             |(
                 (index, factors, effect_count, effect_index, reserved, params),
                 (term_count, reserved_terms, terms),
+                (correction_count, reserved_corrections, values),
             )| {
                 let mut effect_params = [[0.0; MAX_EFFECT_PARAMS]; MAX_ACTIVE_EFFECTS];
                 for (row, p) in effect_params.iter_mut().zip(params) {
                     row[..3].copy_from_slice(&p);
                 }
+                let mut corrections = [0.0; MAX_CORRECTION_VALUES];
+                corrections.copy_from_slice(&values);
                 WireRequest {
                     index,
                     factors,
@@ -436,6 +449,9 @@ fn wire_request() -> BoxedStrategy<WireRequest> {
                     term_count,
                     reserved_terms,
                     terms,
+                    correction_count,
+                    reserved_corrections,
+                    corrections,
                 }
             },
         )

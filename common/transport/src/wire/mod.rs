@@ -16,6 +16,7 @@
 //! implicit padding (explicit `reserved` fields instead).
 
 use iceoryx2::prelude::ZeroCopySend;
+use sepval_common::correction::{CorrectionValues, MAX_CORRECTION_VALUES};
 use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::evaluation::{Candidate, Evaluation, Job, MAX_REASON_BYTES, Outcome};
 use sepval_common::extension::{Axis, MAX_TERMS, Regressor, Term, TermSet};
@@ -32,8 +33,9 @@ use sepval_common::propagator::Observation;
 /// Version 5: the same layout, but a term may name the wind axes (`wind_y`, `wind_z`: axis
 /// indices 7 and 8) and the `wind` family's regressors (indices 24 and 25); a version-4 worker
 /// would fail such a candidate, which a diagnosis would read as a probe that does not simulate,
-/// so the handshake refuses it instead.
-pub const PROTOCOL_VERSION: u32 = 5;
+/// so the handshake refuses it instead. Version 6: a request carries the values of the
+/// scenario's corrections (`sepval update`, docs/model.md section 15) after its terms.
+pub const PROTOCOL_VERSION: u32 = 6;
 
 /// "SEPVAL01" as a little-endian integer: the first field of [`Hello`], [`SetupHeader`] and
 /// every byte-stream frame.
@@ -116,6 +118,12 @@ pub struct WireRequest {
     pub reserved_terms: u32,
     /// The extension terms (unused entries zero).
     pub terms: [WireTerm; MAX_TERMS],
+    /// Number of correction values (0: every correction 0).
+    pub correction_count: u32,
+    /// Reserved (zero).
+    pub reserved_corrections: u32,
+    /// The values of the scenario's corrections (unused entries zero).
+    pub corrections: [f64; MAX_CORRECTION_VALUES],
 }
 
 /// One extension term of a candidate (docs/model.md section 11).
@@ -206,34 +214,8 @@ impl From<WireObservation> for Observation {
     }
 }
 
-/// What a message from another process can get wrong. One set of messages for every transport.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum WireError {
-    /// More effects than a request holds.
-    #[error("effect count {0} exceeds the maximum of {MAX_ACTIVE_EFFECTS}")]
-    EffectCount(u32),
-    /// An effect index outside the catalogue.
-    #[error("effect index {0} is not in the catalogue")]
-    EffectIndex(u32),
-    /// Effect parameters the catalogue refuses.
-    #[error("{0}")]
-    Effect(String),
-    /// Extension terms that cannot be run.
-    #[error("extension term {index}: {reason}")]
-    Term {
-        /// Its index in the request.
-        index: usize,
-        /// Why.
-        reason: String,
-    },
-    /// An unknown response status.
-    #[error("unknown response status {0}")]
-    Status(u32),
-    /// A failure reason longer than its buffer or not UTF-8.
-    #[error("failure reason of {0} bytes is not valid UTF-8 within {REASON_CAPACITY} bytes")]
-    Reason(u32),
-}
+mod error;
+pub use error::WireError;
 
 impl WireRequest {
     /// The wire form of candidate `index`.
@@ -248,7 +230,11 @@ impl WireRequest {
             term_count: c.terms.len() as u32,
             reserved_terms: 0,
             terms: [WireTerm::default(); MAX_TERMS],
+            correction_count: c.corrections.len() as u32,
+            reserved_corrections: 0,
+            corrections: [0.0; MAX_CORRECTION_VALUES],
         };
+        r.corrections[..c.corrections.len()].copy_from_slice(c.corrections.as_slice());
         for (k, a) in c.effects.iter().enumerate() {
             r.effect_index[k] = a.index as u32;
             r.effect_params[k][..a.values().len()].copy_from_slice(a.values());
@@ -316,10 +302,17 @@ impl WireRequest {
                 })
                 .map_err(|e| bad(e.to_string()))?;
         }
+        let n = self.correction_count as usize;
+        if n > MAX_CORRECTION_VALUES {
+            return Err(WireError::CorrectionCount(self.correction_count));
+        }
+        let corrections = CorrectionValues::of(&self.corrections[..n])
+            .map_err(|_| WireError::CorrectionCount(self.correction_count))?;
         Ok(Candidate {
             factors: Factors(self.factors),
             effects,
             terms,
+            corrections,
         })
     }
 }

@@ -35,6 +35,8 @@ fn requests_and_responses_round_trip_and_bad_ones_are_refused() {
         factors: Factors::TRUTH,
         effects,
         terms,
+        corrections: sepval_common::correction::CorrectionValues::of(&[0.25, -1.5, 3.0e-7])
+            .unwrap(),
     };
     let w = WireRequest::new(5, &c);
     assert_eq!(w.candidate().unwrap(), c);
