@@ -150,19 +150,28 @@ fn damping_table(a: &crate::scenario::Aero, mach: &[f64]) -> String {
 /// Names of the interference increments' columns.
 const INTERFERENCE_COLUMNS: [&str; 6] = ["dcx", "dcy", "dcz", "dcl", "dcm", "dcn"];
 
+/// The graded distances \[m\] an interference increment is sampled at when written as a table
+/// (the choice in this module's documentation): every 0.01 m to 1 m, 0.05 m to 3 m, 0.25 m to
+/// `s_end_m`, then `s_end_m` and 100 m (or 1 m beyond `s_end_m`).
+pub fn interference_distances(s_end_m: f64) -> Vec<f64> {
+    let mut d = grid(0.0, 1.0, 0.01);
+    d.extend(grid(1.0, 3.0, 0.05).into_iter().skip(1));
+    d.extend(
+        grid(3.0, s_end_m, 0.25)
+            .into_iter()
+            .skip(1)
+            .filter(|&x| x < s_end_m),
+    );
+    d.retain(|&x| x < s_end_m);
+    d.extend([s_end_m, (s_end_m + 1.0).max(100.0)]);
+    d
+}
+
 /// The interference increments sampled over distance from carriage (finely near the aircraft),
 /// as CSV.
 fn interference_table(i: &crate::scenario::Interference) -> String {
     let decay = InterferenceDecay::new(i.lambda_m, i.s_end_m);
-    let mut d = grid(0.0, 1.0, 0.01);
-    d.extend(grid(1.0, 3.0, 0.05).into_iter().skip(1));
-    d.extend(
-        grid(3.0, i.s_end_m, 0.25)
-            .into_iter()
-            .skip(1)
-            .filter(|&x| x < i.s_end_m),
-    );
-    d.extend([i.s_end_m, (i.s_end_m + 1.0).max(100.0)]);
+    let d = interference_distances(i.s_end_m);
     let values: Vec<Vec<f64>> = i
         .increments()
         .iter()

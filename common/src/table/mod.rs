@@ -287,6 +287,43 @@ impl Table {
         &self.values
     }
 
+    /// The value at `x` (one number per axis, in the axes' units: angles in degrees),
+    /// interpolated multilinearly and held at the edges (docs/model.md section 1): the same
+    /// function the force evaluation interpolates, to rounding.
+    pub fn value_at(&self, x: &[f64]) -> f64 {
+        let sizes = self.shape();
+        let mut strides = vec![1usize; sizes.len()];
+        for k in (0..sizes.len().saturating_sub(1)).rev() {
+            strides[k] = strides[k + 1] * sizes[k + 1];
+        }
+        // Per axis: the lower corner's index and the weight of the upper one.
+        let cells: Vec<(usize, f64)> = self
+            .axes
+            .iter()
+            .zip(x)
+            .map(|(a, &v)| {
+                let b = &a.breakpoints;
+                let i = b.partition_point(|&p| p <= v).clamp(1, b.len() - 1) - 1;
+                let t = ((v - b[i]) / (b[i + 1] - b[i])).clamp(0.0, 1.0);
+                (i, t)
+            })
+            .collect();
+        let mut sum = 0.0;
+        for corner in 0..(1usize << cells.len()) {
+            let mut w = 1.0;
+            let mut at = 0;
+            for (k, &(i, t)) in cells.iter().enumerate() {
+                let upper = (corner >> k) & 1 == 1;
+                w *= if upper { t } else { 1.0 - t };
+                at += (i + usize::from(upper)) * strides[k];
+            }
+            if w != 0.0 {
+                sum += w * self.values[at];
+            }
+        }
+        sum
+    }
+
     /// Number of breakpoints of each axis.
     fn shape(&self) -> Vec<usize> {
         self.axes.iter().map(|a| a.breakpoints.len()).collect()
