@@ -122,6 +122,7 @@ mod discover;
 mod found;
 mod increments;
 mod library;
+mod misfit;
 mod outputs;
 mod page;
 mod probe;
@@ -141,6 +142,8 @@ pub use diagnosis::{
     RivalReport, SkippedRefit,
 };
 pub use found::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
+pub use library::Sample;
+pub use misfit::{Linear, Misfit, reconstruct_misfit};
 pub use reconstruct::{IncrementSeries, Reconstruction};
 pub use residuals::{
     CHANNELS, ChannelReport, LAGS, ResidualReport, SegmentRms, WHITENESS_P, physical_residuals,

@@ -24,6 +24,7 @@
 //! increment. Each event is reconstructed from its own residuals.
 
 use nalgebra::{DMatrix, DMatrixView, DVector, DVectorView};
+use sepval_common::evaluation::Job;
 use serde::{Deserialize, Serialize};
 
 use sepval_common::extension::{Axis, Term};
@@ -153,4 +154,29 @@ pub fn reconstruct(
         rms_after: (res.norm_squared() / m).sqrt(),
         increments,
     }
+}
+
+/// The misfit reconstructed per event (`rows` of the residuals, each event's part of `r0`, of
+/// the factors' columns `fixed` and of the windows' columns `win`).
+pub(crate) fn reconstruct_events(
+    job: &Job,
+    rows: &[usize],
+    r0: &DVector<f64>,
+    fixed: &DMatrix<f64>,
+    win: DMatrixView<f64>,
+    windows: &[Term],
+) -> Vec<Reconstruction> {
+    crate::probe::event_rows(job, rows)
+        .into_iter()
+        .zip(job.events())
+        .map(|((a, b), e)| {
+            reconstruct(
+                &e.name,
+                r0.rows(a, b - a),
+                fixed.rows(a, b - a),
+                win.rows(a, b - a),
+                windows,
+            )
+        })
+        .collect()
 }

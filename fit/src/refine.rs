@@ -90,28 +90,50 @@ impl Solver for ModelLm {
     }
 }
 
+/// A refinement of model candidates that [`refine_together`] can drive with others: a solver
+/// asked for candidates and told their evaluations, which can fail on its own.
+pub trait Refinement: Solver<Point = Candidate, Value = Evaluation> {
+    /// Records why it failed on its own; it asks nothing more.
+    fn record_failure(&mut self, reason: String);
+    /// Why it failed on its own, if it did.
+    fn failure(&self) -> Option<&str>;
+}
+
+impl Refinement for ModelLm {
+    fn record_failure(&mut self, reason: String) {
+        self.failure = Some(reason);
+    }
+
+    fn failure(&self) -> Option<&str> {
+        self.failure.as_deref()
+    }
+}
+
 /// Several refinements driven together: each ask joins the requests of every unfinished run
 /// into one batch, so that the evaluators stay busy. A run whose own ask or tell fails with
 /// [`RunError::Search`] records the reason and asks nothing more; any other error ends all.
-struct Together<'a> {
-    runs: &'a mut [ModelLm],
+struct Together<'a, R> {
+    runs: &'a mut [R],
     owners: Vec<(usize, usize)>,
 }
 
 /// `Ok` of `result`, or `None` after recording a failure of `run` alone in it; other errors
 /// are everyone's.
-fn on_its_own<T>(run: &mut ModelLm, result: Result<T, RunError>) -> Result<Option<T>, RunError> {
+fn on_its_own<T, R: Refinement>(
+    run: &mut R,
+    result: Result<T, RunError>,
+) -> Result<Option<T>, RunError> {
     match result {
         Ok(v) => Ok(Some(v)),
         Err(RunError::Search(reason)) => {
-            run.failure = Some(reason);
+            run.record_failure(reason);
             Ok(None)
         }
         Err(e) => Err(e),
     }
 }
 
-impl Solver for Together<'_> {
+impl<R: Refinement> Solver for Together<'_, R> {
     type Point = Candidate;
     type Value = Evaluation;
 
@@ -119,7 +141,7 @@ impl Solver for Together<'_> {
         let mut points = Vec::new();
         self.owners.clear();
         for (k, run) in self.runs.iter_mut().enumerate() {
-            if run.failure.is_some() {
+            if run.failure().is_some() {
                 continue;
             }
             let asked = run.ask();
@@ -149,9 +171,9 @@ impl Solver for Together<'_> {
 /// the evaluator as one batch. A run that fails on its own is left with its reason
 /// ([`ModelLm::failure`]) while the others go on; an interruption or a failed transport ends
 /// them all with the error.
-pub fn refine_together(
+pub fn refine_together<R: Refinement>(
     evaluator: &mut dyn Evaluator,
-    runs: &mut [ModelLm],
+    runs: &mut [R],
 ) -> Result<(), RunError> {
     let mut together = Together {
         runs,

@@ -3,14 +3,14 @@
 //! reconstruction windows', reduced to the reconstruction and dropped), the regression's F-to-enter against a Bonferroni threshold with the
 //! predicted square error, and the entries worth an output-error refit.
 
-use nalgebra::{DMatrix, DMatrixView, DVector};
+use nalgebra::{DMatrix, DVector};
 use sepval_common::evaluation::{Candidate, Evaluator, Job};
 use sepval_common::extension::Term;
 
 use super::search::{Search, Selection, Trail};
 use crate::found::{DiscoveryStep, Screened};
 use crate::library::{self, Entry, Sample};
-use crate::reconstruct::{Reconstruction, reconstruct};
+use crate::reconstruct::{Reconstruction, reconstruct_events};
 use crate::stepwise::{self, Score};
 use crate::{Fitted, Result, probe};
 
@@ -163,33 +163,11 @@ fn reconstruction(
     Ok(reconstruct_events(
         search.job,
         &search.rows,
-        linear,
+        &linear.r0,
+        &linear.fixed,
         win.as_view(),
         &windows,
     ))
-}
-
-/// The baseline's misfit reconstructed per event from the windows' columns.
-fn reconstruct_events(
-    job: &Job,
-    rows: &[usize],
-    linear: &Linearisation,
-    win: DMatrixView<f64>,
-    windows: &[Term],
-) -> Vec<Reconstruction> {
-    probe::event_rows(job, rows)
-        .into_iter()
-        .zip(job.events())
-        .map(|((a, b), e)| {
-            reconstruct(
-                &e.name,
-                linear.r0.rows(a, b - a),
-                linear.fixed.rows(a, b - a),
-                win.rows(a, b - a),
-                windows,
-            )
-        })
-        .collect()
 }
 
 impl Screening {
