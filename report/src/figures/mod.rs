@@ -26,6 +26,8 @@
 //!   of too small a clearance, or a low percentile of it) coloured by which side of the
 //!   criterion is [`Safety`], the criterion's contour ([`contour_segments`], marching squares)
 //!   over it and the releases flown marked.
+//! - [`correction_figure`]: what an update changed in a store's data, each correction along
+//!   its variable with its band, the range the releases explored and the evidence.
 //! - [`clearance_figure`]: the clearance between a store and the aircraft against time, one
 //!   line per release, the criterion, each release's smallest clearance counted, the time the
 //!   ejector holds the store shaded, and a panel near the criterion when the clearances span
@@ -65,6 +67,7 @@ mod clearance;
 mod condition_map;
 mod contour;
 mod convergence;
+mod corrections;
 mod correlation;
 mod envelope_map;
 mod envelope_scale;
@@ -84,6 +87,7 @@ pub use clearance::{ClearanceSeries, clearance_figure};
 pub use condition_map::{MapAxis, condition_map};
 pub use contour::{GridError, Segment, contour_segments, row_crossings};
 pub use convergence::convergence_figure;
+pub use corrections::{CorrectionPanel, correction_figure};
 pub use correlation::correlation_figure;
 pub use envelope_map::{EnvelopeMap, envelope_map};
 pub use envelope_scale::Safety;
