@@ -35,9 +35,11 @@ MAY_USE = {
                        "sepval-report", "sepval-geometry"},
     "sepval-envelope": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-plan",
                         "sepval-predict", "sepval-geometry", "sepval-report"},
+    "sepval-update": {"sepval-common", "sepval-solve", "sepval-fit", "sepval-diagnose",
+                      "sepval-report"},
     "sepval": {"sepval-common", "sepval-transport", "sepval-solve", "sepval-fit",
                "sepval-diagnose", "sepval-plan", "sepval-predict", "sepval-envelope",
-               "sepval-geometry", "sepval-report"},
+               "sepval-update", "sepval-geometry", "sepval-report"},
     "sepval-worker": {"sepval-common", "sepval-transport"},
     "sepval-tests": set(),
 }

@@ -1,0 +1,228 @@
+//! What the releases explored, and the corrections that may be proposed over it
+//! (docs/model.md section 15.2): a correction spans only the range of its variable that the
+//! releases went through along their fitted trajectories, so that nothing beyond it is
+//! presented as measured.
+//!
+//! Choices, written down in docs/model.md section 15.2:
+//! - **distance from carriage**: [`DISTANCE_KNOTS`] breakpoints from 0 to the largest distance
+//!   reached, spaced quadratically (s_max (j / (n - 1))^2: dense near carriage, where the
+//!   interference changes fastest), then the scenario's `s_end_m` with its value held at 0 (the
+//!   scenario says the interference ends there; the correction falls linearly to it beyond the
+//!   last distance reached);
+//! - **local alpha and beta**: [`ANGLE_KNOTS`] breakpoints evenly over the range reached, when
+//!   it is at least [`MIN_ANGLE_RANGE_DEG`] wide (a narrower range gives a constant, which the
+//!   factor offsets already are);
+//! - **Mach**: the flight Mach numbers of the releases (those within [`MACH_MERGE`] of each
+//!   other counted once). A static coefficient over Mach needs two of them (one would be a
+//!   constant); a derivative may be corrected at one (a constant change of its slope).
+
+use sepval_common::correction::{Derivative, Target};
+use sepval_common::evaluation::Job;
+use sepval_common::table::Variable;
+use sepval_diagnose::Sample;
+
+/// Breakpoints of a correction over distance, before the one at `s_end_m`.
+pub const DISTANCE_KNOTS: usize = 7;
+/// Breakpoints of a correction over local alpha or beta.
+pub const ANGLE_KNOTS: usize = 5;
+/// The narrowest range of local alpha or beta over which a correction is proposed \[deg\].
+pub const MIN_ANGLE_RANGE_DEG: f64 = 1.0;
+/// Flight Mach numbers closer than this are one.
+pub const MACH_MERGE: f64 = 0.005;
+
+/// The ranges the releases explored along their fitted trajectories.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Explored {
+    /// Largest distance of the CG from carriage \[m\] (the smallest is 0, at release).
+    pub distance_m: f64,
+    /// Smallest and largest local angle of attack \[deg\].
+    pub alpha_deg: (f64, f64),
+    /// Smallest and largest local sideslip \[deg\].
+    pub beta_deg: (f64, f64),
+    /// The flight Mach numbers, increasing, near ones merged.
+    pub machs: Vec<f64>,
+    /// The scenario's interference cut-off \[m\].
+    pub s_end_m: f64,
+}
+
+impl Explored {
+    /// What the releases of `job` explored, from what their fitted trajectories saw
+    /// (`history[event][sample]`).
+    pub fn of(job: &Job, history: &[Vec<Sample>]) -> Explored {
+        let samples = || history.iter().flatten();
+        let range = |f: &dyn Fn(&Sample) -> f64| {
+            samples()
+                .map(f)
+                .filter(|x| x.is_finite())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x), hi.max(x))
+                })
+        };
+        let distance = range(&|s| s.input.distance_m).1.max(0.0);
+        let alpha = range(&|s| s.input.alpha_rad.to_degrees());
+        let beta = range(&|s| s.input.beta_rad.to_degrees());
+        let mut machs: Vec<f64> = job
+            .events()
+            .iter()
+            .map(|e| e.simulator.scenario().flight.mach)
+            .collect();
+        machs.sort_by(f64::total_cmp);
+        machs.dedup_by(|a, b| (*a - *b).abs() < MACH_MERGE);
+        Explored {
+            distance_m: distance,
+            alpha_deg: alpha,
+            beta_deg: beta,
+            machs,
+            s_end_m: job.events()[0].simulator.scenario().interference.s_end_m,
+        }
+    }
+
+    /// The explored range of `variable` (Mach: the first and last flight Mach).
+    pub fn range(&self, variable: Variable) -> (f64, f64) {
+        match variable {
+            Variable::Distance => (0.0, self.distance_m),
+            Variable::Alpha => self.alpha_deg,
+            Variable::Beta => self.beta_deg,
+            _ => (
+                self.machs.first().copied().unwrap_or(0.0),
+                self.machs.last().copied().unwrap_or(0.0),
+            ),
+        }
+    }
+}
+
+/// A correction that may be proposed: its field and variable, its breakpoints, and which of
+/// their values are held at 0 (the last breakpoint of one over distance, at `s_end_m`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proposal {
+    /// The field.
+    pub target: Target,
+    /// The variable.
+    pub variable: Variable,
+    /// Breakpoints in the variable's unit.
+    pub breakpoints: Vec<f64>,
+    /// Per breakpoint, whether its value is held at 0.
+    pub pinned: Vec<bool>,
+}
+
+impl Proposal {
+    /// Number of values a fit estimates.
+    pub fn free_values(&self) -> usize {
+        self.pinned.iter().filter(|p| !**p).count()
+    }
+
+    /// The breakpoints whose values a fit estimates.
+    pub fn free_breakpoints(&self) -> Vec<f64> {
+        self.breakpoints
+            .iter()
+            .zip(&self.pinned)
+            .filter(|(_, p)| !**p)
+            .map(|(b, _)| *b)
+            .collect()
+    }
+
+    /// A short name, e.g. `Cm over alpha` or `interference dCZ over distance`.
+    pub fn name(&self) -> String {
+        const AXES: [&str; 6] = ["CA", "CY", "CZ", "Cl", "Cm", "Cn"];
+        const INCREMENTS: [&str; 6] = ["dCX", "dCY", "dCZ", "dCl", "dCm", "dCn"];
+        let what = match self.target {
+            Target::Static(k) => AXES[k].to_string(),
+            Target::Interference(k) => format!("interference {}", INCREMENTS[k]),
+            Target::Derivative(d) => derivative_name(d).to_string(),
+        };
+        let over = match self.variable {
+            Variable::Distance => "distance",
+            Variable::Alpha => "alpha",
+            Variable::Beta => "beta",
+            _ => "Mach",
+        };
+        format!("{what} over {over}")
+    }
+}
+
+/// A derivative's usual name.
+pub fn derivative_name(d: Derivative) -> &'static str {
+    match d {
+        Derivative::CzAlpha => "CZ_alpha",
+        Derivative::CyBeta => "CY_beta",
+        Derivative::CmAlpha => "Cm_alpha",
+        Derivative::CnBeta => "Cn_beta",
+        Derivative::ClP => "Cl_p",
+        Derivative::CmQ => "Cm_q",
+        Derivative::CnR => "Cn_r",
+    }
+}
+
+/// The derivatives whose coefficient is on axis `axis` (0 CA, ..., 5 Cn).
+fn derivatives_of(axis: usize) -> Vec<Derivative> {
+    Derivative::ALL
+        .into_iter()
+        .filter(|&d| Target::Derivative(d).axis() == axis)
+        .collect()
+}
+
+/// `n` breakpoints evenly from `lo` to `hi`.
+fn even(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|j| lo + (hi - lo) * j as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// Every correction of axis `axis` (0 CA, ..., 5 Cn) that the explored ranges allow.
+pub fn proposals(axis: usize, explored: &Explored) -> Vec<Proposal> {
+    let mut out = Vec::new();
+    let free = |b: Vec<f64>| {
+        let n = b.len();
+        (b, vec![false; n])
+    };
+    let s_max = explored.distance_m;
+    if s_max > 0.0 {
+        let mut b: Vec<f64> = (0..DISTANCE_KNOTS)
+            .map(|j| s_max * (j as f64 / (DISTANCE_KNOTS - 1) as f64).powi(2))
+            .collect();
+        let mut pinned = vec![false; b.len()];
+        if explored.s_end_m > s_max * 1.05 {
+            b.push(explored.s_end_m);
+            pinned.push(true);
+        }
+        out.push(Proposal {
+            target: Target::Interference(axis),
+            variable: Variable::Distance,
+            breakpoints: b,
+            pinned,
+        });
+    }
+    for (variable, (lo, hi)) in [
+        (Variable::Alpha, explored.alpha_deg),
+        (Variable::Beta, explored.beta_deg),
+    ] {
+        if hi - lo >= MIN_ANGLE_RANGE_DEG {
+            let (breakpoints, pinned) = free(even(lo, hi, ANGLE_KNOTS));
+            out.push(Proposal {
+                target: Target::Static(axis),
+                variable,
+                breakpoints,
+                pinned,
+            });
+        }
+    }
+    if explored.machs.len() >= 2 {
+        let (breakpoints, pinned) = free(explored.machs.clone());
+        out.push(Proposal {
+            target: Target::Static(axis),
+            variable: Variable::Mach,
+            breakpoints,
+            pinned,
+        });
+    }
+    for d in derivatives_of(axis) {
+        let (breakpoints, pinned) = free(explored.machs.clone());
+        out.push(Proposal {
+            target: Target::Derivative(d),
+            variable: Variable::Mach,
+            breakpoints,
+            pinned,
+        });
+    }
+    out
+}

@@ -1,0 +1,91 @@
+//! `sepval update`: the store's aerodynamic data updated from its releases, as corrections in
+//! the scenario's own table forms, kept only as far as they predict a release they were not
+//! fitted to (docs/model.md section 15).
+//!
+//! This is what engineers do with release data when the catalogue and the term library do not
+//! name the cause: update the store's data with smooth corrections over the states the store
+//! went through (distance from the aircraft, flow angles, Mach), estimated from all releases
+//! together, and trusted only as far as they predict (the practice of aerodynamic model
+//! identification from flight data: R. V. Jategaonkar, *Flight Vehicle System Identification*,
+//! 2nd ed., AIAA 2015, chapters 4 and 12; V. Klein and E. A. Morelli, *Aircraft System
+//! Identification*, AIAA 2006, chapter 5, on estimation before modelling). The update is a
+//! pipeline of named stages ([`update`] shows it whole):
+//!
+//! 1. **baseline**: the 17 factors fitted to every release (the fit pipeline, `ga+lm`, into
+//!    DIR/baseline), refined to convergence ([`Baseline`]);
+//! 2. **misfit**: the missing force and moment reconstructed per release as coefficient
+//!    increments (docs/model.md section 11.6; `sepval_diagnose::reconstruct_misfit`);
+//! 3. **explored** and **screen**: the corrections the explored ranges allow, scored by how
+//!    well each predicts the reconstruction of releases left out ([`screen::Screening`]);
+//! 4. **select**: the corrections proposed refitted by output error with the factors, their
+//!    smoothness and which are kept chosen by cross-validation over releases
+//!    ([`select::Selected`]);
+//! 5. **uncertainty**: the covariance, the bands and the effective number of parameters
+//!    ([`uncertainty::Uncertainty`]);
+//! 6. **validation**: releases given with `--validate`, predicted;
+//! 7. **store**: the corrections merged into the scenario's tables ([`store::Store`]);
+//! 8. **record** and **outputs**: DIR/update.json, DIR/scenario.toml with DIR/tables/*.csv,
+//!    DIR/factors.json, DIR/figures/corrections.png, DIR/report.html.
+
+#![warn(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod assemble;
+pub mod crossval;
+pub mod explored;
+pub mod jobs;
+pub mod outcome;
+pub mod outputs;
+mod page;
+pub mod pipeline;
+pub mod record;
+pub mod refit;
+pub mod screen;
+pub mod select;
+pub mod space;
+pub mod store;
+pub mod uncertainty;
+pub mod validation;
+pub mod words;
+
+use sepval_common::evaluation::EvalError;
+use sepval_solve::run::RunError;
+
+pub use jobs::StartEvaluator;
+pub use outcome::{Baseline, Update};
+pub use outputs::{OutputsError, write_outputs};
+pub use pipeline::{UpdateOptions, update};
+pub use record::{UPDATE_FORMAT, UpdateFile};
+
+/// An update that cannot be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum UpdateError {
+    /// The baseline fit.
+    #[error("the baseline fit")]
+    Baseline(#[source] sepval_fit::FitError),
+    /// The reconstruction of the misfit.
+    #[error("the reconstruction of what the baseline lacks")]
+    Misfit(#[source] sepval_diagnose::DiagnoseError),
+    /// An evaluator that could not be started.
+    #[error("cannot start the evaluator")]
+    Start(#[source] EvalError),
+    /// A search or an evaluation.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A job that cannot be built.
+    #[error("the releases with the corrections proposed: {0}")]
+    Job(String),
+    /// The updated store cannot be written as a scenario.
+    #[error("the updated store: {0}")]
+    Store(String),
+}
+
+impl From<EvalError> for UpdateError {
+    fn from(e: EvalError) -> Self {
+        UpdateError::Run(RunError::from(e))
+    }
+}
+
+/// The update's results.
+pub type Result<T> = std::result::Result<T, UpdateError>;

@@ -1,0 +1,53 @@
+//! What an update produces before anything is written: its baseline, and the update itself
+//! (its record, the store, the factors and what the figure draws).
+
+use sepval_common::factors::Factors;
+use sepval_solve::lm::LmResult;
+
+use crate::record::UpdateFile;
+use crate::store::Store;
+
+/// The baseline: the 17 factors fitted to every release, converged.
+#[derive(Debug, Clone)]
+pub struct Baseline {
+    /// The factors.
+    pub factors: Factors,
+    /// Its refinement (17 parameters, every sample's residuals).
+    pub lm: LmResult,
+    /// Simulations run.
+    pub evaluations: u64,
+}
+
+/// A finished update.
+#[derive(Debug, Clone)]
+pub struct Update {
+    /// DIR/update.json.
+    pub file: UpdateFile,
+    /// The updated store.
+    pub store: Store,
+    /// The factors fitted with it.
+    pub factors: Factors,
+    /// What the figure draws, per correction kept.
+    pub panels: Vec<PanelData>,
+}
+
+/// What the figure draws of one correction.
+#[derive(Debug, Clone)]
+pub struct PanelData {
+    /// Caption.
+    pub caption: String,
+    /// The variable with its unit.
+    pub x_label: String,
+    /// The curve: variable, value, standard deviation.
+    pub x: Vec<f64>,
+    /// See `x`.
+    pub value: Vec<f64>,
+    /// See `x`.
+    pub std: Vec<f64>,
+    /// The explored range.
+    pub explored: (f64, f64),
+    /// Breakpoints and values.
+    pub knots: (Vec<f64>, Vec<f64>),
+    /// The reconstruction's windows as evidence: (variable, value, standard deviation).
+    pub evidence: Vec<(f64, f64, f64)>,
+}

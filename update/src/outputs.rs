@@ -1,0 +1,122 @@
+//! The update's outputs, in this order: DIR/figures/corrections.png (when a correction is
+//! kept), the updated store (DIR/tables/*.csv, then DIR/scenario.toml, read back and compared
+//! with the store fitted), DIR/factors.json, DIR/report.html and DIR/update.json last. Each
+//! file is written atomically and the cancellation flag is checked before each: a failed or
+//! interrupted update leaves no partial file.
+
+use std::path::{Path, PathBuf};
+
+use sepval_common::atomic_file::write_atomically;
+use sepval_common::scenario::Scenario;
+use sepval_report::figures::{CorrectionPanel, correction_figure};
+
+pub use sepval_report::OutputError;
+
+use crate::outcome::Update;
+
+/// Outputs that could not be written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OutputsError {
+    /// A file, the figure or the page.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The store written does not read back as it was fitted.
+    #[error("the updated store written to {} does not read back as it was fitted: {reason}", path.display())]
+    ReadBack {
+        /// The scenario file.
+        path: PathBuf,
+        /// What differs, or why it does not read.
+        reason: String,
+    },
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), OutputsError> {
+    OutputError::check_cancel()?;
+    write_atomically(path, bytes)
+        .map_err(OutputError::Write)
+        .map_err(OutputsError::from)
+}
+
+/// Writes every output into `out`; returns the files written.
+pub fn write_outputs(update: &Update, out: &Path) -> Result<Vec<PathBuf>, OutputsError> {
+    let figures = OutputError::figures_dir(out)?;
+    let mut written = Vec::new();
+    if !update.panels.is_empty() {
+        OutputError::check_cancel()?;
+        let panels: Vec<CorrectionPanel> = update
+            .panels
+            .iter()
+            .map(|p| CorrectionPanel {
+                caption: &p.caption,
+                x_label: &p.x_label,
+                x: &p.x,
+                value: &p.value,
+                std: &p.std,
+                explored: p.explored,
+                knots: (&p.knots.0, &p.knots.1),
+                evidence: p.evidence.clone(),
+            })
+            .collect();
+        let path = figures.join("corrections.png");
+        correction_figure(
+            &path,
+            &panels,
+            "The store's data updated: each correction with its ±2σ band",
+        )
+        .map_err(OutputError::from)?;
+        written.push(path);
+    }
+    written.extend(write_store(update, out)?);
+    let factors = serde_json::to_string_pretty(&update.factors).expect("factors serialise") + "\n";
+    let path = out.join("factors.json");
+    write(&path, factors.as_bytes())?;
+    written.push(path);
+    OutputError::check_cancel()?;
+    let figure = (!update.panels.is_empty()).then_some("figures/corrections.png");
+    let html = crate::page::render(&update.file, figure).map_err(OutputError::from)?;
+    let path = out.join("report.html");
+    write(&path, html.as_bytes())?;
+    written.push(path);
+    let json = serde_json::to_string_pretty(&update.file).expect("an update serialises") + "\n";
+    let path = out.join("update.json");
+    write(&path, json.as_bytes())?;
+    written.push(path);
+    Ok(written)
+}
+
+/// The header of the scenario written.
+const HEADER: &str = "# sepval scenario written by `sepval update` (SI units, angles in degrees; docs/model.md section 1).\n# Its tables are the CSV files under tables/, relative to this file; update.json says what was corrected and how sure it is.\n";
+
+/// DIR/tables/*.csv, then DIR/scenario.toml, then the check that it reads back as fitted.
+fn write_store(update: &Update, out: &Path) -> Result<Vec<PathBuf>, OutputsError> {
+    let mut written = Vec::new();
+    let store = &update.store;
+    if !store.files.is_empty() {
+        let tables = out.join("tables");
+        std::fs::create_dir_all(&tables).map_err(|source| OutputError::Dir {
+            path: tables.clone(),
+            source,
+        })?;
+    }
+    for (rel, text) in &store.files {
+        let path = out.join(rel);
+        write(&path, text.as_bytes())?;
+        written.push(path);
+    }
+    let path = out.join("scenario.toml");
+    let text = format!("{HEADER}{}", store.file_form.to_toml_string());
+    write(&path, text.as_bytes())?;
+    written.push(path.clone());
+    let back = Scenario::load(&path).map_err(|e| OutputsError::ReadBack {
+        path: path.clone(),
+        reason: format!("{e:#}"),
+    })?;
+    if back != store.scenario {
+        return Err(OutputsError::ReadBack {
+            path,
+            reason: "its content differs from the store fitted".into(),
+        });
+    }
+    Ok(written)
+}

@@ -1,0 +1,445 @@
+//! The corrections kept, chosen by what they predict (docs/model.md section 15.5): forward
+//! selection in rounds. Each round screens every correction on the reconstruction of what the
+//! current model lacks (section 15.3, linearised about it, which also chooses the correction's
+//! smoothness), then refits the current model with the best one by output error, to every
+//! release and to each fold, and keeps it only when the folds' predictions of what they left
+//! out improve by more than [`KEEP_MARGIN`] in chi-square; the first correction that does not
+//! ends the selection.
+
+use std::sync::Arc;
+
+use sepval_common::correction::MAX_CORRECTION_VALUES;
+use sepval_common::evaluation::{Candidate, Evaluator, Job};
+use sepval_common::factors::Factors;
+use sepval_diagnose::{Misfit, reconstruct_misfit};
+use sepval_fit::space::Noise;
+use sepval_solve::lm::LmSettings;
+
+use crate::crossval::{Fold, Prediction, RefitSpec, Refitted, predict_all, refit_all};
+use crate::explored::{Explored, Proposal};
+use crate::jobs::{CLOCK, StartEvaluator, with_corrections};
+use crate::record::RoundRecord;
+use crate::refit::Mask;
+use crate::screen::{AxisScreen, Pick, Screening, screen};
+use crate::space::UpdateSpace;
+use crate::{Result, UpdateError};
+
+/// The cross-validated chi-square a correction must save to be kept (the margin of strong
+/// evidence, as the screening's).
+pub const KEEP_MARGIN: f64 = 6.0;
+/// The smoothness of every correction during the rounds: lambda = 1e-6 (weak: a round's choice
+/// of correction should not hang on it); the final one is chosen by [`SMOOTHNESS`].
+pub const LAMBDA0: f64 = 1e-6;
+/// The multipliers of [`LAMBDA0`] tried besides 1 on the corrections kept, by their
+/// cross-validated chi-square (lambda from 1e-8 to 1e-2).
+pub const SMOOTHNESS: [f64; 3] = [1e-2, 1e2, 1e4];
+/// Most rounds (corrections kept).
+pub const MAX_ROUNDS: usize = 6;
+/// Corrections of one round whose cross-validated chi-squares are within this of the best's
+/// cannot be told from it (the margin of strong evidence: R. E. Kass and A. E. Raftery, JASA
+/// 90, 1995).
+pub const CANNOT_TELL: f64 = 6.0;
+
+/// What the selection needs.
+pub struct Setting {
+    /// The releases as given (no corrections).
+    pub job: Arc<Job>,
+    /// The factors fitted by the baseline (the held ones stay there).
+    pub base: Factors,
+    /// The free factors' indices.
+    pub free: Vec<usize>,
+    /// The noise.
+    pub noise: Noise,
+    /// The refits' settings.
+    pub lm: LmSettings,
+    /// The folds.
+    pub folds: Vec<Fold>,
+}
+
+/// Corrections with their smoothness.
+#[derive(Debug, Clone, Default)]
+pub struct Corrections {
+    /// The corrections.
+    pub proposals: Vec<Proposal>,
+    /// Each correction's lambda.
+    pub lambdas: Vec<f64>,
+    /// Each correction's penalty weight (lambda times its values' mean information).
+    pub weights: Vec<f64>,
+}
+
+/// A model of the selection: its corrections, its space and its fits.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// The corrections.
+    pub corrections: Corrections,
+    /// The space.
+    pub space: Arc<UpdateSpace>,
+    /// The refit to every release.
+    pub fit: Refitted,
+    /// Each fold's prediction of what it left out.
+    pub predictions: Vec<Prediction>,
+    /// Their chi-squares summed.
+    pub cv: f64,
+}
+
+/// One fold's predictions of the samples it left out.
+#[derive(Debug, Clone)]
+pub struct FoldScore {
+    /// What was predicted.
+    pub held_out: String,
+    /// The scenario as given with the nominal factors (no fit).
+    pub baseline: Prediction,
+    /// The factors fitted to the fold.
+    pub factors_only: Prediction,
+    /// The factors and the corrections kept, fitted to the fold.
+    pub updated: Prediction,
+}
+
+/// The outcome of the selection.
+#[derive(Debug, Clone)]
+pub struct Selected {
+    /// The model kept.
+    pub model: Model,
+    /// The factors alone.
+    pub factors_only: Model,
+    /// Each round.
+    pub rounds: Vec<RoundRecord>,
+    /// Per fold.
+    pub folds: Vec<FoldScore>,
+    /// The screening of the first round (about the factors alone).
+    pub first_screening: Vec<AxisScreen>,
+    /// What the baseline lacks, reconstructed (the figure's evidence).
+    pub misfit: Misfit,
+    /// What the releases explored.
+    pub explored: Explored,
+    /// The smoothness tried on the corrections kept: (lambda, cross-validated chi-square).
+    pub smoothness: Vec<(f64, f64)>,
+    /// Simulations run.
+    pub evaluations: u64,
+}
+
+/// A model to refit: its corrections, and its space in the evaluator's job (whose corrections
+/// may hold others, held at 0), with its start.
+struct Trial {
+    corrections: Corrections,
+    space: Arc<UpdateSpace>,
+    x0: Vec<f64>,
+}
+
+/// The refits of `trials` on `evaluator`, all in one batch loop: each to every release, then to
+/// each fold from there, then each fold's prediction of what it left out; each model's space
+/// is then its corrections' own (`model`: the corrections' bounds).
+fn fit_models(
+    s: &Setting,
+    evaluator: &mut dyn Evaluator,
+    model: &sepval_common::model::Model,
+    trials: Vec<Trial>,
+    evaluations: &mut u64,
+) -> Result<Vec<Model>> {
+    let every = Mask::all(evaluator.job().events().len());
+    let specs = trials
+        .iter()
+        .map(|t| RefitSpec {
+            space: Arc::clone(&t.space),
+            mask: every.clone(),
+            x0: t.x0.clone(),
+        })
+        .collect();
+    let fits = refit_all(evaluator, specs, s.noise, &s.lm)?;
+    let mut specs = Vec::new();
+    for (t, fit) in trials.iter().zip(&fits) {
+        specs.extend(s.folds.iter().map(|f| RefitSpec {
+            space: Arc::clone(&t.space),
+            mask: f.fit.clone(),
+            x0: fit.lm.x.clone(),
+        }));
+    }
+    let folds = refit_all(evaluator, specs, s.noise, &s.lm)?;
+    *evaluations += fits
+        .iter()
+        .chain(&folds)
+        .map(|r| r.lm.evaluations)
+        .sum::<u64>();
+    let per = s.folds.len();
+    let mut items: Vec<(&UpdateSpace, &[f64], &Mask)> = Vec::new();
+    for (t, chunk) in trials.iter().zip(folds.chunks(per)) {
+        for (r, f) in chunk.iter().zip(&s.folds) {
+            items.push((t.space.as_ref(), r.lm.x.as_slice(), &f.test));
+        }
+    }
+    let predictions = predict_all(evaluator, &items, s.noise)?;
+    *evaluations += predictions.len() as u64;
+    Ok(trials
+        .into_iter()
+        .zip(fits)
+        .zip(predictions.chunks(per))
+        .map(|((t, fit), p)| {
+            let c = &t.corrections;
+            let space = Arc::new(UpdateSpace::new(
+                model,
+                s.base,
+                &s.free,
+                &c.proposals,
+                &c.weights,
+            ));
+            Model {
+                corrections: t.corrections,
+                space,
+                fit,
+                predictions: p.to_vec(),
+                cv: p.iter().map(|p| p.chi2).sum(),
+            }
+        })
+        .collect())
+}
+
+/// What `model` lacks, reconstructed on `evaluator` (whose job holds its corrections): the
+/// free parameters not at a bound stay free.
+fn misfit_of(evaluator: &mut dyn Evaluator, model: &Model, noise: Noise) -> Result<Misfit> {
+    let lm = &model.fit.lm;
+    let m = model.fit.measure.data_rows;
+    let params = &model.space.params;
+    let free: Vec<usize> = (0..lm.x.len())
+        .filter(|&c| {
+            let tol = 1e-6 * params.range(c);
+            lm.x[c] > params.lo[c] + tol && lm.x[c] < params.hi[c] - tol
+        })
+        .collect();
+    let candidate: Candidate = model.space.candidate(&lm.x);
+    reconstruct_misfit(
+        evaluator,
+        &candidate,
+        &lm.residuals[..m],
+        &lm.jacobian.rows(0, m).into_owned(),
+        &free,
+        noise,
+    )
+    .map_err(UpdateError::Misfit)
+}
+
+/// Selects the corrections, starting its evaluators with `start`.
+pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
+    let mut evaluations = 0;
+    let mut evaluator = start(Arc::clone(&s.job)).map_err(UpdateError::Start)?;
+    let model = evaluator.job().events()[0].simulator.model().clone();
+    let none = Arc::new(UpdateSpace::new(&model, s.base, &s.free, &[], &[]));
+    let trial = Trial {
+        corrections: Corrections::default(),
+        x0: none.start(&s.base, None),
+        space: none,
+    };
+    let factors_only =
+        fit_models(s, evaluator.as_mut(), &model, vec![trial], &mut evaluations)?.remove(0);
+    CLOCK.lap("select: the factors alone and their folds");
+    let first = misfit_of(evaluator.as_mut(), &factors_only, s.noise)?;
+    evaluations += first.evaluations;
+    let explored = Explored::of(&s.job, &first.history);
+    let mut misfit = first.clone();
+    let mut current = factors_only.clone();
+    let mut rounds = Vec::new();
+    let mut first_screening = Vec::new();
+    for round in 0..MAX_ROUNDS {
+        let factors = current.space.factors(&current.fit.lm.x);
+        let screening = screen(
+            &s.job,
+            &misfit,
+            &factors,
+            &explored,
+            &current.corrections.proposals,
+        );
+        if round == 0 {
+            first_screening = screening.axes.clone();
+        }
+        let mut record = RoundRecord::of(round, &screening, current.cv);
+        let Some((best, others)) = round_trials(s, start, &current, &screening, &mut evaluations)?
+        else {
+            rounds.push(record);
+            break;
+        };
+        CLOCK.lap(&format!("select: round {}", round + 1));
+        record.correction = best.corrections.proposals.last().map(Proposal::name);
+        record.cv_chi2_with = Some(best.cv);
+        record.kept = best.cv < current.cv - KEEP_MARGIN;
+        record.tried = others
+            .iter()
+            .map(|m| {
+                let name = m.corrections.proposals.last().map(Proposal::name);
+                (name.unwrap_or_default(), m.cv)
+            })
+            .collect();
+        record.cannot_tell = others
+            .iter()
+            .filter(|m| m.cv - best.cv < CANNOT_TELL && m.cv < current.cv - KEEP_MARGIN)
+            .filter_map(|m| m.corrections.proposals.last().map(Proposal::name))
+            .collect();
+        let kept = record.kept;
+        rounds.push(record);
+        if !kept {
+            break;
+        }
+        current = best;
+        let job = Arc::new(with_corrections(&s.job, &current.corrections.proposals)?);
+        evaluator = start(job).map_err(UpdateError::Start)?;
+        misfit = misfit_of(evaluator.as_mut(), &current, s.noise)?;
+        evaluations += misfit.evaluations;
+    }
+    let (current, smoothness) =
+        smoothness(s, evaluator.as_mut(), &model, current, &mut evaluations)?;
+    CLOCK.lap("select: smoothness");
+    drop(evaluator);
+    let mut evaluator = start(Arc::clone(&s.job)).map_err(UpdateError::Start)?;
+    let baseline = nominal_predictions(evaluator.as_mut(), s, &model)?;
+    evaluations += baseline.len() as u64;
+    let folds = s
+        .folds
+        .iter()
+        .zip(baseline)
+        .zip(factors_only.predictions.iter().zip(&current.predictions))
+        .map(|((f, b), (fo, up))| FoldScore {
+            held_out: f.held_out.clone(),
+            baseline: b,
+            factors_only: *fo,
+            updated: *up,
+        })
+        .collect();
+    Ok(Selected {
+        model: current,
+        factors_only,
+        rounds,
+        folds,
+        first_screening,
+        misfit: first,
+        explored,
+        smoothness,
+        evaluations,
+    })
+}
+
+/// The smoothness of the corrections kept, chosen by their cross-validated chi-square: each
+/// multiplier of [`SMOOTHNESS`] on every correction's weight refitted (from the model fitted at
+/// [`LAMBDA0`]) on `evaluator`, whose job holds those corrections. Returns the best model and
+/// every (lambda, cross-validated chi-square).
+fn smoothness(
+    s: &Setting,
+    evaluator: &mut dyn Evaluator,
+    model: &sepval_common::model::Model,
+    current: Model,
+    evaluations: &mut u64,
+) -> Result<(Model, Vec<(f64, f64)>)> {
+    if current.corrections.proposals.is_empty() {
+        return Ok((current, Vec::new()));
+    }
+    let trials: Vec<Trial> = SMOOTHNESS
+        .iter()
+        .map(|&m| {
+            let mut corrections = current.corrections.clone();
+            corrections.lambdas.iter_mut().for_each(|l| *l *= m);
+            corrections.weights.iter_mut().for_each(|w| *w *= m);
+            let space = Arc::new(UpdateSpace::new(
+                model,
+                s.base,
+                &s.free,
+                &corrections.proposals,
+                &corrections.weights,
+            ));
+            Trial {
+                corrections,
+                x0: current.fit.lm.x.clone(),
+                space,
+            }
+        })
+        .collect();
+    let models = fit_models(s, evaluator, model, trials, evaluations)?;
+    let mut all = vec![current];
+    all.extend(models);
+    let mut scores: Vec<(f64, f64)> = all
+        .iter()
+        .map(|m| (m.corrections.lambdas[0], m.cv))
+        .collect();
+    scores.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let best = (0..all.len())
+        .min_by(|&a, &b| all[a].cv.total_cmp(&all[b].cv))
+        .unwrap_or(0);
+    Ok((all.swap_remove(best), scores))
+}
+
+/// The round's picks refitted side by side (each added to the current model, in one job that
+/// holds them all, the others held at 0): the best by its cross-validated chi-square, and the
+/// others; `None` when the screening picked nothing.
+fn round_trials(
+    s: &Setting,
+    start: &mut StartEvaluator<'_>,
+    current: &Model,
+    screening: &Screening,
+    evaluations: &mut u64,
+) -> Result<Option<(Model, Vec<Model>)>> {
+    let mut picks: Vec<&Pick> = Vec::new();
+    let mut values: usize = current
+        .corrections
+        .proposals
+        .iter()
+        .map(|p| p.breakpoints.len())
+        .sum();
+    for p in &screening.picks {
+        if values + p.proposal.breakpoints.len() <= MAX_CORRECTION_VALUES {
+            values += p.proposal.breakpoints.len();
+            picks.push(p);
+        }
+    }
+    if picks.is_empty() {
+        return Ok(None);
+    }
+    let mut union = current.corrections.proposals.clone();
+    union.extend(picks.iter().map(|p| p.proposal.clone()));
+    let job = Arc::new(with_corrections(&s.job, &union)?);
+    let mut evaluator = start(job).map_err(UpdateError::Start)?;
+    let model = evaluator.job().events()[0].simulator.model().clone();
+    let kept = current.corrections.proposals.len();
+    let trials: Vec<Trial> = (0..picks.len())
+        .map(|i| {
+            let mut corrections = current.corrections.clone();
+            corrections.proposals.push(picks[i].proposal.clone());
+            corrections.lambdas.push(LAMBDA0);
+            corrections.weights.push(LAMBDA0 * picks[i].scale);
+            // In the union's order: the current model's, then every pick, the others held.
+            let mut proposals = union.clone();
+            let mut weights = current.corrections.weights.clone();
+            for (j, p) in picks.iter().enumerate() {
+                if j != i {
+                    proposals[kept + j].pinned = vec![true; p.proposal.pinned.len()];
+                }
+                weights.push(if j == i { LAMBDA0 * p.scale } else { 0.0 });
+            }
+            let space = Arc::new(UpdateSpace::new(
+                &model, s.base, &s.free, &proposals, &weights,
+            ));
+            Trial {
+                corrections,
+                x0: space.project(&current.space, &current.fit.lm.x),
+                space,
+            }
+        })
+        .collect();
+    let mut models = fit_models(s, evaluator.as_mut(), &model, trials, evaluations)?;
+    let best = (0..models.len())
+        .min_by(|&a, &b| models[a].cv.total_cmp(&models[b].cv))
+        .unwrap_or(0);
+    let best = models.remove(best);
+    Ok(Some((best, models)))
+}
+
+/// What the scenario as given, with the nominal factors, predicts for each fold's samples left
+/// out.
+fn nominal_predictions(
+    evaluator: &mut dyn Evaluator,
+    s: &Setting,
+    model: &sepval_common::model::Model,
+) -> Result<Vec<Prediction>> {
+    let nominal = UpdateSpace::new(model, Factors::NOMINAL, &[], &[], &[]);
+    let items: Vec<(&UpdateSpace, &[f64], &Mask)> = s
+        .folds
+        .iter()
+        .map(|f| (&nominal, &[][..], &f.test))
+        .collect();
+    predict_all(evaluator, &items, s.noise)
+}

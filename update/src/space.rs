@@ -1,0 +1,262 @@
+//! The parameters of an update's output-error refit (docs/model.md section 15.4): the free
+//! factors, then the free values of every correction (those not held at 0), and the smoothness
+//! penalty on the values as rows appended to the residual vector.
+
+use nalgebra::DMatrix;
+use sepval_common::correction::{Correction, CorrectionValues, Derivative, Target};
+use sepval_common::evaluation::Candidate;
+use sepval_common::factors::{Factor, FactorTable, Factors};
+use sepval_common::model::Model;
+use sepval_solve::params::Params;
+
+use crate::explored::Proposal;
+
+/// The ridge within a correction's smoothness penalty, relative to its second differences': a
+/// whisper that keeps every system definite.
+pub const RIDGE: f64 = 1e-4;
+/// Bound on a static coefficient's correction (either sign).
+pub const STATIC_BOUND: f64 = 2.0;
+/// Smallest bound on a derivative's correction \[1/rad\]; larger derivatives get twice their
+/// size.
+pub const DERIVATIVE_BOUND: f64 = 10.0;
+/// Smallest bound on an interference increment's correction; larger increments at carriage get
+/// twice their size.
+pub const INTERFERENCE_BOUND: f64 = 2.0;
+
+/// The refit's parameters and how they make a candidate.
+#[derive(Debug, Clone)]
+pub struct UpdateSpace {
+    /// Names, units and bounds: the free factors, then every correction's free values.
+    pub params: Params,
+    /// The factors held (and the start of the free ones).
+    base: Factors,
+    /// The free factors' indices.
+    free: Vec<usize>,
+    /// The corrections.
+    corrections: Vec<Proposal>,
+    /// The penalty's square root: (rows, free values); the residual vector gains L v.
+    root: DMatrix<f64>,
+    /// Each correction's bound on its values (either sign).
+    bounds: Vec<f64>,
+}
+
+impl UpdateSpace {
+    /// The space of `corrections` over `model`'s scenario (its derivatives and increments set
+    /// the bounds), with the factors `free` (indices) starting at `base` and the others held
+    /// there. `weights[k]` is correction k's penalty weight: its lambda times its values' mean
+    /// information.
+    pub fn new(
+        model: &Model,
+        base: Factors,
+        free: &[usize],
+        corrections: &[Proposal],
+        weights: &[f64],
+    ) -> UpdateSpace {
+        let table: &FactorTable = &model.scenario().factors;
+        let mut params = Params::empty();
+        let bounds = corrections.iter().map(|p| bound(model, p.target)).collect();
+        for &i in free {
+            let f = &table.0[i];
+            params.push(Factor::NAMES[i], "-", f.min, f.max);
+        }
+        for p in corrections {
+            let bound = bound(model, p.target);
+            for (k, (&b, &pinned)) in p.breakpoints.iter().zip(&p.pinned).enumerate() {
+                if !pinned {
+                    let unit = if matches!(p.target, Target::Derivative(_)) {
+                        "1/rad"
+                    } else {
+                        "-"
+                    };
+                    params.push(
+                        format!("{}[{k}]@{b}", p.target.field()),
+                        unit,
+                        -bound,
+                        bound,
+                    );
+                }
+            }
+        }
+        let values: usize = corrections.iter().map(Proposal::free_values).sum();
+        let rows: usize = corrections
+            .iter()
+            .map(|p| penalty_root(&p.free_breakpoints()).nrows())
+            .sum();
+        let mut root = DMatrix::zeros(rows, values);
+        let (mut r0, mut c0) = (0, 0);
+        for (p, &w) in corrections.iter().zip(weights) {
+            let block = penalty_root(&p.free_breakpoints()) * w.max(0.0).sqrt();
+            root.view_mut((r0, c0), block.shape()).copy_from(&block);
+            r0 += block.nrows();
+            c0 += block.ncols();
+        }
+        UpdateSpace {
+            params,
+            base,
+            free: free.to_vec(),
+            corrections: corrections.to_vec(),
+            root,
+            bounds,
+        }
+    }
+
+    /// The bound on correction `k`'s values (either sign).
+    pub fn bound(&self, k: usize) -> f64 {
+        self.bounds[k]
+    }
+
+    /// The corrections.
+    pub fn corrections(&self) -> &[Proposal] {
+        &self.corrections
+    }
+
+    /// The corrections as a scenario holds them.
+    pub fn checked(&self) -> Vec<Correction> {
+        self.corrections
+            .iter()
+            .map(|p| Correction {
+                target: p.target,
+                variable: p.variable,
+                breakpoints: p.breakpoints.clone(),
+            })
+            .collect()
+    }
+
+    /// The free factors' indices.
+    pub fn free(&self) -> &[usize] {
+        &self.free
+    }
+
+    /// Number of free factors.
+    pub fn factor_count(&self) -> usize {
+        self.free.len()
+    }
+
+    /// The start: the free factors at `base`, the values at `values` (free values only, in
+    /// order) or 0.
+    pub fn start(&self, factors: &Factors, values: Option<&[f64]>) -> Vec<f64> {
+        let mut x: Vec<f64> = self.free.iter().map(|&i| factors.0[i]).collect();
+        let n = self.params.len() - x.len();
+        match values {
+            Some(v) if v.len() == n => x.extend_from_slice(v),
+            _ => x.extend(std::iter::repeat_n(0.0, n)),
+        }
+        x
+    }
+
+    /// The factors at `x`.
+    pub fn factors(&self, x: &[f64]) -> Factors {
+        let mut f = self.base;
+        for (k, &i) in self.free.iter().enumerate() {
+            f.0[i] = x[k];
+        }
+        f
+    }
+
+    /// The free values at `x`.
+    pub fn free_values<'a>(&self, x: &'a [f64]) -> &'a [f64] {
+        &x[self.free.len()..]
+    }
+
+    /// Every breakpoint's value at `x`, per correction (those held: 0).
+    pub fn values(&self, x: &[f64]) -> Vec<Vec<f64>> {
+        let mut it = self.free_values(x).iter();
+        self.corrections
+            .iter()
+            .map(|p| {
+                p.pinned
+                    .iter()
+                    .map(|&pinned| {
+                        if pinned {
+                            0.0
+                        } else {
+                            *it.next().unwrap_or(&0.0)
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The candidate of `x`.
+    pub fn candidate(&self, x: &[f64]) -> Candidate {
+        let all: Vec<f64> = self.values(x).concat();
+        Candidate {
+            corrections: CorrectionValues::of(&all).unwrap_or(CorrectionValues::NONE),
+            ..Candidate::baseline(self.factors(x))
+        }
+    }
+
+    /// The point of this space nearest `x` of `from` (a space of the same corrections, or of
+    /// none): its free factors, and the values of `x` that this space keeps free.
+    pub fn project(&self, from: &UpdateSpace, x: &[f64]) -> Vec<f64> {
+        let factors = from.factors(x);
+        let values = from.values(x);
+        let mut out: Vec<f64> = self.free.iter().map(|&i| factors.0[i]).collect();
+        for (k, p) in self.corrections.iter().enumerate() {
+            for (j, &pinned) in p.pinned.iter().enumerate() {
+                if !pinned {
+                    out.push(values.get(k).and_then(|v| v.get(j)).copied().unwrap_or(0.0));
+                }
+            }
+        }
+        out
+    }
+
+    /// The penalty rows L v at `x` (each correction's weighted).
+    pub fn penalty_rows(&self, x: &[f64]) -> Vec<f64> {
+        let v = nalgebra::DVector::from_column_slice(self.free_values(x));
+        (&self.root * v).iter().copied().collect()
+    }
+
+    /// Number of penalty rows.
+    pub fn penalty_len(&self) -> usize {
+        self.root.nrows()
+    }
+}
+
+/// The square root of one correction's smoothness penalty on the values at its free
+/// breakpoints `b`: the second divided differences, scaled to (1, -2, 1) where the breakpoints
+/// are evenly spaced (row j: h/h_j, -(h/h_j + h/h_{j+1}), h/h_{j+1}, h the mean of the two
+/// spacings h_j, h_{j+1}), which vanish on any straight line whatever the spacing; then a
+/// ridge of sqrt([`RIDGE`]) on each value, so that its square is D2^T D2 + RIDGE I.
+pub fn penalty_root(b: &[f64]) -> DMatrix<f64> {
+    let n = b.len();
+    let d2 = n.saturating_sub(2);
+    let mut root = DMatrix::zeros(d2 + n, n);
+    for j in 0..d2 {
+        let (h0, h1) = (b[j + 1] - b[j], b[j + 2] - b[j + 1]);
+        let h = 0.5 * (h0 + h1);
+        root[(j, j)] = h / h0;
+        root[(j, j + 1)] = -(h / h0 + h / h1);
+        root[(j, j + 2)] = h / h1;
+    }
+    for j in 0..n {
+        root[(d2 + j, j)] = RIDGE.sqrt();
+    }
+    root
+}
+
+/// The bound of a correction of `target` on `model`'s scenario: the larger of a floor and twice
+/// the size of what it corrects at the flight condition.
+fn bound(model: &Model, target: Target) -> f64 {
+    let a = &model.aero_at_mach;
+    match target {
+        Target::Static(_) => STATIC_BOUND,
+        Target::Derivative(d) => {
+            let base = match d {
+                Derivative::CzAlpha => a.cz_alpha_per_rad,
+                Derivative::CyBeta => a.cy_beta_per_rad,
+                Derivative::CmAlpha => a.cm_alpha_per_rad,
+                Derivative::CnBeta => a.cn_beta_per_rad,
+                Derivative::ClP => a.cl_p_per_rad,
+                Derivative::CmQ => a.cm_q_per_rad,
+                Derivative::CnR => a.cn_r_per_rad,
+            };
+            DERIVATIVE_BOUND.max(2.0 * base.abs())
+        }
+        Target::Interference(k) => {
+            INTERFERENCE_BOUND.max(2.0 * model.interference_at_carriage[k].abs())
+        }
+    }
+}
