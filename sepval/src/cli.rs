@@ -47,6 +47,9 @@ pub enum Command {
     /// Map the separation envelope: the store's clearance to the aircraft predicted over a grid
     /// of flight conditions, and where it holds with confidence.
     Envelope(Box<EnvelopeArgs>),
+    /// Update the store's aerodynamic data from its releases: corrections as tables in the
+    /// scenario's own form, kept only as far as they predict a release they were not fitted to.
+    Update(Box<UpdateArgs>),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
     /// Check the Pareto machinery on problems with known fronts.
@@ -412,6 +415,42 @@ pub struct EnvelopeArgs {
     /// Go on with the interrupted sweep in --out (same inputs) instead of starting anew.
     #[arg(long, conflicts_with = "overwrite")]
     pub resume: bool,
+    #[command(flatten)]
+    pub overwrite: OverwriteArgs,
+}
+
+#[derive(clap::Args)]
+pub struct UpdateArgs {
+    #[command(flatten)]
+    pub inputs: InputArgs,
+    /// A release never fitted (CSV; repeatable): the store as given, the factors alone and the
+    /// updated store predict it.
+    #[arg(long, value_name = "FILE.csv")]
+    pub validate: Vec<PathBuf>,
+    /// The factors fitted with the corrections, comma-separated [default: all 17]; the others
+    /// stay at the baseline fit's values.
+    #[arg(long, value_name = "NAME,...")]
+    pub free: Option<String>,
+    /// Seed of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Generations of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 60)]
+    pub generations: usize,
+    /// Population of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 100)]
+    pub population: usize,
+    /// Simulation budget of the baseline's refinement.
+    #[arg(long, default_value_t = 3000)]
+    pub lm_budget: u64,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    /// Output directory (update.json, scenario.toml, tables/, factors.json, report.html,
+    /// figures/, baseline/).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
     #[command(flatten)]
     pub overwrite: OverwriteArgs,
 }

@@ -75,6 +75,7 @@ fn main() -> ExitCode {
         Command::Plan(args) => command::plan::run(*args),
         Command::Predict(args) => command::predict::run(*args),
         Command::Envelope(args) => command::envelope::run(*args),
+        Command::Update(args) => command::update::run(*args),
         Command::Bench(args) => command::bench::run(args),
         Command::Gateway(args) => command::gateway::run(args),
         Command::Selftest(c) => command::selftest::run(c),

@@ -150,7 +150,7 @@ fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunD
 
 /// Starts each condition's evaluator: its workers' joining is told once, the rest of what the
 /// transport says (a worker lost, refused) every time.
-fn starter(
+pub(super) fn starter(
     spec: &EvaluatorSpec,
 ) -> impl FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + '_ {
     let mut started = false;

@@ -19,6 +19,7 @@ pub mod rerun;
 pub mod scenario;
 pub mod selftest;
 pub mod simulate;
+pub mod update;
 
 use std::io::IsTerminal;
 use std::path::PathBuf;

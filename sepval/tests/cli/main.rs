@@ -1,6 +1,6 @@
 //! The `sepval` command line end to end, in one test binary: the commands as a user runs them,
-//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, `diagnose`, `plan`, `predict`, and
-//! property-based hardening of the checkpoint reader on arbitrary and mutated files. The binary
+//! `fit` and `rerun`, edited checkpoints, refinement and identifiability, `diagnose`, `plan`,
+//! `predict`, `update`, and property-based hardening of the checkpoint reader on arbitrary and mutated files. The binary
 //! is run through the shared support of the end-to-end tests (`sepval-tests`). Keep this the
 //! package's only integration test: it is also what makes `cargo test --workspace` build
 //! `sepval`.
@@ -21,3 +21,4 @@ mod predict;
 mod refine;
 mod rivals;
 mod tables;
+mod update;

@@ -1,0 +1,140 @@
+//! `sepval update`: the store's aerodynamic data updated from its releases, as corrections in
+//! the scenario's own table forms kept only as far as they predict (docs/model.md section 15).
+
+use std::sync::Arc;
+
+use anyhow::{Context, Result, bail};
+use sepval_common::factors::Factor;
+use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_fit::sigma::Sigma;
+use sepval_fit::{FitOptions, Method};
+use sepval_solve::ga::GaSettings;
+use sepval_solve::hill::HillSettings;
+use sepval_solve::lm::LmSettings;
+use sepval_update::{UpdateOptions, update, write_outputs};
+
+use super::envelope::starter;
+use super::{Bar, evaluator_spec, inputs};
+use crate::cli::UpdateArgs;
+
+/// Runs `sepval update`. Every input is checked before the output directory is claimed or a
+/// worker started; a refusal deletes nothing.
+pub fn run(args: UpdateArgs) -> Result<()> {
+    let spec = evaluator_spec(&args.eval)?;
+    if args.inputs.data.is_empty() {
+        bail!(
+            "--data FILE.csv is required (repeat it for each release): the releases that update the store's data"
+        );
+    }
+    let free = free_factors(args.free.as_deref())?;
+    let given = &args.inputs;
+    let (job, inputs) = inputs::job(
+        &given.data,
+        given.model.scenario.as_deref(),
+        given.model.extension.as_deref(),
+    )?;
+    let scenario = inputs::scenario(
+        given.model.scenario.as_deref(),
+        given.model.extension.as_deref(),
+    )?;
+    let validation = inputs::validation_job(
+        &args.validate,
+        &given.data,
+        &job,
+        given.model.scenario.as_deref(),
+        given.model.extension.as_deref(),
+    )?;
+    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
+        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
+    let ga = GaSettings {
+        population: args.population,
+        generations: args.generations,
+        seed: args.seed,
+        ..GaSettings::default()
+    };
+    ga.validate()?;
+    let claim = if args.overwrite.overwrite {
+        Claim::Overwrite
+    } else {
+        Claim::Fresh
+    };
+    let run_dir = RunDir::claim(&args.out, claim, "update").with_context(|| {
+        format!(
+            "--out {} (--overwrite clears an earlier run)",
+            args.out.display()
+        )
+    })?;
+    let lm = LmSettings {
+        budget: args.lm_budget,
+        ..LmSettings::default()
+    };
+    let options = UpdateOptions {
+        fit: FitOptions {
+            method: Method::GaLm,
+            ga,
+            hill: HillSettings::default(),
+            sigma,
+            truth: None,
+            out: args.out.join("baseline"),
+            resume: None,
+            inputs,
+            lm: lm.clone(),
+            lm_probe: LmSettings {
+                budget: args.lm_budget.min(800),
+                ..LmSettings::default()
+            },
+        },
+        lm: LmSettings {
+            max_iterations: 400,
+            budget: 20_000,
+            ..lm
+        },
+        free,
+        validation,
+        scenario,
+    };
+    run_dir.prepare()?;
+    let mut start = starter(&spec);
+    let u = update(&options, Arc::new(job), &mut start, &mut Bar::new())?;
+    write_outputs(&u, &args.out)?;
+    drop(run_dir);
+    println!("update:    {}", u.file.verdict);
+    for c in &u.file.cannot_tell {
+        println!("open:      {c}");
+    }
+    println!(
+        "store:     {} ({} table files), factors {}",
+        args.out.join("scenario.toml").display(),
+        u.store.files.len(),
+        args.out.join("factors.json").display()
+    );
+    println!(
+        "report:    {} ({} simulations, {:.1} s)",
+        args.out.join("report.html").display(),
+        u.file.evaluations,
+        u.file.wall_s
+    );
+    Ok(())
+}
+
+/// The factors of `--free NAME,...` (all 17 when absent), as indices.
+fn free_factors(list: Option<&str>) -> Result<Vec<usize>> {
+    let Some(list) = list else {
+        return Ok((0..Factor::ALL.len()).collect());
+    };
+    let mut out = Vec::new();
+    for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let Some(f) = Factor::from_name(name) else {
+            bail!(
+                "--free {name}: not one of the 17 factors (expected a comma-separated list of {})",
+                Factor::NAMES.join(", ")
+            );
+        };
+        if out.contains(&f.index()) {
+            bail!("--free {name}: given twice");
+        }
+        out.push(f.index());
+    }
+    out.sort_unstable();
+    Ok(out)
+}
