@@ -163,11 +163,37 @@ pub fn run(
     worker: Option<PathBuf>,
 ) -> PyResult<Said> {
     let cli = parse(words)?;
-    let token = &TOKEN;
-    wait_for(py, &token.1)?;
-    let result = run_alone(py, cli, progress, worker);
-    let _ = token.0.send(());
-    result
+    if CALLING.get() {
+        return Err(SepvalError::new_err(
+            "a sepval command is already running on this thread (a progress callback cannot \
+             start another)",
+        ));
+    }
+    let _turn = wait_for(py)?;
+    run_alone(py, cli, progress, worker)
+}
+
+thread_local! {
+    /// Whether this thread is in a call (its progress callback runs here too).
+    static CALLING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// The token of the one command running, taken by this thread (CALLING), given back when
+/// dropped (also on a panic).
+struct Turn;
+
+impl Turn {
+    fn taken() -> Turn {
+        CALLING.set(true);
+        Turn
+    }
+}
+
+impl Drop for Turn {
+    fn drop(&mut self) {
+        CALLING.set(false);
+        let _ = TOKEN.0.send(());
+    }
 }
 
 /// The command's words through the CLI's own parser: its refusals read as the CLI's.
@@ -179,11 +205,11 @@ fn parse(words: Vec<String>) -> PyResult<sepval_cli::Cli> {
     })
 }
 
-/// Takes the token, looking for Ctrl-C while another command runs.
-fn wait_for(py: Python<'_>, token: &Receiver<()>) -> PyResult<()> {
+/// Takes the token, looking for Ctrl-C while another thread's command runs.
+fn wait_for(py: Python<'_>) -> PyResult<Turn> {
     loop {
-        match py.detach(|| token.recv_timeout(POLL)) {
-            Ok(()) => return Ok(()),
+        match py.detach(|| TOKEN.1.recv_timeout(POLL)) {
+            Ok(()) => return Ok(Turn::taken()),
             Err(RecvTimeoutError::Timeout) => py.check_signals()?,
             Err(RecvTimeoutError::Disconnected) => {
                 return Err(SepvalError::new_err("sepval's command token is gone"));

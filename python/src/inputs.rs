@@ -81,6 +81,13 @@ pub fn scenario_json(path: Option<&Path>) -> Result<String> {
 /// [`NONFINITE`]), checked as `sepval` checks a scenario file (`name` names it in errors), and
 /// written to `dir` as `scenario-SHA256.toml` (with `write`); its path.
 pub fn store_scenario(json: &str, name: &str, dir: &Path, write: bool) -> Result<PathBuf> {
+    let scenario = scenario_of_json(json, name)?;
+    let canonical = sepval_cli::command::scenario::toml_text(&scenario);
+    store(dir, "scenario", "toml", canonical.as_bytes(), write)
+}
+
+/// The scenario of a dict carried as JSON, checked.
+fn scenario_of_json(json: &str, name: &str) -> Result<Scenario> {
     let value: serde_json::Value =
         serde_json::from_str(json).with_context(|| format!("scenario {name}: not a scenario"))?;
     let toml::Value::Table(table) = toml_value(value, "", name)? else {
@@ -88,9 +95,7 @@ pub fn store_scenario(json: &str, name: &str, dir: &Path, write: bool) -> Result
     };
     let text = toml::to_string(&table)
         .with_context(|| format!("scenario {name}: cannot be written as TOML"))?;
-    let scenario = Scenario::from_toml_str(&text, name)?;
-    let canonical = sepval_cli::command::scenario::toml_text(&scenario);
-    store(dir, "scenario", "toml", canonical.as_bytes(), write)
+    Ok(Scenario::from_toml_str(&text, name)?)
 }
 
 /// The mark of a float JSON cannot carry (`nan`, `inf`, `-inf` follow it).
@@ -137,18 +142,34 @@ fn toml_value(v: serde_json::Value, at: &str, name: &str) -> Result<toml::Value>
     })
 }
 
+/// Where the scenario of a factor set is: a file, a dict carried as JSON (`(a dict)` in
+/// errors), or the embedded default.
+pub enum ScenarioGiven {
+    /// A scenario file.
+    File(PathBuf),
+    /// A dict, as JSON.
+    Dict(String),
+    /// The embedded default.
+    Default,
+}
+
 /// A factor set given as a dict (carried as JSON), checked against the factor table of the
-/// scenario of `scenario` (the embedded default without one) as `--factors FILE.json` is, and
-/// written to `dir` as `factors-SHA256.json`; its path.
+/// scenario as `--factors FILE.json` is, and written to `dir` as `factors-SHA256.json` (with
+/// `write`); its path.
 pub fn store_factors(
     json: &str,
     name: &str,
-    scenario: Option<&Path>,
+    scenario: &ScenarioGiven,
     dir: &Path,
+    write: bool,
 ) -> Result<PathBuf> {
-    let s = sepval_cli::command::inputs::scenario(scenario, None)?;
+    let s = match scenario {
+        ScenarioGiven::File(p) => sepval_cli::command::inputs::scenario(Some(p), None)?,
+        ScenarioGiven::Dict(j) => scenario_of_json(j, "(a dict)")?,
+        ScenarioGiven::Default => Scenario::embedded_default(),
+    };
     Factors::from_json_str(json, &s.factors).with_context(|| format!("factors {name}"))?;
-    store(dir, "factors", "json", json.as_bytes(), true)
+    store(dir, "factors", "json", json.as_bytes(), write)
 }
 
 /// Writes `bytes` to `dir/KIND-SHA256.EXT` unless that file is already there (or `write` is

@@ -98,17 +98,25 @@ fn store_scenario(json: &str, name: &str, dir: PathBuf, write: bool) -> PyResult
     inputs::store_scenario(json, name, &dir, write).map_err(refused)
 }
 
-/// Checks a factor set given as JSON against the factor table of `scenario` and writes it to
-/// `dir`; its path.
+/// Checks a factor set given as JSON against the factor table of the scenario (a file, a dict
+/// as JSON, or the embedded default without either) and, with `write`, writes it to `dir`; its
+/// path.
 #[pyfunction]
-#[pyo3(signature = (json, name, scenario, dir))]
+#[pyo3(signature = (json, name, dir, write, scenario_path=None, scenario_json=None))]
 fn store_factors(
     json: &str,
     name: &str,
-    scenario: Option<PathBuf>,
     dir: PathBuf,
+    write: bool,
+    scenario_path: Option<PathBuf>,
+    scenario_json: Option<String>,
 ) -> PyResult<PathBuf> {
-    inputs::store_factors(json, name, scenario.as_deref(), &dir).map_err(refused)
+    let scenario = match (scenario_path, scenario_json) {
+        (Some(p), _) => inputs::ScenarioGiven::File(p),
+        (None, Some(j)) => inputs::ScenarioGiven::Dict(j),
+        (None, None) => inputs::ScenarioGiven::Default,
+    };
+    inputs::store_factors(json, name, &scenario, &dir, write).map_err(refused)
 }
 
 /// The effect catalogue.

@@ -39,6 +39,15 @@ def cli_binary() -> Path:
     return path
 
 
+@pytest.fixture(scope="session")
+def worker_binary(cli_binary: Path) -> Path:
+    """The `sepval-worker` built beside the `sepval` binary."""
+    path = cli_binary.with_name("sepval-worker")
+    if not path.is_file():
+        pytest.fail(f"{path} is missing: build it with `cargo build --release`")
+    return path
+
+
 @pytest.fixture()
 def cli(cli_binary: Path):
     """Runs the CLI: ``cli(args, cwd) -> CompletedProcess`` (text, never raises)."""

@@ -119,6 +119,8 @@ def test_bad_scenario_and_factor_dicts(tmp_path, store):
         sepval.simulate(scenario=scenario)
     with pytest.raises(sepval.SepvalError, match=r"^factors \(a dict\): factor `aftfac` is missing"):
         sepval.simulate(factors={"fwdfac": 0.3})
+    with pytest.raises(sepval.SepvalError, match=r"^factors \(a dict\): factor `aftfac` is missing"):
+        sepval.simulate(scenario=sepval.scenario(), factors={"fwdfac": 0.3})
     with pytest.raises(ValueError, match=r"factors\['fwdfac'\] = nan: expected a finite number"):
         sepval.simulate(factors={"fwdfac": float("nan")})
     assert list(store.iterdir()) == []

@@ -83,3 +83,11 @@ def test_out_is_protected_as_the_cli_protects_it(cli, tmp_path):
     with pytest.raises(sepval.SepvalError, match="not a sepval output directory"):
         sepval.fit(generations=4, population=40, out=tmp_path / "busy", overwrite=True)
     assert (tmp_path / "busy" / "notes.txt").read_text() == "mine"
+
+
+def test_ipc_workers_give_the_same_bits(worker_binary, tmp_path, monkeypatch):
+    monkeypatch.setenv("SEPVAL_WORKER", str(worker_binary))
+    inproc = sepval.fit(seed=4, generations=3, population=40, figures=False, out=tmp_path / "inproc")
+    ipc = sepval.fit(seed=4, generations=3, population=40, figures=False, evaluator="ipc", workers=2, out=tmp_path / "ipc")
+    assert ipc.to_dict()["run"]["evaluator"].startswith("ipc")
+    assert deterministic(ipc.to_dict()) == deterministic(inproc.to_dict())

@@ -66,3 +66,13 @@ def test_ctrl_c_while_the_command_runs(tmp_path):
     assert not senders[0].is_alive()
     assert not (tmp_path / "run" / "result.json").exists()
     assert sepval.goals(sepval.simulate(t_end_s=0.05), sepval.simulate(t_end_s=0.05)) == (0.0, 0.0)
+
+
+def test_a_callback_cannot_start_another_command(tmp_path):
+    def nested(event):
+        if event["event"] == "step":
+            sepval.simulate(t_end_s=0.05)
+
+    with pytest.raises(sepval.SepvalError, match="a sepval command is already running on this thread"):
+        sepval.fit(generations=4, population=40, out=tmp_path / "run", progress=nested)
+    assert not (tmp_path / "run" / "result.json").exists()

@@ -23,7 +23,7 @@ from __future__ import annotations
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Type, TypeVar
+from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, Type, TypeVar
 
 from . import _frames, _native
 from . import _inputs as inputs
@@ -64,9 +64,24 @@ def _source(from_: Any) -> str:
 
 
 def _geometry(words: List[str], aircraft: Any, store_shape: Any, clearance_mm: Any) -> None:
-    inputs.flag(words, "aircraft", aircraft)
-    inputs.flag(words, "store_shape", store_shape)
-    inputs.flag(words, "clearance_mm", clearance_mm, "number")
+    inputs.flags(words, (("aircraft", aircraft, "path"), ("store_shape", store_shape, "path"), ("clearance_mm", clearance_mm, "number")))
+
+
+def _search(extension: Any, seed: Any, generations: Any, population: Any, lm_budget: Any, sigma: Tuple[Any, Any], strict_tables: Any) -> List[str]:
+    """The flags fit and diagnose share: the model's extension, the baseline search, the
+    noise that weights the goals, the tables' strictness."""
+    words: List[str] = []
+    inputs.flags(words, (
+        ("extension", extension, "path"),
+        ("seed", seed, "int"),
+        ("generations", generations, "int"),
+        ("population", population, "int"),
+        ("lm_budget", lm_budget, "int"),
+        ("sigma_pos_m", sigma[0], "number"),
+        ("sigma_att_deg", sigma[1], "number"),
+        ("strict_tables", strict_tables, "switch"),
+    ))
+    return words
 
 
 def simulate(
@@ -97,13 +112,11 @@ def simulate(
     inputs.flag(words, "noise_seed", noise_seed, "int")
     inputs.flag(words, "t_end", t_end_s, "number")
     inputs.flag(words, "rate", rate_hz, "number")
-    if strict_tables:
-        words.append("--strict-tables")
-    inputs.factors_word(factors, None, check=False)
+    inputs.flag(words, "strict_tables", strict_tables, "switch")
     inputs.scenario_path(scenario, write=False)
-    scenario_file = inputs.scenario_path(scenario)
-    inputs.flag(words, "scenario", scenario_file)
-    words += ["--factors", inputs.factors_word(factors, scenario_file)]
+    inputs.factors_word(factors, scenario, write=False)
+    inputs.flag(words, "scenario", inputs.scenario_path(scenario))
+    words += ["--factors", inputs.factors_word(factors, scenario)]
     if out is not None:
         path = Path(inputs.path_word("out", out))
         run(words + ["--out", str(path)])
@@ -130,24 +143,13 @@ def goals(data: Any, sim: Any) -> "Goals":
     return Goals(*j)
 
 
-class Goals(Tuple[float, float]):
-    """J_pos [m] and J_att [deg]: a pair with the names as attributes."""
+class Goals(NamedTuple):
+    """J_pos [m] and J_att [deg] of a trajectory against data."""
 
-    def __new__(cls, j_pos_m: float, j_att_deg: float) -> "Goals":
-        return super().__new__(cls, (j_pos_m, j_att_deg))
-
-    @property
-    def j_pos_m(self) -> float:
-        """RMS position error [m]."""
-        return self[0]
-
-    @property
-    def j_att_deg(self) -> float:
-        """RMS attitude error [deg]."""
-        return self[1]
-
-    def __repr__(self) -> str:
-        return f"Goals(j_pos_m={self[0]!r}, j_att_deg={self[1]!r})"
+    #: RMS position error [m].
+    j_pos_m: float
+    #: RMS attitude error [deg].
+    j_att_deg: float
 
 
 def fit(
@@ -190,19 +192,11 @@ def fit(
     if not isinstance(method, str):
         raise TypeError(f"method: expected a str, got {type(method).__name__}")
     words = ["--method", method]
-    inputs.flag(words, "extension", extension)
-    inputs.flag(words, "seed", seed, "int")
-    inputs.flag(words, "generations", generations, "int")
-    inputs.flag(words, "population", population, "int")
-    inputs.flag(words, "lm_budget", lm_budget, "int")
-    inputs.flag(words, "hill_budget", hill_budget, "int")
-    inputs.flag(words, "sigma_pos_m", sigma_pos_m, "number")
-    inputs.flag(words, "sigma_att_deg", sigma_att_deg, "number")
-    inputs.flag(words, "resume", resume)
-    if not figures:
-        words.append("--no-figures")
-    if strict_tables:
-        words.append("--strict-tables")
+    words += _search(extension, seed, generations, population, lm_budget, (sigma_pos_m, sigma_att_deg), strict_tables)
+    inputs.flags(words, (("hill_budget", hill_budget, "int"), ("resume", resume, "path")))
+    if not isinstance(figures, bool):
+        raise TypeError(f"figures: expected a bool, got {type(figures).__name__}")
+    inputs.flag(words, "no_figures", not figures, "switch")
     _geometry(words, aircraft, store_shape, clearance_mm)
     flags, worker = inputs.evaluator_words(evaluator, workers)
     stored = lambda write: inputs.data_words("--data", data, "data", write) + inputs.scenario_words(scenario, write)
@@ -236,16 +230,7 @@ def diagnose(
     in any fit, predicted by the baseline, the answer and the alternatives; ``seed``,
     ``generations`` (60), ``population`` (100), ``lm_budget`` (3000): the baseline fit's
     search; the rest as for ``fit``."""
-    words: List[str] = []
-    inputs.flag(words, "extension", extension)
-    inputs.flag(words, "seed", seed, "int")
-    inputs.flag(words, "generations", generations, "int")
-    inputs.flag(words, "population", population, "int")
-    inputs.flag(words, "lm_budget", lm_budget, "int")
-    inputs.flag(words, "sigma_pos_m", sigma_pos_m, "number")
-    inputs.flag(words, "sigma_att_deg", sigma_att_deg, "number")
-    if strict_tables:
-        words.append("--strict-tables")
+    words = _search(extension, seed, generations, population, lm_budget, (sigma_pos_m, sigma_att_deg), strict_tables)
     _geometry(words, aircraft, store_shape, clearance_mm)
     flags, worker = inputs.evaluator_words(evaluator, workers)
 
@@ -289,9 +274,7 @@ def predict(
     inputs.flag(words, "extension", extension)
     inputs.flag(words, "samples", samples, "int")
     inputs.flag(words, "level", level, "number")
-    inputs.flag(words, "seed", seed, "int")
-    if with_noise:
-        words.append("--with-noise")
+    inputs.flags(words, (("seed", seed, "int"), ("with_noise", with_noise, "switch")))
     if isinstance(data, (list, tuple)):
         raise TypeError("data: expected one release flown at the condition, got a list")
     _geometry(words, aircraft, store_shape, clearance_mm)
@@ -364,8 +347,7 @@ def envelope(
     inputs.flag(words, "samples", samples, "int")
     inputs.flag(words, "seed", seed, "int")
     _geometry(words, aircraft, store_shape, clearance_mm)
-    if resume:
-        words.append("--resume")
+    inputs.flag(words, "resume", resume, "switch")
     flags, worker = inputs.evaluator_words(evaluator, workers)
     stored = lambda write: inputs.data_words("--validate", validate, "validate", write)
     return _run_into(Envelope, words + flags, stored, out, overwrite, progress, worker)

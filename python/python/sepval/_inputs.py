@@ -22,13 +22,11 @@ import os
 import shutil
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, List, Optional, Tuple, Union
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from . import _native
-
-PathLike = Union[str, "os.PathLike[str]"]
 
 #: A float the scenario's JSON cannot carry (NaN, infinities), as the Rust side reads it back.
 _NONFINITE = "__sepval_nonfinite__:"
@@ -78,10 +76,17 @@ def path_word(name: str, value: Any) -> str:
 
 def flag(words: List[str], name: str, value: Any, kind: str = "path") -> None:
     """Appends ``--name value`` when ``value`` is given, checked as ``kind`` (path, int,
-    number, range: two numbers LO:HI, or axis: LO:HI:N)."""
+    number, range: two numbers LO:HI, or axis: LO:HI:N), or ``--name`` alone for a switch
+    (a bool) that is on."""
     if value is None:
         return
     option = "--" + name.replace("_", "-")
+    if kind == "switch":
+        if not isinstance(value, bool):
+            raise TypeError(f"{name}: expected a bool, got {type(value).__name__}")
+        if value:
+            words.append(option)
+        return
     if kind == "path":
         text = path_word(name, value)
     elif kind == "int":
@@ -95,6 +100,12 @@ def flag(words: List[str], name: str, value: Any, kind: str = "path") -> None:
     else:
         raise ValueError(f"unknown kind of flag {kind}")
     words += [option, text]
+
+
+def flags(words: List[str], given: Sequence[Tuple[str, Any, str]]) -> None:
+    """``flag`` for each ``(name, value, kind)``."""
+    for name, value, kind in given:
+        flag(words, name, value, kind)
 
 
 def _numbers(name: str, value: Any, count: int, shape: str) -> str:
@@ -237,17 +248,22 @@ def data_words(option: str, value: Any, name: str, write: bool = True) -> List[s
 # --- scenarios and factor sets -------------------------------------------------------------
 
 
-def _carried(value: Any, where: str) -> Any:
-    """``value`` for JSON: non-finite floats marked for the Rust side."""
+def _carried(value: Any) -> Any:
+    """``value`` for JSON: non-finite floats marked for the Rust side, numpy scalars as
+    Python's."""
     if isinstance(value, Mapping):
-        return {str(k): _carried(v, f"{where}.{k}") for k, v in value.items()}
+        return {str(k): _carried(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_carried(v, f"{where}[{k}]") for k, v in enumerate(value)]
+        return [_carried(v) for v in value]
     if isinstance(value, (float, np.floating)) and not math.isfinite(value):
         return _NONFINITE + repr(float(value))
     if isinstance(value, np.generic):
         return value.item()
     return value
+
+
+def _scenario_json(scenario: Mapping) -> str:
+    return json.dumps(_carried(scenario))
 
 
 def scenario_path(scenario: Any, write: bool = True) -> Optional[str]:
@@ -259,8 +275,7 @@ def scenario_path(scenario: Any, write: bool = True) -> Optional[str]:
         return os.fspath(scenario)
     if not isinstance(scenario, Mapping):
         raise TypeError(f"scenario: expected a path or a dict, got {type(scenario).__name__}")
-    text = json.dumps(_carried(scenario, "scenario"))
-    return os.fspath(_native.store_scenario(text, "(a dict)", store_dir(), write))
+    return os.fspath(_native.store_scenario(_scenario_json(scenario), "(a dict)", store_dir(), write))
 
 
 def scenario_words(scenario: Any, write: bool = True) -> List[str]:
@@ -269,9 +284,10 @@ def scenario_words(scenario: Any, write: bool = True) -> List[str]:
     return [] if path is None else ["--scenario", path]
 
 
-def factors_word(factors: Any, scenario: Optional[str], check: bool = True) -> str:
-    """``--factors``: ``truth``, ``nominal``, a path, or a dict checked against the scenario's
-    factor table and stored (with ``check=False``, only its Python types are checked)."""
+def factors_word(factors: Any, scenario: Any, write: bool = True) -> str:
+    """``--factors``: ``truth``, ``nominal``, a path, or a dict checked against the factor
+    table of ``scenario`` (as given: None, a path or a dict) and stored (nothing written
+    without ``write``)."""
     if isinstance(factors, str) and factors in ("truth", "nominal"):
         return factors
     if is_path(factors):
@@ -283,9 +299,10 @@ def factors_word(factors: Any, scenario: Optional[str], check: bool = True) -> s
         values[str(k)] = number(f"factors[{k!r}]", v)
         if not math.isfinite(values[str(k)]):
             raise ValueError(f"factors[{k!r}] = {v!r}: expected a finite number")
-    if not check:
-        return ""
-    path = _native.store_factors(json.dumps(values), "(a dict)", scenario, store_dir())
+    given = {"scenario_path": os.fspath(scenario)} if is_path(scenario) else {}
+    if isinstance(scenario, Mapping):
+        given = {"scenario_json": _scenario_json(scenario)}
+    path = _native.store_factors(json.dumps(values), "(a dict)", store_dir(), write, **given)
     return os.fspath(path)
 
 
