@@ -33,6 +33,9 @@ use sepval_transport::link::Notices;
 use sepval_transport::spec::EvaluatorSpec;
 
 use crate::cli::{EvalArgs, EvaluatorKind};
+/// The terminal's progress bar, where commands used to find it; a command shows progress with
+/// `front::progress()`, which is the bar on the terminal and the callback in Python.
+pub use crate::front::Bar;
 
 /// A count given on the command line: at least 1; the number of cores when absent.
 pub fn count(flag: &str, requested: Option<usize>) -> Result<usize> {
