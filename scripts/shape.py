@@ -41,6 +41,9 @@ MAY_USE = {
                "sepval-diagnose", "sepval-plan", "sepval-predict", "sepval-envelope",
                "sepval-update", "sepval-geometry", "sepval-report"},
     "sepval-worker": {"sepval-common", "sepval-transport"},
+    # The Python package's extension module: the commands of the binary's library, the model
+    # library's readers, the solvers' progress and the output directories' bookkeeping names.
+    "sepval-python": {"sepval", "sepval-common", "sepval-solve", "sepval-fit"},
     "sepval-tests": set(),
 }
 # Intended cycle: the effect catalogue's plug-ins and the model that runs them.
@@ -101,7 +104,7 @@ def without_tests(text):
 
 def sources(root):
     for d, dirs, files in os.walk(root):
-        dirs[:] = sorted(x for x in dirs if x not in ("target", ".git", "python"))
+        dirs[:] = sorted(x for x in dirs if x not in ("target", ".git") and not x.startswith("."))
         if "Cargo.toml" in files and os.path.isdir(os.path.join(d, "src")):
             yield d
 

@@ -20,6 +20,13 @@ pub fn request() {
     REQUESTED.store(true, Ordering::SeqCst);
 }
 
+/// Withdraws the request, for a process that goes on after a cancelled command (the Python
+/// package: a call stopped by KeyboardInterrupt, then the next call). Only once every loop
+/// that may have seen the request has returned.
+pub fn reset() {
+    REQUESTED.store(false, Ordering::SeqCst);
+}
+
 /// Whether the process was asked to stop.
 pub fn requested() -> bool {
     REQUESTED.load(Ordering::Relaxed)

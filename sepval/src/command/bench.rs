@@ -47,7 +47,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         repeat: args.repeat,
     };
     let (job, _) = inputs::job(&[], None, None)?;
-    eprintln!(
+    note!(
         "benchmarking {} simulations of the default event per measurement, median of {} \
          interleaved rounds, on {} core(s)",
         args.evals,
@@ -55,7 +55,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
     let rows = run_bench(Arc::new(job), &options, &mut |r| {
-        eprintln!(
+        note!(
             "  {:<6} {} worker(s): {:.0} simulations/s, {:.0} refused requests/s",
             r.transport,
             r.workers,
@@ -63,7 +63,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             r.evals as f64 / r.probe_wall_s
         );
     })?;
-    print!("{}", table(&rows));
+    crate::front::out(&table(&rows));
     write_csv(&args.out, &rows)?;
     let data = series(&rows);
     let lines: Vec<(&str, &[(usize, f64)])> = data
@@ -71,7 +71,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .map(|(n, v)| (n.as_str(), v.as_slice()))
         .collect();
     throughput_figure(&args.out.join("bench.png"), &lines)?;
-    println!(
+    say!(
         "wrote {} and {}",
         args.out.join("bench.csv").display(),
         args.out.join("bench.png").display()

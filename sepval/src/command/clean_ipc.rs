@@ -6,7 +6,7 @@ use sepval_transport::ipc::clean_stale_runs;
 pub fn run() {
     // Explicitly asked for: any run without a live process, whatever its age.
     let cleaned = clean_stale_runs(None, std::time::Duration::ZERO);
-    println!(
+    say!(
         "cleaned {} stale run(s) {}",
         cleaned.len(),
         cleaned

@@ -204,7 +204,7 @@ pub fn record_releases<T: serde::Serialize>(
 ) -> Result<()> {
     let records = of_releases(c, releases, out)?;
     for r in &records {
-        println!(
+        say!(
             "clearance: {}: smallest {:.1} mm at t = {:.3} s ({} / {}): {}",
             r.release,
             r.min_clearance_mm,

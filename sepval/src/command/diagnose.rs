@@ -12,7 +12,7 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 
-use super::{Bar, clearance, evaluator_spec, inputs, notices};
+use super::{clearance, evaluator_spec, inputs, notices};
 use crate::cli::DiagnoseArgs;
 
 /// Runs `sepval diagnose`. The output directory is claimed (locked and checked) before anything
@@ -37,7 +37,7 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let geometry = clearance::settings(&args.geometry, &base)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;
     run_dir.prepare()?;
-    let mut d = diagnose(&options, evaluator.as_mut(), &mut Bar::new())?;
+    let mut d = diagnose(&options, evaluator.as_mut(), &mut *crate::front::progress())?;
     if let Some(c) = &geometry {
         // The answer's trajectories: the model diagnosis.json records, rebuilt as predict does.
         let source = sepval_predict::read_source(&args.out)?;
@@ -50,12 +50,12 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
             d.clearance = Some(v)
         })?;
     }
-    print!("{}", summary_lines(&d, &args.out));
+    crate::front::out(&summary_lines(&d, &args.out));
     drop(run_dir);
     // Tables left by the fitted runs, as simulate and fit report them (--strict-tables refused
     // them after the baseline fit, before any other work).
     for l in &d.tables_left {
-        eprintln!("warning: {l}");
+        note!("warning: {l}");
     }
     Ok(())
 }

@@ -4,15 +4,19 @@ use sepval_common::effects::CATALOGUE;
 
 /// Runs `sepval effects`.
 pub fn run() {
-    println!("Effect catalogue (docs/model.md section 7): physics the baseline model leaves out.");
-    println!("Give one to `sepval simulate` as --effect ID=V1,V2,... in the units below.\n");
+    say!("Effect catalogue (docs/model.md section 7): physics the baseline model leaves out.");
+    say!("Give one to `sepval simulate` as --effect ID=V1,V2,... in the units below.\n");
     for e in CATALOGUE.iter() {
-        println!("{}", e.id());
-        println!("    adds: {}", e.adds());
+        say!("{}", e.id());
+        say!("    adds: {}", e.adds());
         for p in e.params() {
-            println!(
+            say!(
                 "    {:<9} [{}]  neutral {}, fit range [{}, {}]",
-                p.name, p.unit, p.neutral, p.min, p.max
+                p.name,
+                p.unit,
+                p.neutral,
+                p.min,
+                p.max
             );
         }
     }

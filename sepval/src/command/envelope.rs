@@ -19,7 +19,7 @@ use sepval_transport::link::{Notice, Notices};
 use sepval_transport::spec::EvaluatorSpec;
 
 use super::predict::source_inputs;
-use super::{Bar, clearance, count, evaluator_spec, notices};
+use super::{clearance, count, evaluator_spec, notices};
 use crate::cli::EnvelopeArgs;
 
 /// Runs `sepval envelope`. Every input (the flags, the source, the geometry, the grid) is
@@ -75,7 +75,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         &sweep_inputs,
         progress,
         &mut start_evaluator,
-        &mut Bar::new(),
+        &mut *crate::front::progress(),
     )?;
     let criterion_mm = args.geometry.clearance_mm;
     let summary = summarise(&sweep_inputs.grid, &swept.rows, criterion_mm);
@@ -100,15 +100,19 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     if let Some(dir) = progress_file.parent() {
         let _ = std::fs::remove_dir(dir);
     }
-    println!("envelope:  {}", summary.headline);
+    say!("envelope:  {}", summary.headline);
     for l in &summary.lines {
-        println!("           {l}");
+        say!("           {l}");
     }
-    println!(
+    say!(
         "conditions: {} ({} resumed), {} samples each, {} simulations, {:.1} s",
-        file.conditions, file.resumed, file.samples, file.evaluations, file.wall_s
+        file.conditions,
+        file.resumed,
+        file.samples,
+        file.evaluations,
+        file.wall_s
     );
-    println!("report:    {}", args.out.join("report.html").display());
+    say!("report:    {}", args.out.join("report.html").display());
     drop(run_dir);
     Ok(())
 }
@@ -158,7 +162,7 @@ pub(super) fn starter(
         let told: Notices = if started {
             Arc::new(|n: Notice| {
                 if !matches!(n, Notice::Joined { .. }) {
-                    eprintln!("sepval: {n}");
+                    note!("sepval: {n}");
                 }
             })
         } else {

@@ -13,7 +13,7 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 
-use super::{Bar, clearance, evaluator_spec, inputs, notices};
+use super::{clearance, evaluator_spec, inputs, notices};
 use crate::cli::{FitArgs, MethodArg};
 
 /// The library's method of `--method`.
@@ -42,19 +42,19 @@ pub fn run(args: FitArgs) -> Result<()> {
     if let (Some(c), Some(path)) = (&options.resume, args.resume.as_deref()) {
         // Its members re-evaluated and its generation replayed before going on from it.
         let report = sepval_fit::rerun::confirm(c, path, evaluator.as_mut())?;
-        eprintln!(
+        note!(
             "sepval: resuming from {}: {}",
             path.display(),
             report.checked()
         );
     }
     for removed in run_dir.prepare()? {
-        eprintln!(
+        note!(
             "sepval: removed {} (a later generation of the continuation being replaced)",
             removed.display()
         );
     }
-    let mut output = run_fit(&options, evaluator.as_mut(), &mut Bar::new())?;
+    let mut output = run_fit(&options, evaluator.as_mut(), &mut *crate::front::progress())?;
     if let Some(c) = &geometry {
         best_clearance(c, &args, evaluator.job(), &mut output)?;
     }
@@ -69,7 +69,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         );
     }
     for l in &left {
-        eprintln!("warning: {l}");
+        note!("warning: {l}");
     }
     Ok(())
 }
@@ -249,7 +249,7 @@ fn render(args: &FitArgs, job: &Job, output: &FitOutput) -> Result<()> {
     if !args.no_figures {
         figures(&args.out, job, output)?;
     }
-    println!("results in {}", args.out.join("result.json").display());
+    say!("results in {}", args.out.join("result.json").display());
     Ok(())
 }
 
@@ -269,7 +269,7 @@ fn tables_left(output: &FitOutput) -> Vec<String> {
 
 fn print_summary(output: &FitOutput) {
     let r = &output.result;
-    println!(
+    say!(
         "fit of {} ({} samples), sigma_pos {:.4} m, sigma_att {:.4} deg ({})",
         r.events
             .iter()
@@ -281,12 +281,17 @@ fn print_summary(output: &FitOutput) {
         r.sigma_att_deg,
         r.sigma_source
     );
-    println!(
+    say!(
         "{:<6} {:>12} {:>12} {:>10} {:>12} {:>9}",
-        "method", "J_pos [m]", "J_att [deg]", "weighted", "simulations", "wall [s]"
+        "method",
+        "J_pos [m]",
+        "J_att [deg]",
+        "weighted",
+        "simulations",
+        "wall [s]"
     );
     for (name, m) in &r.methods {
-        println!(
+        say!(
             "{:<6} {:>12.6} {:>12.5} {:>10.3} {:>12} {:>9.1}",
             name,
             m.best.j_pos_m,
@@ -300,7 +305,7 @@ fn print_summary(output: &FitOutput) {
 
 fn figures(dir: &std::path::Path, job: &Job, output: &FitOutput) -> Result<()> {
     let written = write_fit_figures(dir, job, output)?;
-    println!(
+    say!(
         "{} figures in {}",
         written.len(),
         dir.join("figures").display()

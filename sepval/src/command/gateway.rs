@@ -53,7 +53,7 @@ pub fn run(args: GatewayArgs) -> Result<()> {
         notices(),
     )?;
     let mut gateway = Gateway::new(local, job, workers);
-    eprintln!(
+    note!(
         "sepval gateway: joined run {} at {} as {}, serving with {workers} local worker(s) \
          (iceoryx2 run {local_run})",
         args.run,
@@ -62,7 +62,7 @@ pub fn run(args: GatewayArgs) -> Result<()> {
     );
     link.ready(gateway.credits())?;
     let stopped = serve(&mut link, &mut gateway)?;
-    eprintln!("sepval gateway: {stopped}");
+    note!("sepval gateway: {stopped}");
     Ok(())
 }
 

@@ -1,7 +1,8 @@
 //! One file per subcommand: each turns its raw flags into a validated configuration before any
 //! I/O, then calls the libraries and renders what they return. What several commands share
 //! lives here: counts and durations from flags, the evaluator configuration, the worker
-//! executable, and the rendering of transport notices and search progress.
+//! executable, and the rendering of transport notices. What a command prints goes through the
+//! front end ([`crate::front`]: `say!`, `note!`, `front::progress()`), never to stdout directly.
 
 pub mod bench;
 pub mod clean_ipc;
@@ -21,14 +22,11 @@ pub mod selftest;
 pub mod simulate;
 pub mod update;
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use sepval_solve::run::{Progress, ProgressObserver};
 use sepval_transport::RunId;
 use sepval_transport::dispatch::DispatchOptions;
 use sepval_transport::ipc::{IpcOptions, Launch, MAX_WORKERS};
@@ -36,6 +34,9 @@ use sepval_transport::link::Notices;
 use sepval_transport::spec::EvaluatorSpec;
 
 use crate::cli::{EvalArgs, EvaluatorKind};
+/// The terminal's progress bar, where commands used to find it; a command shows progress with
+/// `front::progress()`, which is the bar on the terminal and the callback in Python.
+pub use crate::front::Bar;
 
 /// A count given on the command line: at least 1; the number of cores when absent.
 pub fn count(flag: &str, requested: Option<usize>) -> Result<usize> {
@@ -63,10 +64,14 @@ pub fn seconds(flag: &str, value: f64) -> Result<Duration> {
     Ok(Duration::from_secs_f64(v))
 }
 
-/// The worker executable: $SEPVAL_WORKER, or `sepval-worker` beside this executable.
+/// The worker executable: $SEPVAL_WORKER, the front end's (the Python package finds one on
+/// the PATH), or `sepval-worker` beside this executable.
 pub fn worker_executable() -> Result<PathBuf> {
     if let Some(p) = std::env::var_os("SEPVAL_WORKER") {
         return Ok(PathBuf::from(p));
+    }
+    if let Some(p) = crate::front::current().worker() {
+        return Ok(p);
     }
     let me = std::env::current_exe().context("cannot locate the sepval executable")?;
     let worker = me.with_file_name(format!("sepval-worker{}", std::env::consts::EXE_SUFFIX));
@@ -171,63 +176,7 @@ fn zenoh_spec(_: &EvalArgs, _: Duration, _: Duration) -> Result<EvaluatorSpec> {
     )
 }
 
-/// Transport notices, printed to stderr as `sepval: ...`.
+/// Transport notices, told on stderr as `sepval: ...`.
 pub fn notices() -> Notices {
-    Arc::new(|n| eprintln!("sepval: {n}"))
-}
-
-/// A progress bar on stderr (hidden when stderr is not a terminal).
-pub struct Bar {
-    bar: ProgressBar,
-    started: std::time::Instant,
-}
-
-impl Bar {
-    /// A bar that draws only on a terminal.
-    pub fn new() -> Self {
-        Bar {
-            bar: ProgressBar::hidden(),
-            started: std::time::Instant::now(),
-        }
-    }
-}
-
-impl ProgressObserver for Bar {
-    fn start(&mut self, label: &str, steps: Option<usize>) {
-        self.started = std::time::Instant::now();
-        self.bar = if std::io::stderr().is_terminal() {
-            let bar = ProgressBar::with_draw_target(
-                steps.map(|s| s as u64),
-                ProgressDrawTarget::stderr(),
-            );
-            let template = if steps.is_some() {
-                format!("{label:<7} {{pos:>4}}/{{len}} {{wide_bar}} {{msg}}")
-            } else {
-                format!("{label:<7} {{pos:>4}} {{spinner}} {{msg}}")
-            };
-            bar.set_style(ProgressStyle::with_template(&template).expect("a valid template"));
-            bar
-        } else {
-            ProgressBar::hidden()
-        };
-    }
-
-    fn progress(&mut self, p: &Progress) {
-        self.bar.set_position(p.step as u64);
-        let rate = p.evaluations as f64 / self.started.elapsed().as_secs_f64().max(1e-9);
-        // A stage without goals (a plan's simulations) shows its rate alone.
-        self.bar
-            .set_message(if p.best.iter().all(|v| v.is_finite()) {
-                format!(
-                    "J_pos {:.4} m  J_att {:.3} deg  {rate:.0} sims/s",
-                    p.best[0], p.best[1]
-                )
-            } else {
-                format!("{rate:.0} sims/s")
-            });
-    }
-
-    fn finish(&mut self) {
-        self.bar.finish_and_clear();
-    }
+    Arc::new(|n| note!("sepval: {n}"))
 }

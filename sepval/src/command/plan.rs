@@ -10,7 +10,7 @@ use sepval_plan::{
     PlanFile, Quantity, Range, plan, plan_file, prepare, read_diagnosis, write_outputs,
 };
 
-use super::{Bar, evaluator_spec, inputs, notices};
+use super::{evaluator_spec, inputs, notices};
 use crate::cli::PlanArgs;
 
 /// Runs `sepval plan`. Every input (the flags, the diagnosis, its releases, the ranges against
@@ -47,11 +47,15 @@ pub fn run(args: PlanArgs) -> Result<()> {
     let start = Instant::now();
     let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
     run_dir.prepare()?;
-    let found = plan(&prepared, evaluator.as_mut(), &mut Bar::new())?;
+    let found = plan(
+        &prepared,
+        evaluator.as_mut(),
+        &mut *crate::front::progress(),
+    )?;
     drop(evaluator);
     let file = plan_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
     write_outputs(&prepared, &found, &file, &args.out)?;
-    print!("{}", summary_lines(&file, &args.out));
+    crate::front::out(&summary_lines(&file, &args.out));
     drop(run_dir);
     Ok(())
 }

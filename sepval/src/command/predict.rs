@@ -14,7 +14,7 @@ use sepval_predict::{
     write_outputs,
 };
 
-use super::{Bar, clearance, count, evaluator_spec, inputs, notices};
+use super::{clearance, count, evaluator_spec, inputs, notices};
 use crate::cli::PredictArgs;
 
 /// Runs `sepval predict`. Every input (the flags, the source, its releases, the condition, the
@@ -55,11 +55,15 @@ pub fn run(args: PredictArgs) -> Result<()> {
     let start = Instant::now();
     let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
     run_dir.prepare()?;
-    let found = predict(&prepared, evaluator.as_mut(), &mut Bar::new())?;
+    let found = predict(
+        &prepared,
+        evaluator.as_mut(),
+        &mut *crate::front::progress(),
+    )?;
     drop(evaluator);
     let file = prediction_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
     write_outputs(&found, &file, &args.out)?;
-    print!("{}", summary_lines(&file, &args.out));
+    crate::front::out(&summary_lines(&file, &args.out));
     drop(run_dir);
     Ok(())
 }

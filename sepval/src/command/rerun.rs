@@ -35,17 +35,19 @@ pub fn run(args: RerunArgs) -> Result<()> {
     checkpoint.check_job(&job, &args.checkpoint)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;
     let report = sepval_fit::rerun::check(&checkpoint, &args.checkpoint, evaluator.as_mut())?;
-    println!("{} ({})", report.checked(), evaluator.describe());
+    say!("{} ({})", report.checked(), evaluator.describe());
     if report.reproduces() {
-        println!(
+        say!(
             "generation {}: all {} population and {} archive members reproduce their goals bit \
              for bit",
-            report.generation, report.population, report.archive
+            report.generation,
+            report.population,
+            report.archive
         );
         return Ok(());
     }
     for m in &report.mismatches {
-        println!("{m}");
+        say!("{m}");
     }
     bail!(
         "checkpoint {} does not reproduce: {}",

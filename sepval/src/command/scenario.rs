@@ -10,13 +10,18 @@ use crate::cli::ScenarioArgs;
 
 const HEADER: &str = "# sepval scenario (SI units, angles in degrees); docs/model.md section 1 describes each field.\n";
 
+/// The scenario as `sepval scenario` writes it: TOML, with a header comment.
+pub fn toml_text(scenario: &Scenario) -> String {
+    format!("{HEADER}{}", scenario.to_toml_string())
+}
+
 /// Runs `sepval scenario`.
 pub fn run(args: ScenarioArgs) -> Result<()> {
     let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
     if !args.tables {
-        let text = format!("{HEADER}{}", scenario.to_toml_string());
+        let text = toml_text(&scenario);
         write_atomically(&args.out, text.as_bytes())?;
-        eprintln!("wrote {}", args.out.display());
+        note!("wrote {}", args.out.display());
         return Ok(());
     }
     let form = sepval_common::table_form::table_form(&scenario, args.interference_tables)
@@ -54,7 +59,7 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
     write_atomically(&toml_path, text.as_bytes())?;
     // What was written reads back.
     Scenario::load(&toml_path).context("the scenario written as tables does not read back")?;
-    eprintln!(
+    note!(
         "wrote {} and {} table files in {}",
         toml_path.display(),
         form.files.len(),

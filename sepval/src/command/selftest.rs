@@ -22,8 +22,8 @@ pub fn run(command: SelftestCommand) -> Result<()> {
         ZdtArg::Zdt3 => ("zdt3", Zdt::Zdt3),
     };
     let (hv, front) = run_zdt(zdt, evaluations, seed, bits)?;
-    println!("{hv:.6}");
-    eprintln!(
+    say!("{hv:.6}");
+    note!(
         "{name}: {} points on the final front, seed {seed}",
         front.len()
     );

@@ -59,18 +59,18 @@ pub fn run(args: SimulateArgs) -> Result<()> {
             let line = clearance::words(c, &trace);
             traj.push_metadata("clearance", &line);
             traj.write_with_columns(&args.out, &[("clearance_m", &trace.distance_m)])?;
-            eprintln!("clearance: {line}");
+            note!("clearance: {line}");
         }
         None => traj.write(&args.out)?,
     }
-    eprintln!(
+    note!(
         "wrote {} ({} samples, t = 0 to {} s)",
         args.out.display(),
         traj.len(),
         traj.times_s.last().copied().unwrap_or(0.0)
     );
     for e in &left {
-        eprintln!("warning: {e}");
+        note!("warning: {e}");
     }
     Ok(())
 }

@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
+use sepval_common::evaluation::Job;
 use sepval_common::factors::Factor;
 use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_fit::sigma::Sigma;
@@ -14,45 +15,14 @@ use sepval_solve::lm::LmSettings;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
 use super::envelope::starter;
-use super::{Bar, evaluator_spec, inputs};
+use super::{evaluator_spec, inputs};
 use crate::cli::UpdateArgs;
 
 /// Runs `sepval update`. Every input is checked before the output directory is claimed or a
 /// worker started; a refusal deletes nothing.
 pub fn run(args: UpdateArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
-    if args.inputs.data.is_empty() {
-        bail!(
-            "--data FILE.csv is required (repeat it for each release): the releases that update the store's data"
-        );
-    }
-    let free = free_factors(args.free.as_deref())?;
-    let given = &args.inputs;
-    let (job, inputs) = inputs::job(
-        &given.data,
-        given.model.scenario.as_deref(),
-        given.model.extension.as_deref(),
-    )?;
-    let scenario = inputs::scenario(
-        given.model.scenario.as_deref(),
-        given.model.extension.as_deref(),
-    )?;
-    let validation = inputs::validation_job(
-        &args.validate,
-        &given.data,
-        &job,
-        given.model.scenario.as_deref(),
-        given.model.extension.as_deref(),
-    )?;
-    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
-        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
-    let ga = GaSettings {
-        population: args.population,
-        generations: args.generations,
-        seed: args.seed,
-        ..GaSettings::default()
-    };
-    ga.validate()?;
+    let (options, job) = configure(&args)?;
     let claim = if args.overwrite.overwrite {
         Claim::Overwrite
     } else {
@@ -64,6 +34,66 @@ pub fn run(args: UpdateArgs) -> Result<()> {
             args.out.display()
         )
     })?;
+    run_dir.prepare()?;
+    let mut start = starter(&spec);
+    let u = update(
+        &options,
+        Arc::new(job),
+        &mut start,
+        &mut *crate::front::progress(),
+    )?;
+    write_outputs(&u, &args.out)?;
+    drop(run_dir);
+    say!("update:    {}", u.file.verdict);
+    for c in &u.file.cannot_tell {
+        say!("open:      {c}");
+    }
+    say!(
+        "store:     {} ({} table files), factors {}",
+        args.out.join("scenario.toml").display(),
+        u.store.files.len(),
+        args.out.join("factors.json").display()
+    );
+    say!(
+        "report:    {} ({} simulations, {:.1} s)",
+        args.out.join("report.html").display(),
+        u.file.evaluations,
+        u.file.wall_s
+    );
+    Ok(())
+}
+
+/// The flags as a validated configuration, and the job of the `--data` releases.
+fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
+    if args.inputs.data.is_empty() {
+        bail!(
+            "--data FILE.csv is required (repeat it for each release): the releases that update the store's data"
+        );
+    }
+    let free = free_factors(args.free.as_deref())?;
+    let given = &args.inputs;
+    let (scenario_path, extension_path) = (
+        given.model.scenario.as_deref(),
+        given.model.extension.as_deref(),
+    );
+    let (job, inputs) = inputs::job(&given.data, scenario_path, extension_path)?;
+    let scenario = inputs::scenario(scenario_path, extension_path)?;
+    let validation = inputs::validation_job(
+        &args.validate,
+        &given.data,
+        &job,
+        scenario_path,
+        extension_path,
+    )?;
+    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
+        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
+    let ga = GaSettings {
+        population: args.population,
+        generations: args.generations,
+        seed: args.seed,
+        ..GaSettings::default()
+    };
+    ga.validate()?;
     let lm = LmSettings {
         budget: args.lm_budget,
         ..LmSettings::default()
@@ -93,28 +123,7 @@ pub fn run(args: UpdateArgs) -> Result<()> {
         validation,
         scenario,
     };
-    run_dir.prepare()?;
-    let mut start = starter(&spec);
-    let u = update(&options, Arc::new(job), &mut start, &mut Bar::new())?;
-    write_outputs(&u, &args.out)?;
-    drop(run_dir);
-    println!("update:    {}", u.file.verdict);
-    for c in &u.file.cannot_tell {
-        println!("open:      {c}");
-    }
-    println!(
-        "store:     {} ({} table files), factors {}",
-        args.out.join("scenario.toml").display(),
-        u.store.files.len(),
-        args.out.join("factors.json").display()
-    );
-    println!(
-        "report:    {} ({} simulations, {:.1} s)",
-        args.out.join("report.html").display(),
-        u.file.evaluations,
-        u.file.wall_s
-    );
-    Ok(())
+    Ok((options, job))
 }
 
 /// The factors of `--free NAME,...` (all 17 when absent), as indices.

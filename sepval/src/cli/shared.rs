@@ -1,0 +1,119 @@
+//! The groups of flags several commands share (flattened into their argument structs): the
+//! inputs of a fit, the model, tables, geometry, overwriting, noise and the evaluator.
+
+use std::path::PathBuf;
+
+use sepval_transport::RunId;
+
+use super::EvaluatorKind;
+
+/// The measured data and the model a fit runs on (fit, diagnose, rerun).
+#[derive(clap::Args)]
+pub struct InputArgs {
+    /// Measured trajectory (CSV; repeatable for several releases). Default: the embedded
+    /// synthetic flight test (truth factors plus noise).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: Vec<PathBuf>,
+    #[command(flatten)]
+    pub model: ModelArgs,
+}
+
+/// The model a command simulates (simulate, and through [`InputArgs`] fit, diagnose, rerun).
+#[derive(clap::Args)]
+pub struct ModelArgs {
+    /// Scenario file (TOML); the embedded default (Eglin benchmark store) when absent.
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    /// Model extension (TOML, as `diagnose` writes DIR/extension.toml): terms added to the model.
+    #[arg(long, value_name = "FILE")]
+    pub extension: Option<PathBuf>,
+}
+
+/// What a run that leaves a table does (simulate, fit, diagnose).
+#[derive(clap::Args)]
+pub struct TablesArgs {
+    /// Fail (exit 2) when the run leaves one of the scenario's tables (by default the value is
+    /// held at the table's edge and the excursion reported); simulate then writes nothing, fit
+    /// writes result.json, which records it, diagnose stops after its baseline fit.
+    #[arg(long)]
+    pub strict_tables: bool,
+}
+
+/// The store and the aircraft whose clearance is assessed (docs/geometry.md).
+#[derive(clap::Args)]
+pub struct GeometryArgs {
+    /// The aircraft's geometry in the launch frame: STL (ASCII or binary) or TOML of
+    /// primitives, e.g. examples/geometry/aircraft.toml.
+    #[arg(long, value_name = "FILE")]
+    pub aircraft: Option<PathBuf>,
+    /// The store's shape in body axes about its CG (STL or TOML) [default: the scenario's
+    /// store of revolution with four fins].
+    #[arg(long, value_name = "FILE", requires = "aircraft")]
+    pub store_shape: Option<PathBuf>,
+    /// The smallest clearance allowed [mm] (MIL-STD-1289D: 25.4).
+    #[arg(
+        long,
+        default_value_t = 25.4,
+        value_name = "MM",
+        allow_hyphen_values = true
+    )]
+    pub clearance_mm: f64,
+}
+
+/// Whether an earlier run in `--out` may be cleared (fit, diagnose, plan).
+#[derive(clap::Args)]
+pub struct OverwriteArgs {
+    /// Clear --out first if it holds an earlier sepval run (it is refused otherwise).
+    #[arg(long)]
+    pub overwrite: bool,
+}
+
+/// The measurement noise that weights the goals (shared by every search command).
+#[derive(clap::Args)]
+pub struct NoiseArgs {
+    /// Position noise [m] weighting J_pos (default: estimated from the data).
+    #[arg(long)]
+    pub sigma_pos_m: Option<f64>,
+    /// Attitude noise [deg] weighting J_att (default: estimated from the data).
+    #[arg(long)]
+    pub sigma_att_deg: Option<f64>,
+}
+
+/// How simulations are run (shared by every search command).
+#[derive(clap::Args)]
+pub struct EvalArgs {
+    /// `ipc`: worker processes over iceoryx2 shared memory; `inproc`: threads of this process;
+    /// `zenoh`: workers on any host that joins --listen (built with the `zenoh` feature).
+    #[arg(long, value_enum, default_value_t = EvaluatorKind::Ipc)]
+    pub evaluator: EvaluatorKind,
+    /// Worker processes (ipc) [default: the number of cores]; with zenoh, the workers to wait
+    /// for before the search starts [default: 1] (more may join at any time).
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// zenoh: the endpoint to listen on for workers, e.g. tcp/0.0.0.0:7447 (explicit port).
+    #[arg(long, value_name = "ENDPOINT")]
+    pub listen: Option<String>,
+    /// zenoh: a zenoh JSON5 configuration to start from (TLS certificates, authentication);
+    /// sepval still sets peer mode, the endpoint and switches scouting off.
+    #[arg(long, value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
+    /// Threads (inproc) [default: the number of cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Do not start workers: create run RUN_ID and wait for --workers externally started
+    /// `sepval-worker --run RUN_ID`.
+    #[arg(long, value_name = "RUN_ID")]
+    pub attach: Option<RunId>,
+    /// Run id of spawned workers [default: a fresh one].
+    #[arg(long, value_name = "RUN_ID")]
+    pub run_id: Option<RunId>,
+    /// A worker that holds a chunk longer than this [s] is killed and replaced.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    pub worker_timeout: f64,
+    /// How long to wait for workers to join [s].
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    pub join_timeout: f64,
+    /// Announce this protocol version in the job setup (compatibility testing only).
+    #[arg(long, hide = true)]
+    pub announce_protocol: Option<u32>,
+}
