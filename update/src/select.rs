@@ -122,6 +122,8 @@ pub struct Selected {
 /// may hold others, held at 0), with its start.
 struct Trial {
     corrections: Corrections,
+    /// Where the factors it holds stay.
+    base: Factors,
     space: Arc<UpdateSpace>,
     x0: Vec<f64>,
 }
@@ -177,7 +179,7 @@ fn fit_models(
             let c = &t.corrections;
             let space = Arc::new(UpdateSpace::new(
                 model,
-                s.base,
+                t.base,
                 &s.free,
                 &c.proposals,
                 &c.weights,
@@ -220,11 +222,13 @@ fn misfit_of(evaluator: &mut dyn Evaluator, model: &Model, noise: Noise) -> Resu
 /// Selects the corrections, starting its evaluators with `start`.
 pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
     let mut evaluations = 0;
+    // One evaluator at a time: an iceoryx2 run has one coordinator.
     let mut evaluator = start(Arc::clone(&s.job)).map_err(UpdateError::Start)?;
     let model = evaluator.job().events()[0].simulator.model().clone();
     let none = Arc::new(UpdateSpace::new(&model, s.base, &s.free, &[], &[]));
     let trial = Trial {
         corrections: Corrections::default(),
+        base: s.base,
         x0: none.start(&s.base, None),
         space: none,
     };
@@ -251,9 +255,11 @@ pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
             first_screening = screening.axes.clone();
         }
         let mut record = RoundRecord::of(round, &screening, current.cv);
+        drop(evaluator);
         let Some((best, others)) = round_trials(s, start, &current, &screening, &mut evaluations)?
         else {
             rounds.push(record);
+            evaluator = start_with(s, start, &current)?;
             break;
         };
         CLOCK.lap(&format!("select: round {}", round + 1));
@@ -274,12 +280,13 @@ pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
             .collect();
         let kept = record.kept;
         rounds.push(record);
+        if kept {
+            current = best;
+        }
+        evaluator = start_with(s, start, &current)?;
         if !kept {
             break;
         }
-        current = best;
-        let job = Arc::new(with_corrections(&s.job, &current.corrections.proposals)?);
-        evaluator = start(job).map_err(UpdateError::Start)?;
         misfit = misfit_of(evaluator.as_mut(), &current, s.noise)?;
         evaluations += misfit.evaluations;
     }
@@ -329,6 +336,7 @@ fn smoothness(
     if current.corrections.proposals.is_empty() {
         return Ok((current, Vec::new()));
     }
+    let base = current.space.factors(&current.fit.lm.x);
     let trials: Vec<Trial> = SMOOTHNESS
         .iter()
         .map(|&m| {
@@ -337,13 +345,14 @@ fn smoothness(
             corrections.weights.iter_mut().for_each(|w| *w *= m);
             let space = Arc::new(UpdateSpace::new(
                 model,
-                s.base,
+                base,
                 &s.free,
                 &corrections.proposals,
                 &corrections.weights,
             ));
             Trial {
                 corrections,
+                base,
                 x0: current.fit.lm.x.clone(),
                 space,
             }
@@ -361,6 +370,16 @@ fn smoothness(
         .min_by(|&a, &b| all[a].cv.total_cmp(&all[b].cv))
         .unwrap_or(0);
     Ok((all.swap_remove(best), scores))
+}
+
+/// An evaluator of the releases with `model`'s corrections.
+fn start_with(
+    s: &Setting,
+    start: &mut StartEvaluator<'_>,
+    model: &Model,
+) -> Result<Box<dyn Evaluator>> {
+    let job = Arc::new(with_corrections(&s.job, &model.corrections.proposals)?);
+    start(job).map_err(UpdateError::Start)
 }
 
 /// The round's picks refitted side by side (each added to the current model, in one job that
@@ -395,6 +414,7 @@ fn round_trials(
     let mut evaluator = start(job).map_err(UpdateError::Start)?;
     let model = evaluator.job().events()[0].simulator.model().clone();
     let kept = current.corrections.proposals.len();
+    let base = current.space.factors(&current.fit.lm.x);
     let trials: Vec<Trial> = (0..picks.len())
         .map(|i| {
             let mut corrections = current.corrections.clone();
@@ -411,10 +431,11 @@ fn round_trials(
                 weights.push(if j == i { LAMBDA0 * p.scale } else { 0.0 });
             }
             let space = Arc::new(UpdateSpace::new(
-                &model, s.base, &s.free, &proposals, &weights,
+                &model, base, &s.free, &proposals, &weights,
             ));
             Trial {
                 corrections,
+                base,
                 x0: space.project(&current.space, &current.fit.lm.x),
                 space,
             }

@@ -42,8 +42,8 @@ pub struct UpdateSpace {
 
 impl UpdateSpace {
     /// The space of `corrections` over `model`'s scenario (its derivatives and increments set
-    /// the bounds), with the factors `free` (indices) starting at `base` and the others held
-    /// there. `weights[k]` is correction k's penalty weight: its lambda times its values' mean
+    /// the bounds), with the factors `free` (indices; less those the corrections take over,
+    /// [`taken_over`]) starting at `base` and the others held there. `weights[k]` is correction k's penalty weight: its lambda times its values' mean
     /// information.
     pub fn new(
         model: &Model,
@@ -53,6 +53,13 @@ impl UpdateSpace {
         weights: &[f64],
     ) -> UpdateSpace {
         let table: &FactorTable = &model.scenario().factors;
+        let taken = taken_over(corrections);
+        let free: Vec<usize> = free
+            .iter()
+            .copied()
+            .filter(|i| !taken.contains(i))
+            .collect();
+        let free = free.as_slice();
         let mut params = Params::empty();
         let bounds = corrections.iter().map(|p| bound(model, p.target)).collect();
         for &i in free {
@@ -213,6 +220,39 @@ impl UpdateSpace {
     pub fn penalty_len(&self) -> usize {
         self.root.nrows()
     }
+}
+
+/// The factors the corrections take over, which a refit holds where they are: a correction
+/// that would duplicate a factor would leave the two undetermined together (a static
+/// coefficient's constant part is its axis's offset, caoff ... cnoff; an interference
+/// increment's size is its axis's multiplier, caintfac ... cnintfac). A correction whose values
+/// are all held takes nothing over.
+pub fn taken_over(corrections: &[Proposal]) -> Vec<usize> {
+    const OFFSETS: [Factor; 6] = [
+        Factor::Caoff,
+        Factor::Cyoff,
+        Factor::Czoff,
+        Factor::Cloff,
+        Factor::Cmoff,
+        Factor::Cnoff,
+    ];
+    const MULTIPLIERS: [Factor; 6] = [
+        Factor::Caintfac,
+        Factor::Cyintfac,
+        Factor::Czintfac,
+        Factor::Clintfac,
+        Factor::Cmintfac,
+        Factor::Cnintfac,
+    ];
+    corrections
+        .iter()
+        .filter(|p| p.free_values() > 0)
+        .filter_map(|p| match p.target {
+            Target::Static(k) => Some(OFFSETS[k].index()),
+            Target::Interference(k) => Some(MULTIPLIERS[k].index()),
+            Target::Derivative(_) => None,
+        })
+        .collect()
 }
 
 /// The square root of one correction's smoothness penalty on the values at its free

@@ -150,11 +150,17 @@ pub fn cannot_tell(job: &Job, file: &UpdateFile) -> Vec<String> {
 pub fn notes(selected: &Selected, uncertainty: &Uncertainty, file: &UpdateFile) -> Vec<String> {
     let mut out = Vec::new();
     let model = &selected.model;
-    let grid = crate::screen::lambda_grid();
+    let grid: Vec<f64> = std::iter::once(1.0)
+        .chain(crate::select::SMOOTHNESS)
+        .map(|m| m * crate::select::LAMBDA0)
+        .collect();
+    let (lo, hi) = grid
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
     let values = model.space.values(&model.fit.lm.x);
     for (k, c) in model.space.corrections().iter().enumerate() {
         let lambda = model.corrections.lambdas[k];
-        if lambda <= grid[0] || lambda >= grid[grid.len() - 1] {
+        if lambda <= lo * 1.000_001 || lambda >= hi / 1.000_001 {
             out.push(format!(
                 "{}: its smoothness, lambda = {}, is at the edge of the weights tried",
                 c.name(),

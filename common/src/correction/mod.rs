@@ -25,9 +25,10 @@
 //! | `interference.dcx0` ... `interference.dcn0` | `distance_m` | the increment += c, times its multiplier |
 //!
 //! Mach is the flight condition's, fixed for a run, so a correction over Mach is folded into the
-//! run's constants when it is set up ([`CorrectionRun::fold`]); the others are evaluated at every
-//! force evaluation at the stage's local alpha, beta and distance from carriage
-//! ([`CorrectionRun::add`]). A run without correction values takes none of these paths.
+//! run's constants when it is set up ([`CorrectionRun::new`] returns them as [`Folded`]); the
+//! others are evaluated at every force evaluation at the stage's local alpha, beta and distance
+//! from carriage ([`CorrectionRun::evaluate`]). A run without correction values takes none of
+//! these paths.
 
 mod run;
 

@@ -18,7 +18,7 @@ use super::kit::{
 pub struct CorrectionPanel<'a> {
     /// The caption, for example "Cm over local alpha".
     pub caption: &'a str,
-    /// The variable with its unit, for example "local alpha [deg]".
+    /// The variable with its unit, for example "local alpha \[deg\]".
     pub x_label: &'a str,
     /// The variable at the curve's points.
     pub x: &'a [f64],
