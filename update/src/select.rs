@@ -3,8 +3,8 @@
 //! current model lacks (section 15.3, linearised about it, which also chooses the correction's
 //! smoothness), then refits the current model with the best one by output error, to every
 //! release and to each fold, and keeps it only when the folds' predictions of what they left
-//! out improve by more than [`KEEP_MARGIN`] in chi-square; the first correction that does not
-//! ends the selection.
+//! out improve by more than [`KEEP_MARGIN`] in chi-square and by [`KEEP_FRACTION`] of it; the
+//! first correction that does not ends the selection.
 
 use std::sync::Arc;
 
@@ -27,12 +27,15 @@ use crate::{Result, UpdateError};
 /// The cross-validated chi-square a correction must save to be kept (the margin of strong
 /// evidence, as the screening's).
 pub const KEEP_MARGIN: f64 = 6.0;
-/// The smoothness of every correction during the rounds: lambda = 1e-6 (weak: a round's choice
-/// of correction should not hang on it); the final one is chosen by [`SMOOTHNESS`].
-pub const LAMBDA0: f64 = 1e-6;
-/// The multipliers of [`LAMBDA0`] tried besides 1 on the corrections kept, by their
-/// cross-validated chi-square (lambda from 1e-8 to 1e-2).
-pub const SMOOTHNESS: [f64; 3] = [1e-2, 1e2, 1e4];
+/// The fraction of the cross-validated chi-square a correction must also save to be kept: on
+/// thousands of samples a drop of 6 is within what chance gives a correction of null data
+/// (seen in the null test, 2026-11-26), and a change of the store that predicts 2 % better is
+/// the least worth writing into it.
+pub const KEEP_FRACTION: f64 = 0.02;
+/// The multipliers tried besides 1 on every kept correction's lambda (each the one its
+/// screening chose, by the linearised cross-validation), by the output-error cross-validated
+/// chi-square: the linearisation's choice checked on either side.
+pub const SMOOTHNESS: [f64; 2] = [0.1, 10.0];
 /// Most rounds (corrections kept).
 pub const MAX_ROUNDS: usize = 6;
 /// Corrections of one round whose cross-validated chi-squares are within this of the best's
@@ -265,7 +268,7 @@ pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
         CLOCK.lap(&format!("select: round {}", round + 1));
         record.correction = best.corrections.proposals.last().map(Proposal::name);
         record.cv_chi2_with = Some(best.cv);
-        record.kept = best.cv < current.cv - KEEP_MARGIN;
+        record.kept = best.cv < current.cv - keep_needed(current.cv);
         record.tried = others
             .iter()
             .map(|m| {
@@ -275,7 +278,7 @@ pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
             .collect();
         record.cannot_tell = others
             .iter()
-            .filter(|m| m.cv - best.cv < CANNOT_TELL && m.cv < current.cv - KEEP_MARGIN)
+            .filter(|m| m.cv - best.cv < CANNOT_TELL && m.cv < current.cv - keep_needed(current.cv))
             .filter_map(|m| m.corrections.proposals.last().map(Proposal::name))
             .collect();
         let kept = record.kept;
@@ -324,7 +327,7 @@ pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
 
 /// The smoothness of the corrections kept, chosen by their cross-validated chi-square: each
 /// multiplier of [`SMOOTHNESS`] on every correction's weight refitted (from the model fitted at
-/// [`LAMBDA0`]) on `evaluator`, whose job holds those corrections. Returns the best model and
+/// the screening's lambdas) on `evaluator`, whose job holds those corrections. Returns the best model and
 /// every (lambda, cross-validated chi-square).
 fn smoothness(
     s: &Setting,
@@ -370,6 +373,11 @@ fn smoothness(
         .min_by(|&a, &b| all[a].cv.total_cmp(&all[b].cv))
         .unwrap_or(0);
     Ok((all.swap_remove(best), scores))
+}
+
+/// The drop of the cross-validated chi-square from `cv` a correction must make to be kept.
+pub fn keep_needed(cv: f64) -> f64 {
+    KEEP_MARGIN.max(KEEP_FRACTION * cv)
 }
 
 /// An evaluator of the releases with `model`'s corrections.
@@ -419,8 +427,8 @@ fn round_trials(
         .map(|i| {
             let mut corrections = current.corrections.clone();
             corrections.proposals.push(picks[i].proposal.clone());
-            corrections.lambdas.push(LAMBDA0);
-            corrections.weights.push(LAMBDA0 * picks[i].scale);
+            corrections.lambdas.push(picks[i].lambda);
+            corrections.weights.push(picks[i].lambda * picks[i].scale);
             // In the union's order: the current model's, then every pick, the others held.
             let mut proposals = union.clone();
             let mut weights = current.corrections.weights.clone();
@@ -428,7 +436,7 @@ fn round_trials(
                 if j != i {
                     proposals[kept + j].pinned = vec![true; p.proposal.pinned.len()];
                 }
-                weights.push(if j == i { LAMBDA0 * p.scale } else { 0.0 });
+                weights.push(if j == i { p.lambda * p.scale } else { 0.0 });
             }
             let space = Arc::new(UpdateSpace::new(
                 &model, base, &s.free, &proposals, &weights,

@@ -43,8 +43,8 @@ pub struct UpdateSpace {
 impl UpdateSpace {
     /// The space of `corrections` over `model`'s scenario (its derivatives and increments set
     /// the bounds), with the factors `free` (indices; less those the corrections take over,
-    /// [`taken_over`]) starting at `base` and the others held there. `weights[k]` is correction k's penalty weight: its lambda times its values' mean
-    /// information.
+    /// [`taken_over`]) starting at `base` and the others held there. `weights[k]` is correction
+    /// k's penalty weight: its lambda times its values' mean information.
     pub fn new(
         model: &Model,
         base: Factors,
@@ -222,11 +222,14 @@ impl UpdateSpace {
     }
 }
 
-/// The factors the corrections take over, which a refit holds where they are: a correction
-/// that would duplicate a factor would leave the two undetermined together (a static
-/// coefficient's constant part is its axis's offset, caoff ... cnoff; an interference
-/// increment's size is its axis's multiplier, caintfac ... cnintfac). A correction whose values
-/// are all held takes nothing over.
+/// The factors the corrections take over, which a refit holds where they are: a static
+/// coefficient's correction over alpha, beta or Mach holds a constant part, which is its axis's
+/// offset (caoff ... cnoff), and the two together would be undetermined. An interference
+/// increment's correction keeps its axis's multiplier free: the multiplier scales the
+/// increment and the correction together (section 15.1), so holding it where the factors alone
+/// put it (near 0 when the scenario's shape is wrong) would leave the correction no effect; the
+/// smoothness penalty settles what the two share. A correction whose values are all held takes
+/// nothing over.
 pub fn taken_over(corrections: &[Proposal]) -> Vec<usize> {
     const OFFSETS: [Factor; 6] = [
         Factor::Caoff,
@@ -236,21 +239,12 @@ pub fn taken_over(corrections: &[Proposal]) -> Vec<usize> {
         Factor::Cmoff,
         Factor::Cnoff,
     ];
-    const MULTIPLIERS: [Factor; 6] = [
-        Factor::Caintfac,
-        Factor::Cyintfac,
-        Factor::Czintfac,
-        Factor::Clintfac,
-        Factor::Cmintfac,
-        Factor::Cnintfac,
-    ];
     corrections
         .iter()
         .filter(|p| p.free_values() > 0)
         .filter_map(|p| match p.target {
             Target::Static(k) => Some(OFFSETS[k].index()),
-            Target::Interference(k) => Some(MULTIPLIERS[k].index()),
-            Target::Derivative(_) => None,
+            Target::Interference(_) | Target::Derivative(_) => None,
         })
         .collect()
 }

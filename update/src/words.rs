@@ -103,10 +103,11 @@ pub fn verdict(file: &UpdateFile) -> String {
     }
     if let Some(r) = file.rounds.iter().find(|r| r.correction.is_some()) {
         return format!(
-            "No correction kept: the best the reconstruction proposed ({}) does not predict {target} better than the factors alone (cross-validated chi-square {} against {}). The store's data stand; the factors are refitted, and predict {} (the data as given: {}).",
+            "No correction kept: the best the reconstruction proposed ({}) does not predict {target} enough better than the factors alone to be kept (cross-validated chi-square {} against {}; a correction must lower it by {}). The store's data stand; the factors are refitted, and predict {} (the data as given: {}).",
             r.correction.clone().unwrap_or_default(),
             number(r.cv_chi2_with.unwrap_or(f64::NAN), 5),
             number(r.cv_chi2_before, 5),
+            number(crate::select::keep_needed(r.cv_chi2_before), 3),
             goals_text(&factors),
             goals_text(&base)
         );
@@ -150,23 +151,20 @@ pub fn cannot_tell(job: &Job, file: &UpdateFile) -> Vec<String> {
 pub fn notes(selected: &Selected, uncertainty: &Uncertainty, file: &UpdateFile) -> Vec<String> {
     let mut out = Vec::new();
     let model = &selected.model;
-    let grid: Vec<f64> = std::iter::once(1.0)
-        .chain(crate::select::SMOOTHNESS)
-        .map(|m| m * crate::select::LAMBDA0)
-        .collect();
-    let (lo, hi) = grid
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+    // The smoothness stage scales every lambda the screening chose by one multiplier: a best
+    // at either end of those tried may lie beyond them.
+    let tried = &selected.smoothness;
+    let best = (0..tried.len()).min_by(|&a, &b| tried[a].1.total_cmp(&tried[b].1));
+    if let Some(best) = best.filter(|&b| tried.len() > 1 && (b == 0 || b + 1 == tried.len())) {
+        out.push(format!(
+            "the corrections' smoothness is at the {} edge of the weights tried (lambda {} for the first): the cross-validation may prefer {} still",
+            if best == 0 { "weak" } else { "strong" },
+            number(tried[best].0, 2),
+            if best == 0 { "less" } else { "more" },
+        ));
+    }
     let values = model.space.values(&model.fit.lm.x);
     for (k, c) in model.space.corrections().iter().enumerate() {
-        let lambda = model.corrections.lambdas[k];
-        if lambda <= lo * 1.000_001 || lambda >= hi / 1.000_001 {
-            out.push(format!(
-                "{}: its smoothness, lambda = {}, is at the edge of the weights tried",
-                c.name(),
-                number(lambda, 2)
-            ));
-        }
         if values[k]
             .iter()
             .any(|v| v.abs() >= 0.999 * model.space.bound(k))
