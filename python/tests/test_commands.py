@@ -77,3 +77,23 @@ def test_envelope_is_the_cli_s(cli, fitted, tmp_path):
     assert deterministic(e.to_dict()) == deterministic(expected)
     assert e.conditions == 3 and len(e.rows) == 3 and list(e.rows["mach"]) == [0.6, 0.75, 0.9]
     assert e.headline == expected["headline"]
+
+
+def test_update_is_the_cli_s_and_its_store_is_a_scenario(cli, releases, tmp_path):
+    a, b = releases / "a.csv", releases / "b.csv"
+    cli_ok(cli(["update", "--data", a, "--data", b, "--generations", "4", "--population", "40",
+                "--evaluator", "inproc", "--threads", "2", "--out", tmp_path / "cli"], tmp_path))
+    u = sepval.update([a, b], generations=4, population=40, workers=2, out=tmp_path / "py")
+    assert deterministic(u.to_dict()) == deterministic(read_json(tmp_path / "cli" / "update.json"))
+    assert (tmp_path / "py" / "scenario.toml").read_text() == (tmp_path / "cli" / "scenario.toml").read_text()
+    assert u.verdict == u.to_dict()["verdict"] and isinstance(u.corrections, list)
+    assert isinstance(u.folds, pd.DataFrame) and len(u.folds) == 2
+    assert len(u.factors) == 17
+    # The updated store is a scenario every command takes, with its factors.
+    sim = sepval.simulate(scenario=u.scenario_path, factors=u.factors_path)
+    assert len(sim) == 201
+    with pytest.raises(TypeError, match="free"):
+        sepval.update([a], free="fwdfac")
+    with pytest.raises(sepval.SepvalError, match="--free wingfac: not one of the 17 factors"):
+        sepval.update([a], free=["wingfac"], out=tmp_path / "bad")
+    assert not (tmp_path / "bad").exists()

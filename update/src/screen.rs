@@ -1,5 +1,5 @@
 //! Which coefficients need a correction, and over which variable: estimation before modelling
-//! (docs/model.md section 15.3). The missing force and moment are reconstructed per release
+//! (docs/model.md section 15.3.1). The missing force and moment are reconstructed per release
 //! as coefficient increments on time windows (section 11.6, `sepval_diagnose::
 //! reconstruct_misfit`), whose linear model of the residuals is r0 + J a + W u (J the free
 //! factors' sensitivities, W the windows'). A correction proposed for an axis
@@ -15,11 +15,11 @@
 //! ```
 //!
 //! (D2 the second difference within a correction, s_b the mean of its columns' squared norms,
-//! lambda among 10^-3, 10^-2.5, ..., 10^3), each release left out in turn (one release: each of
+//! lambda among 10^-5, 10^-4.5, ..., 10^3), each release left out in turn (one release: each of
 //! [`TIME_BLOCKS`] contiguous blocks of its rows), the chi-square of the rows left out summed,
-//! at the best lambda. An axis takes the proposal that lowers the score of the factors alone
-//! most, if by more than [`GAIN_MIN`], then a second on the same terms; every proposal within
-//! [`MARGIN`] of the one taken is reported as one the data cannot tell from it.
+//! at the best lambda, which the proposal keeps as its smoothness. The [`PICKS`] best go on to
+//! the round's output-error refit when each lowers the current score by more than [`GAIN_MIN`]
+//! and [`GAIN_FRACTION`] of it; an axis holds at most [`MAX_PER_AXIS`] corrections.
 
 use nalgebra::{DMatrix, DVector};
 use sepval_common::correction::{Derivative, Target, weights};
@@ -37,10 +37,6 @@ pub const GAIN_MIN: f64 = 10.0;
 /// The smallest drop of the cross-validated chi-square for which a correction is taken, as a
 /// fraction of the chi-square it starts from.
 pub const GAIN_FRACTION: f64 = 0.02;
-/// Proposals whose cross-validated chi-square is within this of the one taken cannot be told
-/// from it (the margin of "strong" evidence on the BIC scale: R. E. Kass and A. E. Raftery,
-/// JASA 90, 1995).
-pub const MARGIN: f64 = 6.0;
 /// Contiguous blocks of rows of the cross-validation of a single release.
 pub const TIME_BLOCKS: usize = 5;
 /// Most corrections a round refits to choose among (the best of the screening).

@@ -266,21 +266,7 @@ pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
             break;
         };
         CLOCK.lap(&format!("select: round {}", round + 1));
-        record.correction = best.corrections.proposals.last().map(Proposal::name);
-        record.cv_chi2_with = Some(best.cv);
-        record.kept = best.cv < current.cv - keep_needed(current.cv);
-        record.tried = others
-            .iter()
-            .map(|m| {
-                let name = m.corrections.proposals.last().map(Proposal::name);
-                (name.unwrap_or_default(), m.cv)
-            })
-            .collect();
-        record.cannot_tell = others
-            .iter()
-            .filter(|m| m.cv - best.cv < CANNOT_TELL && m.cv < current.cv - keep_needed(current.cv))
-            .filter_map(|m| m.corrections.proposals.last().map(Proposal::name))
-            .collect();
+        judge(&mut record, &current, &best, &others);
         let kept = record.kept;
         rounds.push(record);
         if kept {
@@ -373,6 +359,27 @@ fn smoothness(
         .min_by(|&a, &b| all[a].cv.total_cmp(&all[b].cv))
         .unwrap_or(0);
     Ok((all.swap_remove(best), scores))
+}
+
+/// Records a round's choice `best` among its refits (`others` the rest) against `current`:
+/// whether it is kept, and which of the others the releases cannot tell from it.
+fn judge(record: &mut RoundRecord, current: &Model, best: &Model, others: &[Model]) {
+    let needed = keep_needed(current.cv);
+    record.correction = best.corrections.proposals.last().map(Proposal::name);
+    record.cv_chi2_with = Some(best.cv);
+    record.kept = best.cv < current.cv - needed;
+    record.tried = others
+        .iter()
+        .map(|m| {
+            let name = m.corrections.proposals.last().map(Proposal::name);
+            (name.unwrap_or_default(), m.cv)
+        })
+        .collect();
+    record.cannot_tell = others
+        .iter()
+        .filter(|m| m.cv - best.cv < CANNOT_TELL && m.cv < current.cv - needed)
+        .filter_map(|m| m.corrections.proposals.last().map(Proposal::name))
+        .collect();
 }
 
 /// The drop of the cross-validated chi-square from `cv` a correction must make to be kept.

@@ -32,11 +32,12 @@ from ._commands import (
     read_telemetry,
     scenario,
     simulate,
+    update,
 )
 from ._errors import SepvalError, SepvalWarning
 from ._frames import COLUMNS, Telemetry
 from ._native import version as _version
-from ._results import Diagnosis, Envelope, Fit, Plan, Prediction, Result
+from ._results import Diagnosis, Envelope, Fit, Plan, Prediction, Result, Update
 
 __version__: str = _version()
 
@@ -52,6 +53,7 @@ __all__ = [
     "SepvalError",
     "SepvalWarning",
     "Telemetry",
+    "Update",
     "diagnose",
     "effects",
     "envelope",
@@ -62,4 +64,5 @@ __all__ = [
     "read_telemetry",
     "scenario",
     "simulate",
+    "update",
 ]

@@ -27,7 +27,7 @@ from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tu
 
 from . import _frames, _native
 from . import _inputs as inputs
-from ._results import Diagnosis, Envelope, Fit, Plan, Prediction, Result
+from ._results import Diagnosis, Envelope, Fit, Plan, Prediction, Result, Update
 from ._run import Progress, check_progress, out_dir, run
 
 R = TypeVar("R", bound=Result)
@@ -351,6 +351,48 @@ def envelope(
     flags, worker = inputs.evaluator_words(evaluator, workers)
     stored = lambda write: inputs.data_words("--validate", validate, "validate", write)
     return _run_into(Envelope, words + flags, stored, out, overwrite, progress, worker)
+
+
+def update(
+    data: Any,
+    validate: Any = None,
+    scenario: Any = None,
+    extension: Any = None,
+    free: Optional[List[str]] = None,
+    seed: int = 1,
+    generations: Optional[int] = None,
+    population: Optional[int] = None,
+    lm_budget: Optional[int] = None,
+    sigma_pos_m: Optional[float] = None,
+    sigma_att_deg: Optional[float] = None,
+    evaluator: str = "inproc",
+    workers: Optional[int] = None,
+    out: Any = None,
+    overwrite: bool = False,
+    progress: Progress = None,
+) -> Update:
+    """The store's aerodynamic data updated from its releases (``sepval update``): corrections
+    as tables in the scenario's own form, fitted with the factors and kept only as far as they
+    predict a release they were not fitted to.
+
+    ``data``: the releases (as for ``fit``; their metadata sets each flight condition);
+    ``validate``: releases never fitted, predicted by the data as given, the factors alone and
+    the updated store; ``free``: the factors fitted with the corrections (names; all 17 by
+    default); ``seed``, ``generations`` (60), ``population`` (100), ``lm_budget`` (3000): the
+    baseline fit's search; the rest as for ``fit``. The result's ``scenario_path`` and
+    ``factors_path`` are the updated store and its factors."""
+    words = _search(extension, seed, generations, population, lm_budget, (sigma_pos_m, sigma_att_deg), None)
+    if free is not None:
+        if isinstance(free, str) or not all(isinstance(f, str) for f in free):
+            raise TypeError("free: expected a list of factor names (str)")
+        words += ["--free", ",".join(free)]
+    flags, worker = inputs.evaluator_words(evaluator, workers)
+
+    def stored(write: bool) -> List[str]:
+        releases = inputs.data_words("--data", data, "data", write)
+        return releases + inputs.data_words("--validate", validate, "validate", write) + inputs.scenario_words(scenario, write)
+
+    return _run_into(Update, words + flags, stored, out, overwrite, progress, worker)
 
 
 def scenario(path: Any = None) -> Dict[str, Any]:

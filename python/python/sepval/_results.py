@@ -225,3 +225,40 @@ class Envelope(Result):
 
     def __repr__(self) -> str:
         return f"<sepval.Envelope {self.headline!r} in {self.out}>"
+
+
+class Update(Result):
+    """An update of the store's aerodynamic data (``update.json``): ``verdict`` (the answer in
+    words), ``corrections`` (a list of dicts: ``name``, ``field``, ``variable``,
+    ``breakpoints``, ``values``, ``std``, ``explored``), ``factors`` (fitted with them),
+    ``folds`` (a DataFrame: what each fold left out, and the RMS errors the data as given, the
+    factors alone and the updated store predict for it), ``cannot_tell``, ``notes``; and the
+    updated store, which every command takes as it is: ``scenario_path`` (``scenario.toml``, its
+    tables under ``tables/``) and ``factors_path`` (``factors.json``)."""
+
+    command = "update"
+    record = "update.json"
+
+    def _read(self, r: Dict[str, Any]) -> None:
+        self.verdict: str = r["verdict"]
+        self.corrections: List[Dict[str, Any]] = r["corrections"]
+        self.factors: Dict[str, float] = r["fitted"]["factors"]
+        self.goals: Dict[str, Optional[float]] = r["fitted"]["goals"]
+        self.cannot_tell: List[str] = r["cannot_tell"]
+        self.notes: List[str] = r["notes"]
+        self.effective_parameters: float = r["effective_parameters"]
+        flat = []
+        for f in r["cross_validation"]["folds"]:
+            item: Dict[str, Any] = {"held_out": f["held_out"]}
+            for model in ("baseline", "factors_only", "updated"):
+                item[f"{model}_j_pos_m"] = f[model]["j_pos_m"]
+                item[f"{model}_j_att_deg"] = f[model]["j_att_deg"]
+            flat.append(item)
+        self.folds: Any = _frames.rows(flat)
+        self.validation: List[Dict[str, Any]] = r["validation"]
+        self.scenario_path: Path = self.out / "scenario.toml"
+        self.factors_path: Path = self.out / "factors.json"
+        self.evaluations: int = r["evaluations"]
+
+    def __repr__(self) -> str:
+        return f"<sepval.Update {len(self.corrections)} correction(s) in {self.out}>"

@@ -145,6 +145,12 @@ fn draw_panel(area: &Root<'_>, p: &CorrectionPanel) -> DrawResult {
             upper.chain(lower).collect::<Vec<_>>(),
             tint(colour(0), BAND_WHITE).filled(),
         )))?;
+    } else if let [(ex, lo, hi)] = edges[..] {
+        // One breakpoint (a correction at one Mach): the band as a bar.
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(ex, lo), (ex, hi)],
+            tint(colour(0), BAND_WHITE).stroke_width(10),
+        )))?;
     }
     chart.draw_series(std::iter::once(PathElement::new(
         vec![(x.0, 0.0), (x.1, 0.0)],
