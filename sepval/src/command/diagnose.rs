@@ -7,9 +7,7 @@ use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
 use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_fit::sigma::Sigma;
-use sepval_fit::{FitOptions, Method};
 use sepval_solve::ga::GaSettings;
-use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 
 use super::{clearance, evaluator_spec, inputs, notices};
@@ -101,21 +99,7 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
         budget: args.lm_budget,
         ..LmSettings::default()
     };
-    let fit = FitOptions {
-        method: Method::GaLm,
-        ga,
-        hill: HillSettings::default(),
-        sigma,
-        truth: None,
-        out: args.out.join("baseline"),
-        resume: None,
-        inputs,
-        lm: lm.clone(),
-        lm_probe: LmSettings {
-            budget: args.lm_budget.min(800),
-            ..LmSettings::default()
-        },
-    };
+    let fit = inputs::baseline_fit(ga, sigma, &lm, &args.out, inputs);
     let options = DiagnoseOptions {
         fit,
         out: args.out.clone(),

@@ -226,3 +226,30 @@ fn same_samples(a: &Trajectory, b: &Trajectory) -> bool {
         && same(a.pos_m.iter().flatten(), b.pos_m.iter().flatten())
         && same(a.att_deg.iter().flatten(), b.att_deg.iter().flatten())
 }
+
+/// The baseline fit of a diagnosis or an update: the study's GA, then Levenberg-Marquardt
+/// with `lm` (its probes' refinements within 800 simulations), written to `out`/baseline.
+pub fn baseline_fit(
+    ga: sepval_solve::ga::GaSettings,
+    sigma: sepval_fit::sigma::Sigma,
+    lm: &sepval_solve::lm::LmSettings,
+    out: &Path,
+    inputs: sepval_fit::checkpoint::InputsRecord,
+) -> sepval_fit::FitOptions {
+    use sepval_solve::lm::LmSettings;
+    sepval_fit::FitOptions {
+        method: sepval_fit::Method::GaLm,
+        ga,
+        hill: sepval_solve::hill::HillSettings::default(),
+        sigma,
+        truth: None,
+        out: out.join("baseline"),
+        resume: None,
+        inputs,
+        lm: lm.clone(),
+        lm_probe: LmSettings {
+            budget: lm.budget.min(800),
+            ..LmSettings::default()
+        },
+    }
+}

@@ -8,9 +8,7 @@ use sepval_common::evaluation::Job;
 use sepval_common::factors::Factor;
 use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_fit::sigma::Sigma;
-use sepval_fit::{FitOptions, Method};
 use sepval_solve::ga::GaSettings;
-use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
@@ -99,21 +97,7 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
         ..LmSettings::default()
     };
     let options = UpdateOptions {
-        fit: FitOptions {
-            method: Method::GaLm,
-            ga,
-            hill: HillSettings::default(),
-            sigma,
-            truth: None,
-            out: args.out.join("baseline"),
-            resume: None,
-            inputs,
-            lm: lm.clone(),
-            lm_probe: LmSettings {
-                budget: args.lm_budget.min(800),
-                ..LmSettings::default()
-            },
-        },
+        fit: inputs::baseline_fit(ga, sigma, &lm, &args.out, inputs),
         lm: LmSettings {
             max_iterations: 400,
             budget: 20_000,
