@@ -5,7 +5,6 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
-use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
@@ -19,17 +18,7 @@ use crate::cli::DiagnoseArgs;
 pub fn run(args: DiagnoseArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     // The output directory, before anything runs (no worker is started for a refused --out).
-    let claim = if args.overwrite.overwrite {
-        Claim::Overwrite
-    } else {
-        Claim::Fresh
-    };
-    let run_dir = RunDir::claim(&args.out, claim, "diagnose").with_context(|| {
-        format!(
-            "--out {} (--overwrite clears an earlier run)",
-            args.out.display()
-        )
-    })?;
+    let run_dir = super::claim_out(&args.out, &args.overwrite, "diagnose")?;
     let DiagnoseConfig { job, options } = configure(&args)?;
     let base = job.events()[0].simulator.scenario().clone();
     let geometry = clearance::settings(&args.geometry, &base)?;

@@ -180,3 +180,24 @@ fn zenoh_spec(_: &EvalArgs, _: Duration, _: Duration) -> Result<EvaluatorSpec> {
 pub fn notices() -> Notices {
     Arc::new(|n| note!("sepval: {n}"))
 }
+
+/// Claims `--out` for a run of `command`: a fresh directory, or with `--overwrite` one whose
+/// earlier sepval run it clears; a refusal names the flag.
+pub fn claim_out(
+    out: &std::path::Path,
+    overwrite: &crate::cli::OverwriteArgs,
+    command: &str,
+) -> Result<sepval_fit::out_dir::RunDir> {
+    use sepval_fit::out_dir::{Claim, RunDir};
+    let claim = if overwrite.overwrite {
+        Claim::Overwrite
+    } else {
+        Claim::Fresh
+    };
+    RunDir::claim(out, claim, command).with_context(|| {
+        format!(
+            "--out {} (--overwrite clears an earlier run)",
+            out.display()
+        )
+    })
+}

@@ -5,7 +5,6 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_plan::{
     PlanFile, Quantity, Range, plan, plan_file, prepare, read_diagnosis, write_outputs,
 };
@@ -33,17 +32,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
         )
     })?;
     let prepared = prepare(diagnosis, &flown, &ranges, args.points)?;
-    let claim = if args.overwrite.overwrite {
-        Claim::Overwrite
-    } else {
-        Claim::Fresh
-    };
-    let run_dir = RunDir::claim(&args.out, claim, "plan").with_context(|| {
-        format!(
-            "--out {} (--overwrite clears an earlier run)",
-            args.out.display()
-        )
-    })?;
+    let run_dir = super::claim_out(&args.out, &args.overwrite, "plan")?;
     let start = Instant::now();
     let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
     run_dir.prepare()?;

@@ -8,7 +8,6 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{Event, Job};
 use sepval_common::telemetry::Trajectory;
-use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_predict::{
     Flown, PredictionFile, Settings, Source, predict, prediction_file, prepare, read_source,
     write_outputs,
@@ -45,13 +44,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
         Some(c) => prepared.with_clearance(c),
         None => prepared,
     };
-    let claim = if args.overwrite.overwrite {
-        Claim::Overwrite
-    } else {
-        Claim::Fresh
-    };
-    let run_dir = RunDir::claim(&args.out, claim, "predict")
-        .with_context(|| format!("--out {}", args.out.display()))?;
+    let run_dir = super::claim_out(&args.out, &args.overwrite, "predict")?;
     let start = Instant::now();
     let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
     run_dir.prepare()?;

@@ -6,7 +6,6 @@ use std::sync::Arc;
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_common::factors::Factor;
-use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
@@ -21,17 +20,7 @@ use crate::cli::UpdateArgs;
 pub fn run(args: UpdateArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let (options, job) = configure(&args)?;
-    let claim = if args.overwrite.overwrite {
-        Claim::Overwrite
-    } else {
-        Claim::Fresh
-    };
-    let run_dir = RunDir::claim(&args.out, claim, "update").with_context(|| {
-        format!(
-            "--out {} (--overwrite clears an earlier run)",
-            args.out.display()
-        )
-    })?;
+    let run_dir = super::claim_out(&args.out, &args.overwrite, "update")?;
     run_dir.prepare()?;
     let mut start = starter(&spec);
     let u = update(
