@@ -138,15 +138,22 @@ fn draw_panel(area: &Root<'_>, p: &CorrectionPanel) -> DrawResult {
             .map(|((&x, &v), &s)| (x, v - 2.0 * s, v + 2.0 * s))
             .filter(|&(x, a, b)| plottable(x) && plottable(a) && plottable(b))
             .collect();
-    if edges.len() > 1 {
+    let (x_lo, x_hi) = edges
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), e| {
+            (a.min(e.0), b.max(e.0))
+        });
+    if edges.len() > 1 && x_hi > x_lo {
         let upper = edges.iter().map(|&(x, _, hi)| (x, hi));
         let lower = edges.iter().rev().map(|&(x, lo, _)| (x, lo));
         chart.draw_series(std::iter::once(Polygon::new(
             upper.chain(lower).collect::<Vec<_>>(),
             tint(colour(0), BAND_WHITE).filled(),
         )))?;
-    } else if let [(ex, lo, hi)] = edges[..] {
-        // One breakpoint (a correction at one Mach): the band as a bar.
+    } else if let Some(&(ex, _, _)) = edges.first() {
+        // All at one x (a correction at one Mach): the band as a bar.
+        let lo = edges.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
+        let hi = edges.iter().map(|e| e.2).fold(f64::NEG_INFINITY, f64::max);
         chart.draw_series(std::iter::once(PathElement::new(
             vec![(ex, lo), (ex, hi)],
             tint(colour(0), BAND_WHITE).stroke_width(10),
