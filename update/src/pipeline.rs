@@ -76,7 +76,7 @@ pub fn update(
     };
     let selected = select(&setting, start)?;
     CLOCK.lap("select");
-    let uncertainty = Uncertainty::of(&selected.model.fit);
+    let uncertainty = Uncertainty::of(&selected.model.fit, &selected.model.space.shared_factors());
     let validation = crate::validation::validate(options.validation.as_ref(), &selected, noise)?;
     let store = store(options, &job, &selected)?;
     let evaluations = baseline.evaluations + selected.evaluations + validation.1;

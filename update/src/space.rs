@@ -129,6 +129,38 @@ impl UpdateSpace {
             .collect()
     }
 
+    /// The positions among the parameters of the factors that share what an interference
+    /// correction (with free values) describes: its axis's multiplier, which scales the
+    /// scenario's increment and the correction together, and its axis's offset, which within
+    /// the distances the releases reached is the correction's constant part.
+    pub fn shared_factors(&self) -> Vec<usize> {
+        const MULTIPLIERS: [Factor; 6] = [
+            Factor::Caintfac,
+            Factor::Cyintfac,
+            Factor::Czintfac,
+            Factor::Clintfac,
+            Factor::Cmintfac,
+            Factor::Cnintfac,
+        ];
+        const OFFSETS: [Factor; 6] = [
+            Factor::Caoff,
+            Factor::Cyoff,
+            Factor::Czoff,
+            Factor::Cloff,
+            Factor::Cmoff,
+            Factor::Cnoff,
+        ];
+        self.corrections
+            .iter()
+            .filter(|p| p.free_values() > 0)
+            .flat_map(|p| match p.target {
+                Target::Interference(a) => vec![MULTIPLIERS[a].index(), OFFSETS[a].index()],
+                _ => Vec::new(),
+            })
+            .filter_map(|i| self.free.iter().position(|&f| f == i))
+            .collect()
+    }
+
     /// The free factors' indices.
     pub fn free(&self) -> &[usize] {
         &self.free

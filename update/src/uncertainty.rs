@@ -13,7 +13,12 @@
 //! ```
 //!
 //! A correction's band at x is 2 sqrt(w(x)^T Cov w(x)), w(x) the interpolation weights of its
-//! free values at x.
+//! free values at x. An interference correction shares its size with its axis's multiplier,
+//! which scales the scenario's increment and the correction together (section 15.4), and its
+//! constant part, within the distances the releases reached, with its axis's offset: the
+//! covariance is taken given those fitted factors (the rows and columns of `held` left out of H
+//! before it is inverted), or the bands would show those shared directions, not what the
+//! releases measured of the correction's shape.
 
 use nalgebra::DMatrix;
 use sepval_common::correction::weights;
@@ -33,8 +38,9 @@ pub struct Uncertainty {
 }
 
 impl Uncertainty {
-    /// The uncertainty of `fit`.
-    pub fn of(fit: &Refitted) -> Uncertainty {
+    /// The uncertainty of `fit`, its covariance given the parameters `held` (positions), whose
+    /// rows and columns are 0.
+    pub fn of(fit: &Refitted, held: &[usize]) -> Uncertainty {
         let j = &fit.lm.jacobian;
         let n = fit.lm.x.len();
         let m = fit.measure.data_rows;
@@ -53,7 +59,7 @@ impl Uncertainty {
         for k in 0..n {
             reg[(k, k)] += 1e-12 * scale;
         }
-        let Some(inv) = reg.cholesky().map(|c| c.inverse()) else {
+        let Some(inv) = reg.clone().cholesky().map(|c| c.inverse()) else {
             return Uncertainty {
                 effective_parameters: n as f64,
                 residual_scale: 1.0,
@@ -63,10 +69,31 @@ impl Uncertainty {
         let edf: f64 = (0..n).map(|k| (inv.row(k) * d.column(k))[(0, 0)]).sum();
         let chi2 = fit.data_chi2();
         let s2 = (chi2 / (m as f64 - edf).max(1.0)).max(1.0);
+        let covariance = if held.is_empty() {
+            inv * s2
+        } else {
+            // A unit row and column for each one held: the rest of the inverse is the inverse
+            // of H without them.
+            let mut given = reg;
+            for &k in held.iter().filter(|&&k| k < n) {
+                given.row_mut(k).fill(0.0);
+                given.column_mut(k).fill(0.0);
+                given[(k, k)] = 1.0;
+            }
+            match given.cholesky().map(|c| c.inverse()) {
+                Some(mut inv) => {
+                    for &k in held.iter().filter(|&&k| k < n) {
+                        inv[(k, k)] = 0.0;
+                    }
+                    inv * s2
+                }
+                None => DMatrix::from_element(n, n, f64::NAN),
+            }
+        };
         Uncertainty {
             effective_parameters: edf,
             residual_scale: s2,
-            covariance: inv * s2,
+            covariance,
         }
     }
 
