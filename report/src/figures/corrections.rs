@@ -4,12 +4,14 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::FigureError;
 use super::kit::{
-    DrawResult, FLOOR_GREY, LegendMark, Root, colour, draw_dashed, draw_legend_strip, draw_mesh,
-    draw_polyline, fmt_tick, padded_range, plottable, plottable_point, render, text, tint,
+    Chart2d, DrawResult, FLOOR_GREY, LegendMark, Root, colour, draw_dashed, draw_legend_strip,
+    draw_mesh, draw_polyline, fmt_tick, padded_range, plottable, plottable_point, render, text,
+    tint,
 };
 
 /// One correction: its value and standard deviation along its variable, what the releases
@@ -138,27 +140,7 @@ fn draw_panel(area: &Root<'_>, p: &CorrectionPanel) -> DrawResult {
             .map(|((&x, &v), &s)| (x, v - 2.0 * s, v + 2.0 * s))
             .filter(|&(x, a, b)| plottable(x) && plottable(a) && plottable(b))
             .collect();
-    let (x_lo, x_hi) = edges
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), e| {
-            (a.min(e.0), b.max(e.0))
-        });
-    if edges.len() > 1 && x_hi > x_lo {
-        let upper = edges.iter().map(|&(x, _, hi)| (x, hi));
-        let lower = edges.iter().rev().map(|&(x, lo, _)| (x, lo));
-        chart.draw_series(std::iter::once(Polygon::new(
-            upper.chain(lower).collect::<Vec<_>>(),
-            tint(colour(0), BAND_WHITE).filled(),
-        )))?;
-    } else if let Some(&(ex, _, _)) = edges.first() {
-        // All at one x (a correction at one Mach): the band as a bar.
-        let lo = edges.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
-        let hi = edges.iter().map(|e| e.2).fold(f64::NEG_INFINITY, f64::max);
-        chart.draw_series(std::iter::once(PathElement::new(
-            vec![(ex, lo), (ex, hi)],
-            tint(colour(0), BAND_WHITE).stroke_width(10),
-        )))?;
-    }
+    draw_band(&mut chart, &edges)?;
     chart.draw_series(std::iter::once(PathElement::new(
         vec![(x.0, 0.0), (x.1, 0.0)],
         FLOOR_GREY.stroke_width(1),
@@ -202,6 +184,36 @@ fn draw_panel(area: &Root<'_>, p: &CorrectionPanel) -> DrawResult {
             .filter(|(x, v)| plottable_point((**x, **v)))
             .map(|(&x, &v)| Circle::new((x, v), 5, colour(0).filled())),
     )?;
+    Ok(())
+}
+
+/// The ±2σ band through `edges` (x, lower, upper): a filled area, or a bar where every edge
+/// has the same x (a correction at one Mach, whose area would have no width).
+fn draw_band(
+    chart: &mut Chart2d<'_, '_, RangedCoordf64, RangedCoordf64>,
+    edges: &[(f64, f64, f64)],
+) -> DrawResult {
+    let (x_lo, x_hi) = edges
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), e| {
+            (a.min(e.0), b.max(e.0))
+        });
+    if edges.len() > 1 && x_hi > x_lo {
+        let upper = edges.iter().map(|&(x, _, hi)| (x, hi));
+        let lower = edges.iter().rev().map(|&(x, lo, _)| (x, lo));
+        chart.draw_series(std::iter::once(Polygon::new(
+            upper.chain(lower).collect::<Vec<_>>(),
+            tint(colour(0), BAND_WHITE).filled(),
+        )))?;
+    } else if let Some(&(ex, _, _)) = edges.first() {
+        // All at one x (a correction at one Mach): the band as a bar.
+        let lo = edges.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
+        let hi = edges.iter().map(|e| e.2).fold(f64::NEG_INFINITY, f64::max);
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(ex, lo), (ex, hi)],
+            tint(colour(0), BAND_WHITE).stroke_width(10),
+        )))?;
+    }
     Ok(())
 }
 
