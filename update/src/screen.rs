@@ -25,12 +25,13 @@ use nalgebra::{DMatrix, DVector};
 use sepval_common::correction::{Derivative, Target, weights};
 use sepval_common::evaluation::Job;
 use sepval_common::extension::Axis;
-use sepval_common::factors::{Factor, Factors};
+use sepval_common::factors::Factors;
 use sepval_common::table::Variable;
 use sepval_diagnose::{Linear, Misfit, Sample};
 use serde::{Deserialize, Serialize};
 
 use crate::explored::{Explored, Proposal, proposals};
+use crate::space::MULTIPLIERS;
 
 /// The smallest drop of the cross-validated chi-square for which a correction is taken.
 pub const GAIN_MIN: f64 = 10.0;
@@ -46,14 +47,6 @@ pub const MAX_PER_AXIS: usize = 2;
 
 const AXES: [&str; 6] = ["CA", "CY", "CZ", "Cl", "Cm", "Cn"];
 const WINDOW_AXES: [Axis; 6] = [Axis::CA, Axis::CY, Axis::CZ, Axis::Cl, Axis::Cm, Axis::Cn];
-const MULTIPLIERS: [Factor; 6] = [
-    Factor::Caintfac,
-    Factor::Cyintfac,
-    Factor::Czintfac,
-    Factor::Clintfac,
-    Factor::Cmintfac,
-    Factor::Cnintfac,
-];
 
 /// One proposal's score.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -23,6 +23,25 @@ pub const DERIVATIVE_BOUND: f64 = 10.0;
 /// twice their size.
 pub const INTERFERENCE_BOUND: f64 = 2.0;
 
+/// Each axis's offset factor (CA ... Cn): a constant added to its coefficient.
+pub const OFFSETS: [Factor; 6] = [
+    Factor::Caoff,
+    Factor::Cyoff,
+    Factor::Czoff,
+    Factor::Cloff,
+    Factor::Cmoff,
+    Factor::Cnoff,
+];
+/// Each axis's interference multiplier (CA ... Cn): it scales the axis's increment.
+pub const MULTIPLIERS: [Factor; 6] = [
+    Factor::Caintfac,
+    Factor::Cyintfac,
+    Factor::Czintfac,
+    Factor::Clintfac,
+    Factor::Cmintfac,
+    Factor::Cnintfac,
+];
+
 /// The refit's parameters and how they make a candidate.
 #[derive(Debug, Clone)]
 pub struct UpdateSpace {
@@ -134,22 +153,6 @@ impl UpdateSpace {
     /// scenario's increment and the correction together, and its axis's offset, which within
     /// the distances the releases reached is the correction's constant part.
     pub fn shared_factors(&self) -> Vec<usize> {
-        const MULTIPLIERS: [Factor; 6] = [
-            Factor::Caintfac,
-            Factor::Cyintfac,
-            Factor::Czintfac,
-            Factor::Clintfac,
-            Factor::Cmintfac,
-            Factor::Cnintfac,
-        ];
-        const OFFSETS: [Factor; 6] = [
-            Factor::Caoff,
-            Factor::Cyoff,
-            Factor::Czoff,
-            Factor::Cloff,
-            Factor::Cmoff,
-            Factor::Cnoff,
-        ];
         self.corrections
             .iter()
             .filter(|p| p.free_values() > 0)
@@ -263,14 +266,6 @@ impl UpdateSpace {
 /// smoothness penalty settles what the two share. A correction whose values are all held takes
 /// nothing over.
 pub fn taken_over(corrections: &[Proposal]) -> Vec<usize> {
-    const OFFSETS: [Factor; 6] = [
-        Factor::Caoff,
-        Factor::Cyoff,
-        Factor::Czoff,
-        Factor::Cloff,
-        Factor::Cmoff,
-        Factor::Cnoff,
-    ];
     corrections
         .iter()
         .filter(|p| p.free_values() > 0)
