@@ -96,6 +96,27 @@ fn baseline_failure(baseline: &ModelSummary, noise: Noise) -> Option<String> {
     })
 }
 
+/// Whether `fitted` explains the data to the noise: both goals within the noise floor (1.1
+/// sigma) and every channel's residuals white (`residuals`). With a converged baseline, this is
+/// what `explained` says of the catalogue's answer.
+pub(super) fn explains(setting: &Setting, fitted: &Fitted) -> Result<bool> {
+    let job = &*setting.job;
+    let report = residual_report(
+        job,
+        &fitted.lm,
+        &fitted.candidate(job)?,
+        setting.noise,
+        setting.floor,
+    );
+    Ok(report.white && report.at_noise_floor)
+}
+
+/// Whether the converged `baseline` reached near the noise, so that the tests of its
+/// extensions mean something (see [`baseline_failure`]).
+pub(super) fn baseline_converged(setting: &Setting, baseline: &Fitted) -> bool {
+    baseline_failure(&summary(setting, baseline), setting.noise).is_none()
+}
+
 /// The diagnosis of `d`; `t0` is when the diagnosis started.
 pub(super) fn analyse(
     options: &DiagnoseOptions,
@@ -103,14 +124,13 @@ pub(super) fn analyse(
     d: Decided,
     t0: Instant,
 ) -> Result<Analysis> {
-    let (job, noise, floor) = (&*setting.job, setting.noise, setting.floor);
+    let (job, noise) = (&*setting.job, setting.noise);
     let answer_fit = d.answer.model(&d.baseline);
     let base_summary = summary(setting, &d.baseline);
     let unreliable = baseline_failure(&base_summary, noise);
     // The catalogue's model: the baseline when it chose no effect.
     let cat_fit = d.answer.selected().map_or(&d.baseline, |s| &s.fitted);
-    let cat_report = residual_report(job, &cat_fit.lm, &cat_fit.candidate(job)?, noise, floor);
-    let explained = cat_report.white && cat_report.at_noise_floor && unreliable.is_none();
+    let explained = explains(setting, cat_fit)? && unreliable.is_none();
     let (causes, discovered) = d.answer.named();
     let (parameters, identifiability) = answer_estimates(setting, &d.answer, answer_fit);
     let rivals: Vec<RivalReport> = d.rivals.iter().map(|(_, r)| r.clone()).collect();

@@ -14,6 +14,8 @@
 //! 3. **Discovery** (`discover`): beyond the catalogue, the missing force and moment are
 //!    reconstructed as time histories, and terms of a documented library (docs/model.md
 //!    section 11) are selected by stepwise regression and verified by an output-error refit.
+//!    When the catalogue's answer explains the data to the noise, discovery stops as soon as
+//!    its model can no longer replace or rival that answer (`discover::reach`).
 //! 4. **The answer.** The catalogue's effects (`causes`) stay the answer unless the discovered
 //!    extension beats them by more than [`BIC_MARGIN`] in BIC (R. E. Kass and A. E. Raftery,
 //!    JASA 90, 1995: a difference above 6 is strong evidence), in which case the catalogue's
@@ -281,11 +283,7 @@ pub fn diagnose(
         &mut skipped,
     )?;
     stage_clock::lap("catalogue");
-    // What the catalogue's answer changes in the residuals: discovery looks for its mimics.
-    let signature: Option<Vec<f64>> = (!cat.chosen.is_empty()).then(|| {
-        let (b, c) = (&baseline.lm.residuals, &cat.fitted.lm.residuals);
-        b.iter().zip(c).map(|(b, c)| b - c).collect()
-    });
+    let (signature, yardstick) = discovery_inputs(&setting, &baseline, &cat)?;
     let disc = discover::discover(
         evaluator,
         job,
@@ -293,6 +291,7 @@ pub fn diagnose(
         setting.noise,
         &candidate_lm,
         signature.as_deref(),
+        yardstick,
     )?;
     evaluations += disc.evaluations;
     stage_clock::lap("discovery");
@@ -335,6 +334,27 @@ pub fn diagnose(
     write_outputs(&options.out, &setting, &analysis, progress)?;
     stage_clock::lap("outputs");
     Ok(analysis.diagnosis)
+}
+
+/// What discovery takes from the catalogue: what the catalogue's answer changes in the
+/// residuals (discovery looks for its mimics), and the answer as discovery's yardstick when it
+/// explains the data to the noise (discovery stops once it can no longer reach it).
+fn discovery_inputs(
+    setting: &Setting,
+    baseline: &Fitted,
+    cat: &catalogue::CatalogueOutcome,
+) -> Result<(Option<Vec<f64>>, Option<discover::Yardstick>)> {
+    if cat.chosen.is_empty() {
+        return Ok((None, None));
+    }
+    let (b, c) = (&baseline.lm.residuals, &cat.fitted.lm.residuals);
+    let signature = b.iter().zip(c).map(|(b, c)| b - c).collect();
+    let explained = analysis::baseline_converged(setting, baseline)
+        && analysis::explains(setting, &cat.fitted)?;
+    let yardstick = explained.then(|| discover::Yardstick {
+        bic: setting.bic(&cat.fitted),
+    });
+    Ok((Some(signature), yardstick))
 }
 
 /// The baseline: the factors fitted by the fit pipeline and refined again to convergence.

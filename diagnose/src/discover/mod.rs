@@ -47,6 +47,7 @@ use crate::found::{Discovery, Found, Gain};
 use crate::reconstruct::Reconstruction;
 use crate::{Fitted, Result, stepwise};
 use picked::Picked;
+pub(crate) use reach::Yardstick;
 use search::{Search, Selection, Trail};
 use verify::Refit;
 
@@ -54,6 +55,7 @@ mod locate;
 mod mimic;
 mod naming;
 mod picked;
+mod reach;
 mod remove;
 mod screen;
 mod search;
@@ -69,6 +71,7 @@ pub(super) fn discover(
     noise: Noise,
     settings: &LmSettings,
     signature: Option<&[f64]>,
+    yardstick: Option<Yardstick>,
 ) -> Result<Discovery> {
     let search = Search::new(job, noise, settings);
     let mut trail = Trail::default();
@@ -95,6 +98,10 @@ pub(super) fn discover(
         groups: Vec::new(),
         without: None,
     };
+    let (mut bic_before, mut best_gain) = (
+        crate::bic(baseline.lm.cost, baseline.space(job).len(), search.m),
+        0.0,
+    );
     for step in 0..stepwise::MAX_ENTRIES {
         let Some(entered) = enter(
             evaluator,
@@ -113,6 +120,21 @@ pub(super) fn discover(
         crate::stage_clock::lap(&format!("discovery step {}: the rest", step + 1));
         sel = remove::f_to_remove(evaluator, &search, entered, &mut trail)?;
         crate::stage_clock::lap(&format!("discovery step {} F-to-remove", step + 1));
+        let bic = crate::bic(sel.current.lm.cost, sel.current.space(job).len(), search.m);
+        let last_gain = bic_before - bic;
+        best_gain = f64::max(best_gain, last_gain);
+        bic_before = bic;
+        let standing = reach::Standing {
+            step: step + 1,
+            bic,
+            best_gain,
+            last_gain,
+            steps_left: stepwise::MAX_ENTRIES - step - 1,
+        };
+        if let Some(note) = reach::out_of_reach(yardstick, standing) {
+            trail.notes.push(note);
+            break;
+        }
     }
     let found = conclude(evaluator, &search, baseline, sel, &mut trail)?;
     crate::stage_clock::lap("discovery's gains");
