@@ -10,7 +10,10 @@
    well (a cycle between two folders is a cycle too); the effect plug-ins and the model that
    lists them are the one intended exception (a registry);
 3. the crates depend on each other one way only, as ARCHITECTURE.md draws them: each crate's
-   `sepval-*` dependencies (normal, not dev) are within the set it may use.
+   `sepval-*` dependencies (normal, not dev) are within the set it may use;
+4. a crate whose library or binary says `test = false` (no unit-test harness: its compile in
+   test mode is skipped, which CI's time needs) has no `#[test]` in its sources, since such a
+   test would never run.
 
 Usage: scripts/shape.py [ROOT]. Prints what breaks a rule and exits 1 if anything does.
 """
@@ -228,6 +231,15 @@ def layers(root, crate, problems):
         problems.append(f"crate {name} depends on {d}, which ARCHITECTURE.md does not allow")
 
 
+def untested(crate, problems):
+    toml = open(os.path.join(crate, "Cargo.toml"), encoding="utf-8").read()
+    if not re.search(r"^test\s*=\s*false", toml, flags=re.M):
+        return
+    for path in rust_files(os.path.join(crate, "src")):
+        if "#[test]" in open(path, encoding="utf-8", errors="replace").read():
+            problems.append(f"{path}: has #[test], but its crate's Cargo.toml says test = false (the test would never run)")
+
+
 def main():
     root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..")
     root = os.path.abspath(root)
@@ -237,9 +249,10 @@ def main():
             sizes(root, path, open(path, encoding="utf-8", errors="replace").read(), problems)
         cycles(root, crate, problems)
         layers(root, crate, problems)
+        untested(crate, problems)
     for p in problems:
         print(p)
-    print(f"shape: {len(problems)} problem(s) (files <= {FILE_MAX} lines, functions <= {FN_MAX}, no module cycle, crates one way)")
+    print(f"shape: {len(problems)} problem(s) (files <= {FILE_MAX} lines, functions <= {FN_MAX}, no module cycle, crates one way, no test left unrun)")
     sys.exit(1 if problems else 0)
 
 

@@ -58,6 +58,22 @@ pub fn propagate_lanes<S: SampleSink>(
     sinks: &mut [S],
 ) -> Vec<Result<RunLog, Diverged>> {
     check_batch(runs, sinks);
+    lanes_dyn(model, runs, times_s, &mut dyn_sinks(sinks))
+}
+
+/// The sinks behind pointers: the lane propagator is compiled once, in this crate, for
+/// `&mut dyn SampleSink` (as [`propagate`] is, and for the same reason).
+fn dyn_sinks<S: SampleSink>(sinks: &mut [S]) -> Vec<&mut dyn SampleSink> {
+    sinks.iter_mut().map(|s| s as &mut dyn SampleSink).collect()
+}
+
+/// [`propagate_lanes`] for sinks behind pointers: the one compiled copy.
+fn lanes_dyn(
+    model: &Model,
+    runs: &[RunSetup],
+    times_s: &[f64],
+    sinks: &mut [&mut dyn SampleSink],
+) -> Vec<Result<RunLog, Diverged>> {
     #[cfg(target_arch = "x86_64")]
     if runs.len() > 1
         && std::arch::is_x86_feature_detected!("fma")
@@ -90,6 +106,16 @@ pub fn propagate_lanes_portable<S: SampleSink>(
     sinks: &mut [S],
 ) -> Vec<Result<RunLog, Diverged>> {
     check_batch(runs, sinks);
+    lanes_portable_dyn(model, runs, times_s, &mut dyn_sinks(sinks))
+}
+
+/// [`propagate_lanes_portable`] for sinks behind pointers: the one compiled copy.
+fn lanes_portable_dyn(
+    model: &Model,
+    runs: &[RunSetup],
+    times_s: &[f64],
+    sinks: &mut [&mut dyn SampleSink],
+) -> Vec<Result<RunLog, Diverged>> {
     lanes_inline(model, runs, times_s, sinks)
 }
 

@@ -27,8 +27,10 @@
 //!   carriage state.
 
 mod lanes;
+mod sink;
 
 pub use lanes::{LANES, propagate_lanes, propagate_lanes_portable};
+pub use sink::SampleSink;
 
 use nalgebra::Vector3;
 
@@ -59,25 +61,6 @@ pub struct Observation {
     pub pos_m: [f64; 3],
     /// Euler angles (roll, pitch, yaw) \[deg\].
     pub att_deg: [f64; 3],
-}
-
-/// Receives the simulated samples of a run, in time order.
-pub trait SampleSink {
-    /// Sample `index` (of the requested times) is `obs`, observed from the state `x` (for a
-    /// time before release, the carriage state).
-    fn record(&mut self, index: usize, obs: &Observation, x: &StateVector);
-}
-
-impl SampleSink for Vec<Observation> {
-    fn record(&mut self, _index: usize, obs: &Observation, _x: &StateVector) {
-        self.push(*obs);
-    }
-}
-
-impl SampleSink for Vec<(Observation, StateVector)> {
-    fn record(&mut self, _index: usize, obs: &Observation, x: &StateVector) {
-        self.push((*obs, *x));
-    }
 }
 
 /// Mode of one ejector foot (docs/model.md section 3a).
@@ -120,18 +103,31 @@ struct Cursor {
 /// time, to a copy of the integrator compiled for them, where each is one instruction; the
 /// portable copy ([`propagate_portable`]) gives the same bits everywhere (on x86-64 hosts
 /// without FMA units, slowly, through the C library's correctly rounded `fma`).
+/// Compiled once, here, with the sink behind a pointer (one indirect call per sample): generic
+/// over the sink, the model was compiled again into every crate that called it, two thirds of
+/// `sepval-fit`'s code and most of a release build's time.
 pub fn propagate<S: SampleSink>(
     model: &Model,
     run: &RunSetup,
     times_s: &[f64],
     sink: &mut S,
 ) -> Result<RunLog, Diverged> {
+    propagate_dyn(model, run, times_s, sink)
+}
+
+/// [`propagate`] for a sink behind a pointer: the one compiled copy.
+fn propagate_dyn(
+    model: &Model,
+    run: &RunSetup,
+    times_s: &[f64],
+    mut sink: &mut dyn SampleSink,
+) -> Result<RunLog, Diverged> {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports the features `propagate_fma` is compiled for.
-        return unsafe { propagate_fma(model, run, times_s, sink) };
+        return unsafe { propagate_fma(model, run, times_s, &mut sink) };
     }
-    propagate_portable(model, run, times_s, sink)
+    portable_dyn(model, run, times_s, sink)
 }
 
 /// [`propagate`] compiled for x86-64 hosts with AVX2 and FMA units.
@@ -156,7 +152,17 @@ pub fn propagate_portable<S: SampleSink>(
     times_s: &[f64],
     sink: &mut S,
 ) -> Result<RunLog, Diverged> {
-    propagate_inline(model, run, times_s, sink)
+    portable_dyn(model, run, times_s, sink)
+}
+
+/// [`propagate_portable`] for a sink behind a pointer: the one compiled copy.
+fn portable_dyn(
+    model: &Model,
+    run: &RunSetup,
+    times_s: &[f64],
+    mut sink: &mut dyn SampleSink,
+) -> Result<RunLog, Diverged> {
+    propagate_inline(model, run, times_s, &mut sink)
 }
 
 /// The body of [`propagate`], inlined into each compiled copy (with everything it calls on
