@@ -100,15 +100,20 @@ fn baseline_failure(baseline: &ModelSummary, noise: Noise) -> Option<String> {
 /// sigma) and every channel's residuals white (`residuals`). With a converged baseline, this is
 /// what `explained` says of the catalogue's answer.
 pub(super) fn explains(setting: &Setting, fitted: &Fitted) -> Result<bool> {
+    let report = residuals_of(setting, fitted)?;
+    Ok(report.white && report.at_noise_floor)
+}
+
+/// The residual report of `fitted` against the setting's noise and noise floor.
+fn residuals_of(setting: &Setting, fitted: &Fitted) -> Result<ResidualReport> {
     let job = &*setting.job;
-    let report = residual_report(
+    Ok(residual_report(
         job,
         &fitted.lm,
         &fitted.candidate(job)?,
         setting.noise,
         setting.floor,
-    );
-    Ok(report.white && report.at_noise_floor)
+    ))
 }
 
 /// Whether the converged `baseline` reached near the noise, so that the tests of its
@@ -393,15 +398,8 @@ fn extension_report(
     f: &Found,
     converged: bool,
 ) -> Result<ExtensionReport> {
-    let job = &*setting.job;
     let fitted = &f.fitted;
-    let report = residual_report(
-        job,
-        &fitted.lm,
-        &fitted.candidate(job)?,
-        setting.noise,
-        setting.floor,
-    );
+    let report = residuals_of(setting, fitted)?;
     let is_answer = matches!(answer, Answer::Discovered { .. });
     Ok(ExtensionReport {
         answer: is_answer,

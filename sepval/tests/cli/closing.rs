@@ -174,7 +174,7 @@ fn weaker_roll_damping_is_named_after_the_planned_release() {
 }
 
 #[test]
-#[ignore = "about 76 s on 2 cores, too long for CI: the joint diagnosis of release_rates is slow \
+#[ignore = "128 s beside another test (2026-11-26), too long for CI: the joint diagnosis of release_rates is slow \
             (issue 22's speed item); run it with `cargo test --release -p sepval --test cli \
             closing -- --ignored`"]
 fn rates_at_release_are_named_after_the_planned_release() {
