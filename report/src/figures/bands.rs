@@ -7,8 +7,8 @@ use plotters::prelude::*;
 
 use super::FigureError;
 use super::kit::{
-    LegendMark, colour, draw_legend_strip, draw_mesh, draw_polyline, fmt_tick, padded_range,
-    plottable, render, text, tint,
+    LegendMark, band_polygon, colour, draw_legend_strip, draw_mesh, draw_polyline, fmt_tick,
+    padded_range, plottable, render, text, tint,
 };
 
 /// The six channels: caption and unit, in the order of a sample's values.
@@ -112,10 +112,8 @@ pub fn band_figure(
                 .map(|i| (times_s[i], b.lo[i], b.hi[i]))
                 .collect();
             if edge.len() > 1 {
-                let upper = edge.iter().map(|&(t, _, hi)| (t, hi));
-                let lower = edge.iter().rev().map(|&(t, lo, _)| (t, lo));
-                chart.draw_series(std::iter::once(Polygon::new(
-                    upper.chain(lower).collect::<Vec<_>>(),
+                chart.draw_series(std::iter::once(band_polygon(
+                    &edge,
                     tint(colour(0), BAND_WHITE).filled(),
                 )))?;
             }

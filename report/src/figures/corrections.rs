@@ -9,9 +9,9 @@ use plotters::prelude::*;
 
 use super::FigureError;
 use super::kit::{
-    Chart2d, DrawResult, FLOOR_GREY, LegendMark, Root, colour, draw_dashed, draw_legend_strip,
-    draw_mesh, draw_polyline, fmt_tick, padded_range, plottable, plottable_point, render, text,
-    tint,
+    Chart2d, DrawResult, FLOOR_GREY, LegendMark, Root, band_polygon, colour, draw_dashed,
+    draw_legend_strip, draw_mesh, draw_polyline, fmt_tick, padded_range, plottable,
+    plottable_point, render, text, tint,
 };
 
 /// One correction: its value and standard deviation along its variable, what the releases
@@ -199,10 +199,8 @@ fn draw_band(
             (a.min(e.0), b.max(e.0))
         });
     if edges.len() > 1 && x_hi > x_lo {
-        let upper = edges.iter().map(|&(x, _, hi)| (x, hi));
-        let lower = edges.iter().rev().map(|&(x, lo, _)| (x, lo));
-        chart.draw_series(std::iter::once(Polygon::new(
-            upper.chain(lower).collect::<Vec<_>>(),
+        chart.draw_series(std::iter::once(band_polygon(
+            edges,
             tint(colour(0), BAND_WHITE).filled(),
         )))?;
     } else if let Some(&(ex, _, _)) = edges.first() {

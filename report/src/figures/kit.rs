@@ -236,6 +236,14 @@ pub(super) fn text(size: f64) -> TextStyle<'static> {
     TextStyle::from((FONT, size).into_font()).color(&BLACK)
 }
 
+/// A band as one filled polygon: along its upper edge, back along its lower, from the points
+/// `(x, lo, hi)` in order of x.
+pub(super) fn band_polygon(edges: &[(f64, f64, f64)], style: ShapeStyle) -> Polygon<(f64, f64)> {
+    let upper = edges.iter().map(|&(x, _, hi)| (x, hi));
+    let lower = edges.iter().rev().map(|&(x, lo, _)| (x, lo));
+    Polygon::new(upper.chain(lower).collect::<Vec<_>>(), style)
+}
+
 /// `c` mixed with white, `white` of it white (0: `c` itself, 1: white): the light tint of a
 /// series colour that bands are filled with.
 pub(super) fn tint(c: RGBColor, white: f64) -> RGBColor {
