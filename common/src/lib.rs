@@ -20,7 +20,6 @@
 //! - [`elementary`], [`lanes`]: section 9, sepval's own elementary functions (no C library),
 //!   written once for one double and for four lanes.
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod atmosphere;

@@ -47,6 +47,8 @@
 //! decided once (`answer`), the diagnosis record (`analysis`), and only then the files
 //! (`outputs`; the HTML page from the template `templates/report.html`, through `page`).
 
+#![deny(clippy::float_cmp)]
+
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;

@@ -23,7 +23,6 @@
 //!
 //! [`Evidence`]: sepval_predict::discrepancy::Evidence
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod grid;

@@ -19,7 +19,6 @@
 //! The library returns typed errors and prints nothing: progress reaches the caller through a
 //! [`ProgressObserver`](sepval_solve::run::ProgressObserver).
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 // Matrix and array code indexes by (row, column) as the equations it implements do.
 #![allow(clippy::needless_range_loop)]

@@ -19,7 +19,6 @@
 //! (E. G. Gilbert, D. W. Johnson and S. S. Keerthi, IEEE J. Robotics and Automation 4 (1988);
 //! G. van den Bergen, *Collision Detection in Interactive 3D Environments*, 2003), bounding-
 //! volume trees inside meshes. No parry or glam type appears in this crate's public API.
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 mod body;

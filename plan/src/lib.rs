@@ -19,7 +19,6 @@
 //! 7. [`record`] and [`outputs`]: DIR/plan.json, DIR/plan.html and the figures, written
 //!    atomically.
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod conditions;

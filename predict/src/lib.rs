@@ -22,7 +22,6 @@
 //! 8. [`record`] and [`outputs`]: DIR/prediction.json, DIR/bands.csv, DIR/report.html and
 //!    DIR/figures/prediction.png, written atomically.
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod bands;

@@ -3,7 +3,6 @@
 //! template. Fits, diagnoses and the commands to come describe what to show; this crate knows
 //! nothing of how it was computed.
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod figures;

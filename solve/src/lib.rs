@@ -12,7 +12,6 @@
 //! library (a gene's bounds and bits, a chromosome, an evaluation's outcome, the cancellation
 //! flag) comes from `sepval-common`.
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 // Matrix and array code indexes by (row, column) as the equations it implements do.
 #![allow(clippy::needless_range_loop)]

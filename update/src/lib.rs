@@ -27,7 +27,6 @@
 //! 8. **record** and **outputs**: DIR/update.json, DIR/scenario.toml with DIR/tables/*.csv,
 //!    DIR/factors.json, DIR/figures/corrections.png, DIR/report.html.
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod assemble;

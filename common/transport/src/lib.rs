@@ -17,7 +17,6 @@
 //!
 //! Nothing here prints: what the user should hear goes out as [`link::Notice`]s.
 
-#![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
 pub mod bench;
