@@ -78,6 +78,24 @@ pub const REDUCED_BUDGET: [&str; 6] = [
     "2",
 ];
 
+/// The environment variable that runs the slow tier: set (to anything but `0`) by the README's
+/// test command and by CI, unset in a plain `cargo test`.
+pub const SLOW_TESTS_VAR: &str = "SEPVAL_SLOW_TESTS";
+
+/// Whether a test of the slow tier is skipped (after rust-analyzer's `skip_slow_tests`): the
+/// sweeps over many cases (every catalogue effect, every discovery family, rivals, closed loops,
+/// pooled and two-release fits) run only when [`SLOW_TESTS_VAR`] is set; a plain `cargo test`
+/// runs the fast tier, which keeps one end-to-end run per command and everything only the
+/// binary can show (flags, exit codes, refusals, files, signals). A skipped test says so on
+/// stderr (`cargo test -- --nocapture` shows it). Call it first: `if skip_slow_tests() { return; }`.
+pub fn skip_slow_tests() -> bool {
+    let run = std::env::var_os(SLOW_TESTS_VAR).is_some_and(|v| v != "0");
+    if !run {
+        eprintln!("slow tier: skipped ({SLOW_TESTS_VAR}=1 runs it)");
+    }
+    !run
+}
+
 /// Fails the test with sepval's stderr unless it exited successfully; returns its stdout.
 pub fn ok(out: &Output) -> String {
     assert!(

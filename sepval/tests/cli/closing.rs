@@ -130,6 +130,9 @@ fn separates(plan: &Value, a: &str, b: &str) -> bool {
 
 #[test]
 fn weaker_roll_damping_is_named_after_the_planned_release() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // Roll damping half the model's: on one release the catalogue's roll_due_to_sideslip fits
     // as well as the true cause (a Cl change with p d/2V), and so do other Cl terms.
     let model = default_scenario();
@@ -209,6 +212,9 @@ fn rates_at_release_are_named_after_the_planned_release() {
 
 #[test]
 fn a_gust_is_named_and_its_coefficient_mimics_dropped_after_the_planned_release() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // A short lateral gust: on one release coefficient terms (a side-force step among them) fit
     // about as well. The same gust on a release at the plan's top condition settles it.
     let dir = tempfile::tempdir().unwrap();

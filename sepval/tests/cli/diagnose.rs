@@ -86,6 +86,9 @@ fn named_first(effect: &str) {
 
 #[test]
 fn roll_due_to_sideslip_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let d = diagnose_hidden(&["roll_due_to_sideslip=-0.3"], "5", None);
     assert_eq!(causes(&d), ["roll_due_to_sideslip"]);
     let p = &d["parameters"]["roll_due_to_sideslip"][0];
@@ -108,41 +111,65 @@ fn roll_due_to_sideslip_is_found() {
 
 #[test]
 fn pitch_stiffness_cubic_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("pitch_stiffness_cubic=30");
 }
 
 #[test]
 fn cg_offset_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("cg_offset=0.05");
 }
 
 #[test]
 fn inertia_product_xz_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("inertia_product_xz=30");
 }
 
 #[test]
 fn ejector_delay_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("ejector_delay=0.01");
 }
 
 #[test]
 fn ejector_cant_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("ejector_cant=0.1");
 }
 
 #[test]
 fn interference_decay_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("interference_decay=1.5");
 }
 
 #[test]
 fn release_rates_are_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("release_rates=0.2,-0.1,0.1");
 }
 
 #[test]
 fn telemetry_time_offset_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("telemetry_time_offset=0.01");
 }
 
@@ -153,11 +180,17 @@ fn attitude_bias_is_found() {
 
 #[test]
 fn tracked_point_offset_is_found() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     named_first("tracked_point_offset=0.5");
 }
 
 #[test]
 fn two_effects_hidden_together_are_both_named() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let d = diagnose_hidden(
         &["roll_due_to_sideslip=-0.3", "ejector_cant=0.1"],
         "8",
@@ -176,6 +209,9 @@ fn two_effects_hidden_together_are_both_named() {
 
 #[test]
 fn data_from_the_baseline_model_name_no_cause() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     for seed in ["1", "2", "3"] {
         let d = diagnose_hidden(&[], seed, None);
         assert!(causes(&d).is_empty(), "seed {seed}: {}", d["verdict"]);
@@ -190,6 +226,9 @@ fn data_from_the_baseline_model_name_no_cause() {
 
 #[test]
 fn an_effect_outside_the_catalogue_is_not_explained() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // Pitch damping four times stronger than the scenario's: no catalogue effect is that.
     let scenario = sepval_scenario().replace("cm_q_per_rad = -80.0", "cm_q_per_rad = -400.0");
     let d = diagnose_hidden(&[], "3", Some(&scenario));
@@ -212,6 +251,9 @@ fn sepval_scenario() -> String {
 /// simulator with the catalogue (docs/eglin-cfd.md).
 #[test]
 fn the_eglin_cfd_trajectory_is_diagnosed_honestly() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let data =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/eglin-cfd/M095_AOA0.csv");
     if !data.exists() {
@@ -273,6 +315,9 @@ fn diagnosis_in(dir: &Path) -> Value {
 /// as explained, and marks the answer unreliable in diagnosis.json, the page and the summary.
 #[test]
 fn a_baseline_that_cannot_fit_makes_the_answer_unreliable() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let light = sepval_scenario().replace("mass_kg = 907.18474", "mass_kg = 500.0");
     std::fs::write(dir.path().join("light.toml"), light).unwrap();
@@ -338,6 +383,9 @@ fn eight_terms() -> String {
 /// the verdict say so instead of blaming a cause outside both the catalogue and the library.
 #[test]
 fn a_full_term_budget_is_said_to_stop_discovery() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("eight.toml"), eight_terms()).unwrap();
     // A side force step in the data: neither the catalogue nor the zero terms explain it.
@@ -387,6 +435,9 @@ fn a_full_term_budget_is_said_to_stop_discovery() {
 /// before any other work, writing no diagnosis.
 #[test]
 fn tables_left_are_reported_and_refused_with_strict_tables() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let example =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/tabulated-store/scenario.toml");

@@ -191,6 +191,9 @@ pub(crate) fn params(v: &[f64]) -> [f64; MAX_EFFECT_PARAMS] {
 
 #[test]
 fn a_side_force_step_is_discovered_and_located() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let r = release(
         &default_scenario(),
@@ -205,6 +208,9 @@ fn a_side_force_step_is_discovered_and_located() {
 
 #[test]
 fn a_roll_buffet_is_discovered_at_its_frequency() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let r = release(
         &default_scenario(),
@@ -219,6 +225,9 @@ fn a_roll_buffet_is_discovered_at_its_frequency() {
 
 #[test]
 fn a_roll_damping_change_is_discovered_as_a_rate_term() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // The store leaves with a known roll rate (the scenario says so), and the data's roll
     // damping is twice the model's: a rate derivative, not an effect.
     let dir = tempfile::tempdir().unwrap();
@@ -237,6 +246,9 @@ fn a_roll_damping_change_is_discovered_as_a_rate_term() {
 
 #[test]
 fn a_sideslip_dependent_interference_yaw_moment_needs_two_releases() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // A yaw moment near the aircraft growing with sideslip, in releases at +3 and -3 deg of
     // sideslip: on one release the interference factors absorb it (and nothing beyond the
     // catalogue is claimed); pooled, its sign follows the sideslip and it is found.
@@ -269,6 +281,9 @@ fn a_sideslip_dependent_interference_yaw_moment_needs_two_releases() {
 
 #[test]
 fn an_ejector_force_falling_along_the_stroke_is_discovered() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let mut s = default_scenario();
     let f0 = s.ejector.curve[0][1];
@@ -282,6 +297,9 @@ fn an_ejector_force_falling_along_the_stroke_is_discovered() {
 
 #[test]
 fn a_mach_dependent_drag_needs_two_releases_and_predicts_a_third() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // The same store at Mach 0.95, alpha 0 and Mach 0.8, alpha 3: on one release the drag rise
     // is a constant the axial offset absorbs; pooled, it is a Mach term. A third release at
     // Mach 0.88 is predicted, not fitted.
@@ -319,6 +337,9 @@ fn a_mach_dependent_drag_needs_two_releases_and_predicts_a_third() {
 
 #[test]
 fn null_data_name_neither_an_effect_nor_a_term() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let mut s = default_scenario();
     for (seed, events) in [(21, 1), (23, 2)] {
         let dir = tempfile::tempdir().unwrap();

@@ -283,6 +283,9 @@ fn true_clearance_mm(dir: &Path, mach: f64, altitude_m: f64) -> f64 {
 
 #[test]
 fn the_envelope_clears_where_the_true_store_misses_a_tail_and_not_where_it_strikes() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let p = fixture();
     std::fs::write(p.join("tail.toml"), TAIL).unwrap();
     ok(&sepval(
@@ -339,6 +342,9 @@ fn the_envelope_clears_where_the_true_store_misses_a_tail_and_not_where_it_strik
 
 #[test]
 fn fit_and_diagnose_record_the_clearance_of_their_best_trajectories() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let p = fixture();
     let aircraft = example("aircraft.toml");
     let common = [

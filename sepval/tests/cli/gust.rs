@@ -80,6 +80,9 @@ pub(crate) fn terms(model: &Value) -> Vec<(String, String)> {
 
 #[test]
 fn a_short_gust_and_a_side_force_step_are_rivals_on_one_release() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // An 8 m/s gust lasting 0.1 s: on one release a step of the side force fits about as well.
     let dir = tempfile::tempdir().unwrap();
     let dir = dir.path();
@@ -100,6 +103,9 @@ fn a_short_gust_and_a_side_force_step_are_rivals_on_one_release() {
 
 #[test]
 fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let dir = dir.path();
     std::fs::write(dir.join("base.json"), BASE).unwrap();
@@ -173,6 +179,9 @@ fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
 
 #[test]
 fn a_baseline_in_a_local_optimum_is_restarted_and_names_no_effect() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // The short gust on two releases, the second at 1 000 m where the dynamic pressure is 3.4
     // times the first's: the baseline's refinement stops in a local optimum of the factors (12
     // sigma in position), from which each catalogue refit escapes with its effect near neutral.

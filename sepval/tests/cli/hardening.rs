@@ -375,6 +375,9 @@ fn goals_printed(stdout: &str) -> [f64; 2] {
 /// DIR/factors.json --extension DIR/extension.toml`) reproduces the answer's goals.
 #[test]
 fn the_extension_written_reproduces_the_answer_with_the_users_terms() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let term = |axis: &str, regressor_lines: &str, c: f64| {
         format!("\n[[term]]\naxis = \"{axis}\"\n{regressor_lines}coefficient = {c}\n")

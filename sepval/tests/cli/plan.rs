@@ -18,8 +18,8 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
  "cloff": -0.05, "caintfac": 1.1, "cyintfac": 1.4, "czintfac": 0.9, "cmintfac": 1.3,
  "cnintfac": 0.8, "clintfac": 1.6}"#;
 
-/// A directory holding `diag/` (a diagnosis with no rivals) and `damping/diag/` (a diagnosis
-/// with real rivals), made once for every test here.
+/// A directory holding `diag/` (a diagnosis with no rivals), made once for every test here;
+/// [`with_rivals`] adds `damping/diag/` (a diagnosis with real rivals) for the slow tier.
 pub(crate) fn fixture() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
@@ -49,6 +49,16 @@ pub(crate) fn fixture() -> &'static Path {
             serde_json::from_str(&std::fs::read_to_string(p.join("diag/diagnosis.json")).unwrap())
                 .unwrap();
         assert_eq!(d["rivals"], json!([]), "{}", d["verdict"]);
+        dir
+    })
+    .path()
+}
+
+/// The fixture with `damping/diag/` too: a diagnosis with real rivals, made once.
+pub(crate) fn with_rivals() -> &'static Path {
+    static DAMPING: OnceLock<()> = OnceLock::new();
+    let p = fixture();
+    DAMPING.get_or_init(|| {
         // Real rivals: roll damping half the model's, on one release (`rivals`' first case, by
         // `discover`'s generator): the catalogue's roll_due_to_sideslip and the library's Cl
         // terms, the true `Cl p` among them, cannot be told apart.
@@ -65,9 +75,8 @@ pub(crate) fn fixture() -> &'static Path {
             Some(&model),
         );
         assert_eq!(d["ambiguous"], true, "{}", d["verdict"]);
-        dir
-    })
-    .path()
+    });
+    p
 }
 
 /// Runs `sepval plan --from FROM --out OUT` with `extra` flags in the fixture, in process;
@@ -146,6 +155,10 @@ fn without_rivals_the_plan_ranks_by_information() {
 
 #[test]
 fn with_rivals_the_plan_ranks_by_pairs_separated_and_ipc_gives_the_same_bits() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
+    with_rivals();
     let flags = ["--mach", "0.7:0.95", "--beta-deg", "-6:6", "--points", "3"];
     let p = plan("damping/diag", "sep", &flags);
     assert_eq!(p["ranked_by"], "separation");

@@ -211,7 +211,10 @@ fn the_same_seed_gives_the_same_bands_over_workers_as_in_process() {
 
 #[test]
 fn a_diagnosis_with_rivals_weights_them_by_their_evidence() {
-    let p = super::plan::fixture();
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
+    let p = super::plan::with_rivals();
     condition(p, "cond-plan.toml", 0.9, 2.0, 3.0);
     let j = predict(
         p,

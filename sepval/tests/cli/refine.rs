@@ -132,6 +132,9 @@ fn refined_factors_respect_the_bounds_of_the_scenario() {
 
 #[test]
 fn pooling_two_events_narrows_the_compensating_pair() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     ok(&sepval(&["scenario", "--out", "base.toml"], dir.path()));
     let base = std::fs::read_to_string(dir.path().join("base.toml")).unwrap();

@@ -59,6 +59,9 @@ fn shown(d: &Value) -> String {
 
 #[test]
 fn weaker_roll_damping_and_its_catalogue_mimic_are_rivals() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // The data's roll damping is half the model's; the store rolls from interference alone. On
     // one release the catalogue's rolling moment due to sideslip fits as well: the diagnosis
     // must name the true cause (a Cl change with p d/2V) beside whichever it answers.
@@ -88,6 +91,9 @@ fn weaker_roll_damping_and_its_catalogue_mimic_are_rivals() {
 
 #[test]
 fn a_term_mimics_rates_at_release() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // The store leaves with pitch and yaw rates the model does not have (the catalogue's
     // release_rates): on one release a discovered term explains it within the margin too.
     let dir = tempfile::tempdir().unwrap();

@@ -315,6 +315,9 @@ fn store(edits: &[(&str, &str)]) -> Scenario {
 
 #[test]
 fn a_store_whose_drag_and_pitch_stiffness_change_with_mach_needs_its_tables() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // A synthetic store (not the Eglin data): drag rising through transonic, pitch stiffness
     // from unstable to stable, released at Mach 0.7 and 1.1.
     let tables = store(&[
@@ -360,6 +363,9 @@ fn a_store_whose_drag_and_pitch_stiffness_change_with_mach_needs_its_tables() {
 
 #[test]
 fn an_interference_field_no_exponential_has_is_recovered_by_a_pooled_fit() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     // Pitching moment increment changing sign below the carriage and a normal-force bump,
     // over distance and local alpha; two releases at different aircraft alpha.
     let field = store(&[

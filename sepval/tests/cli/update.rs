@@ -176,6 +176,9 @@ fn the_updated_store_is_written_and_predicts_as_its_record_says() {
 
 #[test]
 fn ipc_workers_update_the_store_as_the_process_does() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let p = fixture();
     let ipc = update(p, "up_ipc", &["--evaluator", "ipc", "--workers", "2"]);
     let inproc: Value =
