@@ -7,3 +7,5 @@ mod outcomes;
 mod transport;
 #[cfg(feature = "zenoh")]
 mod zenoh;
+#[cfg(feature = "zenoh")]
+mod zenoh_commands;
