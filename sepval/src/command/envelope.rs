@@ -26,6 +26,7 @@ use crate::cli::EnvelopeArgs;
 /// checked before the output directory is claimed or a worker started.
 pub fn run(args: EnvelopeArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
+    super::several_jobs(&args.eval, "envelope", "one per condition")?;
     let settings = Settings {
         samples: args.samples,
         level: 0.95,
