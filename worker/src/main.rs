@@ -99,7 +99,6 @@ fn main() -> ExitCode {
 /// Joins a run over zenoh and serves it.
 #[cfg(feature = "zenoh")]
 fn serve_zenoh(cli: &Cli, run: &RunId, endpoint: &str, setup_timeout: Duration) -> Result<Stopped> {
-    use sepval_transport::serve::Server;
     use sepval_transport::zenoh::{JoinOptions, ZenohWorker};
     let mut link = ZenohWorker::join(JoinOptions {
         endpoint: endpoint.to_string(),
@@ -113,7 +112,6 @@ fn serve_zenoh(cli: &Cli, run: &RunId, endpoint: &str, setup_timeout: Duration) 
         link.worker_id()
     );
     let mut local = Local(Arc::clone(link.job()));
-    link.ready(local.credits())?;
     Ok(serve(&mut link, &mut local)?)
 }
 

@@ -86,7 +86,8 @@ mod kind {
 /// One message between a coordinator and a worker over a byte transport.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Frame {
-    /// The job setup of run `run_id` (coordinator to worker).
+    /// The job setup of run `run_id` (coordinator to worker: the answer to a worker's query,
+    /// and, sent on the worker's own channel, the run's next job).
     Setup {
         /// The run the setup belongs to.
         run_id: String,
@@ -369,7 +370,8 @@ impl Frame {
     }
 
     /// What a frame from the coordinator means to a worker: a chunk, or the end of the run;
-    /// `Dropped`, or a frame coordinators do not send, is an error.
+    /// `Dropped`, or a frame coordinators do not send, is an error. (A setup, the run's next
+    /// job, is the link's to check and accept before this.)
     pub fn into_incoming(self) -> Result<crate::link::Incoming, crate::TransportError> {
         use crate::link::{Incoming, Stopped};
         match self {

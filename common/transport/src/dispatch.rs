@@ -10,7 +10,7 @@
 //! instead of hanging. The dispatcher is an [`Evaluator`]: the searches cannot tell it from the
 //! in-process thread pool.
 
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -18,7 +18,7 @@ use sepval_common::evaluation::{Candidate, EvalError, Evaluation, Evaluator, Job
 use sepval_common::propagator::LANES;
 
 use crate::TransportError;
-use crate::link::{Link, LinkEvent, Notice, Notices, WorkerId};
+use crate::link::{Link, LinkEvent, NextJob, Notice, Notices, WorkerId};
 use crate::wire::Chunk;
 
 /// How often the dispatcher checks deadlines while it waits.
@@ -142,6 +142,40 @@ impl<L: Link> Dispatcher<L> {
             }
             self.link.poll((deadline - now).min(TICK), &mut events)?;
             for e in events.drain(..) {
+                self.handle(e, &mut VecDeque::new(), &mut []);
+            }
+        }
+        Ok(())
+    }
+
+    /// Waits until every worker in `told` has joined again or is gone, and one at least serves,
+    /// within the join timeout (after it, those that joined go on alone).
+    fn wait_for_rejoin(&mut self, told: Vec<WorkerId>) -> Result<(), TransportError> {
+        if told.is_empty() {
+            return self.wait_for_workers(self.options.min_workers, self.options.join_timeout);
+        }
+        let wanted = told.len();
+        let mut awaiting: BTreeSet<WorkerId> = told.into_iter().collect();
+        let deadline = Instant::now() + self.options.join_timeout;
+        let mut events = Vec::new();
+        while !awaiting.is_empty() || self.workers.is_empty() {
+            let now = Instant::now();
+            if now >= deadline {
+                if self.workers.is_empty() {
+                    return Err(TransportError::TooFewWorkers {
+                        joined: 0,
+                        wanted,
+                        run: self.link.run_id().to_string(),
+                        seconds: self.options.join_timeout.as_secs_f64(),
+                    });
+                }
+                break;
+            }
+            self.link.poll((deadline - now).min(TICK), &mut events)?;
+            for e in events.drain(..) {
+                if let LinkEvent::Joined { worker, .. } | LinkEvent::Lost { worker, .. } = &e {
+                    awaiting.remove(worker);
+                }
                 self.handle(e, &mut VecDeque::new(), &mut []);
             }
         }
@@ -345,6 +379,20 @@ impl<L: Link> Dispatcher<L> {
             .into_iter()
             .map(|r| r.expect("every candidate has exactly one result"))
             .collect())
+    }
+}
+
+impl<L: NextJob> Dispatcher<L> {
+    /// Moves the workers that joined on to `job` (the next job of the same run), telling
+    /// `notices` from now on, and waits until they serve it (or, if none is left, for
+    /// `min_workers` new ones), within the join timeout. Chunk ids go on from the last job's,
+    /// so no answer to a chunk of it can be taken for one of this job's.
+    pub fn next_job(&mut self, job: Arc<Job>, notices: Notices) -> Result<(), TransportError> {
+        let told = self.link.next_job(&job)?;
+        self.job = job;
+        self.notices = notices;
+        self.workers.clear();
+        self.wait_for_rejoin(told)
     }
 }
 

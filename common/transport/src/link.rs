@@ -4,7 +4,10 @@
 //! index, deadlines, re-dispatch after a loss, the serve loop) is written once, in
 //! [`crate::dispatch`] and [`crate::serve`], for every transport.
 
+use std::sync::Arc;
 use std::time::Duration;
+
+use sepval_common::evaluation::Job;
 
 use crate::wire::{Answer, Chunk};
 
@@ -73,6 +76,16 @@ pub trait Link {
     fn describe(&self) -> String;
 }
 
+/// A link whose workers stay for the next job of the same run (zenoh: the hosts that joined
+/// serve the whole command). Links without it start anew for each job (iceoryx2 spawns its
+/// workers for it).
+pub trait NextJob: Link {
+    /// Moves the run on to `job`: its setup is on offer from now on and sent to every worker
+    /// that joined, which joins again (a [`LinkEvent::Joined`]) once it has accepted it.
+    /// Returns the workers told.
+    fn next_job(&mut self, job: &Job) -> Result<Vec<WorkerId>, crate::TransportError>;
+}
+
 /// What a worker's link delivers.
 #[derive(Debug)]
 pub enum Incoming {
@@ -80,6 +93,9 @@ pub enum Incoming {
     Chunk(Chunk),
     /// Nothing within the timeout.
     Idle,
+    /// The coordinator moved on to the next job of the same run (an envelope's next condition,
+    /// an update's next round), whose setup the link has accepted: serve it from now on.
+    Job(Arc<Job>),
     /// The worker should stop (normally).
     Stop(Stopped),
 }
@@ -114,6 +130,14 @@ pub trait WorkerLink {
 
     /// Sends the answer to a chunk.
     fn answer(&mut self, answer: &Answer) -> Result<(), crate::TransportError>;
+
+    /// Tells the coordinator that this worker serves the job it accepted last and can hold
+    /// `credits` chunks (zenoh's `Ready`); the serve loop calls it before the first chunk and
+    /// after every next job. Links whose workers announce themselves as they join (iceoryx2's
+    /// hello, a socket's handshake) have nothing to add.
+    fn ready(&mut self, _credits: u32) -> Result<(), crate::TransportError> {
+        Ok(())
+    }
 }
 
 /// What the transports tell the user: rendered by the binary (the libraries print nothing).

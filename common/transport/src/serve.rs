@@ -35,6 +35,9 @@ pub trait Server {
 
     /// Answers `chunks`, one answer per chunk in order.
     fn serve(&mut self, chunks: &[Chunk]) -> Result<Vec<Answer>, TransportError>;
+
+    /// Serves `job` from now on: the coordinator moved on to the next job of the same run.
+    fn next_job(&mut self, job: Arc<Job>) -> Result<(), TransportError>;
 }
 
 /// The plain worker: simulates each candidate itself.
@@ -44,15 +47,23 @@ impl Server for Local {
     fn serve(&mut self, chunks: &[Chunk]) -> Result<Vec<Answer>, TransportError> {
         Ok(chunks.iter().map(|c| serve_locally(&self.0, c)).collect())
     }
+
+    fn next_job(&mut self, job: Arc<Job>) -> Result<(), TransportError> {
+        self.0 = job;
+        Ok(())
+    }
 }
 
 /// Serves chunks from `link` with `server` until the coordinator ends the run, goes away, or a
-/// signal asks this process to stop.
+/// signal asks this process to stop; when the coordinator moves on to the next job of the run,
+/// the server takes it and the worker says it is ready again, so a worker that joined a run
+/// serves it until the coordinator's command ends.
 pub fn serve(
     link: &mut dyn WorkerLink,
     server: &mut dyn Server,
 ) -> Result<Stopped, TransportError> {
     let mut queue: VecDeque<Chunk> = VecDeque::new();
+    link.ready(server.credits())?;
     loop {
         // Take everything already here; block only when there is nothing to do.
         let timeout = if queue.is_empty() {
@@ -66,6 +77,14 @@ pub fn serve(
                 continue;
             }
             Incoming::Stop(s) => return Ok(s),
+            Incoming::Job(job) => {
+                // The coordinator moves on only when every chunk of the last job is answered
+                // or given to another worker: what is still queued belongs to that job.
+                queue.clear();
+                server.next_job(job)?;
+                link.ready(server.credits())?;
+                continue;
+            }
             Incoming::Idle => {}
         }
         let Some(kind) = queue.front().map(|c| c.header.with_samples) else {

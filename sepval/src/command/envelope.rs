@@ -16,7 +16,7 @@ use sepval_fit::out_dir::{Claim, RunDir};
 use sepval_plan::conditions::Quantity;
 use sepval_predict::Settings;
 use sepval_transport::link::{Notice, Notices};
-use sepval_transport::spec::EvaluatorSpec;
+use sepval_transport::spec::{EvaluatorSpec, Starter};
 
 use super::predict::source_inputs;
 use super::{clearance, count, evaluator_spec, notices};
@@ -26,6 +26,7 @@ use crate::cli::EnvelopeArgs;
 /// checked before the output directory is claimed or a worker started.
 pub fn run(args: EnvelopeArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
+    super::several_jobs(&args.eval, "envelope", "one per condition")?;
     let settings = Settings {
         samples: args.samples,
         level: 0.95,
@@ -152,12 +153,14 @@ fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunD
     Ok((run_dir, progress))
 }
 
-/// Starts each condition's evaluator: its workers' joining is told once, the rest of what the
-/// transport says (a worker lost, refused) every time.
+/// Starts each job's evaluator (an envelope's conditions, an update's rounds) with one
+/// [`Starter`], so that zenoh hosts that joined serve every job: their joining is told once, the
+/// rest of what the transport says (a worker lost, refused) every time.
 pub(super) fn starter(
     spec: &EvaluatorSpec,
 ) -> impl FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + '_ {
     let mut started = false;
+    let mut evaluators = Starter::new(spec.clone());
     move |job| {
         let told: Notices = if started {
             Arc::new(|n: Notice| {
@@ -169,7 +172,7 @@ pub(super) fn starter(
             notices()
         };
         started = true;
-        spec.start(job, told).map_err(EvalError::transport)
+        evaluators.start(job, told).map_err(EvalError::transport)
     }
 }
 

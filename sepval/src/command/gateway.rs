@@ -10,9 +10,9 @@ pub fn run(args: GatewayArgs) -> Result<()> {
     use std::sync::Arc;
 
     use sepval_transport::RunId;
-    use sepval_transport::dispatch::{DispatchOptions, Dispatcher};
-    use sepval_transport::ipc::{IpcLink, IpcOptions, Launch};
-    use sepval_transport::serve::{Server, serve};
+    use sepval_transport::dispatch::DispatchOptions;
+    use sepval_transport::ipc::{IpcOptions, Launch};
+    use sepval_transport::serve::serve;
     use sepval_transport::zenoh::{Gateway, JoinOptions, ZenohWorker};
 
     use super::{count, notices, seconds, worker_executable};
@@ -31,28 +31,20 @@ pub fn run(args: GatewayArgs) -> Result<()> {
     let job = Arc::clone(link.job());
     let local_run = RunId::fresh();
     let join_timeout = std::time::Duration::from_secs(60);
-    let ipc = IpcLink::start(
-        &job,
-        IpcOptions {
-            run_id: local_run.clone(),
-            workers,
-            launch: Launch::Spawn { executable },
-            max_respawns: 2 * workers + 2,
-            join_timeout,
-            announce_protocol: None,
-        },
-    )?;
-    let local = Dispatcher::start(
-        ipc,
-        Arc::clone(&job),
-        DispatchOptions {
-            min_workers: workers,
-            join_timeout,
-            chunk_deadline,
-        },
-        notices(),
-    )?;
-    let mut gateway = Gateway::new(local, job, workers);
+    let ipc = IpcOptions {
+        run_id: local_run.clone(),
+        workers,
+        launch: Launch::Spawn { executable },
+        max_respawns: 2 * workers + 2,
+        join_timeout,
+        announce_protocol: None,
+    };
+    let dispatch = DispatchOptions {
+        min_workers: workers,
+        join_timeout,
+        chunk_deadline,
+    };
+    let mut gateway = Gateway::start(ipc, dispatch, job, notices())?;
     note!(
         "sepval gateway: joined run {} at {} as {}, serving with {workers} local worker(s) \
          (iceoryx2 run {local_run})",
@@ -60,7 +52,6 @@ pub fn run(args: GatewayArgs) -> Result<()> {
         args.connect,
         link.worker_id()
     );
-    link.ready(gateway.credits())?;
     let stopped = serve(&mut link, &mut gateway)?;
     note!("sepval gateway: {stopped}");
     Ok(())

@@ -176,6 +176,20 @@ fn zenoh_spec(_: &EvalArgs, _: Duration, _: Duration) -> Result<EvaluatorSpec> {
     )
 }
 
+/// Refuses `--attach` for `command`, which evaluates several jobs one after another (an
+/// envelope's conditions, an update's rounds): iceoryx2 workers attached by hand serve one job
+/// and leave with it, so the next would wait for workers that never come back.
+pub fn several_jobs(args: &EvalArgs, command: &str, jobs: &str) -> Result<()> {
+    if let Some(run) = &args.attach {
+        bail!(
+            "--attach {run}: workers attached by hand serve one job of a run, and `{command}` runs \
+             {jobs}; leave out --attach (sepval starts the iceoryx2 workers of each job) or use \
+             --evaluator zenoh, whose workers serve every job of the run"
+        );
+    }
+    Ok(())
+}
+
 /// Transport notices, told on stderr as `sepval: ...`.
 pub fn notices() -> Notices {
     Arc::new(|n| note!("sepval: {n}"))

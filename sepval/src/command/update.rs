@@ -19,6 +19,7 @@ use crate::cli::UpdateArgs;
 /// worker started; a refusal deletes nothing.
 pub fn run(args: UpdateArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
+    super::several_jobs(&args.eval, "update", "one per round")?;
     let (options, job) = configure(&args)?;
     let run_dir = super::claim_out(&args.out, &args.overwrite, "update")?;
     run_dir.prepare()?;

@@ -16,6 +16,7 @@ mod fuzz;
 mod gust;
 mod hardening;
 mod hardening_on_disk;
+mod jobs;
 mod plan;
 mod predict;
 mod refine;

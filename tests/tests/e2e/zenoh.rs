@@ -10,7 +10,7 @@ use std::time::Duration;
 use sepval_tests::*;
 
 /// A free TCP port on the loopback interface (bound, read, released).
-fn free_port() -> u16 {
+pub(super) fn free_port() -> u16 {
     std::net::TcpListener::bind("127.0.0.1:0")
         .and_then(|l| l.local_addr())
         .expect("a free port")
@@ -85,7 +85,7 @@ fn start_coordinator(
         .expect("start sepval")
 }
 
-fn start_worker(prefix: &[String], endpoint: &str, run: &str, extra: &[&str]) -> Child {
+pub(super) fn start_worker(prefix: &[String], endpoint: &str, run: &str, extra: &[&str]) -> Child {
     command(prefix, &binary("sepval-worker"))
         .args(["--connect", endpoint, "--run", run])
         .args(extra)

@@ -25,9 +25,15 @@
 //! [`WireResponse`]: crate::wire::WireResponse
 //! [`WireObservation`]: crate::wire::WireObservation
 
+mod cleanup;
 mod coordinator;
 mod worker;
 
+pub(crate) use cleanup::RunCleanup;
+pub use cleanup::{
+    Cleaned, LEFTOVER_GRACE, STALE_AFTER, clean_run_if_stale, clean_stale_runs, files_of_run,
+    nodes_dir, resource_files, runs_with_resources,
+};
 pub use coordinator::{IpcLink, IpcOptions, Launch};
 pub use worker::IpcWorker;
 
@@ -47,16 +53,6 @@ pub const REQUEST_BUFFER: usize = 8;
 pub const IN_FLIGHT_PER_WORKER: usize = 2;
 /// Most workers one run accepts.
 pub const MAX_WORKERS: usize = 64;
-
-/// Removes a run's iceoryx2 resources when dropped, if no process of the run is left: the last
-/// field of whatever owns a run's node, so that it drops after the node.
-pub(crate) struct RunCleanup(pub(crate) RunId);
-
-impl Drop for RunCleanup {
-    fn drop(&mut self) {
-        let _ = clean_run_if_stale(&self.0);
-    }
-}
 
 /// One of a worker's chunk services (requests, responses, samples): slices of `T` behind a
 /// [`ChunkHeader`](crate::wire::ChunkHeader).
@@ -160,75 +156,6 @@ pub mod names {
 /// A service name from text.
 pub fn service_name(name: &str) -> Result<ServiceName, TransportError> {
     ServiceName::new(name).map_err(iox(format!("service name {name}")))
-}
-
-/// Run ids that have iceoryx2 resources on this host (shared memory or files under the
-/// iceoryx2 root), found by their `sepval_<run id>_` prefix, with the age of each run's newest
-/// resource.
-pub fn runs_with_resources() -> Vec<(String, std::time::Duration)> {
-    let mut ids: std::collections::BTreeMap<String, std::time::Duration> =
-        std::collections::BTreeMap::new();
-    quiet_logs();
-    let root = Config::global_config().global.root_path().to_string();
-    let mut dirs = vec![std::path::PathBuf::from("/dev/shm")];
-    let root = std::path::PathBuf::from(root);
-    dirs.push(root.join("services"));
-    if let Ok(nodes) = std::fs::read_dir(root.join("nodes")) {
-        dirs.extend(nodes.flatten().map(|e| e.path()));
-    }
-    for dir in dirs {
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            continue;
-        };
-        for e in entries.flatten() {
-            let name = e.file_name().to_string_lossy().into_owned();
-            if let Some(rest) = name.strip_prefix("sepval_") {
-                if let Some((id, _)) = rest.split_once('_') {
-                    if RunId::new(id).is_ok() {
-                        let age = e
-                            .metadata()
-                            .and_then(|m| m.modified())
-                            .ok()
-                            .and_then(|t| t.elapsed().ok())
-                            .unwrap_or_default();
-                        let entry = ids.entry(id.to_string()).or_insert(age);
-                        *entry = (*entry).min(age);
-                    }
-                }
-            }
-        }
-    }
-    ids.into_iter().collect()
-}
-
-/// Runs younger than this are never cleaned by another run: their processes may be starting.
-pub const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(30);
-
-/// Removes the iceoryx2 resources of run `run_id` if none of its nodes is alive: the dead
-/// nodes' resources (through iceoryx2's own cleanup) and the run's management segment.
-/// Returns whether the run was stale (and cleaned).
-pub fn clean_run_if_stale(run_id: &RunId) -> Result<bool, TransportError> {
-    let cfg = run_config(run_id)?;
-    let (alive, _) = node_states(&cfg)?;
-    if !alive.is_empty() {
-        return Ok(false);
-    }
-    node(&cfg, "sepval-janitor")?.try_cleanup_dead_nodes();
-    // SAFETY: no node of this run is alive (checked above); the management segment only
-    // counts node creations and is recreated by the next node of the run.
-    let _ = unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&cfg) };
-    Ok(true)
-}
-
-/// Cleans every stale sepval run on this host except `except`: runs whose newest resource is
-/// older than `min_age` and none of whose nodes is alive (returns the runs cleaned).
-pub fn clean_stale_runs(except: Option<&RunId>, min_age: std::time::Duration) -> Vec<RunId> {
-    runs_with_resources()
-        .into_iter()
-        .filter(|(id, age)| except.is_none_or(|e| e.as_str() != id) && *age >= min_age)
-        .filter_map(|(id, _)| RunId::new(&id).ok())
-        .filter(|id| clean_run_if_stale(id).unwrap_or(false))
-        .collect()
 }
 
 /// Presence of the nodes of one name in a run.

@@ -5,8 +5,16 @@
 //! and hears their `Ready` and `Answer` frames. A worker of another protocol version, or one that
 //! accepted another setup, is told it is dropped and ignored from then on. Workers may join at
 //! any time; when none is left, the dispatcher waits up to the join timeout for one.
+//!
+//! One link serves a whole command: for the next job of the run (an envelope's next condition,
+//! an update's next round), [`ZenohLink::next_job`] serves the new setup and sends it to every
+//! worker that joined, which says `Ready` again with its hash; until then its answers (to
+//! chunks of the job before) are not heard. A worker that said `Ready` to an earlier setup of
+//! the run is sent the current one; only `Quit`, when the link is dropped at the command's end,
+//! tells the workers that the run is finished.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crossbeam::channel::{Receiver, RecvTimeoutError, unbounded};
@@ -18,7 +26,7 @@ use zenoh::sample::SampleKind;
 
 use super::{Role, keys, zerr};
 use crate::codec::{CodecError, Frame};
-use crate::link::{Link, LinkEvent, Notice, WorkerId};
+use crate::link::{Link, LinkEvent, NextJob, Notice, WorkerId};
 use crate::setup::encode_setup_as;
 use crate::wire::{Chunk, PROTOCOL_VERSION};
 use crate::{RunId, TransportError};
@@ -48,6 +56,30 @@ enum Heard {
 struct Remote {
     id: WorkerId,
     publisher: zenoh::pubsub::Publisher<'static>,
+    /// It said `Ready` to the current setup (its answers are heard).
+    serving: bool,
+}
+
+/// The setup on offer: its frame (what the queryable answers) and its hash.
+struct Offer {
+    frame: Vec<u8>,
+    sha256: [u8; 32],
+}
+
+impl Offer {
+    fn of(job: &Job, run: &str, protocol: u32) -> Offer {
+        let (header, bytes) = encode_setup_as(job, protocol);
+        let frame = Frame::Setup {
+            run_id: run.to_string(),
+            header,
+            bytes,
+        }
+        .encode_as(protocol);
+        Offer {
+            frame,
+            sha256: header.sha256,
+        }
+    }
 }
 
 /// The coordinator's end of the zenoh transport.
@@ -59,7 +91,10 @@ pub struct ZenohLink {
     /// Workers refused or given up on: ignored from then on.
     dropped: BTreeSet<String>,
     next_worker: WorkerId,
-    setup_sha256: [u8; 32],
+    /// The current setup, shared with the queryable that serves it.
+    offer: Arc<Mutex<Arc<Offer>>>,
+    /// Hashes of the earlier setups of this run (jobs done).
+    earlier: Vec<[u8; 32]>,
     early: Vec<Notice>,
     _queryable: zenoh::query::Queryable<()>,
     _subscribers: (zenoh::pubsub::Subscriber<()>, zenoh::pubsub::Subscriber<()>),
@@ -77,20 +112,16 @@ impl ZenohLink {
         let session = super::open(cfg, &options.listen)?;
         let run = options.run_id.to_string();
         let protocol = options.announce_protocol.unwrap_or(PROTOCOL_VERSION);
-        let (header, bytes) = encode_setup_as(job, protocol);
-        let setup = Frame::Setup {
-            run_id: run.clone(),
-            header,
-            bytes,
-        }
-        .encode_as(protocol);
+        let offer = Arc::new(Mutex::new(Arc::new(Offer::of(job, &run, protocol))));
         let setup_key = keys::setup(&run);
         let queryable = {
             let key = setup_key.clone();
+            let offer = Arc::clone(&offer);
             session
                 .declare_queryable(&setup_key)
                 .callback(move |query| {
-                    let _ = query.reply(&key, setup.clone()).wait();
+                    let current = Arc::clone(&offer.lock().expect("the offer's lock"));
+                    let _ = query.reply(&key, current.frame.clone()).wait();
                 })
                 .wait()
                 .map_err(zerr("serving the setup"))?
@@ -135,12 +166,17 @@ impl ZenohLink {
             workers: BTreeMap::new(),
             dropped: BTreeSet::new(),
             next_worker: 0,
-            setup_sha256: header.sha256,
+            offer,
+            earlier: Vec::new(),
             early,
             _queryable: queryable,
             _subscribers: (alive, ups),
             _token: token,
         })
+    }
+
+    fn current(&self) -> Arc<Offer> {
+        Arc::clone(&self.offer.lock().expect("the offer's lock"))
     }
 
     /// Tells worker `zid` it is dropped and ignores it from now on.
@@ -185,7 +221,8 @@ impl ZenohLink {
                         host,
                     }) => self.ready(zid, pid, credits, setup_sha256, host, events)?,
                     Ok(Frame::Answer(answer)) => {
-                        if let Some(w) = self.workers.get(&zid) {
+                        // Only a worker serving the current job is heard.
+                        if let Some(w) = self.workers.get(&zid).filter(|w| w.serving) {
                             events.push(LinkEvent::Answer {
                                 worker: w.id,
                                 answer,
@@ -233,7 +270,9 @@ impl ZenohLink {
         events: &mut Vec<LinkEvent>,
     ) -> Result<(), TransportError> {
         let label = format!("{host} pid {pid} ({zid})");
-        if setup_sha256 != self.setup_sha256 {
+        let current = self.current();
+        let serving = setup_sha256 == current.sha256;
+        if !serving && !self.earlier.contains(&setup_sha256) {
             events.push(LinkEvent::Notice(Notice::Refused {
                 label,
                 reason: "it accepted another setup".into(),
@@ -241,21 +280,33 @@ impl ZenohLink {
             self.refuse(&zid, "it accepted another setup");
             return Ok(());
         }
-        let id = match self.workers.get(&zid) {
-            Some(w) => w.id,
-            None => {
-                let publisher = self
-                    .session
-                    .declare_publisher(keys::down(self.options.run_id.as_str(), &zid))
-                    .congestion_control(CongestionControl::Block)
-                    .wait()
-                    .map_err(zerr(format!("publishing to worker {label}")))?;
-                let id = self.next_worker;
-                self.next_worker += 1;
-                self.workers.insert(zid, Remote { id, publisher });
-                id
+        if !self.workers.contains_key(&zid) {
+            let publisher = self
+                .session
+                .declare_publisher(keys::down(self.options.run_id.as_str(), &zid))
+                .congestion_control(CongestionControl::Block)
+                .wait()
+                .map_err(zerr(format!("publishing to worker {label}")))?;
+            let id = self.next_worker;
+            self.next_worker += 1;
+            let remote = Remote {
+                id,
+                publisher,
+                serving: false,
+            };
+            self.workers.insert(zid.clone(), remote);
+        }
+        let w = self.workers.get_mut(&zid).expect("inserted above");
+        w.serving = serving;
+        if !serving {
+            // It joined while an earlier job ran: it is sent the current one.
+            if let Err(e) = w.publisher.put(current.frame.clone()).wait() {
+                let why = format!("sending the current job failed: {e}");
+                self.refuse(&zid, &why);
             }
-        };
+            return Ok(());
+        }
+        let id = w.id;
         events.push(LinkEvent::Joined {
             worker: id,
             label,
@@ -322,6 +373,31 @@ impl Link for ZenohLink {
 
     fn describe(&self) -> String {
         format!("zenoh at {}", self.options.listen)
+    }
+}
+
+impl NextJob for ZenohLink {
+    /// Serves `job`'s setup from now on and sends it to every worker that joined, whose answers
+    /// are not heard until it says `Ready` to it.
+    fn next_job(&mut self, job: &Job) -> Result<Vec<WorkerId>, TransportError> {
+        let protocol = self.options.announce_protocol.unwrap_or(PROTOCOL_VERSION);
+        let next = Arc::new(Offer::of(job, self.options.run_id.as_str(), protocol));
+        let last = std::mem::replace(&mut *self.offer.lock().expect("the offer's lock"), next);
+        self.earlier.push(last.sha256);
+        let frame = self.current().frame.clone();
+        let mut told = Vec::new();
+        let mut unreachable = Vec::new();
+        for (zid, w) in self.workers.iter_mut() {
+            w.serving = false;
+            match w.publisher.put(frame.clone()).wait() {
+                Ok(()) => told.push(w.id),
+                Err(e) => unreachable.push((zid.clone(), e.to_string())),
+            }
+        }
+        for (zid, why) in unreachable {
+            self.refuse(&zid, &format!("sending the next job failed: {why}"));
+        }
+        Ok(told)
     }
 }
 

@@ -2,53 +2,86 @@
 //! workers, so the zero-copy path is kept within the host and the zenoh traffic is one session
 //! per host. It holds two chunks per local worker and evaluates one chunk per local worker at a
 //! time as one batch (spread over its workers by the dispatcher), so the next chunks are
-//! already here when a batch ends.
+//! already here when a batch ends. For the next job of the run, its local workers are started
+//! anew for that job (as an iceoryx2 coordinator does for each of its jobs).
 
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Evaluator, Job};
 
 use crate::TransportError;
-use crate::dispatch::Dispatcher;
-use crate::ipc::IpcLink;
+use crate::dispatch::{DispatchOptions, Dispatcher};
+use crate::ipc::{IpcLink, IpcOptions};
+use crate::link::Notices;
 use crate::serve::Server;
 use crate::wire::{Answer, Chunk, serve_chunks};
 
 /// A [`Server`] over a host's iceoryx2 workers.
 pub struct Gateway {
-    local: Dispatcher<IpcLink>,
+    ipc: IpcOptions,
+    dispatch: DispatchOptions,
+    notices: Notices,
+    local: Option<Dispatcher<IpcLink>>,
     job: Arc<Job>,
-    workers: usize,
 }
 
 impl Gateway {
-    /// A gateway over `local`, a dispatcher of `workers` local iceoryx2 workers for `job`.
-    pub fn new(local: Dispatcher<IpcLink>, job: Arc<Job>, workers: usize) -> Self {
-        Gateway {
-            local,
-            job,
-            workers,
-        }
+    /// A gateway for `job` over the local iceoryx2 workers of `ipc`, started now and dispatched
+    /// to with `dispatch`; their notices go to `notices`.
+    pub fn start(
+        ipc: IpcOptions,
+        dispatch: DispatchOptions,
+        job: Arc<Job>,
+        notices: Notices,
+    ) -> Result<Self, TransportError> {
+        let mut gateway = Gateway {
+            ipc,
+            dispatch,
+            notices,
+            local: None,
+            job: Arc::clone(&job),
+        };
+        gateway.next_job(job)?;
+        Ok(gateway)
     }
 }
 
 impl Server for Gateway {
     fn credits(&self) -> u32 {
-        (2 * self.workers).clamp(1, 64) as u32
+        (2 * self.ipc.workers).clamp(1, 64) as u32
     }
 
     fn parallelism(&self) -> usize {
-        self.workers
+        self.ipc.workers
     }
 
     fn serve(&mut self, chunks: &[Chunk]) -> Result<Vec<Answer>, TransportError> {
+        let local = self
+            .local
+            .as_mut()
+            .ok_or_else(|| TransportError::Serve("the host's iceoryx2 workers are gone".into()))?;
         serve_chunks(&self.job, chunks, |batch, with_samples| {
-            self.local.evaluate(batch, with_samples).map_err(|e| {
+            local.evaluate(batch, with_samples).map_err(|e| {
                 TransportError::Serve(format!(
                     "the host's iceoryx2 workers failed: {}",
                     crate::error_chain(&e)
                 ))
             })
         })
+    }
+
+    fn next_job(&mut self, job: Arc<Job>) -> Result<(), TransportError> {
+        // One iceoryx2 coordinator per run at a time: the last job's goes first.
+        self.local = None;
+        let link = IpcLink::start(&job, self.ipc.clone())?;
+        let local = Dispatcher::start(
+            link,
+            Arc::clone(&job),
+            self.dispatch.clone(),
+            Arc::clone(&self.notices),
+        )?;
+        self.local = Some(local);
+        self.job = job;
+        Ok(())
     }
 }

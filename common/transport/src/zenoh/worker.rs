@@ -2,8 +2,11 @@
 //!
 //! A worker connects to the coordinator's endpoint, declares its liveliness, asks for the setup
 //! until `setup_timeout` and checks it (run id, protocol version, catalogue, hash) before it
-//! says `Ready` with its credits. It stops when the coordinator says `Quit`, when the
-//! coordinator's liveliness token goes, or on a signal; a `Dropped` message is an error.
+//! says `Ready` with its credits. When the coordinator sends another setup of the same run (the
+//! next job of an envelope or an update), it checks it alike, serves it from then on and says
+//! `Ready` again, so a worker that joined serves the run until the coordinator's command ends.
+//! It stops when the coordinator says `Quit`, when the coordinator's liveliness token goes, or
+//! on a signal; a `Dropped` message is an error.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -189,16 +192,6 @@ impl ZenohWorker {
             .wait()
             .map_err(zerr("sending to the coordinator"))
     }
-
-    /// Tells the coordinator we are ready to hold `credits` chunks.
-    pub fn ready(&self, credits: u32) -> Result<(), TransportError> {
-        self.put(&Frame::Ready {
-            pid: std::process::id(),
-            credits: credits.max(1),
-            setup_sha256: self.setup_sha256,
-            host: host_name(),
-        })
-    }
 }
 
 impl WorkerLink for ZenohWorker {
@@ -220,17 +213,35 @@ impl WorkerLink for ZenohWorker {
             Inbox::CoordinatorAlive(false) => Ok(Incoming::Stop(Stopped::CoordinatorGone(
                 self.options.run_id.to_string(),
             ))),
-            Inbox::Down(bytes) => Frame::decode(&bytes)
-                .map_err(|source| TransportError::Codec {
+            Inbox::Down(bytes) => {
+                let frame = Frame::decode(&bytes).map_err(|source| TransportError::Codec {
                     what: "message from the coordinator".into(),
                     source,
-                })?
-                .into_incoming(),
+                })?;
+                if !matches!(frame, Frame::Setup { .. }) {
+                    return frame.into_incoming();
+                }
+                // The next job of the run: checked as the first setup was.
+                let (job, setup_sha256) = accept_setup(&self.options.run_id, &bytes)?;
+                self.job = Arc::new(job);
+                self.setup_sha256 = setup_sha256;
+                Ok(Incoming::Job(Arc::clone(&self.job)))
+            }
         }
     }
 
     fn answer(&mut self, answer: &Answer) -> Result<(), TransportError> {
         self.put(&Frame::Answer(answer.clone()))
+    }
+
+    /// Tells the coordinator we accepted its latest setup and can hold `credits` chunks.
+    fn ready(&mut self, credits: u32) -> Result<(), TransportError> {
+        self.put(&Frame::Ready {
+            pid: std::process::id(),
+            credits: credits.max(1),
+            setup_sha256: self.setup_sha256,
+            host: host_name(),
+        })
     }
 }
 

@@ -111,7 +111,8 @@ impl IpcLink {
         }
         let early: Vec<Notice> = super::clean_stale_runs(Some(&options.run_id), super::STALE_AFTER)
             .into_iter()
-            .map(|run| Notice::CleanedStaleRun {
+            .filter(|(_, cleaned)| cleaned.removed_anything())
+            .map(|(run, _)| Notice::CleanedStaleRun {
                 run: run.to_string(),
             })
             .collect();
