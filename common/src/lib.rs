@@ -26,6 +26,7 @@ pub mod atmosphere;
 pub mod atomic_file;
 pub mod cancel;
 pub mod correction;
+pub mod defect;
 pub mod effects;
 pub mod elementary;
 pub mod encoding;

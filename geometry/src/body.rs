@@ -3,12 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::GeometryError;
+use crate::domain;
 use crate::input::{MAX_FILE_BYTES, MAX_TRIANGLES, read_capped};
-use crate::parts::{self, Part, PartProblem};
+use crate::parts::{self, MeshRefusal, Part, PartProblem};
 use crate::primitives::Primitives;
 use crate::stl::{self, StlProblem};
 use crate::store::StoreSpec;
+use crate::{GeometryError, Stop};
 
 /// Which body a file describes: it decides the TOML format and the frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,12 +40,18 @@ impl Body {
     /// Reads `path` as an STL (`.stl`) or a TOML (`.toml`) file of the body `role`, refusing
     /// bad geometry with an error that names the file, the line or field, and what is wrong.
     pub fn read(path: &Path, role: Role) -> Result<Body, GeometryError> {
+        Body::read_until(path, role, &|| false)
+    }
+
+    /// [`Body::read`], asking `stop` every few milliseconds while a mesh is read and built
+    /// ([`GeometryError::Interrupted`] when it says stop).
+    pub fn read_until(path: &Path, role: Role, stop: Stop) -> Result<Body, GeometryError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         let parts = match ext.as_deref() {
-            Some("stl") => read_stl(path)?,
+            Some("stl") => read_stl(path, stop)?,
             Some("toml") => read_toml(path, role)?,
             _ => {
                 return Err(GeometryError::UnknownFormat {
@@ -57,21 +64,23 @@ impl Body {
     }
 
     /// The Eglin benchmark store scaled to `diameter_m` (every length in proportion; at
-    /// 0.508 m exactly examples/geometry/store.toml). Refuses a diameter that is not finite and
-    /// positive.
+    /// 0.508 m exactly examples/geometry/store.toml). Refuses a diameter outside the domain of
+    /// a size, or one that makes a length of the store leave it (over 10 km long: a diameter
+    /// over 1.68 km).
     pub fn default_store(diameter_m: f64) -> Result<Body, GeometryError> {
         let source = format!("default store, diameter {diameter_m} m");
         let path = PathBuf::from("<default store>");
-        if !(diameter_m.is_finite() && diameter_m > 0.0) {
-            return Err(invalid(
+        domain::size("diameter_m", diameter_m).map_err(|(f, w)| invalid(&path, f, w))?;
+        let parts = StoreSpec::eglin(diameter_m).parts().map_err(|(f, w)| {
+            invalid(
                 &path,
                 "diameter_m".into(),
-                format!("{diameter_m} must be finite and positive"),
-            ));
-        }
-        let parts = StoreSpec::eglin(diameter_m)
-            .parts()
-            .map_err(|(f, w)| invalid(&path, f, w))?;
+                format!(
+                    "{} m: the store scaled to this diameter has {f}: {w}",
+                    domain::number(diameter_m)
+                ),
+            )
+        })?;
         Body::from_parts(source, parts).map_err(|(f, w)| invalid(&path, f, w))
     }
 
@@ -115,9 +124,12 @@ fn invalid(path: &Path, field: String, what: String) -> GeometryError {
     }
 }
 
-fn read_stl(path: &Path) -> Result<Vec<Part>, GeometryError> {
+fn read_stl(path: &Path, stop: Stop) -> Result<Vec<Part>, GeometryError> {
+    let interrupted = || GeometryError::Interrupted {
+        what: format!("reading {}", path.display()),
+    };
     let bytes = read_capped(path, MAX_FILE_BYTES)?;
-    let solids = stl::parse(&bytes, MAX_TRIANGLES).map_err(|p| match p {
+    let solids = stl::parse(&bytes, MAX_TRIANGLES, stop).map_err(|p| match p {
         StlProblem::Malformed { line, what } => GeometryError::Stl {
             path: path.to_path_buf(),
             line,
@@ -128,6 +140,7 @@ fn read_stl(path: &Path) -> Result<Vec<Part>, GeometryError> {
             count,
             limit: MAX_TRIANGLES,
         },
+        StlProblem::Stopped => interrupted(),
     })?;
     let stem = path
         .file_stem()
@@ -148,7 +161,10 @@ fn read_stl(path: &Path) -> Result<Vec<Part>, GeometryError> {
             });
         }
         out.push(
-            parts::mesh(name, &field, &solid.triangles).map_err(|(f, w)| invalid(path, f, w))?,
+            parts::mesh(name, &field, &solid.triangles, stop).map_err(|r| match r {
+                MeshRefusal::Problem((f, w)) => invalid(path, f, w),
+                MeshRefusal::Stopped => interrupted(),
+            })?,
         );
     }
     if out.is_empty() {

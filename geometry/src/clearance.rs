@@ -12,11 +12,12 @@ use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::{Pose as PPose, Vector};
 use parry3d_f64::query::{self, ClosestPoints};
 
-use crate::GeometryError;
 use crate::body::Body;
 use crate::error::CarriageOverlap;
 use crate::frames::{array, body_pose};
+use crate::mesh_distance;
 use crate::parts::{Bound, Part};
+use crate::{GeometryError, Stop};
 
 /// How deep the store may intersect the aircraft at carriage (identity pose): 2 mm. Surfaces
 /// modelled in contact (sway braces, lugs, a store drawn touching its pylon) and meshes
@@ -83,10 +84,21 @@ impl Geometry {
     /// more than [`CARRIAGE_TOLERANCE_M`] (penetration depth from parry's contact query), or
     /// when one lies inside a closed mesh of the other.
     pub fn new(store: Body, aircraft: Body) -> Result<Geometry, GeometryError> {
+        Geometry::new_until(store, aircraft, &|| false)
+    }
+
+    /// [`Geometry::new`], asking `stop` before each pair of parts is checked
+    /// ([`GeometryError::Interrupted`] when it says stop).
+    pub fn new_until(store: Body, aircraft: Body, stop: Stop) -> Result<Geometry, GeometryError> {
         let g = Geometry { store, aircraft };
         let body = PPose::IDENTITY;
         for (i, sp) in g.store.parts.iter().enumerate() {
             for (j, ap) in g.aircraft.parts.iter().enumerate() {
+                if stop() {
+                    return Err(GeometryError::Interrupted {
+                        what: "checking the store against the aircraft at carriage".into(),
+                    });
+                }
                 let refuse = |how: String| {
                     GeometryError::IntersectsAtCarriage(Box::new(CarriageOverlap {
                         store: g.store.source().to_string(),
@@ -217,13 +229,7 @@ impl Geometry {
         let (sp, ap) = (&self.store.parts[i], &self.aircraft.parts[j]);
         let pos1 = *body * sp.pose;
         let margin = best.distance_m.min(f64::MAX);
-        let Ok(result) = query::closest_points(
-            &pos1,
-            sp.shape.as_ref(),
-            &ap.pose,
-            ap.shape.as_ref(),
-            margin,
-        ) else {
+        let Some(result) = closest_points(sp, &pos1, ap, margin) else {
             return;
         };
         let (distance_m, p1, p2) = match result {
@@ -264,6 +270,25 @@ impl Geometry {
         }
         None
     }
+}
+
+/// The closest points of store part `sp` at `pos1` and aircraft part `ap` (store point first,
+/// in L) within `margin`: a mesh against a convex part by [`mesh_distance`], anything else by
+/// parry; `None` for a pair parry does not support.
+fn closest_points(sp: &Part, pos1: &PPose, ap: &Part, margin: f64) -> Option<ClosestPoints> {
+    let (s, a) = (sp.shape.as_ref(), ap.shape.as_ref());
+    // The relative poses and the order of the transforms are parry's, for the same bits.
+    if let (Some(mesh), Some(_)) = (a.as_trimesh(), s.as_support_map()) {
+        let rel = pos1.inv_mul(&ap.pose).inverse();
+        let found = mesh_distance::closest_points(mesh, &rel, s, margin);
+        return Some(found.flipped().transform_by(pos1, &ap.pose));
+    }
+    if let (Some(mesh), Some(_)) = (s.as_trimesh(), a.as_support_map()) {
+        let rel = pos1.inv_mul(&ap.pose);
+        let found = mesh_distance::closest_points(mesh, &rel, a, margin);
+        return Some(found.transform_by(pos1, &ap.pose));
+    }
+    query::closest_points(pos1, s, &ap.pose, a, margin).ok()
 }
 
 /// parry's contact between store part `sp` at `pos1` and aircraft part `ap`: signed distance

@@ -90,6 +90,12 @@ pub enum GeometryError {
     /// The store intersects the aircraft at carriage.
     #[error("{0}")]
     IntersectsAtCarriage(Box<CarriageOverlap>),
+    /// The caller's [`crate::Stop`] asked to stop.
+    #[error("interrupted while {what}")]
+    Interrupted {
+        /// What was under way ("reading FILE", "checking the carriage", ...).
+        what: String,
+    },
     /// A trajectory that cannot be assessed (lengths differ, no sample, a non-finite value).
     #[error("trajectory: {what}")]
     Trajectory {

@@ -23,9 +23,11 @@
 
 mod body;
 mod clearance;
+mod domain;
 mod error;
 mod frames;
 mod input;
+mod mesh_distance;
 mod parts;
 mod primitives;
 mod stl;
@@ -34,9 +36,16 @@ mod trace;
 
 pub use body::{Body, Role};
 pub use clearance::{CARRIAGE_TOLERANCE_M, Closest, Geometry, Pose};
+pub use domain::{MAX_ANGLE_DEG, MAX_COORDINATE_M, MAX_SIZE_M, MIN_SIZE_M};
 pub use error::{CarriageOverlap, GeometryError};
 pub use input::{MAX_FILE_BYTES, MAX_TRIANGLES};
 pub use trace::{Smallest, Trace};
+
+/// What asks a long computation of this crate to stop (reading and building a mesh, the
+/// check at carriage, the clearance along a trajectory): asked every few milliseconds of work,
+/// `true` ends the computation with [`GeometryError::Interrupted`]. The binaries pass their
+/// cancellation flag (SIGINT, SIGTERM); `&|| false` never stops.
+pub type Stop<'a> = &'a (dyn Fn() -> bool + Sync);
 
 /// The smallest clearance between store and aircraft that MIL-STD-1289D (Department of Defense
 /// Interface Standard, "Airborne stores ejection clearance", 2003) asks for: 1 inch.

@@ -11,6 +11,8 @@ use parry3d_f64::shape::{
     ConvexPolyhedron, Cuboid, Cylinder, HalfSpace, SharedShape, TriMesh, TriMeshFlags,
 };
 
+use crate::Stop;
+use crate::domain;
 use crate::frames::vector;
 
 /// A part of a body: a name, a shape placed in the body's frame, and the bounds used to skip it.
@@ -74,29 +76,11 @@ fn bounded(
     }
 }
 
-/// Checks that `v` is finite, naming `field`.
-pub(crate) fn finite(field: &str, v: &[f64]) -> Result<(), PartProblem> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(problem(field, format!("{v:?} is not finite")))
-    }
-}
-
-/// Checks that `v` is finite and positive, naming `field`.
-pub(crate) fn positive(field: &str, v: f64) -> Result<(), PartProblem> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(problem(field, format!("{v} must be finite and positive")))
-    }
-}
-
 /// The convex hull of `points` (body frame), refused when fewer than four or flat: thinner
 /// than 1e-9 of its extent in some direction.
 pub(crate) fn hull(name: String, field: &str, points: &[[f64; 3]]) -> Result<Part, PartProblem> {
-    for p in points {
-        finite(field, p)?;
+    for (k, p) in points.iter().enumerate() {
+        domain::point(&format!("{field}[{k}]"), p)?;
     }
     let pts: Vec<Vector> = points.iter().map(|p| vector(*p)).collect();
     check_solid(field, &pts)?;
@@ -154,9 +138,9 @@ pub(crate) fn cuboid(
     half_extents_m: [f64; 3],
     rotation: parry3d_f64::math::Rotation,
 ) -> Result<Part, PartProblem> {
-    finite(field, &centre_m)?;
+    domain::point(&format!("{field}.centre_m"), &centre_m)?;
     for h in half_extents_m {
-        positive(&format!("{field}.half_extents_m"), h)?;
+        domain::size(&format!("{field}.half_extents_m"), h)?;
     }
     let pose = PPose::from_parts(vector(centre_m), rotation);
     let corner = Vector::new(half_extents_m[0], half_extents_m[1], half_extents_m[2]);
@@ -173,10 +157,10 @@ pub(crate) fn cylinder(
     radius_m: f64,
     length_m: f64,
 ) -> Result<Part, PartProblem> {
-    finite(&format!("{field}.centre_m"), &centre_m)?;
-    finite(&format!("{field}.axis"), &axis)?;
-    positive(&format!("{field}.radius_m"), radius_m)?;
-    positive(&format!("{field}.length_m"), length_m)?;
+    domain::point(&format!("{field}.centre_m"), &centre_m)?;
+    domain::direction(&format!("{field}.axis"), &axis)?;
+    domain::size(&format!("{field}.radius_m"), radius_m)?;
+    domain::size(&format!("{field}.length_m"), length_m)?;
     let axis = vector(axis);
     if axis.length() < 1e-12 || !axis.length().is_finite() {
         return Err(problem(
@@ -199,8 +183,8 @@ pub(crate) fn half_space(
     point_m: [f64; 3],
     outward_normal: [f64; 3],
 ) -> Result<Part, PartProblem> {
-    finite(&format!("{field}.point_m"), &point_m)?;
-    finite(&format!("{field}.outward_normal"), &outward_normal)?;
+    domain::point(&format!("{field}.point_m"), &point_m)?;
+    domain::direction(&format!("{field}.outward_normal"), &outward_normal)?;
     let n = vector(outward_normal);
     if n.length().is_nan() || n.length() <= 1e-12 {
         return Err(problem(
@@ -220,26 +204,31 @@ pub(crate) fn half_space(
     })
 }
 
-/// A triangle mesh (vertices in the body frame). Zero-area triangles are dropped; a mesh with
-/// none left is refused. A closed mesh (every edge shared by two triangles that run it in
+/// A triangle mesh (vertices in the body frame, within the domain of a coordinate). Zero-area
+/// triangles (height under `DEGENERATE` of the longest edge) are dropped; a mesh with none
+/// left is refused. A closed mesh (every edge shared by two triangles that run it in
 /// opposite directions) is oriented outward and can contain points.
 pub(crate) fn mesh(
     name: String,
     field: &str,
     triangles: &[[[f64; 3]; 3]],
-) -> Result<Part, PartProblem> {
-    let (vertices, mut indices) = indexed(triangles);
+    stop: Stop,
+) -> Result<Part, MeshRefusal> {
+    let (vertices, mut indices) = indexed(triangles, stop).ok_or(MeshRefusal::Stopped)?;
     if indices.is_empty() {
-        return Err(problem(
+        return Err(MeshRefusal::Problem(problem(
             field,
             format!("all {} triangles have zero area", triangles.len()),
-        ));
+        )));
     }
-    let closed = is_closed(&indices);
+    let closed = is_closed(&indices, stop).ok_or(MeshRefusal::Stopped)?;
     if closed && signed_volume(&vertices, &indices) < 0.0 {
         for t in &mut indices {
             t.swap(1, 2);
         }
+    }
+    if stop() {
+        return Err(MeshRefusal::Stopped);
     }
     let surface_point = vertices[indices[0][0] as usize];
     let flags = TriMeshFlags::HALF_EDGE_TOPOLOGY | TriMeshFlags::ORIENTED;
@@ -251,7 +240,8 @@ pub(crate) fn mesh(
     let (shape, closed_mesh) = match oriented {
         Some(m) => (m, true),
         None => (
-            TriMesh::new(vertices, indices).map_err(|e| problem(field, e.to_string()))?,
+            TriMesh::new(vertices, indices)
+                .map_err(|e| MeshRefusal::Problem(problem(field, e.to_string())))?,
             false,
         ),
     };
@@ -264,14 +254,37 @@ pub(crate) fn mesh(
     ))
 }
 
-/// Vertices merged where equal, and the triangles of non-zero area as indices.
-fn indexed(triangles: &[[[f64; 3]; 3]]) -> (Vec<Vector>, Vec<[u32; 3]>) {
+/// Why a mesh was not made.
+pub(crate) enum MeshRefusal {
+    /// The field and what is wrong.
+    Problem(PartProblem),
+    /// `stop` asked to stop.
+    Stopped,
+}
+
+/// Triangles handled between two calls of `stop`.
+const STOP_EVERY: usize = 1 << 14;
+
+/// A triangle whose height is under this share of its longest edge has no area in double
+/// precision (its normal would be rounding noise): it is dropped.
+const DEGENERATE: f64 = 1e-12;
+
+/// Vertices merged where equal, and the triangles of non-zero area as indices; `None` when
+/// `stop` asked to stop.
+fn indexed(triangles: &[[[f64; 3]; 3]], stop: Stop) -> Option<(Vec<Vector>, Vec<[u32; 3]>)> {
     let mut index: HashMap<[u64; 3], u32> = HashMap::new();
     let mut vertices = Vec::new();
     let mut indices = Vec::with_capacity(triangles.len());
-    for t in triangles {
+    for (k, t) in triangles.iter().enumerate() {
+        if k % STOP_EVERY == 0 && stop() {
+            return None;
+        }
         let [a, b, c] = t.map(vector);
-        if (b - a).cross(c - a).length() <= 0.0 {
+        let longest = [b - a, c - b, a - c]
+            .map(|e| e.length_squared())
+            .into_iter()
+            .fold(0.0, f64::max);
+        if !((b - a).cross(c - a).length() > DEGENERATE * longest) {
             continue;
         }
         let ids = t.map(|v| {
@@ -284,20 +297,25 @@ fn indexed(triangles: &[[[f64; 3]; 3]]) -> (Vec<Vector>, Vec<[u32; 3]>) {
         });
         indices.push(ids);
     }
-    (vertices, indices)
+    Some((vertices, indices))
 }
 
-/// Every directed edge appears once and its reverse once.
-fn is_closed(indices: &[[u32; 3]]) -> bool {
+/// Every directed edge appears once and its reverse once; `None` when `stop` asked to stop.
+fn is_closed(indices: &[[u32; 3]], stop: Stop) -> Option<bool> {
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-    for t in indices {
+    for (i, t) in indices.iter().enumerate() {
+        if i % STOP_EVERY == 0 && stop() {
+            return None;
+        }
         for k in 0..3 {
             *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
         }
     }
-    edges
-        .iter()
-        .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
+    Some(
+        edges
+            .iter()
+            .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1)),
+    )
 }
 
 fn signed_volume(vertices: &[Vector], indices: &[[u32; 3]]) -> f64 {

@@ -5,6 +5,7 @@
 
 use serde::Deserialize;
 
+use crate::domain;
 use crate::frames::rotation_321_deg;
 use crate::parts::{self, Part, PartProblem};
 
@@ -72,7 +73,7 @@ impl Primitives {
         let mut out = Vec::new();
         for (i, b) in self.boxes.iter().enumerate() {
             let field = format!("box[{i}] \"{}\"", b.name);
-            parts::finite(&format!("{field}.rotation_deg"), &b.rotation_deg)?;
+            domain::angles(&format!("{field}.rotation_deg"), &b.rotation_deg)?;
             let rotation = rotation_321_deg(b.rotation_deg);
             out.push(parts::cuboid(
                 b.name.clone(),

@@ -8,6 +8,9 @@
 //! start with the word `solid` too), otherwise ASCII when it starts with `solid`. Normals are
 //! read and ignored (the vertices' order is what counts).
 
+use crate::Stop;
+use crate::domain::{MAX_COORDINATE_M, number};
+
 /// One solid: a name and its triangles (vertices in metres).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Solid {
@@ -24,6 +27,8 @@ pub(crate) enum StlProblem {
     Malformed { line: usize, what: String },
     /// More than the limit of triangles.
     TooMany { count: u64 },
+    /// `stop` asked to stop before the file was read.
+    Stopped,
 }
 
 fn bad(line: usize, what: impl Into<String>) -> StlProblem {
@@ -33,12 +38,20 @@ fn bad(line: usize, what: impl Into<String>) -> StlProblem {
     }
 }
 
-/// The solids of an STL file's bytes, at most `max_triangles` triangles in all.
-pub(crate) fn parse(bytes: &[u8], max_triangles: u64) -> Result<Vec<Solid>, StlProblem> {
+/// Lines or triangles read between two calls of `stop`: a few milliseconds' work.
+const STOP_EVERY: usize = 1 << 14;
+
+/// The solids of an STL file's bytes, at most `max_triangles` triangles in all; `stop` is
+/// asked every [`STOP_EVERY`] lines or triangles.
+pub(crate) fn parse(
+    bytes: &[u8],
+    max_triangles: u64,
+    stop: Stop,
+) -> Result<Vec<Solid>, StlProblem> {
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
         if 84 + 50 * n == bytes.len() as u64 {
-            return parse_binary(bytes, n, max_triangles);
+            return parse_binary(bytes, n, max_triangles, stop);
         }
     }
     let start = bytes
@@ -46,7 +59,7 @@ pub(crate) fn parse(bytes: &[u8], max_triangles: u64) -> Result<Vec<Solid>, StlP
         .position(|b| !b.is_ascii_whitespace())
         .unwrap_or(bytes.len());
     if bytes[start..].starts_with(b"solid") {
-        return parse_ascii(bytes, max_triangles);
+        return parse_ascii(bytes, max_triangles, stop);
     }
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
@@ -69,12 +82,20 @@ pub(crate) fn parse(bytes: &[u8], max_triangles: u64) -> Result<Vec<Solid>, StlP
     ))
 }
 
-fn parse_binary(bytes: &[u8], n: u64, max_triangles: u64) -> Result<Vec<Solid>, StlProblem> {
+fn parse_binary(
+    bytes: &[u8],
+    n: u64,
+    max_triangles: u64,
+    stop: Stop,
+) -> Result<Vec<Solid>, StlProblem> {
     if n > max_triangles {
         return Err(StlProblem::TooMany { count: n });
     }
     let mut triangles = Vec::with_capacity(n as usize);
     for (k, record) in bytes[84..].chunks_exact(50).enumerate() {
+        if k % STOP_EVERY == 0 && stop() {
+            return Err(StlProblem::Stopped);
+        }
         let f = |i: usize| {
             let o = 12 + 4 * i;
             f32::from_le_bytes([record[o], record[o + 1], record[o + 2], record[o + 3]]) as f64
@@ -84,6 +105,16 @@ fn parse_binary(bytes: &[u8], n: u64, max_triangles: u64) -> Result<Vec<Solid>, 
             return Err(bad(
                 0,
                 format!("triangle {}: a vertex coordinate is not finite", k + 1),
+            ));
+        }
+        if let Some(v) = t.iter().flatten().find(|v| v.abs() > MAX_COORDINATE_M) {
+            return Err(bad(
+                0,
+                format!(
+                    "triangle {}: vertex coordinate {} is beyond +-{MAX_COORDINATE_M} m (the domain of a coordinate)",
+                    k + 1,
+                    number(*v)
+                ),
             ));
         }
         triangles.push(t);
@@ -105,7 +136,7 @@ enum Expect {
     EndFacet,
 }
 
-fn parse_ascii(bytes: &[u8], max_triangles: u64) -> Result<Vec<Solid>, StlProblem> {
+fn parse_ascii(bytes: &[u8], max_triangles: u64, stop: Stop) -> Result<Vec<Solid>, StlProblem> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         let line = 1 + bytes[..e.valid_up_to()]
             .iter()
@@ -119,6 +150,9 @@ fn parse_ascii(bytes: &[u8], max_triangles: u64) -> Result<Vec<Solid>, StlProble
     let mut count = 0u64;
     let mut last_line = 0;
     for (i, raw) in text.lines().enumerate() {
+        if i % STOP_EVERY == 0 && stop() {
+            return Err(StlProblem::Stopped);
+        }
         let line = i + 1;
         let mut words = raw.split_whitespace();
         let Some(word) = words.next() else { continue };
@@ -204,6 +238,14 @@ fn vertex<'a>(
                 format!("vertex: {axis} coordinate `{word}` is not finite"),
             ));
         }
+        if value.abs() > MAX_COORDINATE_M {
+            return Err(bad(
+                line,
+                format!(
+                    "vertex: {axis} coordinate `{word}` is beyond +-{MAX_COORDINATE_M} m (the domain of a coordinate)"
+                ),
+            ));
+        }
         *slot = value;
     }
     if let Some(extra) = words.next() {
@@ -225,7 +267,7 @@ mod tests {
 
     #[test]
     fn ascii_solids_become_named_solids() {
-        let solids = parse(TWO_SOLIDS.as_bytes(), 10).unwrap();
+        let solids = parse(TWO_SOLIDS.as_bytes(), 10, &|| false).unwrap();
         assert_eq!(solids.len(), 2);
         assert_eq!(solids[0].name, "a");
         assert_eq!(solids[1].name, "b c");
@@ -239,16 +281,16 @@ mod tests {
     fn ascii_refusals_name_the_line() {
         let text = TWO_SOLIDS.replace("vertex 1 0 1", "vertex 1 nan 1");
         assert_eq!(
-            parse(text.as_bytes(), 10).unwrap_err(),
+            parse(text.as_bytes(), 10, &|| false).unwrap_err(),
             bad(14, "vertex: y coordinate `nan` is not finite")
         );
         let text = TWO_SOLIDS.replace("endloop\n endfacet\nendsolid\n", "");
         assert!(matches!(
-            parse(text.as_bytes(), 10),
+            parse(text.as_bytes(), 10, &|| false),
             Err(StlProblem::Malformed { line: 15, .. })
         ));
         assert_eq!(
-            parse(TWO_SOLIDS.as_bytes(), 1).unwrap_err(),
+            parse(TWO_SOLIDS.as_bytes(), 1, &|| false).unwrap_err(),
             StlProblem::TooMany { count: 2 }
         );
     }
@@ -263,25 +305,25 @@ mod tests {
             bytes.extend(v.to_le_bytes());
         }
         bytes.extend([0u8; 2]);
-        let solids = parse(&bytes, 10).unwrap();
+        let solids = parse(&bytes, 10, &|| false).unwrap();
         // Exactly the f32 values written (0 and 1 are exact).
         assert_eq!(
             solids[0].triangles[0][2].map(f64::to_bits),
             [0.0f64, 1.0, 0.0].map(f64::to_bits)
         );
         assert_eq!(
-            parse(&bytes, 0).unwrap_err(),
+            parse(&bytes, 0, &|| false).unwrap_err(),
             StlProblem::TooMany { count: 1 }
         );
         // One byte more: not binary, and not text either.
         bytes.push(0);
         assert!(matches!(
-            parse(&bytes, 10),
+            parse(&bytes, 10, &|| false),
             Err(StlProblem::Malformed { line: 1, .. })
         ));
         bytes[0] = b'x';
         assert!(matches!(
-            parse(&bytes, 10),
+            parse(&bytes, 10, &|| false),
             Err(StlProblem::Malformed { line: 0, .. })
         ));
     }

@@ -13,6 +13,7 @@
 
 use serde::Deserialize;
 
+use crate::domain;
 use crate::parts::{self, Part, PartProblem};
 use crate::primitives::{BoxSpec, CylinderSpec, HalfSpaceSpec, HullSpec, Primitives};
 
@@ -119,13 +120,17 @@ impl StoreSpec {
             ("body.diameter_m", b.diameter_m),
             ("body.nose_length_m", b.nose_length_m),
         ] {
-            parts::positive(field, v)?;
+            domain::size(field, v)?;
         }
-        let tip_x = b.cg_from_nose_m;
-        parts::finite("body.cg_from_nose_m", &[tip_x])?;
-        parts::finite("body.boattail_length_m", &[b.boattail_length_m])?;
+        domain::within(
+            "body.boattail_length_m",
+            b.boattail_length_m,
+            0.0,
+            b.length_m,
+            "from 0 (none) to the body's length",
+        )?;
         let cylinder_m = b.length_m - b.nose_length_m - b.boattail_length_m;
-        if !(b.boattail_length_m >= 0.0 && cylinder_m > 0.0) {
+        if !(cylinder_m > 0.0) {
             return Err((
                 "body".into(),
                 format!(
@@ -134,6 +139,14 @@ impl StoreSpec {
                 ),
             ));
         }
+        let tip_x = b.cg_from_nose_m;
+        domain::within(
+            "body.cg_from_nose_m",
+            tip_x,
+            0.0,
+            b.length_m,
+            "the CG lies on the store, between its nose tip and its base (body.length_m)",
+        )?;
         let mut out = vec![parts::hull(
             "nose".into(),
             "body.nose",
@@ -157,7 +170,7 @@ impl StoreSpec {
             ));
         }
         if let Some(f) = &self.fins {
-            out.extend(fins(f, r, tip_x)?);
+            out.extend(fins(f, r, tip_x, b.length_m)?);
         }
         let extra = Primitives {
             boxes: self.boxes.iter().map(clone_box).collect(),
@@ -227,10 +240,14 @@ fn boattail(b: &Revolution, r: f64, tip_x: f64) -> Result<Part, PartProblem> {
             "needed with boattail_length_m".to_string(),
         )
     })?;
-    if !(base_d.is_finite() && base_d > 0.0 && base_d <= b.diameter_m) {
+    domain::size("body.base_diameter_m", base_d)?;
+    if base_d > b.diameter_m {
         return Err((
             "body.base_diameter_m".into(),
-            format!("{base_d} must be positive and at most the diameter"),
+            format!(
+                "{} must be positive and at most the diameter",
+                domain::number(base_d)
+            ),
         ));
     }
     let start_x = tip_x - (b.length_m - b.boattail_length_m);
@@ -240,7 +257,7 @@ fn boattail(b: &Revolution, r: f64, tip_x: f64) -> Result<Part, PartProblem> {
     parts::hull("boattail".into(), "body.boattail", &pts)
 }
 
-fn fins(f: &Fins, r: f64, tip_x: f64) -> Result<Vec<Part>, PartProblem> {
+fn fins(f: &Fins, r: f64, tip_x: f64, length_m: f64) -> Result<Vec<Part>, PartProblem> {
     if !(1..=16).contains(&f.count) {
         return Err(("fins.count".into(), format!("{} must be 1 to 16", f.count)));
     }
@@ -249,16 +266,23 @@ fn fins(f: &Fins, r: f64, tip_x: f64) -> Result<Vec<Part>, PartProblem> {
         ("fins.span_m", f.span_m),
         ("fins.thickness_m", f.thickness_m),
     ] {
-        parts::positive(field, v)?;
+        domain::size(field, v)?;
     }
-    parts::finite(
-        "fins",
-        &[f.tip_chord_m, f.leading_edge_from_nose_m, f.roll_deg],
+    domain::within(
+        "fins.leading_edge_from_nose_m",
+        f.leading_edge_from_nose_m,
+        0.0,
+        length_m,
+        "the fins' roots start on the body, between its nose tip and its base",
     )?;
-    if !(f.tip_chord_m >= 0.0 && f.tip_chord_m <= f.root_chord_m) {
+    domain::angles("fins.roll_deg", &[f.roll_deg])?;
+    if !(f.tip_chord_m.is_finite() && f.tip_chord_m >= 0.0 && f.tip_chord_m <= f.root_chord_m) {
         return Err((
             "fins.tip_chord_m".into(),
-            format!("{} must be from 0 to the root chord", f.tip_chord_m),
+            format!(
+                "{} must be from 0 to the root chord",
+                domain::number(f.tip_chord_m)
+            ),
         ));
     }
     let le_x = tip_x - f.leading_edge_from_nose_m;

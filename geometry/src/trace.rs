@@ -7,8 +7,8 @@
 //! the rack is the rack's business; MIL-STD-1289D's criterion concerns free flight. When no
 //! sample gets that far, every sample is assessed.
 
-use crate::GeometryError;
 use crate::clearance::{Closest, Geometry, Pose};
+use crate::{GeometryError, Stop};
 
 /// The clearance along one trajectory.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,6 +38,18 @@ impl Geometry {
         poses: &[Pose],
         free_after_m: f64,
     ) -> Result<Trace, GeometryError> {
+        self.trace_until(t_s, poses, free_after_m, &|| false)
+    }
+
+    /// [`Geometry::trace`], asking `stop` before each pose ([`GeometryError::Interrupted`]
+    /// when it says stop).
+    pub fn trace_until(
+        &self,
+        t_s: &[f64],
+        poses: &[Pose],
+        free_after_m: f64,
+        stop: Stop,
+    ) -> Result<Trace, GeometryError> {
         check(t_s, poses, free_after_m)?;
         let free = first_free(poses, free_after_m);
         let assessed_from = free.unwrap_or(0);
@@ -48,6 +60,9 @@ impl Geometry {
         };
         let mut index_min = assessed_from;
         for (k, pose) in poses.iter().enumerate() {
+            if stop() {
+                return Err(interrupted());
+            }
             let c = self.clearance(pose);
             distance_m.push(c.distance_m);
             if k >= assessed_from && c.distance_m < min.distance_m {
@@ -76,6 +91,18 @@ impl Geometry {
         poses: &[Pose],
         free_after_m: f64,
     ) -> Result<Smallest, GeometryError> {
+        self.smallest_until(t_s, poses, free_after_m, &|| false)
+    }
+
+    /// [`Geometry::smallest`], asking `stop` before each pose measured
+    /// ([`GeometryError::Interrupted`] when it says stop).
+    pub fn smallest_until(
+        &self,
+        t_s: &[f64],
+        poses: &[Pose],
+        free_after_m: f64,
+        stop: Stop,
+    ) -> Result<Smallest, GeometryError> {
         check(t_s, poses, free_after_m)?;
         let free = first_free(poses, free_after_m);
         let assessed_from = free.unwrap_or(0);
@@ -87,6 +114,9 @@ impl Geometry {
         for (k, pose) in poses.iter().enumerate().skip(assessed_from) {
             if self.pose_lower_bound(pose) >= min.distance_m {
                 continue;
+            }
+            if stop() {
+                return Err(interrupted());
             }
             let c = self.clearance(pose);
             if c.distance_m < min.distance_m {
@@ -117,6 +147,12 @@ pub struct Smallest {
     pub index_min: usize,
     /// Its time (s).
     pub t_min_s: f64,
+}
+
+fn interrupted() -> GeometryError {
+    GeometryError::Interrupted {
+        what: "computing the clearance along a trajectory".into(),
+    }
 }
 
 /// The first sample at which the CG has moved `free_after_m` from carriage.

@@ -20,6 +20,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use sepval_common::cancel::{self, Cancelled};
 use sepval_geometry::{Geometry, Pose};
 
 use crate::bands::quantile;
@@ -113,7 +114,8 @@ struct SampleClosest {
 
 /// The clearance statistics of the samples (`samples[s]`: sample s's trajectory at the grid,
 /// `None` when it did not run), each offset by its discrepancy deviation (module docs), on
-/// `threads` threads.
+/// `threads` threads. Every thread asks the cancellation flag before each pose it measures:
+/// [`Cancelled`] within milliseconds of a signal, whatever the meshes.
 pub fn assess(
     settings: &ClearanceSettings,
     samples: &[Option<&GridTrajectory>],
@@ -121,7 +123,7 @@ pub fn assess(
     grid: &Grid,
     seed: u64,
     threads: usize,
-) -> ClearanceStats {
+) -> Result<ClearanceStats, Cancelled> {
     let n = samples.len();
     let chunk = n.div_ceil(threads.max(1)).max(1);
     let mut closest: Vec<Option<SampleClosest>> = vec![None; n];
@@ -130,6 +132,9 @@ pub fn assess(
             let start = c * chunk;
             scope.spawn(move || {
                 for (k, slot) in out.iter_mut().enumerate() {
+                    if cancel::requested() {
+                        return;
+                    }
                     let s = start + k;
                     *slot = samples[s].and_then(|t| {
                         sample_closest(settings, t, discrepancy, grid, seed, s as u64)
@@ -138,7 +143,9 @@ pub fn assess(
             });
         }
     });
-    stats(settings, &closest)
+    // A sample stopped by the flag reads as one that did not run: nothing of it is kept.
+    cancel::check()?;
+    Ok(stats(settings, &closest))
 }
 
 /// Sample `s`'s closest approach (`None` when its trajectory cannot be placed: a value that
@@ -166,7 +173,7 @@ fn sample_closest(
         .collect();
     let trace = settings
         .geometry
-        .smallest(&grid.t_s, &poses, settings.free_after_m)
+        .smallest_until(&grid.t_s, &poses, settings.free_after_m, &cancel::requested)
         .ok()?;
     Some(SampleClosest {
         distance_m: trace.min.distance_m,

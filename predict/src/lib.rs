@@ -87,6 +87,9 @@ pub enum PredictError {
     /// The outputs.
     #[error(transparent)]
     Outputs(#[from] outputs::OutputError),
+    /// A signal asked the process to stop.
+    #[error(transparent)]
+    Cancelled(#[from] sepval_common::cancel::Cancelled),
 }
 
 /// A release flown at the condition, to check against the bands.
@@ -259,19 +262,23 @@ pub fn predict_with(
         Some(ev) => discrepancy::carry(&calibration, ev, &prepared.grid)?,
         None => discrepancy::calibrate(&calibration, &prepared.grid)?,
     };
-    let clearance = prepared.clearance.as_ref().map(|c| {
-        let trajectories: Vec<Option<&GridTrajectory>> =
-            runs.trajectories.iter().map(|t| t.as_ref().ok()).collect();
-        let s = &prepared.settings;
-        clearance::assess(
-            c,
-            &trajectories,
-            &discrepancy.sd,
-            &prepared.grid,
-            s.seed,
-            s.threads,
-        )
-    });
+    let clearance = prepared
+        .clearance
+        .as_ref()
+        .map(|c| {
+            let trajectories: Vec<Option<&GridTrajectory>> =
+                runs.trajectories.iter().map(|t| t.as_ref().ok()).collect();
+            let s = &prepared.settings;
+            clearance::assess(
+                c,
+                &trajectories,
+                &discrepancy.sd,
+                &prepared.grid,
+                s.seed,
+                s.threads,
+            )
+        })
+        .transpose()?;
     let flown = prepared
         .flown
         .as_ref()

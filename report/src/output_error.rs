@@ -35,8 +35,10 @@ pub enum OutputError {
 
 impl OutputError {
     /// Creates `out/figures` (and `out`) and returns it: the first step of every command that
-    /// writes figures.
+    /// writes figures. The cancellation flag is asked first, so an interrupted command leaves
+    /// no empty `figures/` behind (a run directory that received nothing is removed).
     pub fn figures_dir(out: &std::path::Path) -> Result<PathBuf, OutputError> {
+        OutputError::check_cancel()?;
         let figures = out.join("figures");
         std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
             path: figures.clone(),

@@ -2,12 +2,14 @@
 //!
 //! The command line only: the library (`sepval_cli`) declares the flags and runs the commands;
 //! this file parses the arguments, installs the signal handlers and reports errors: the whole
-//! cause chain, exit status 2 (130 after SIGINT/SIGTERM).
+//! cause chain, exit status 2 (130 after SIGINT/SIGTERM); a panic is reported as a defect, with
+//! its message and place, exit status 2 (`sepval_common::defect`).
 
 use std::process::ExitCode;
 
 use clap::Parser;
 use sepval_cli::Cli;
+use sepval_common::defect;
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -21,9 +23,19 @@ fn main() -> ExitCode {
         }
     };
     sepval_common::cancel::install_signal_handlers();
-    match sepval_cli::run(cli.command) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
+    defect::install_hook();
+    let outcome = defect::catch(|| {
+        defect::inject("start");
+        sepval_cli::run(cli.command)
+    });
+    match outcome {
+        Ok(Ok(())) => ExitCode::SUCCESS,
+        // A panic has unwound: the lock, temporary files and workers are gone with it.
+        Err(defect) => {
+            eprintln!("sepval: {defect}");
+            ExitCode::from(2)
+        }
+        Ok(Err(e)) => {
             eprintln!("sepval: error: {e:#}");
             if sepval_common::cancel::requested() {
                 ExitCode::from(130)

@@ -4,7 +4,8 @@
 //! `--connect` over zenoh, `--uds` over a Unix socket), then the one serve loop of
 //! `sepval_transport::serve` with this process's own simulations. A worker validates every
 //! request and answers a bad one with a typed failure instead of crashing; it ends cleanly when
-//! its coordinator ends the run or goes away, or on SIGINT/SIGTERM. Run `iox2 service list`
+//! its coordinator ends the run or goes away, or on SIGINT/SIGTERM. A panic is reported as a
+//! defect with its message and place, exit status 2 (`sepval_common::defect`). Run `iox2 service list`
 //! with the run's configuration to see its services (see the README).
 
 // The doc comments here are clap's --help text, where units read `[s]`, `[m]`; rustdoc would
@@ -17,6 +18,7 @@ use std::time::Duration;
 
 use anyhow::Result;
 use clap::Parser;
+use sepval_common::defect;
 use sepval_transport::RunId;
 use sepval_transport::ipc::IpcWorker;
 use sepval_transport::link::Stopped;
@@ -67,20 +69,18 @@ fn positive_seconds(text: &str) -> Result<f64, String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     sepval_common::cancel::install_signal_handlers();
-    let setup_timeout = Duration::from_secs_f64(cli.setup_timeout);
-    let result = match (&cli.run, &cli.uds, &cli.connect) {
-        (Some(run), _, Some(endpoint)) => serve_zenoh(&cli, run, endpoint, setup_timeout),
-        (Some(run), _, None) => (|| {
-            let mut link = IpcWorker::join(run.clone(), setup_timeout, cli.announce_protocol)?;
-            let mut local = Local(Arc::clone(link.job()));
-            Ok(serve(&mut link, &mut local)?)
-        })(),
-        (None, Some(path), _) => (|| {
-            let mut link = UdsWorker::join(path, setup_timeout)?;
-            let mut local = Local(Arc::clone(link.job()));
-            Ok(serve(&mut link, &mut local)?)
-        })(),
-        (None, None, _) => unreachable!("clap requires one transport"),
+    defect::install_hook();
+    let outcome = defect::catch(|| {
+        defect::inject("worker");
+        serve_as(&cli)
+    });
+    let result = match outcome {
+        Ok(result) => result,
+        // A panic has unwound (the link and its shared memory dropped): a defect, said so.
+        Err(defect) => {
+            eprintln!("sepval-worker: {defect}");
+            return ExitCode::from(2);
+        }
     };
     match result {
         // The coordinator's own SIGTERM at the end of a run is not worth a word.
@@ -93,6 +93,25 @@ fn main() -> ExitCode {
             eprintln!("sepval-worker: error: {e:#}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// Joins the transport the flags name and serves the run.
+fn serve_as(cli: &Cli) -> Result<Stopped> {
+    let setup_timeout = Duration::from_secs_f64(cli.setup_timeout);
+    match (&cli.run, &cli.uds, &cli.connect) {
+        (Some(run), _, Some(endpoint)) => serve_zenoh(cli, run, endpoint, setup_timeout),
+        (Some(run), _, None) => (|| {
+            let mut link = IpcWorker::join(run.clone(), setup_timeout, cli.announce_protocol)?;
+            let mut local = Local(Arc::clone(link.job()));
+            Ok(serve(&mut link, &mut local)?)
+        })(),
+        (None, Some(path), _) => (|| {
+            let mut link = UdsWorker::join(path, setup_timeout)?;
+            let mut local = Local(Arc::clone(link.job()));
+            Ok(serve(&mut link, &mut local)?)
+        })(),
+        (None, None, _) => unreachable!("clap requires one transport"),
     }
 }
 

@@ -50,12 +50,14 @@ pub struct GeometryArgs {
     /// store of revolution with four fins].
     #[arg(long, value_name = "FILE", requires = "aircraft")]
     pub store_shape: Option<PathBuf>,
-    /// The smallest clearance allowed [mm] (MIL-STD-1289D: 25.4).
+    /// The smallest clearance allowed [mm] (MIL-STD-1289D: 25.4); only with --aircraft (a
+    /// criterion without an aircraft would be ignored, so it is refused).
     #[arg(
         long,
         default_value_t = 25.4,
         value_name = "MM",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        requires = "aircraft"
     )]
     pub clearance_mm: f64,
 }

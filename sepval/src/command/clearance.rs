@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::atomic_file::write_atomically;
+use sepval_common::cancel;
 use sepval_common::evaluation::{Candidate, Evaluator, InProcess, Job};
 use sepval_common::scenario::Scenario;
 use sepval_common::telemetry::Trajectory;
@@ -43,16 +44,16 @@ pub fn geometry(
     store_shape: Option<&Path>,
     scenario: &Scenario,
 ) -> Result<Geometry> {
-    let plane = Body::read(aircraft, Role::Aircraft)
+    let stop = &cancel::requested;
+    let plane = Body::read_until(aircraft, Role::Aircraft, stop)
         .with_context(|| format!("--aircraft {}", aircraft.display()))?;
     let store = match store_shape {
-        Some(p) => {
-            Body::read(p, Role::Store).with_context(|| format!("--store-shape {}", p.display()))?
-        }
+        Some(p) => Body::read_until(p, Role::Store, stop)
+            .with_context(|| format!("--store-shape {}", p.display()))?,
         None => Body::default_store(scenario.store.diameter_m)
-            .context("the default store shape of the scenario")?,
+            .context("the default store shape, made of the scenario's store.diameter_m")?,
     };
-    Geometry::new(store, plane).with_context(|| {
+    Geometry::new_until(store, plane, stop).with_context(|| {
         format!(
             "--aircraft {} with the store {}",
             aircraft.display(),
@@ -75,7 +76,7 @@ pub fn trace(c: &ClearanceSettings, traj: &Trajectory) -> Result<Trace> {
         })
         .collect();
     c.geometry
-        .trace(&traj.times_s, &poses, c.free_after_m)
+        .trace_until(&traj.times_s, &poses, c.free_after_m, &cancel::requested)
         .context("the clearance of the trajectory")
 }
 

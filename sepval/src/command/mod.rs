@@ -208,10 +208,12 @@ pub fn claim_out(
     } else {
         Claim::Fresh
     };
-    RunDir::claim(out, claim, command).with_context(|| {
+    let dir = RunDir::claim(out, claim, command).with_context(|| {
         format!(
             "--out {} (--overwrite clears an earlier run)",
             out.display()
         )
-    })
+    })?;
+    sepval_common::defect::inject("claimed");
+    Ok(dir)
 }
