@@ -299,7 +299,7 @@ fn predict_names_outliers_stores_and_the_scenario_file() {
     );
     refused(
         &with(&["--scenario", "cond.toml", "--data", "spiky-b.csv"]),
-        &format!("--data spiky-b.csv: spiky-b.csv: 1 outlier(s)"),
+        "--data spiky-b.csv: spiky-b.csv: 1 outlier(s)",
     );
     refused(
         &with(&["--scenario", "heavy.toml"]),
