@@ -41,6 +41,7 @@ pub mod limits;
 pub mod model;
 pub mod noise;
 pub mod nonfinite;
+pub mod number_text;
 pub mod propagator;
 pub mod scenario;
 pub mod simulation;

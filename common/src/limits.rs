@@ -27,6 +27,11 @@ pub const MAX_ANGLE_DEG: f64 = 3600.0;
 /// The file is streamed line by line (never held whole), so this bounds the time spent on it,
 /// not memory.
 pub const MAX_TELEMETRY_BYTES: u64 = MAX_SAMPLES as u64 * 512;
+/// Longest line of a telemetry file \[bytes\]: 64 KiB. A row of the seven columns in full
+/// precision takes at most 175 bytes (sepval writes about 120) and a comment a few hundred;
+/// a longer line is refused once this many bytes of it are read, so a file without a newline
+/// (a gigabyte of NUL bytes) costs this much memory, not its size.
+pub const MAX_TELEMETRY_LINE_BYTES: usize = 64 << 10;
 /// Most values one table may hold (its grid points).
 pub const MAX_TABLE_VALUES: usize = 1_000_000;
 /// Largest table CSV file \[bytes\]: a table of the most grid points ([`MAX_TABLE_VALUES`]) in
@@ -44,19 +49,23 @@ pub const MAX_EXTENSION_BYTES: u64 = 1 << 20;
 /// candidates, a few MB at the study's settings.
 pub const MAX_JSON_BYTES: u64 = 256 << 20;
 
+use crate::number_text::Shown;
+
 /// A run beyond the limits.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum LimitError {
     /// Too long an event.
-    #[error("an event of {span_s} s is longer than the limit of {MAX_SPAN_S} s")]
+    #[error("an event of {} s is longer than the limit of {MAX_SPAN_S} s", Shown(*span_s))]
     Span {
         /// The span asked for \[s\].
         span_s: f64,
     },
     /// Too many integration steps.
     #[error(
-        "{steps:.3e} RK4 steps ({span_s} s at dt = {dt_s} s) exceed the limit of {MAX_STEPS:.0e} steps per run"
+        "{steps:.3e} RK4 steps ({} s at dt = {} s) exceed the limit of {MAX_STEPS:.0e} steps per run",
+        Shown(*span_s),
+        Shown(*dt_s)
     )]
     Steps {
         /// Steps asked for.
@@ -67,7 +76,7 @@ pub enum LimitError {
         dt_s: f64,
     },
     /// Too many samples.
-    #[error("{samples} samples exceed the limit of {MAX_SAMPLES} per event")]
+    #[error("{} samples exceed the limit of {MAX_SAMPLES} per event", Shown(*samples))]
     Samples {
         /// Samples asked for.
         samples: f64,
@@ -118,6 +127,10 @@ mod tests {
         assert_eq!(
             check_steps(1000.0, 1e-5).unwrap_err().to_string(),
             "1.000e8 RK4 steps (1000 s at dt = 0.00001 s) exceed the limit of 1e7 steps per run"
+        );
+        assert_eq!(
+            check_steps(1e308, 0.0005).unwrap_err().to_string(),
+            "an event of 1e308 s is longer than the limit of 3600 s"
         );
         assert_eq!(
             check_sampling(1.0, 1e9).unwrap_err().to_string(),

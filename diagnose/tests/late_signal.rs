@@ -62,6 +62,7 @@ fn options(out: &Path, job: &Job) -> DiagnoseOptions {
                 data: Vec::new(),
                 scenario: None,
                 extension: None,
+                outliers: Default::default(),
             },
             lm: lm.clone(),
             lm_probe: lm.clone(),

@@ -87,6 +87,13 @@ pub struct InputsRecord {
     /// Model-extension file (absolute path), if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extension: Option<PathBuf>,
+    /// What was done with outliers in the data (docs/model.md section 6); written only when
+    /// they were dropped, so that a record of the default reads and hashes as before.
+    #[serde(
+        default,
+        skip_serializing_if = "sepval_common::telemetry::outliers::Policy::is_refuse"
+    )]
+    pub outliers: sepval_common::telemetry::outliers::Policy,
 }
 
 /// The noise floor.

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 #[non_exhaustive]
 pub enum GeometryError {
     /// The file could not be opened or read.
-    #[error("{path}: cannot read the geometry file: {source}")]
+    #[error("{path}: cannot read the geometry file")]
     Unreadable {
         /// The file.
         path: PathBuf,

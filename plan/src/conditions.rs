@@ -6,6 +6,7 @@
 //! Mach breakpoints of the scenario's tables (a table is held at its edge beyond them, so a
 //! planned release there would fly on made-up aerodynamics).
 
+use sepval_common::number_text::Shown;
 use serde::{Deserialize, Serialize};
 
 use sepval_common::scenario::{Flight, Scenario};
@@ -103,7 +104,7 @@ pub struct Range {
 #[non_exhaustive]
 pub enum ConditionError {
     /// A range that is not `LO:HI` with finite numbers and LO <= HI.
-    #[error("{flag} {lo}:{hi}: {message}")]
+    #[error("{flag} {}:{}: {message}", Shown(*lo), Shown(*hi))]
     Range {
         /// The flag.
         flag: &'static str,
@@ -267,8 +268,12 @@ fn check_range(base: &Scenario, r: &Range) -> Result<(), ConditionError> {
     for v in [r.lo, r.hi] {
         let mut s = base.clone();
         r.quantity.set(&mut s.flight, v);
-        s.validate("the planned condition")
-            .map_err(|e| bad(format!("{v} is not a condition the scenario can fly: {e}")))?;
+        s.validate("the planned condition").map_err(|e| {
+            bad(format!(
+                "{} is not a condition the scenario can fly: {e}",
+                Shown(v)
+            ))
+        })?;
     }
     if r.quantity == Quantity::Mach {
         if let Some((lo, hi)) = mach_coverage(base) {

@@ -5,7 +5,8 @@
 //! and `--samples` is at least 1, at most [`MAX_SAMPLES`], and their trajectories at the
 //! band's points fit [`MAX_VALUE_BYTES`].
 
-use sepval_common::scenario::Scenario;
+use sepval_common::number_text::Shown;
+use sepval_common::scenario::{Scenario, StoreDifference};
 
 /// The most samples of one prediction.
 pub const MAX_SAMPLES: usize = 100_000;
@@ -18,7 +19,7 @@ pub const MAX_VALUE_BYTES: usize = 1 << 30;
 #[non_exhaustive]
 pub enum ConditionError {
     /// `--level` outside (0, 1).
-    #[error("--level {0}: expected a number between 0 and 1 (exclusive), e.g. 0.95")]
+    #[error("--level {}: expected a number between 0 and 1 (exclusive), e.g. 0.95", Shown(*.0))]
     Level(f64),
     /// `--samples` 0 or too many.
     #[error("--samples {samples}: {message}")]
@@ -30,13 +31,11 @@ pub enum ConditionError {
     },
     /// A scenario of another store.
     #[error(
-        "--scenario {scenario}: its {part} differs from that of the releases fitted ({fitted}): a prediction flies the store that was fitted; change only [flight]"
+        "its store differs from that of the releases fitted ({fitted}): {difference}; a prediction flies the store that was fitted: change only [flight]"
     )]
     OtherStore {
-        /// The scenario's name.
-        scenario: String,
-        /// The part that differs.
-        part: &'static str,
+        /// The first field that differs.
+        difference: StoreDifference,
         /// The fitted scenario's name.
         fitted: String,
     },
@@ -95,27 +94,11 @@ impl Settings {
     }
 }
 
-/// Checks that `condition` flies the store of `fitted`.
+/// Checks that `condition` flies the store of `fitted` ([`Scenario::store_difference`]).
 pub fn check_condition(fitted: &Scenario, condition: &Scenario) -> Result<(), ConditionError> {
-    let differs: Option<&'static str> = if fitted.store != condition.store {
-        Some("store (mass properties, ejector geometry)")
-    } else if fitted.ejector != condition.ejector {
-        Some("ejector force curve")
-    } else if fitted.aero != condition.aero {
-        Some("aerodynamic database")
-    } else if fitted.interference != condition.interference {
-        Some("interference model")
-    } else if fitted.factors != condition.factors {
-        Some("factor table")
-    } else if fitted.extension != condition.extension {
-        Some("extension terms")
-    } else {
-        None
-    };
-    match differs {
-        Some(part) => Err(ConditionError::OtherStore {
-            scenario: condition.name.clone(),
-            part,
+    match fitted.store_difference(condition) {
+        Some(difference) => Err(ConditionError::OtherStore {
+            difference,
             fitted: fitted.name.clone(),
         }),
         None => Ok(()),

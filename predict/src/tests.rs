@@ -194,5 +194,11 @@ fn settings_and_conditions_are_checked() {
     assert!(check_condition(&fitted, &other).is_ok());
     other.store.mass_kg *= 1.1;
     let e = check_condition(&fitted, &other).unwrap_err();
-    assert!(e.to_string().contains("its store (mass properties"), "{e}");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "its store differs from that of the releases fitted ({}): store.mass_kg is {}, not {}; a prediction flies the store that was fitted: change only [flight]",
+            fitted.name, other.store.mass_kg, fitted.store.mass_kg
+        )
+    );
 }

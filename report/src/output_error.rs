@@ -14,7 +14,7 @@ pub enum OutputError {
     #[error("cannot write {}", .0.path.display())]
     Write(#[source] sepval_common::atomic_file::WriteError),
     /// A directory.
-    #[error("cannot create {}: {source}", path.display())]
+    #[error("cannot create {}", path.display())]
     Dir {
         /// The directory.
         path: PathBuf,

@@ -494,7 +494,10 @@ pub fn hex_sha256(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+mod same_store;
 mod validate;
+
+pub use same_store::StoreDifference;
 
 #[cfg(test)]
 mod tests;

@@ -143,6 +143,19 @@ pub enum TelemetryError {
         /// The field.
         value: String,
     },
+    /// A line longer than [`MAX_TELEMETRY_LINE_BYTES`](crate::limits::MAX_TELEMETRY_LINE_BYTES),
+    /// refused once that many bytes of it were read.
+    #[error(
+        "{file}: line {line} is longer than {limit} bytes, the limit of a telemetry line (sepval_common::limits; a row is a few hundred bytes): is it a telemetry file?"
+    )]
+    LineTooLong {
+        /// The file.
+        file: String,
+        /// The line.
+        line: usize,
+        /// The limit \[bytes\].
+        limit: usize,
+    },
     /// More samples than an event may have.
     #[error("{file}: line {line}: more than {limit} samples, the limit per event")]
     TooManySamples {

@@ -18,21 +18,24 @@
 //!   +-[`MAX_ANGLE_DEG`](crate::limits::MAX_ANGLE_DEG); a value beyond them is refused with its line and column (it is a
 //!   unit or export mistake, and it would overflow the goals).
 //! - Files are read line by line: the text is never held whole in memory. Only a regular file
-//!   is read, of at most [`MAX_TELEMETRY_BYTES`] ([`crate::input_file`]).
+//!   is read, of at most [`MAX_TELEMETRY_BYTES`] ([`crate::input_file`]), each line of at most
+//!   [`MAX_TELEMETRY_LINE_BYTES`] (refused once that many bytes of it were read).
 //! - Files sepval writes print every number in the shortest form that reads back as the same
 //!   double, so writing and reading is exact.
 
 use std::fmt::Write as _;
-use std::io::BufRead;
 use std::path::Path;
 
 use crate::atomic_file::{WriteError, write_atomically};
 use crate::input_file::{InputFile, InputFileError};
-use crate::limits::{MAX_SAMPLES, MAX_TELEMETRY_BYTES};
+use crate::limits::{MAX_SAMPLES, MAX_TELEMETRY_BYTES, MAX_TELEMETRY_LINE_BYTES};
 use crate::units::M_PER_FT;
 
 mod error;
+mod lines;
+pub mod outliers;
 pub use error::{Bound, TelemetryError};
+use lines::{BoundedLines, too_long as line_too_long};
 
 /// A trajectory: samples of position and attitude against time.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
@@ -47,6 +50,16 @@ pub struct Trajectory {
     pub metadata: Vec<(String, String)>,
     /// All comment lines (text after `#`, trimmed), in file order.
     pub comments: Vec<String>,
+}
+
+/// A trajectory read from a file or text, with the line of each sample (so that a message
+/// about a sample can name its line).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Numbered {
+    /// The trajectory.
+    pub trajectory: Trajectory,
+    /// The 1-based line of each sample in the file.
+    pub lines: Vec<usize>,
 }
 
 /// One quantity of a telemetry row: its name, accepted headers with their scale to SI, and how
@@ -112,6 +125,11 @@ impl Trajectory {
 
     /// Reads a telemetry file, line by line.
     pub fn read(path: &Path) -> Result<Trajectory, TelemetryError> {
+        Trajectory::read_numbered(path).map(|n| n.trajectory)
+    }
+
+    /// Reads a telemetry file, line by line, with the line of each sample.
+    pub fn read_numbered(path: &Path) -> Result<Numbered, TelemetryError> {
         let name = path.display().to_string();
         let file =
             InputFile::open(path, "telemetry file", MAX_TELEMETRY_BYTES).map_err(|e| {
@@ -123,12 +141,17 @@ impl Trajectory {
                     Err(refused) => TelemetryError::Input(Box::new(refused)),
                 }
             })?;
-        let lines = std::io::BufReader::new(file).split(b'\n');
+        let lines = BoundedLines::new(std::io::BufReader::new(file), MAX_TELEMETRY_LINE_BYTES);
         Trajectory::parse_lines(lines, &name, MAX_SAMPLES)
     }
 
     /// Parses telemetry text; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Trajectory, TelemetryError> {
+        Trajectory::parse_numbered(text, file).map(|n| n.trajectory)
+    }
+
+    /// Parses telemetry text, with the line of each sample; `file` names it in errors.
+    pub fn parse_numbered(text: &str, file: &str) -> Result<Numbered, TelemetryError> {
         let lines = text.split('\n').map(|l| Ok(l.as_bytes().to_vec()));
         Trajectory::parse_lines(lines, file, MAX_SAMPLES)
     }
@@ -139,24 +162,14 @@ impl Trajectory {
         lines: impl Iterator<Item = std::io::Result<Vec<u8>>>,
         file: &str,
         max_samples: usize,
-    ) -> Result<Trajectory, TelemetryError> {
+    ) -> Result<Numbered, TelemetryError> {
         let file = file.to_string();
         let mut out = Trajectory::default();
+        let mut sample_lines = Vec::new();
         let mut header: Option<Header> = None;
         for (i, raw) in lines.enumerate() {
             let line = i + 1;
-            let raw = raw.map_err(|e| match InputFileError::from_io(&e) {
-                // A file that grew past its limit while read.
-                Some(_) => TelemetryError::Input(Box::new(
-                    *e.into_inner()
-                        .and_then(|inner| inner.downcast::<InputFileError>().ok())
-                        .expect("checked: it carries an InputFileError"),
-                )),
-                None => TelemetryError::Io {
-                    file: file.clone(),
-                    message: format!("line {line}: {e}"),
-                },
-            })?;
+            let raw = line_bytes(raw, &file, line)?;
             let text = std::str::from_utf8(&raw).map_err(|_| TelemetryError::NotText {
                 file: file.clone(),
                 line,
@@ -217,13 +230,17 @@ impl Trajectory {
             out.times_s.push(values[0]);
             out.pos_m.push([values[1], values[2], values[3]]);
             out.att_deg.push([values[4], values[5], values[6]]);
+            sample_lines.push(line);
         }
         match header {
             None => Err(TelemetryError::Empty { file }),
             Some(Header { line, .. }) if out.times_s.is_empty() => {
                 Err(TelemetryError::NoSamples { file, line })
             }
-            Some(_) => Ok(out),
+            Some(_) => Ok(Numbered {
+                trajectory: out,
+                lines: sample_lines,
+            }),
         }
     }
 
@@ -293,6 +310,43 @@ impl Trajectory {
         self.comments.push(format!("{key} = {value}"));
         self.metadata.push((key.to_string(), value.to_string()));
     }
+}
+
+/// The bytes of line `line` as read: an I/O error, a file that grew past its limit or a line
+/// longer than [`MAX_TELEMETRY_LINE_BYTES`] become the error that says so.
+fn line_bytes(
+    raw: std::io::Result<Vec<u8>>,
+    file: &str,
+    line: usize,
+) -> Result<Vec<u8>, TelemetryError> {
+    let raw = raw.map_err(|e| match InputFileError::from_io(&e) {
+        // A file that grew past its limit while read.
+        Some(_) => TelemetryError::Input(Box::new(
+            *e.into_inner()
+                .and_then(|inner| inner.downcast::<InputFileError>().ok())
+                .expect("checked: it carries an InputFileError"),
+        )),
+        None => match line_too_long(&e) {
+            Some(limit) => TelemetryError::LineTooLong {
+                file: file.to_string(),
+                line,
+                limit,
+            },
+            None => TelemetryError::Io {
+                file: file.to_string(),
+                message: format!("line {line}: {e}"),
+            },
+        },
+    })?;
+    if raw.len() > MAX_TELEMETRY_LINE_BYTES {
+        // Text given whole (not read from a file) is held to the same bound.
+        return Err(TelemetryError::LineTooLong {
+            file: file.to_string(),
+            line,
+            limit: MAX_TELEMETRY_LINE_BYTES,
+        });
+    }
+    Ok(raw)
 }
 
 /// The seven values of a data row in SI (time, position, attitude): each field a finite number

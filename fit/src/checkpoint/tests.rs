@@ -78,6 +78,7 @@ fn checkpoint(job: &Arc<Job>, generations: usize, finish: bool) -> Checkpoint {
             data: Vec::new(),
             scenario: None,
             extension: None,
+            outliers: Default::default(),
         },
         state: ga.state().unwrap().clone(),
         probes: Vec::new(),

@@ -240,6 +240,7 @@ pub fn fitted_source(case: &Case, job: &Arc<Job>) -> Source {
             data: Vec::new(),
             scenario: None,
             extension: None,
+            outliers: Default::default(),
         },
         held_out: Vec::new(),
     }

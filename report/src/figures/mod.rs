@@ -142,7 +142,7 @@ pub enum FigureError {
         message: String,
     },
     /// The file could not be written (for example because its directory does not exist).
-    #[error("{}: cannot write: {source}", path.display())]
+    #[error("{}: cannot write", path.display())]
     Write {
         /// The figure file.
         path: PathBuf,

@@ -8,7 +8,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 mod shared;
 use sepval_transport::RunId;
 pub use shared::{
-    EvalArgs, GeometryArgs, InputArgs, ModelArgs, NoiseArgs, OverwriteArgs, TablesArgs,
+    EvalArgs, GeometryArgs, InputArgs, ModelArgs, NoiseArgs, OutlierArg, OutlierArgs,
+    OverwriteArgs, TablesArgs,
 };
 
 #[derive(Parser)]
@@ -246,6 +247,8 @@ pub struct PredictArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub validate: Vec<PathBuf>,
     #[command(flatten)]
+    pub outliers: OutlierArgs,
+    #[command(flatten)]
     pub geometry: GeometryArgs,
     #[command(flatten)]
     pub eval: EvalArgs,
@@ -358,6 +361,8 @@ pub struct EnvelopeArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub validate: Vec<PathBuf>,
     #[command(flatten)]
+    pub outliers: OutlierArgs,
+    #[command(flatten)]
     pub geometry: GeometryArgs,
     #[command(flatten)]
     pub eval: EvalArgs,
@@ -444,6 +449,8 @@ pub struct GoalsArgs {
     /// Simulated trajectory (CSV) at the same sample times.
     #[arg(long, value_name = "B.csv")]
     pub sim: PathBuf,
+    #[command(flatten)]
+    pub outliers: OutlierArgs,
 }
 
 #[derive(clap::Args)]

@@ -1,8 +1,9 @@
 //! The groups of flags several commands share (flattened into their argument structs): the
-//! inputs of a fit, the model, tables, geometry, overwriting, noise and the evaluator.
+//! inputs of a fit, the model, outliers, tables, geometry, overwriting, noise and the evaluator.
 
 use std::path::PathBuf;
 
+use sepval_common::telemetry::outliers::Policy;
 use sepval_transport::RunId;
 
 use super::EvaluatorKind;
@@ -16,6 +17,43 @@ pub struct InputArgs {
     pub data: Vec<PathBuf>,
     #[command(flatten)]
     pub model: ModelArgs,
+    #[command(flatten)]
+    pub outliers: OutlierArgs,
+}
+
+/// What is done with outliers in the telemetry a command reads (docs/model.md section 6).
+#[derive(clap::Args)]
+pub struct OutlierArgs {
+    /// Samples far from the trend of their neighbours (docs/model.md section 6): `refuse` the
+    /// file naming them, or `drop` the rows that hold one [default: refuse; rerun, and the
+    /// releases a source records: what their fit did].
+    #[arg(long, value_enum, value_name = "refuse|drop")]
+    pub outliers: Option<OutlierArg>,
+}
+
+/// `--outliers`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutlierArg {
+    /// Refuse a file that holds one, naming them.
+    Refuse,
+    /// Leave out the rows that hold one (said on stderr).
+    Drop,
+}
+
+impl OutlierArgs {
+    /// The policy given, else the default (refuse).
+    pub fn policy(&self) -> Policy {
+        self.or(Policy::Refuse)
+    }
+
+    /// The policy given, else `recorded`.
+    pub fn or(&self, recorded: Policy) -> Policy {
+        match self.outliers {
+            Some(OutlierArg::Refuse) => Policy::Refuse,
+            Some(OutlierArg::Drop) => Policy::Drop,
+            None => recorded,
+        }
+    }
 }
 
 /// The model a command simulates (simulate, and through [`InputArgs`] fit, diagnose, rerun).

@@ -46,7 +46,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         worker_executable: worker_executable()?,
         repeat: args.repeat,
     };
-    let (job, _) = inputs::job(&[], None, None)?;
+    let (job, _) = inputs::job(&[], None, None, Default::default())?;
     note!(
         "benchmarking {} simulations of the default event per measurement, median of {} \
          interleaved rounds, on {} core(s)",

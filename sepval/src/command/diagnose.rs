@@ -65,10 +65,12 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
     };
     ga.validate()?;
     let given = &args.inputs;
+    let policy = given.outliers.policy();
     let (job, inputs) = inputs::job(
         &given.data,
         given.model.scenario.as_deref(),
         given.model.extension.as_deref(),
+        policy,
     )?;
     // The --extension terms, written again with the discovered ones to DIR/extension.toml.
     let given_terms = match given.model.extension.as_deref() {
@@ -76,7 +78,7 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
         None => Vec::new(),
     };
     let validation = inputs::validation_job(
-        &args.validate,
+        &inputs::with_policy(&args.validate, policy),
         &given.data,
         &job,
         given.model.scenario.as_deref(),

@@ -50,8 +50,12 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         .iter()
         .map(|(q, text)| Axis::parse(*q, text))
         .collect::<Result<_, _>>()?;
-    let (source, fitted, held_out) =
-        source_inputs(&args.from, args.extension.as_deref(), &args.validate)?;
+    let (source, fitted, held_out) = source_inputs(
+        &args.from,
+        args.extension.as_deref(),
+        &args.validate,
+        args.outliers.policy(),
+    )?;
     let base = fitted.events()[0].simulator.scenario().clone();
     let grid = Grid::of(&base, &axes)?;
     let Some(clearance) = clearance::settings(&args.geometry, &base)? else {
@@ -240,7 +244,7 @@ fn digest(
         .iter()
         .map(|(q, t)| format!("{}={t}", q.flag()))
         .collect();
-    let settings = format!(
+    let mut settings = format!(
         "samples={} seed={} clearance_mm={} validate={} axes={}",
         args.samples,
         args.seed,
@@ -248,6 +252,10 @@ fn digest(
         validate.join(";"),
         axes.join(";")
     );
+    if args.outliers.policy() == sepval_common::telemetry::outliers::Policy::Drop {
+        // Only when given, so that the digest of an envelope without it stays as it was.
+        settings.push_str(" outliers=drop");
+    }
     parts.push(("settings".into(), settings.into_bytes()));
     let refs: Vec<(&str, &[u8])> = parts
         .iter()

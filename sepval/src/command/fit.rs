@@ -121,10 +121,15 @@ fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
             given.model.extension.clone(),
         ),
     };
+    let recorded = resume
+        .as_ref()
+        .map(|c| c.inputs.outliers)
+        .unwrap_or_default();
     let (job, inputs) = inputs::job(
         &data_paths,
         scenario_path.as_deref(),
         extension_path.as_deref(),
+        given.outliers.or(recorded),
     )?;
     let method = match (args.method, &resume) {
         (Some(m), _) => method(m),

@@ -4,12 +4,18 @@ use anyhow::{Context, Result};
 use sepval_common::goals::{Goals, goals_between};
 use sepval_common::telemetry::Trajectory;
 
+use super::releases;
 use crate::cli::GoalsArgs;
 
-/// Runs `sepval goals`.
+/// Runs `sepval goals`. Both files are screened for outliers; `--outliers drop` leaves out the
+/// rows of either's outliers from both, so that their times still pair.
 pub fn run(args: GoalsArgs) -> Result<()> {
-    let data = Trajectory::read(&args.data)?;
-    let sim = Trajectory::read(&args.sim)?;
+    let policy = args.outliers.policy();
+    let (data, in_data) = releases::read_screened(&args.data)?;
+    let (sim, in_sim) = releases::read_screened(&args.sim)?;
+    let either: Vec<_> = in_data.iter().chain(&in_sim).copied().collect();
+    let data = releases::screen(&args.data, data, &in_data, &either, policy)?;
+    let sim = releases::screen(&args.sim, sim, &in_sim, &either, policy)?;
     let g = between(
         (&args.data.display().to_string(), &data),
         (&args.sim.display().to_string(), &sim),

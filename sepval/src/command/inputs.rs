@@ -9,6 +9,9 @@ use sepval_common::factors::{FactorTable, Factors};
 use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
 use sepval_common::telemetry::Trajectory;
+use sepval_common::telemetry::outliers::Policy;
+
+use super::releases::{self, Release};
 
 /// The scenario of `--scenario FILE`, or the embedded default, extended by the terms of
 /// `--extension FILE` (docs/model.md section 11).
@@ -21,7 +24,11 @@ pub fn scenario(path: Option<&Path>, extension: Option<&Path>) -> Result<Scenari
         let terms = sepval_common::extension::load_extension(e)?;
         s.extension
             .extend(terms.iter().map(sepval_common::extension::TermRecord::of));
-        s.validate(&format!("{} extended by {}", s.name, e.display()))?;
+        s.validate(&format!(
+            "{} extended by {}",
+            scenario_name(path),
+            e.display()
+        ))?;
     }
     Ok(s)
 }
@@ -57,24 +64,31 @@ pub fn effects(specs: &[String]) -> Result<EffectSet> {
     Ok(set)
 }
 
-/// The measured data of `--data FILE` (several allowed), or the embedded default synthetic
-/// flight test when none is given.
-pub fn data(paths: &[std::path::PathBuf]) -> Result<Vec<Trajectory>> {
+/// The measured data of `--data FILE` (several allowed), each screened for outliers by
+/// `policy`, or the embedded default synthetic flight test when none is given.
+pub fn data(paths: &[std::path::PathBuf], policy: Policy) -> Result<Vec<Trajectory>> {
     if paths.is_empty() {
         return Ok(vec![default_flight_test()]);
     }
-    paths
-        .iter()
-        .map(|p| Trajectory::read(p).map_err(anyhow::Error::from))
-        .collect()
+    paths.iter().map(|p| releases::read(p, policy)).collect()
+}
+
+/// `paths`, each to be read with `policy`.
+pub fn with_policy(
+    paths: &[std::path::PathBuf],
+    policy: Policy,
+) -> Vec<(std::path::PathBuf, Policy)> {
+    paths.iter().map(|p| (p.clone(), policy)).collect()
 }
 
 /// The job of a fit: each data file (or the embedded default flight test) with the scenario,
-/// and the record of where they came from.
+/// screened for outliers by `policy`, each release once and of the store fitted, and the record
+/// of where they came from.
 pub fn job(
     data_paths: &[std::path::PathBuf],
     scenario_path: Option<&Path>,
     extension_path: Option<&Path>,
+    policy: Policy,
 ) -> Result<(
     sepval_common::evaluation::Job,
     sepval_fit::checkpoint::InputsRecord,
@@ -93,27 +107,54 @@ pub fn job(
         }
     }
     let scen = scenario(scenario_path, extension_path)?;
-    let data = data(data_paths)?;
+    let data = data(data_paths, policy)?;
     let names: Vec<String> = if data_paths.is_empty() {
         vec!["embedded default synthetic flight test".to_string()]
     } else {
         data_paths.iter().map(|p| p.display().to_string()).collect()
     };
-    let mut events = Vec::with_capacity(data.len());
-    for (name, data) in names.into_iter().zip(data) {
-        let scenario = event_scenario(&scen, &data, &name)?;
-        events.push(Event {
-            name,
-            simulator: Simulator::new(&scenario),
-            data,
-        });
+    let mut scenarios = Vec::with_capacity(data.len());
+    for (name, data) in names.iter().zip(&data) {
+        let scenario = event_scenario(&scen, data, name)?;
+        releases::check_store(&scen, data, name, &scenario_name(scenario_path))?;
+        scenarios.push(scenario);
     }
+    let given: Vec<Release> = names
+        .iter()
+        .zip(&data)
+        .zip(&scenarios)
+        .map(|((name, data), s)| Release {
+            given: format!("--data {name}"),
+            data,
+            flight: &s.flight,
+        })
+        .collect();
+    releases::refuse_duplicates(&given)?;
+    let events = names
+        .into_iter()
+        .zip(data)
+        .zip(&scenarios)
+        .map(|((name, data), scenario)| Event {
+            name,
+            simulator: Simulator::new(scenario),
+            data,
+        })
+        .collect();
     let record = sepval_fit::checkpoint::InputsRecord {
         data: data_paths.iter().map(|p| absolute(p)).collect(),
         scenario: scenario_path.map(absolute),
         extension: extension_path.map(absolute),
+        outliers: policy,
     };
     Ok((Job::new(events)?, record))
+}
+
+/// How messages name the scenario fitted: its file, or the embedded default.
+pub fn scenario_name(path: Option<&Path>) -> String {
+    match path {
+        Some(p) => format!("scenario {}", p.display()),
+        None => "the embedded default scenario".to_string(),
+    }
 }
 
 /// The scenario of one event: `base` with the flight condition named in the data's `#`
@@ -143,12 +184,12 @@ pub fn event_scenario(
     Ok(s)
 }
 
-/// The events of `--validate FILE` (none: `None`), read like `--data` with the same scenario
-/// and extension; a release given both to fit and to validate is refused, as is one given twice
-/// to validate: the same file by its path, a copy by its samples (`fitted`, the job of the
-/// `--data` files, holds theirs).
+/// The events of `--validate FILE` (none: `None`), each with the outlier policy it is read
+/// with, read like `--data` with the same scenario and extension; a release given both to fit
+/// and to validate is refused, as is one given twice to validate: the same file by its path, a
+/// copy by its samples and condition (`fitted`, the job of the `--data` files, holds theirs).
 pub fn validation_job(
-    paths: &[std::path::PathBuf],
+    held: &[(std::path::PathBuf, Policy)],
     data_paths: &[std::path::PathBuf],
     fitted: &sepval_common::evaluation::Job,
     scenario_path: Option<&Path>,
@@ -156,11 +197,11 @@ pub fn validation_job(
 ) -> Result<Option<sepval_common::evaluation::Job>> {
     use sepval_common::evaluation::{Event, Job};
     use sepval_common::simulation::Simulator;
-    if paths.is_empty() {
+    if held.is_empty() {
         return Ok(None);
     }
     let absolute = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
-    for (i, p) in paths.iter().enumerate() {
+    for (i, (p, _)) in held.iter().enumerate() {
         if let Some(q) = data_paths.iter().find(|q| absolute(q) == absolute(p)) {
             bail!(
                 "--validate {} is the same file as --data {}: a release used for fitting cannot measure prediction",
@@ -168,7 +209,7 @@ pub fn validation_job(
                 q.display()
             );
         }
-        if let Some(q) = paths[..i].iter().find(|q| absolute(q) == absolute(p)) {
+        if let Some((q, _)) = held[..i].iter().find(|(q, _)| absolute(q) == absolute(p)) {
             bail!(
                 "--validate {} is the same file as --validate {}: give each release once",
                 p.display(),
@@ -177,54 +218,51 @@ pub fn validation_job(
         }
     }
     let scen = scenario(scenario_path, extension_path)?;
-    let mut events: Vec<Event> = Vec::with_capacity(paths.len());
-    for p in paths {
-        let data = Trajectory::read(p).with_context(|| format!("--validate {}", p.display()))?;
-        if let Some(e) = fitted
-            .events()
-            .iter()
-            .find(|e| same_samples(&e.data, &data))
-        {
-            let fitted = if data_paths.is_empty() {
-                format!("the data fitted ({})", e.name)
-            } else {
-                format!("--data {}", e.name)
-            };
-            bail!(
-                "--validate {} holds the same samples as {fitted}: a release used for fitting \
-                 cannot measure prediction",
-                p.display()
-            );
-        }
-        if let Some(e) = events.iter().find(|e| same_samples(&e.data, &data)) {
-            bail!(
-                "--validate {} holds the same samples as --validate {}: give each release once",
-                p.display(),
-                e.name
-            );
-        }
+    let fitted_releases: Vec<Release> = fitted
+        .events()
+        .iter()
+        .map(|e| Release {
+            given: match data_paths.is_empty() {
+                true => format!("the data fitted ({})", e.name),
+                false => format!("--data {}", e.name),
+            },
+            data: &e.data,
+            flight: &e.simulator.scenario().flight,
+        })
+        .collect();
+    let mut read = Vec::with_capacity(held.len());
+    for (p, policy) in held {
         let name = p.display().to_string();
+        let data = releases::read(p, *policy).with_context(|| format!("--validate {name}"))?;
         let scenario = event_scenario(&scen, &data, &name)?;
-        events.push(Event {
+        releases::check_store(&scen, &data, &name, &scenario_name(scenario_path))?;
+        read.push((name, data, scenario));
+    }
+    let validating: Vec<Release> = read
+        .iter()
+        .map(|(name, data, s)| Release {
+            given: format!("--validate {name}"),
+            data,
+            flight: &s.flight,
+        })
+        .collect();
+    for (i, r) in validating.iter().enumerate() {
+        releases::refuse_twice(
+            &fitted_releases,
+            r,
+            "a release used for fitting cannot measure prediction",
+        )?;
+        releases::refuse_twice(&validating[..i], r, "give each release once")?;
+    }
+    let events: Vec<Event> = read
+        .into_iter()
+        .map(|(name, data, scenario)| Event {
             name,
             simulator: Simulator::new(&scenario),
             data,
-        });
-    }
+        })
+        .collect();
     Ok(Some(Job::new(events)?))
-}
-
-/// Whether two records are the same release: the same samples bit for bit and the same
-/// metadata (the flight condition), whatever the files' names and other comments.
-fn same_samples(a: &Trajectory, b: &Trajectory) -> bool {
-    fn same<'a>(x: impl Iterator<Item = &'a f64>, y: impl Iterator<Item = &'a f64>) -> bool {
-        x.zip(y).all(|(u, v)| u.to_bits() == v.to_bits())
-    }
-    a.len() == b.len()
-        && a.metadata == b.metadata
-        && same(a.times_s.iter(), b.times_s.iter())
-        && same(a.pos_m.iter().flatten(), b.pos_m.iter().flatten())
-        && same(a.att_deg.iter().flatten(), b.att_deg.iter().flatten())
 }
 
 /// The baseline fit of a diagnosis or an update: the study's GA, then Levenberg-Marquardt

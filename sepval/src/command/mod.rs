@@ -16,6 +16,7 @@ pub mod goals;
 pub mod inputs;
 pub mod plan;
 pub mod predict;
+pub mod releases;
 pub mod rerun;
 pub mod scenario;
 pub mod selftest;
@@ -27,6 +28,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
+use sepval_common::number_text::Shown;
 use sepval_transport::RunId;
 use sepval_transport::dispatch::DispatchOptions;
 use sepval_transport::ipc::{IpcOptions, Launch, MAX_WORKERS};
@@ -50,7 +52,7 @@ pub fn count(flag: &str, requested: Option<usize>) -> Result<usize> {
 /// A strictly positive, finite number given on the command line.
 pub fn positive(flag: &str, value: f64) -> Result<f64> {
     if !(value.is_finite() && value > 0.0) {
-        bail!("{flag} = {value}: expected a finite number > 0");
+        bail!("{flag} = {}: expected a finite number > 0", Shown(value));
     }
     Ok(value)
 }
@@ -59,7 +61,10 @@ pub fn positive(flag: &str, value: f64) -> Result<f64> {
 pub fn seconds(flag: &str, value: f64) -> Result<Duration> {
     let v = positive(flag, value)?;
     if v > 3.2e7 {
-        bail!("{flag} = {value}: expected at most 32 000 000 s (a year)");
+        bail!(
+            "{flag} = {}: expected at most 32 000 000 s (a year)",
+            Shown(value)
+        );
     }
     Ok(Duration::from_secs_f64(v))
 }

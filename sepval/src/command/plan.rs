@@ -24,6 +24,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
         &record.data,
         record.scenario.as_deref(),
         record.extension.as_deref(),
+        record.outliers,
     )
     .with_context(|| {
         format!(

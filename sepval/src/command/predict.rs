@@ -7,13 +7,12 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{Event, Job};
-use sepval_common::telemetry::Trajectory;
 use sepval_predict::{
     Flown, PredictionFile, Settings, Source, predict, prediction_file, prepare, read_source,
     write_outputs,
 };
 
-use super::{clearance, count, evaluator_spec, inputs, notices};
+use super::{clearance, count, evaluator_spec, inputs, notices, releases};
 use crate::cli::PredictArgs;
 
 /// Runs `sepval predict`. Every input (the flags, the source, its releases, the condition, the
@@ -29,13 +28,20 @@ pub fn run(args: PredictArgs) -> Result<()> {
         threads: count("--threads", args.eval.threads)?,
     };
     settings.check()?;
-    let (source, fitted, held_out) =
-        source_inputs(&args.from, args.extension.as_deref(), &args.validate)?;
+    let policy = args.outliers.policy();
+    let (source, fitted, held_out) = source_inputs(
+        &args.from,
+        args.extension.as_deref(),
+        &args.validate,
+        policy,
+    )?;
     let extension = args.extension.clone().or(source.inputs.extension.clone());
     let condition = inputs::scenario(Some(&args.scenario), extension.as_deref())
         .with_context(|| format!("--scenario {}", args.scenario.display()))?;
+    sepval_predict::check_condition(fitted.events()[0].simulator.scenario(), &condition)
+        .with_context(|| format!("--scenario {}", args.scenario.display()))?;
     let flown = match &args.data {
-        Some(path) => Some(flown(path, &condition)?),
+        Some(path) => Some(flown(path, (args.scenario.as_path(), &condition), policy)?),
         None => None,
     };
     let clearance = clearance::settings(&args.geometry, &condition)?;
@@ -62,11 +68,13 @@ pub fn run(args: PredictArgs) -> Result<()> {
 }
 
 /// The source of `--from` read and checked, the releases it was fitted to, and the releases held
-/// out (`--validate`, then those the source records).
+/// out (`--validate`, read with `policy`, then those the source records, read as its fit read
+/// its data).
 pub fn source_inputs(
     from: &Path,
     extension: Option<&Path>,
     validate: &[PathBuf],
+    policy: sepval_common::telemetry::outliers::Policy,
 ) -> Result<(Source, Job, Vec<Event>)> {
     let source = read_source(from)?;
     let record = source.inputs.clone();
@@ -77,14 +85,15 @@ pub fn source_inputs(
         &record.data,
         record.scenario.as_deref(),
         extension.as_deref(),
+        record.outliers,
     )
     .with_context(|| format!("--from {}: the releases it was fitted to", from.display()))?;
-    let mut held: Vec<PathBuf> = validate.to_vec();
+    let mut held = inputs::with_policy(validate, policy);
     let recorded = source
         .held_out
         .iter()
-        .filter(|p| !held.contains(p))
-        .cloned();
+        .filter(|p| !validate.contains(p))
+        .map(|p| (p.clone(), record.outliers));
     held.extend(recorded.collect::<Vec<_>>());
     let held_out: Vec<Event> = inputs::validation_job(
         &held,
@@ -100,10 +109,16 @@ pub fn source_inputs(
 
 /// The flown release of `--data`, whose metadata (when it names one) must give the condition
 /// of `--scenario`.
-fn flown(path: &Path, condition: &sepval_common::scenario::Scenario) -> Result<Flown> {
+fn flown(
+    path: &Path,
+    (scenario_path, condition): (&Path, &sepval_common::scenario::Scenario),
+    policy: sepval_common::telemetry::outliers::Policy,
+) -> Result<Flown> {
     let name = path.display().to_string();
-    let data = Trajectory::read(path).with_context(|| format!("--data {name}"))?;
+    let data = releases::read(path, policy).with_context(|| format!("--data {name}"))?;
     let named = inputs::event_scenario(condition, &data, &name)?;
+    let scenario_name = format!("--scenario {}", scenario_path.display());
+    releases::check_store(condition, &data, &name, &scenario_name)?;
     let (a, b) = (&named.flight, &condition.flight);
     let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + x.abs().max(y.abs()));
     if !(same(a.mach, b.mach)

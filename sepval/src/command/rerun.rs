@@ -31,6 +31,7 @@ pub fn run(args: RerunArgs) -> Result<()> {
         data_paths,
         scenario_path.map(PathBuf::as_path),
         extension_path.map(PathBuf::as_path),
+        given.outliers.or(recorded.outliers),
     )?;
     checkpoint.check_job(&job, &args.checkpoint)?;
     let mut evaluator = spec.start(Arc::new(job), notices())?;

@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result};
 use sepval_common::limits::{check_sampling, check_steps};
+use sepval_common::number_text::Shown;
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test_logged;
 
@@ -22,8 +23,10 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     let t_end = t_end.unwrap_or(scenario.integrator.t_end_s);
     let rate = rate.unwrap_or(scenario.integrator.rate_hz);
     // The work of the run, refused before the sample times are made.
-    check_steps(t_end, scenario.integrator.dt_s).with_context(|| format!("--t-end {t_end}"))?;
-    check_sampling(t_end, rate).with_context(|| format!("--t-end {t_end} with --rate {rate}"))?;
+    let (t_shown, rate_shown) = (Shown(t_end), Shown(rate));
+    check_steps(t_end, scenario.integrator.dt_s).with_context(|| format!("--t-end {t_shown}"))?;
+    check_sampling(t_end, rate)
+        .with_context(|| format!("--t-end {t_shown} with --rate {rate_shown}"))?;
     let sim = Simulator::new(&scenario);
     let times = sample_times(t_end, rate);
     let (mut traj, log) =

@@ -64,10 +64,11 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
         given.model.scenario.as_deref(),
         given.model.extension.as_deref(),
     );
-    let (job, inputs) = inputs::job(&given.data, scenario_path, extension_path)?;
+    let policy = given.outliers.policy();
+    let (job, inputs) = inputs::job(&given.data, scenario_path, extension_path, policy)?;
     let scenario = inputs::scenario(scenario_path, extension_path)?;
     let validation = inputs::validation_job(
-        &args.validate,
+        &inputs::with_policy(&args.validate, policy),
         &given.data,
         &job,
         scenario_path,

@@ -16,6 +16,7 @@ mod fuzz;
 mod gust;
 mod hardening;
 mod hardening3_geometry;
+mod hardening3_releases;
 mod hardening_on_disk;
 mod jobs;
 mod plan;

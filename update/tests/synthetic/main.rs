@@ -113,6 +113,7 @@ fn run_update(
                 data: Vec::new(),
                 scenario: None,
                 extension: None,
+                outliers: Default::default(),
             },
             lm: LmSettings::default(),
             lm_probe: LmSettings {
