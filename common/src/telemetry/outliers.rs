@@ -28,9 +28,9 @@ pub const NEIGHBOURS: usize = 6;
 /// Robust sigmas a sample's score must exceed to be an outlier.
 pub const K_SIGMA: f64 = 8.0;
 /// The least departure from the trend of a position sample that is an outlier \[m\].
-pub const FLOOR_POSITION_M: f64 = 0.05;
+pub const FLOOR_POSITION_M: f64 = 0.5;
 /// The least departure from the trend of an angle sample that is an outlier \[deg\].
-pub const FLOOR_ANGLE_DEG: f64 = 1.0;
+pub const FLOOR_ANGLE_DEG: f64 = 5.0;
 
 /// The six channels of a sample, by their names in SI.
 pub const CHANNELS: [&str; 6] = ["x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"];

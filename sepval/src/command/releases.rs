@@ -73,7 +73,7 @@ pub fn screen(
     }
 }
 
-/// `line 60, z_m = 10.57 m, 10 m from the trend (threshold 0.05 m)`.
+/// `line 60, z_m = 10.57 m, 10 m from the trend (threshold 0.5 m)`.
 fn describe(o: &Outlier, line: usize) -> String {
     let unit = o.unit();
     format!(

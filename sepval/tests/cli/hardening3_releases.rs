@@ -190,7 +190,7 @@ fn outliers_are_named_with_file_line_channel_and_size_then_refused_or_dropped() 
     let named = format!(
         "spiky.csv: 1 outlier(s), sample(s) far from the trend of their neighbours (docs/model.md section 6): line {line}, z_m = "
     );
-    let remedy = "m from the trend (threshold 0.05 m); correct the file, or give --outliers \
+    let remedy = "m from the trend (threshold 0.5 m); correct the file, or give --outliers \
                   drop to leave out the rows that hold one";
     for args in [
         vec!["fit", "--data", "spiky.csv", "--out", "o"],

@@ -83,7 +83,7 @@ fn two_wild_samples_in_one_window_are_both_found_and_their_neighbours_are_not() 
     let mut ends = release(0.95, 0.0, 200.0, Some(12));
     ends.pos_m[0][1] += 1.0;
     let last = ends.len() - 1;
-    ends.att_deg[last][2] += 5.0;
+    ends.att_deg[last][2] += 10.0;
     let found: Vec<(usize, usize)> = find(&ends).iter().map(|o| (o.sample, o.channel)).collect();
     assert_eq!(found, [(0, 1), (last, 5)]);
 }
