@@ -15,6 +15,7 @@ mod fit;
 mod fuzz;
 mod gust;
 mod hardening;
+mod hardening3_records;
 mod hardening_on_disk;
 mod plan;
 mod predict;
