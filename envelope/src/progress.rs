@@ -207,13 +207,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = progress_path(dir.path());
         let named = |axes: &str| BTreeMap::from([("--mach".to_string(), axes.to_string())]);
-        let given = |axes: &str| {
-            Progress::new(
-                inputs_digest(&[("axes", axes.as_bytes())]),
-                named(axes),
-                4,
-            )
-        };
+        let given =
+            |axes: &str| Progress::new(inputs_digest(&[("axes", axes.as_bytes())]), named(axes), 4);
         let mut p = given("0.6:0.9:4");
         p.rows.push(row(2));
         p.write(&path).unwrap();

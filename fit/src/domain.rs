@@ -241,7 +241,10 @@ mod tests {
         assert!(check(&s).is_ok());
         s.flight.mach = 5.0;
         let e = check(&s).unwrap_err().to_string();
-        assert!(e.starts_with("Mach = 5 is outside the model's domain"), "{e}");
+        assert!(
+            e.starts_with("Mach = 5 is outside the model's domain"),
+            "{e}"
+        );
         s.flight.mach = 0.95;
         s.flight.alpha_deg = 89.0;
         let e = check(&s).unwrap_err().to_string();
@@ -259,8 +262,14 @@ mod tests {
         let mut away = base.clone();
         away.mach = 2.5;
         let words = far(&[&base], &away).unwrap();
-        assert!(words.starts_with("Far from every release fitted"), "{words}");
-        assert!(words.contains("Mach 2.5 against 0.95 of the releases"), "{words}");
+        assert!(
+            words.starts_with("Far from every release fitted"),
+            "{words}"
+        );
+        assert!(
+            words.contains("Mach 2.5 against 0.95 of the releases"),
+            "{words}"
+        );
         assert!(words.contains("dynamic pressure"), "{words}");
     }
 }

@@ -195,7 +195,11 @@ pub fn read_record<T: Record>(path: &Path, label: &'static str) -> Result<T, Rec
             command: T::COMMAND,
         });
     }
-    let Some(stored) = value.get(DIGEST_KEY).and_then(Value::as_str).map(str::to_string) else {
+    let Some(stored) = value
+        .get(DIGEST_KEY)
+        .and_then(Value::as_str)
+        .map(str::to_string)
+    else {
         return Err(RecordError::NoDigest {
             path: path.to_path_buf(),
             command: T::COMMAND,
@@ -312,7 +316,10 @@ pub fn check_identifiability(
             p.value.is_finite(),
             "a finite number",
         )?;
-        for (name, se) in [("std_error", p.std_error), ("std_error_white", p.std_error_white)] {
+        for (name, se) in [
+            ("std_error", p.std_error),
+            ("std_error_white", p.std_error_white),
+        ] {
             if let Some(se) = se {
                 field(
                     format!("{here}.{name}"),
@@ -354,6 +361,33 @@ pub fn check_factors(at: &str, f: &sepval_common::factors::Factors) -> Result<()
         )?;
     }
     Ok(())
+}
+
+impl Record for crate::results::FitResult {
+    const FORMAT: &'static str = crate::results::RESULT_FORMAT;
+    const COMMAND: &'static str = "fit";
+
+    /// What `sepval predict` reads: the noise, each method's best (factors, weighted goal,
+    /// residual RMS) and the identifiability.
+    fn check(&self) -> Result<(), FieldError> {
+        check_noise(self.sigma_pos_m, self.sigma_att_deg)?;
+        for (name, m) in &self.methods {
+            let at = format!("methods.{name}.best");
+            check_factors(&format!("{at}.factors"), &m.best.factors)?;
+            let w = m.best.weighted;
+            field(
+                format!("{at}.weighted"),
+                w,
+                w.is_finite() && w >= 0.0,
+                "a finite weighted goal >= 0",
+            )?;
+            check_rms(&format!("{at}.channel_rms"), &m.best.channel_rms)?;
+        }
+        if let Some(i) = &self.identifiability {
+            check_identifiability("identifiability", i)?;
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

@@ -325,31 +325,3 @@ fn rms_of(sums: [f64; 6], n: usize) -> ChannelRms {
         yaw_deg: v[5],
     }
 }
-
-impl crate::record::Record for FitResult {
-    const FORMAT: &'static str = RESULT_FORMAT;
-    const COMMAND: &'static str = "fit";
-
-    /// What `sepval predict` reads: the noise, each method's best (factors, weighted goal,
-    /// residual RMS) and the identifiability.
-    fn check(&self) -> Result<(), crate::record::FieldError> {
-        use crate::record::{check_factors, check_identifiability, check_noise, check_rms, field};
-        check_noise(self.sigma_pos_m, self.sigma_att_deg)?;
-        for (name, m) in &self.methods {
-            let at = format!("methods.{name}.best");
-            check_factors(&format!("{at}.factors"), &m.best.factors)?;
-            let w = m.best.weighted;
-            field(
-                format!("{at}.weighted"),
-                w,
-                w.is_finite() && w >= 0.0,
-                "a finite weighted goal >= 0",
-            )?;
-            check_rms(&format!("{at}.channel_rms"), &m.best.channel_rms)?;
-        }
-        if let Some(i) = &self.identifiability {
-            check_identifiability("identifiability", i)?;
-        }
-        Ok(())
-    }
-}

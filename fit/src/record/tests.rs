@@ -40,20 +40,28 @@ fn a_sealed_record_reads_back_whatever_its_spelling() {
     let value: Value = serde_json::from_str(&text).unwrap();
     let respelled = text.replace("0.005", "5e-3").replace("  ", "");
     assert_eq!(read(&respelled).unwrap(), small());
-    assert_eq!(read(&serde_json::to_string(&value).unwrap()).unwrap(), small());
+    assert_eq!(
+        read(&serde_json::to_string(&value).unwrap()).unwrap(),
+        small()
+    );
 }
 
 #[test]
 fn an_edit_a_missing_digest_and_bad_json_are_refused_by_name() {
     let text = String::from_utf8(sealed(&small())).unwrap();
-    let e = read(&text.replace("0.005", "0.006")).unwrap_err().to_string();
+    let e = read(&text.replace("0.005", "0.006"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("does not match its digest"), "{e}");
     let mut value: Value = serde_json::from_str(&text).unwrap();
     value.as_object_mut().unwrap().remove(DIGEST_KEY);
     let e = read(&value.to_string()).unwrap_err().to_string();
     assert!(e.contains("records no digest"), "{e}");
     let e = read("").unwrap_err().to_string();
-    assert!(e.contains("line 1, column 0: not JSON: EOF while parsing"), "{e}");
+    assert!(
+        e.contains("line 1, column 0: not JSON: EOF while parsing"),
+        "{e}"
+    );
     let e = read("{\"format\": \"small/1\",\n \"sigma_pos_m\": NaN}")
         .unwrap_err()
         .to_string();

@@ -269,7 +269,10 @@ fn digest(
     parts.push(("settings".into(), settings.into_bytes()));
     named.insert("--samples".into(), args.samples.to_string());
     named.insert("--seed".into(), args.seed.to_string());
-    named.insert("--clearance-mm".into(), args.geometry.clearance_mm.to_string());
+    named.insert(
+        "--clearance-mm".into(),
+        args.geometry.clearance_mm.to_string(),
+    );
     if !validate.is_empty() {
         named.insert("--validate".into(), validate.join(" "));
     }

@@ -37,20 +37,17 @@ pub fn run(args: RerunArgs) -> Result<()> {
         if let (Some(x), CheckpointError::OtherJob { .. }) = (&given.model.extension, &e) {
             let recorded_x = recorded.extension.as_deref();
             let same_but_extension = job.data_sha256() == checkpoint.data_sha256
-                && inputs::job(
-                    data_paths,
-                    scenario_path.map(PathBuf::as_path),
-                    recorded_x,
-                )
-                .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
+                && inputs::job(data_paths, scenario_path.map(PathBuf::as_path), recorded_x)
+                    .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
             if same_but_extension {
                 bail!(
                     "checkpoint {} was made with another extension: --extension {} is not {}; give that extension file, or leave --extension out to use the recorded one",
                     args.checkpoint.display(),
                     x.display(),
-                    recorded_x.map_or("none (the checkpoint was made without an extension)".into(), |p| {
-                        format!("the one it was made with ({})", p.display())
-                    })
+                    recorded_x.map_or(
+                        "none (the checkpoint was made without an extension)".into(),
+                        |p| { format!("the one it was made with ({})", p.display()) }
+                    )
                 );
             }
         }

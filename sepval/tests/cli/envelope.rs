@@ -122,7 +122,15 @@ fn bad_envelope_input_is_refused_with_nothing_written() {
     .unwrap();
     std::fs::write(p.join("empty.stl"), "").unwrap();
     let run = |out: &str, extra: &[&str]| {
-        let mut args = vec!["envelope", "--from", "fit", "--out", out, "--samples", "400"];
+        let mut args = vec![
+            "envelope",
+            "--from",
+            "fit",
+            "--out",
+            out,
+            "--samples",
+            "400",
+        ];
         args.extend(extra);
         sepval(&args, p)
     };

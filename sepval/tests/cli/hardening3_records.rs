@@ -53,7 +53,15 @@ fn plan_refused(dir: &Path, from: &str, expected: &str) -> String {
     let out = format!("plan-{from}");
     let e = refused(
         &sepval(
-            &["plan", "--from", from, "--evaluator", "inproc", "--out", &out],
+            &[
+                "plan",
+                "--from",
+                from,
+                "--evaluator",
+                "inproc",
+                "--out",
+                &out,
+            ],
             dir,
         ),
         expected,
@@ -91,7 +99,10 @@ fn an_edited_diagnosis_is_refused_by_its_digest_and_out_of_range_values_by_their
     // The source is refused before the scenario is read: cond.toml need not exist here.
     let p = diagnosed();
     let sealed = std::fs::read_to_string(p.join("diag/diagnosis.json")).unwrap();
-    assert!(sealed.contains("\"digest\": \""), "diagnosis.json is sealed");
+    assert!(
+        sealed.contains("\"digest\": \""),
+        "diagnosis.json is sealed"
+    );
     // Edited by hand to a plausible value: the digest catches it.
     edited(p, "diag", "diagnosis.json", "d-plausible", false, |v| {
         v["sigma_att_deg"] = json!(0.2);
@@ -161,11 +172,7 @@ fn a_record_that_is_not_json_is_refused_with_its_line_and_column() {
             "",
             "line 1, column 0: not JSON: EOF while parsing a value".into(),
         ),
-        (
-            "j-cut",
-            cut,
-            format!("line {cut_lines}, column"),
-        ),
+        ("j-cut", cut, format!("line {cut_lines}, column")),
         (
             "j-text",
             "not json at all",
