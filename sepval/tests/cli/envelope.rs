@@ -239,7 +239,7 @@ fn simulate_and_predict_report_the_clearance() {
     assert_eq!(c["criterion_mm"], 25.4);
     assert_eq!(
         c["samples"].as_u64().unwrap() + c["diverged"].as_u64().unwrap(),
-        100
+        400
     );
     let m = &c["min_clearance_mm"];
     assert!(m["p5"].as_f64().unwrap() <= m["p50"].as_f64().unwrap());

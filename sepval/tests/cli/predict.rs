@@ -223,7 +223,7 @@ fn a_diagnosis_with_rivals_weights_them_by_their_evidence() {
     let w: f64 = models.iter().map(|m| m["weight"].as_f64().unwrap()).sum();
     assert!((w - 1.0).abs() < 1e-9);
     let drawn: u64 = models.iter().map(|m| m["samples"].as_u64().unwrap()).sum();
-    assert_eq!(drawn, 200);
+    assert_eq!(drawn, 400);
     assert_eq!(j["from_kind"], "diagnosis");
     // One release fitted, none held out: the discrepancy comes from its misfit alone.
     assert!(
