@@ -132,6 +132,7 @@ mod page;
 mod probe;
 pub mod readings;
 mod reconstruct;
+mod record_check;
 mod residuals;
 mod restart;
 mod rivals;

@@ -95,9 +95,8 @@ pub(super) fn write_outputs(
         steps.written(1);
     }
     let html = report_html(d, &figures)?;
-    let json = serde_json::to_vec_pretty(d).expect("a diagnosis serialises");
     steps.next()?;
-    write_atomically(&out.join("diagnosis.json"), &json)?;
+    sepval_fit::record::write_record(&out.join("diagnosis.json"), d)?;
     steps.written(1);
     steps.next()?;
     write_atomically(&out.join("report.html"), html.as_bytes())?;

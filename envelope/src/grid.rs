@@ -2,7 +2,7 @@
 //! N = 1 holds the axis at LO), the conditions their product around the condition of the
 //! source's first release (an axis not given stays there), each range checked as a plan's is
 //! (`sepval_plan::conditions`: finite, ordered, a condition the scenario can fly, within the
-//! Mach breakpoints of its tables). At most [`MAX_CONDITIONS`] conditions and [`MAX_POINTS`]
+//! model's domain and its tables' breakpoints, `sepval_fit::domain`). At most [`MAX_CONDITIONS`] conditions and [`MAX_POINTS`]
 //! per axis.
 //!
 //! The map shows the first two varied axes in the order Mach, altitude, alpha, beta, gamma;

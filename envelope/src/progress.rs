@@ -2,10 +2,12 @@
 //! DIR/sweep/progress.json holds the rows done, rewritten atomically after each condition, and
 //! the SHA-256 of the sweep's inputs (the source's records, the geometry files, the axes and
 //! the settings: [`inputs_digest`]), so that a resume with other inputs is refused rather than
-//! mixing two envelopes. A resumed sweep predicts only the conditions not done; each row is a
+//! mixing two envelopes; each input's own digest (a file) or value (a setting) is kept beside
+//! it ([`Progress::inputs`]), so that the refusal names the inputs that differ. A resumed sweep predicts only the conditions not done; each row is a
 //! pure function of the inputs and its condition, so the envelope is the same bits as an
 //! uninterrupted one. The file is removed once the outputs are written.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -42,12 +44,14 @@ pub enum ProgressError {
     },
     /// Of another sweep.
     #[error(
-        "{}: it records a sweep of other inputs (the source, the geometry, the axes or the settings differ): run without --resume into a new --out",
+        "{}: it records a sweep of other inputs ({differs}): give the same inputs to --resume, or run without --resume into a new --out",
         path.display()
     )]
     OtherInputs {
         /// The file.
         path: PathBuf,
+        /// What differs, in words.
+        differs: String,
     },
     /// Cannot be written.
     #[error("cannot write {}", .0.path.display())]
@@ -61,6 +65,11 @@ pub struct Progress {
     pub format: String,
     /// The inputs' digest.
     pub inputs_sha256: String,
+    /// Each input by name: a file's SHA-256 (`the --aircraft file`), a setting's value
+    /// (`--samples`), so that a resume with other inputs names them (empty in files written
+    /// before it was recorded).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub inputs: BTreeMap<String, String>,
     /// Conditions of the grid.
     pub conditions: usize,
     /// Rows done, in the order they were done.
@@ -68,22 +77,26 @@ pub struct Progress {
 }
 
 impl Progress {
-    /// A sweep not started.
-    pub fn new(inputs_sha256: String, conditions: usize) -> Progress {
+    /// A sweep not started, of the inputs `inputs` (each by name) whose digest is
+    /// `inputs_sha256`.
+    pub fn new(
+        inputs_sha256: String,
+        inputs: BTreeMap<String, String>,
+        conditions: usize,
+    ) -> Progress {
         Progress {
             format: PROGRESS_FORMAT.into(),
             inputs_sha256,
+            inputs,
             conditions,
             rows: Vec::new(),
         }
     }
 
-    /// Reads `path`, which must record a sweep of `inputs_sha256` over `conditions`.
-    pub fn read(
-        path: &Path,
-        inputs_sha256: &str,
-        conditions: usize,
-    ) -> Result<Progress, ProgressError> {
+    /// Reads `path`, which must record a sweep of the same inputs as `given` (a sweep not
+    /// started: its digest, its inputs by name and its conditions).
+    pub fn read(path: &Path, given: &Progress) -> Result<Progress, ProgressError> {
+        let (inputs_sha256, conditions) = (&given.inputs_sha256, given.conditions);
         let text = read_string(path, "envelope progress file", MAX_JSON_BYTES)?;
         let format = |message: String| ProgressError::Format {
             path: path.to_path_buf(),
@@ -96,9 +109,10 @@ impl Progress {
                 p.format
             )));
         }
-        if p.inputs_sha256 != inputs_sha256 || p.conditions != conditions {
+        if &p.inputs_sha256 != inputs_sha256 || p.conditions != conditions {
             return Err(ProgressError::OtherInputs {
                 path: path.to_path_buf(),
+                differs: differs(&p.inputs, &given.inputs),
             });
         }
         if let Some(r) = p.rows.iter().find(|r| r.index >= conditions) {
@@ -126,6 +140,36 @@ impl Progress {
         let json = serde_json::to_string(self).expect("a progress record serialises") + "\n";
         write_atomically(path, json.as_bytes())?;
         Ok(())
+    }
+}
+
+/// The inputs that differ between a sweep's record `then` and those given `now`, in words.
+fn differs(then: &BTreeMap<String, String>, now: &BTreeMap<String, String>) -> String {
+    if then.is_empty() {
+        return "the source, the geometry, the axes or the settings differ; the file is of an earlier sepval, which did not record which".into();
+    }
+    let names: std::collections::BTreeSet<&String> = then.keys().chain(now.keys()).collect();
+    let words: Vec<String> = names
+        .into_iter()
+        .filter(|n| then.get(*n) != now.get(*n))
+        .map(|n| {
+            let (a, b) = (then.get(n), now.get(n));
+            if n.starts_with("--") {
+                let v = |x: Option<&String>| x.map_or("not given".to_string(), |s| s.clone());
+                format!("{n} was {}, now {}", v(a), v(b))
+            } else {
+                match (a, b) {
+                    (Some(_), Some(_)) => format!("{n}: its content differs"),
+                    (Some(_), None) => format!("{n}: not given now"),
+                    _ => format!("{n}: not given then"),
+                }
+            }
+        })
+        .collect();
+    if words.is_empty() {
+        "the grid differs".into()
+    } else {
+        words.join("; ")
     }
 }
 
@@ -162,18 +206,25 @@ mod tests {
     fn a_progress_file_reads_back_and_refuses_other_inputs() {
         let dir = tempfile::tempdir().unwrap();
         let path = progress_path(dir.path());
-        let mut p = Progress::new(inputs_digest(&[("axes", b"0.6:0.9:4")]), 4);
+        let named = |axes: &str| BTreeMap::from([("--mach".to_string(), axes.to_string())]);
+        let given =
+            |axes: &str| Progress::new(inputs_digest(&[("axes", axes.as_bytes())]), named(axes), 4);
+        let mut p = given("0.6:0.9:4");
         p.rows.push(row(2));
         p.write(&path).unwrap();
-        let back = Progress::read(&path, &p.inputs_sha256, 4).unwrap();
+        let back = Progress::read(&path, &given("0.6:0.9:4")).unwrap();
         assert!(back.done(2) && !back.done(0));
         assert_eq!(back.rows[0].p_fail.to_bits(), 1.0f64.to_bits());
         assert!(back.rows[0].clearance_p5_mm.is_nan(), "NaN reads back");
-        let other = inputs_digest(&[("axes", b"0.6:0.9:5")]);
-        let e = Progress::read(&path, &other, 4).unwrap_err().to_string();
-        assert!(e.contains("other inputs"), "{e}");
+        let e = Progress::read(&path, &given("0.6:0.9:5"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("other inputs (--mach was 0.6:0.9:4, now 0.6:0.9:5)"),
+            "{e}"
+        );
         std::fs::write(&path, "{\"format\": 3}").unwrap();
-        let e = Progress::read(&path, &p.inputs_sha256, 4)
+        let e = Progress::read(&path, &given("0.6:0.9:4"))
             .unwrap_err()
             .to_string();
         assert!(e.contains("not a sepval envelope progress file"), "{e}");

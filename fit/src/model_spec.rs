@@ -38,14 +38,15 @@ pub struct ModelSpec {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum ModelSpecError {
-    /// An effect that is unknown or has the wrong number of values.
-    #[error("effect `{id}`: {source}")]
+    /// An effect that is unknown or has the wrong number of values. Its message is the
+    /// effect's own, which names the effect (not also a cause in the chain: it was printed
+    /// three times).
+    #[error("{error}")]
     Effect {
         /// Its id.
         id: String,
         /// Why.
-        #[source]
-        source: EffectError,
+        error: EffectError,
     },
     /// A term record that does not name a term.
     #[error("term {index} ({axis}): field `{field}`: {message}")]
@@ -61,7 +62,7 @@ pub enum ModelSpecError {
     },
     /// Terms that cannot run together.
     #[error("terms: {0}")]
-    Terms(#[source] TermError),
+    Terms(TermError),
 }
 
 impl ModelSpec {
@@ -87,9 +88,9 @@ impl ModelSpec {
         for e in &self.effects {
             effects
                 .push_id(&e.id, &e.values)
-                .map_err(|source| ModelSpecError::Effect {
+                .map_err(|error| ModelSpecError::Effect {
                     id: e.id.clone(),
-                    source,
+                    error,
                 })?;
         }
         let mut terms = TermSet::NONE;

@@ -20,7 +20,7 @@ pub const TERM_COEFFICIENT_SPAN: f64 = 10.0;
 #[non_exhaustive]
 pub enum RebuildError {
     /// A model record that names no model.
-    #[error("{which}: {source}")]
+    #[error("{which}")]
     Spec {
         /// Which model (`the answer`, `rival N`).
         which: String,

@@ -3,14 +3,14 @@
 //! flight-path angle), each axis not given held at the condition of the diagnosis's first
 //! release. A range is checked before anything runs: LO <= HI, finite, within what the scenario
 //! accepts (section 1: Mach > 0, the ISA troposphere, angles within +-90 deg) and within the
-//! Mach breakpoints of the scenario's tables (a table is held at its edge beyond them, so a
-//! planned release there would fly on made-up aerodynamics).
+//! model's domain and the breakpoints of the scenario's tables in Mach, alpha and beta
+//! ([`sepval_fit::domain`]: a table is held at its edge beyond them, so a planned release
+//! there would fly on made-up aerodynamics).
 
 use sepval_common::number_text::Shown;
 use serde::{Deserialize, Serialize};
 
 use sepval_common::scenario::{Flight, Scenario};
-use sepval_common::table::{Coefficient, Variable};
 
 /// Points per axis when `--points` is not given.
 pub const DEFAULT_POINTS: usize = 9;
@@ -74,6 +74,17 @@ impl Quantity {
             Quantity::AlphaDeg => f.alpha_deg,
             Quantity::BetaDeg => f.beta_deg,
             Quantity::GammaDeg => f.gamma_deg,
+        }
+    }
+
+    /// The quantity the model's domain bounds ([`sepval_fit::domain`]), if it is one.
+    pub fn bounded(self) -> Option<sepval_fit::domain::Bounded> {
+        use sepval_fit::domain::Bounded;
+        match self {
+            Quantity::Mach => Some(Bounded::Mach),
+            Quantity::AlphaDeg => Some(Bounded::AlphaDeg),
+            Quantity::BetaDeg => Some(Bounded::BetaDeg),
+            Quantity::AltitudeM | Quantity::GammaDeg => None,
         }
     }
 
@@ -251,7 +262,8 @@ impl Conditions {
 }
 
 /// Checks one range: finite, ordered, accepted by the scenario at both ends (the other
-/// quantities at the base condition) and within the Mach breakpoints of its tables.
+/// quantities at the base condition) and within the model's domain and its tables'
+/// breakpoints ([`sepval_fit::domain`]).
 fn check_range(base: &Scenario, r: &Range) -> Result<(), ConditionError> {
     let bad = |message: String| ConditionError::Range {
         flag: r.quantity.flag(),
@@ -275,35 +287,12 @@ fn check_range(base: &Scenario, r: &Range) -> Result<(), ConditionError> {
             ))
         })?;
     }
-    if r.quantity == Quantity::Mach {
-        if let Some((lo, hi)) = mach_coverage(base) {
-            if r.lo < lo || r.hi > hi {
-                return Err(bad(format!(
-                    "outside the Mach breakpoints of the scenario's tables ({lo} to {hi}): beyond them a table is held at its edge"
-                )));
-            }
+    if let Some(q) = r.quantity.bounded() {
+        for v in [r.lo, r.hi] {
+            sepval_fit::domain::check_value(base, q, v).map_err(|e| bad(e.to_string()))?;
         }
     }
     Ok(())
-}
-
-/// The Mach span every Mach table of the scenario covers (the intersection of their
-/// breakpoints' spans), if it has any.
-pub fn mach_coverage(s: &Scenario) -> Option<(f64, f64)> {
-    let mut span: Option<(f64, f64)> = None;
-    for (_, c) in s.aero.fields() {
-        let Coefficient::Table(t) = c else { continue };
-        for a in t.axes().iter().filter(|a| a.variable == Variable::Mach) {
-            let (Some(&lo), Some(&hi)) = (a.breakpoints.first(), a.breakpoints.last()) else {
-                continue;
-            };
-            span = Some(match span {
-                None => (lo, hi),
-                Some((l, h)) => (l.max(lo), h.min(hi)),
-            });
-        }
-    }
-    span
 }
 
 #[cfg(test)]

@@ -58,6 +58,15 @@ pub enum PlanError {
         /// What is missing or wrong.
         message: String,
     },
+    /// A diagnosis.json that cannot be used (not JSON, another format, edited, a value out of
+    /// range).
+    #[error("--from {}", path.display())]
+    Record {
+        /// The directory.
+        path: PathBuf,
+        /// Why.
+        source: sepval_fit::record::RecordError,
+    },
     /// A model of the diagnosis that cannot be rebuilt.
     #[error("the models of the diagnosis")]
     Models(#[from] models::ModelsError),
@@ -73,7 +82,9 @@ pub enum PlanError {
 }
 
 /// The diagnosis in `dir` (DIR/diagnosis.json of `sepval diagnose`, format
-/// [`sepval_diagnose::DIAGNOSIS_FORMAT`]).
+/// [`sepval_diagnose::DIAGNOSIS_FORMAT`]), read and checked by the records' one reader
+/// ([`sepval_fit::record::read_record`]: parse errors with line and column, format, digest,
+/// ranges).
 pub fn read_diagnosis(dir: &Path) -> Result<Diagnosis, PlanError> {
     let bad = |message: String| PlanError::NotADiagnosis {
         path: dir.to_path_buf(),
@@ -90,23 +101,10 @@ pub fn read_diagnosis(dir: &Path) -> Result<Diagnosis, PlanError> {
             "holds no diagnosis.json: not the output of `sepval diagnose`".into(),
         ));
     }
-    let text = sepval_common::input_file::read_string(
-        &path,
-        "diagnosis",
-        sepval_common::limits::MAX_JSON_BYTES,
-    )
-    .map_err(|e| bad(e.to_string()))?;
-    let format: Option<String> = serde_json::from_str::<serde_json::Value>(&text)
-        .ok()
-        .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_string));
-    if format.as_deref() != Some(sepval_diagnose::DIAGNOSIS_FORMAT) {
-        return Err(bad(format!(
-            "diagnosis.json has format {}, expected {} (diagnose again with this sepval)",
-            format.unwrap_or_else(|| "none".into()),
-            sepval_diagnose::DIAGNOSIS_FORMAT
-        )));
-    }
-    serde_json::from_str(&text).map_err(|e| bad(format!("diagnosis.json: {e}")))
+    sepval_fit::record::read_record(&path, "diagnosis").map_err(|source| PlanError::Record {
+        path: dir.to_path_buf(),
+        source,
+    })
 }
 
 /// A plan's inputs, checked, before anything is simulated.

@@ -1,9 +1,10 @@
 //! The condition predicted and the prediction's settings, checked before anything runs: the
 //! scenario of `--scenario COND.toml` must fly the store that was fitted (the same store,
 //! ejector, aerodynamics, interference, factor table and extension terms as the releases
-//! fitted: only `[flight]`, the name and the integrator may differ), `--level` lies in (0, 1),
-//! and `--samples` is at least 1, at most [`MAX_SAMPLES`], and their trajectories at the
-//! band's points fit [`MAX_VALUE_BYTES`].
+//! fitted: only `[flight]`, the name and the integrator may differ) at a condition within the
+//! model's domain ([`sepval_fit::domain`]), `--level` lies in (0, 1), and `--samples` is at
+//! least [`min_samples`] of the level (20 / (1 - level)), at most [`MAX_SAMPLES`], and their
+//! trajectories at the band's points fit [`MAX_VALUE_BYTES`].
 
 use sepval_common::number_text::Shown;
 use sepval_common::scenario::{Scenario, StoreDifference};
@@ -13,6 +14,17 @@ pub const MAX_SAMPLES: usize = 100_000;
 /// The samples' trajectories held at once (samples x points x 6 doubles) are refused beyond
 /// this \[bytes\].
 pub const MAX_VALUE_BYTES: usize = 1 << 30;
+
+/// Samples beyond the band's level asked of the fewest samples a level takes: 20 / (1 - level)
+/// samples leave 20 outside the level (10 beyond each edge of a two-sided band, 20 below the
+/// 5 % quantile of an envelope's clearance), enough for the edge not to be one sample's value.
+pub const SAMPLES_OUTSIDE_LEVEL: f64 = 20.0;
+
+/// The fewest samples that give bands at `level`: 20 / (1 - level), rounded up (400 at 0.95).
+pub fn min_samples(level: f64) -> usize {
+    // Less a hair, so that 20 / (1 - 0.9) = 200.00000000000003 asks for 200.
+    (SAMPLES_OUTSIDE_LEVEL / (1.0 - level) - 1e-6).ceil() as usize
+}
 
 /// A condition, flown release or setting that cannot be predicted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -28,6 +40,12 @@ pub enum ConditionError {
         samples: usize,
         /// What is wrong.
         message: String,
+    },
+    /// A condition outside the model's domain or its scenario's tables.
+    #[error("the condition's {domain}")]
+    Domain {
+        /// Which quantity, and the domain.
+        domain: sepval_fit::domain::DomainError,
     },
     /// A scenario of another store.
     #[error(
@@ -62,11 +80,14 @@ impl Settings {
         if !(self.level > 0.0 && self.level < 1.0) {
             return Err(ConditionError::Level(self.level));
         }
-        if self.samples == 0 {
+        let least = min_samples(self.level);
+        if self.samples < least {
             return Err(ConditionError::Samples {
-                samples: 0,
-                message: "expected at least 1 (1000 gives 95 % bands to about +-1 % in level)"
-                    .into(),
+                samples: self.samples,
+                message: format!(
+                    "bands at level {} need at least {least} samples (20 / (1 - level), so that 20 samples fall outside the level); give --samples {least} or more, or a lower --level",
+                    self.level
+                ),
             });
         }
         if self.samples > MAX_SAMPLES {
@@ -94,13 +115,14 @@ impl Settings {
     }
 }
 
-/// Checks that `condition` flies the store of `fitted` ([`Scenario::store_difference`]).
+/// Checks that `condition` flies the store of `fitted` ([`Scenario::store_difference`]),
+/// within the model's domain ([`sepval_fit::domain`]).
 pub fn check_condition(fitted: &Scenario, condition: &Scenario) -> Result<(), ConditionError> {
-    match fitted.store_difference(condition) {
-        Some(difference) => Err(ConditionError::OtherStore {
+    if let Some(difference) = fitted.store_difference(condition) {
+        return Err(ConditionError::OtherStore {
             difference,
             fitted: fitted.name.clone(),
-        }),
-        None => Ok(()),
+        });
     }
+    sepval_fit::domain::check(condition).map_err(|domain| ConditionError::Domain { domain })
 }

@@ -126,6 +126,9 @@ pub struct Prepared {
     pub settings: Settings,
     /// The clearance to assess, if any ([`Prepared::with_clearance`]).
     pub clearance: Option<ClearanceSettings>,
+    /// When the condition lies far from every release fitted ([`sepval_fit::domain::far`]),
+    /// the sentence that says so: the first of the prediction's summary.
+    pub extrapolation: Option<String>,
 }
 
 impl Prepared {
@@ -185,6 +188,12 @@ pub fn prepare(
     };
     let job = simulate::release_job(&condition, &times, "prediction")
         .map_err(simulate::SimulateError::from)?;
+    let releases: Vec<&sepval_common::scenario::Flight> = fitted
+        .events()
+        .iter()
+        .map(|e| &e.simulator.scenario().flight)
+        .collect();
+    let extrapolation = sepval_fit::domain::far(&releases, &condition.flight);
     Ok(Prepared {
         source,
         ensemble,
@@ -197,6 +206,7 @@ pub fn prepare(
         flown,
         settings,
         clearance: None,
+        extrapolation,
     })
 }
 

@@ -124,8 +124,12 @@ fn headline(f: &PredictionFile) -> String {
             number(ch[c].hi[k])
         )
     };
+    let far = f
+        .extrapolation
+        .as_ref()
+        .map_or(String::new(), |w| format!("{w} "));
     format!(
-        "At {}, {} s after release the store is predicted at {}, {}, {} and {} ({:.0} % bands).",
+        "{far}At {}, {} s after release the store is predicted at {}, {}, {} and {} ({:.0} % bands).",
         condition_words(f),
         number(t),
         at(0, "m"),

@@ -116,6 +116,10 @@ pub struct PredictionFile {
     pub seed: u64,
     /// The condition.
     pub condition: ConditionRecord,
+    /// When the condition lies far from every release fitted, the sentence that says so
+    /// (docs/model.md section 13, "Far from the releases"); the summary's first sentence.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extrapolation: Option<String>,
     /// Times of the band points \[s\].
     pub t_s: Vec<f64>,
     /// Downrange \[m\].
@@ -249,6 +253,7 @@ pub fn prediction_file(
         samples_used: p.bands.used,
         seed: prepared.settings.seed,
         condition: ConditionRecord::of(f),
+        extrapolation: prepared.extrapolation.clone(),
         t_s: prepared.grid.t_s.clone(),
         x_m,
         y_m,

@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 
 use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::model_spec::ModelSpec;
-use sepval_fit::results::{FitResult, RESULT_FORMAT};
+use sepval_fit::record::{Record, read_record};
+use sepval_fit::results::FitResult;
 use sepval_fit::space::Noise;
 use sepval_solve::identifiability::Identifiability;
 
@@ -27,7 +28,16 @@ pub enum SourceError {
         /// What is missing.
         message: String,
     },
-    /// A file that cannot be read or parsed, or of another format.
+    /// A record that cannot be used: unreadable, not JSON, of another format, edited, a value
+    /// out of range (the message names the file, and the line and column or the field).
+    #[error("--from {}: {message}", path.display())]
+    Record {
+        /// The directory.
+        path: PathBuf,
+        /// What is wrong, with its causes.
+        message: String,
+    },
+    /// A record that lacks what a prediction needs.
     #[error("--from {}: {file}: {message}", path.display())]
     File {
         /// The directory.
@@ -123,41 +133,36 @@ pub fn read_source(dir: &Path) -> Result<Source, SourceError> {
     ))
 }
 
-/// The text of `dir/file` whose `format` is `format`.
-fn read_json(dir: &Path, file: &'static str, format: &str) -> Result<String, SourceError> {
-    let bad = |message: String| SourceError::File {
+/// The record `dir/file`, read and checked by the records' one reader
+/// ([`sepval_fit::record::read_record`]: parse errors with line and column, format, digest,
+/// ranges).
+fn read<T: Record>(dir: &Path, file: &'static str, label: &'static str) -> Result<T, SourceError> {
+    read_record(&dir.join(file), label).map_err(|e| SourceError::Record {
         path: dir.to_path_buf(),
-        file,
-        message,
-    };
-    let text = sepval_common::input_file::read_string(
-        &dir.join(file),
-        file,
-        sepval_common::limits::MAX_JSON_BYTES,
-    )
-    .map_err(|e| bad(e.to_string()))?;
-    let found: Option<String> = serde_json::from_str::<serde_json::Value>(&text)
-        .ok()
-        .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_string));
-    if found.as_deref() != Some(format) {
-        return Err(bad(format!(
-            "format {}, expected {format} (run it again with this sepval)",
-            found.unwrap_or_else(|| "none".into())
-        )));
+        message: chain(&e),
+    })
+}
+
+/// An error and its causes, joined by ": ".
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        text.push_str(": ");
+        text.push_str(&c.to_string());
+        cause = c.source();
     }
-    Ok(text)
+    text
 }
 
 fn diagnosis_source(dir: &Path) -> Result<Source, SourceError> {
     let file = "diagnosis.json";
-    let text = read_json(dir, file, sepval_diagnose::DIAGNOSIS_FORMAT)?;
+    let d: sepval_diagnose::Diagnosis = read(dir, file, "diagnosis")?;
     let bad = |message: String| SourceError::File {
         path: dir.to_path_buf(),
         file,
         message,
     };
-    let d: sepval_diagnose::Diagnosis =
-        serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     let identifiability = d.identifiability.clone().ok_or_else(|| {
         bad("records no covariance of the answer's parameters (`identifiability`, written by sepval since predict): diagnose again with this sepval".into())
     })?;
@@ -192,13 +197,12 @@ fn diagnosis_source(dir: &Path) -> Result<Source, SourceError> {
 
 fn fit_source(dir: &Path) -> Result<Source, SourceError> {
     let file = "result.json";
-    let text = read_json(dir, file, RESULT_FORMAT)?;
+    let r: FitResult = read(dir, file, "fit result")?;
     let bad = |message: String| SourceError::File {
         path: dir.to_path_buf(),
         file,
         message,
     };
-    let r: FitResult = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     // The refined methods; the identifiability is that of the best of them.
     let best = r
         .methods

@@ -167,10 +167,24 @@ fn settings_and_conditions_are_checked() {
     }
     let e = Settings { samples: 0, ..ok }.check().unwrap_err();
     assert!(
-        e.to_string()
-            .starts_with("--samples 0: expected at least 1"),
+        e.to_string().starts_with(
+            "--samples 0: bands at level 0.95 need at least 400 samples (20 / (1 - level)"
+        ),
         "{e}"
     );
+    // The rule at other levels, exactly at its edge.
+    for (level, least) in [(0.95, 400), (0.9, 200), (0.5, 40), (0.99, 2000)] {
+        assert_eq!(crate::condition::min_samples(level), least, "{level}");
+        let at = |samples| {
+            Settings {
+                samples,
+                level,
+                ..ok
+            }
+            .check()
+        };
+        assert!(at(least).is_ok() && at(least - 1).is_err(), "{level}");
+    }
     let e = Settings {
         samples: 1_000_000,
         ..ok
@@ -200,5 +214,12 @@ fn settings_and_conditions_are_checked() {
             "its store differs from that of the releases fitted ({}): store.mass_kg is {}, not {}; a prediction flies the store that was fitted: change only [flight]",
             fitted.name, other.store.mass_kg, fitted.store.mass_kg
         )
+    );
+    let mut far = fitted.clone();
+    far.flight.mach = 5.0;
+    let e = check_condition(&fitted, &far).unwrap_err().to_string();
+    assert!(
+        e.contains("the condition's Mach = 5 is outside the model's domain"),
+        "{e}"
     );
 }

@@ -83,12 +83,13 @@ def store(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPa
 
 def deterministic(record: Any) -> Any:
     """A result file without what depends on the run rather than on its inputs: wall times,
-    `run`, where the inputs and the source were (paths), the names of the events (paths)."""
+    `run`, where the inputs and the source were (paths), the names of the events (paths), and
+    the record's `digest` (of all of it, those included)."""
     if isinstance(record, dict):
         return {
             k: deterministic(v)
             for k, v in record.items()
-            if k not in ("wall_s", "run", "inputs", "from", "name", "event", "release", "progress")
+            if k not in ("wall_s", "run", "inputs", "from", "name", "event", "release", "progress", "digest")
         }
     if isinstance(record, list):
         return [deterministic(v) for v in record]

@@ -33,9 +33,9 @@ def condition():
 
 
 def test_predict_is_the_cli_bit_for_bit(cli, fitted, releases, tmp_path):
-    cli_ok(cli(["predict", "--from", fitted, "--scenario", releases / "cond.toml", "--samples", "60", "--seed", "4",
+    cli_ok(cli(["predict", "--from", fitted, "--scenario", releases / "cond.toml", "--samples", "400", "--seed", "4",
                 "--evaluator", "inproc", "--threads", "2", "--out", tmp_path / "cli"], tmp_path))
-    p = sepval.predict(fitted, scenario=condition(), samples=60, seed=4, out=tmp_path / "py")
+    p = sepval.predict(fitted, scenario=condition(), samples=400, seed=4, out=tmp_path / "py")
     expected = read_json(tmp_path / "cli" / "prediction.json")
     assert deterministic(p.to_dict()) == deterministic(expected)
     assert p.condition == {"mach": 0.7, "altitude_m": 7924.8, "alpha_deg": 1.5, "beta_deg": -2.0, "gamma_deg": 0.0}
@@ -49,7 +49,7 @@ def test_predict_is_the_cli_bit_for_bit(cli, fitted, releases, tmp_path):
 def test_a_flown_release_is_checked_against_the_bands(fitted, tmp_path):
     s = condition()
     flown = sepval.simulate(scenario=s, noise_seed=9)
-    p = sepval.predict(sepval.Fit.load(fitted), scenario=s, samples=60, data=flown, with_noise=True)
+    p = sepval.predict(sepval.Fit.load(fitted), scenario=s, samples=400, data=flown, with_noise=True)
     assert p.check is not None and p.verdict == p.check["verdict"]
     assert p.verdict.startswith(("inside the predicted bands", "outside from"))
 
@@ -70,9 +70,9 @@ def test_diagnose_plan_and_their_results(cli, tmp_path):
 
 
 def test_envelope_is_the_cli_s(cli, fitted, tmp_path):
-    cli_ok(cli(["envelope", "--from", fitted, "--aircraft", AIRCRAFT, "--mach", "0.6:0.9:3", "--samples", "20",
+    cli_ok(cli(["envelope", "--from", fitted, "--aircraft", AIRCRAFT, "--mach", "0.6:0.9:3", "--samples", "400",
                 "--evaluator", "inproc", "--threads", "2", "--out", tmp_path / "cli"], tmp_path))
-    e = sepval.envelope(fitted, aircraft=AIRCRAFT, mach=(0.6, 0.9, 3), samples=20, out=tmp_path / "py")
+    e = sepval.envelope(fitted, aircraft=AIRCRAFT, mach=(0.6, 0.9, 3), samples=400, out=tmp_path / "py")
     expected = read_json(tmp_path / "cli" / "envelope.json")
     assert deterministic(e.to_dict()) == deterministic(expected)
     assert e.conditions == 3 and len(e.rows) == 3 and list(e.rows["mach"]) == [0.6, 0.75, 0.9]

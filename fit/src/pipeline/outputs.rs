@@ -5,7 +5,6 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use sepval_common::atomic_file::write_atomically;
 use sepval_common::evaluation::{Candidate, Evaluator, Job, Outcome};
 use sepval_common::factors::{FACTOR_COUNT, Factors};
 use sepval_common::goals::GoalSums;
@@ -284,7 +283,6 @@ pub(super) fn method_result(
 
 /// Writes DIR/result.json atomically.
 pub fn write_result(dir: &Path, result: &FitResult) -> Result<(), FitError> {
-    let json = serde_json::to_vec_pretty(result).expect("a result serialises");
-    write_atomically(&dir.join("result.json"), &json)?;
+    crate::record::write_record(&dir.join("result.json"), result)?;
     Ok(())
 }

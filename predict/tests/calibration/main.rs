@@ -22,7 +22,7 @@ fn bands_hold_the_truth_and_are_not_too_wide() {
     let mut coverage = 0.0;
     for &(i, releases, seed) in &picks {
         let c = case(all[i], releases, seed);
-        let m = measure(&c, 200);
+        let m = measure(&c, 400);
         eprintln!("{}: {m:?}", c.cause.name());
         coverage += m.coverage / picks.len() as f64;
         assert!(m.width_ratio < MAX_WIDTH_RATIO, "{}: {m:?}", c.cause.name());
@@ -55,7 +55,7 @@ fn table() {
             let first = 1000 * i as u64 + 100 * releases as u64;
             let seeds = first..first + 8;
             let runs: Vec<_> = seeds
-                .map(|s| measure(&case(cause, releases, s), 300))
+                .map(|s| measure(&case(cause, releases, s), 400))
                 .collect();
             let n = runs.len() as f64;
             let mean = |f: &dyn Fn(&cases::Measured) -> f64| runs.iter().map(f).sum::<f64>() / n;
@@ -88,7 +88,7 @@ fn the_check_says_inside_for_a_release_of_the_model_and_outside_for_a_cause_it_l
         name: "flown.csv".into(),
         data: noisy(truth(&c, &c.predicted), 777),
     };
-    let p = predicted(&prepared(&c, 200, Some(flown)), 2);
+    let p = predicted(&prepared(&c, 400, Some(flown)), 2);
     let check = p.check.unwrap();
     assert!(check.inside, "{check:?}");
     assert_eq!(check.verdict, "inside the predicted bands");
@@ -105,7 +105,7 @@ fn the_check_says_inside_for_a_release_of_the_model_and_outside_for_a_cause_it_l
         name: "flown.csv".into(),
         data: noisy(truth(&c, &c.predicted), 778),
     };
-    let p = predicted(&prepared(&c, 200, Some(flown)), 2);
+    let p = predicted(&prepared(&c, 400, Some(flown)), 2);
     let check = p.check.unwrap();
     assert!(!check.inside, "{check:?}");
     let yaw = &check.channels[5];
@@ -128,7 +128,7 @@ fn bands_shrink_when_a_second_release_is_pooled() {
     let mut one = two.clone();
     one.fitted.truncate(1);
     let width = |c: &cases::Case| {
-        let p = predicted(&prepared(c, 200, None), 2);
+        let p = predicted(&prepared(c, 400, None), 2);
         p.bands
             .channels
             .iter()
@@ -146,7 +146,7 @@ fn bands_shrink_when_a_second_release_is_pooled() {
 #[test]
 fn the_same_seed_gives_the_same_bands_whatever_the_thread_count() {
     let c = case(causes()[1], 2, 41);
-    let p = prepared(&c, 64, None);
+    let p = prepared(&c, 400, None);
     let (a, b) = (predicted(&p, 1), predicted(&p, 2));
     for (x, y) in a.bands.channels.iter().zip(&b.bands.channels) {
         for (u, v) in

@@ -216,7 +216,6 @@ pub fn record_releases<T: serde::Serialize>(
         );
     }
     set(record, records);
-    let json = serde_json::to_vec_pretty(record).context("a record serialises")?;
-    write_atomically(&out.join(file), &json)?;
+    sepval_fit::record::write_record(&out.join(file), record)?;
     Ok(())
 }

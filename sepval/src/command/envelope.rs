@@ -2,12 +2,14 @@
 //! conditions from a fit or a diagnosis, mapped as a separation envelope; `--resume` goes on
 //! with an interrupted sweep.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{EvalError, Evaluator, Job};
+use sepval_common::scenario::hex_sha256;
 use sepval_envelope::grid::{Axis, Grid};
 use sepval_envelope::progress::{Progress, inputs_digest, progress_path};
 use sepval_envelope::summary::summarise;
@@ -61,9 +63,9 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     let Some(clearance) = clearance::settings(&args.geometry, &base)? else {
         bail!("--aircraft FILE is required");
     };
-    let digest = digest(&args, &source.dir, &aircraft, &given)?;
+    let (digest, named) = digest(&args, &source.dir, &aircraft, &given)?;
     let inputs_sha256 = digest.clone();
-    let (run_dir, progress) = claim(&args, digest, grid.len())?;
+    let (run_dir, progress) = claim(&args, Progress::new(digest, named, grid.len()))?;
     run_dir.prepare()?;
     let start = Instant::now();
     let sweep_inputs = Sweep {
@@ -123,11 +125,24 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
 }
 
 /// Claims `--out` (fresh, cleared with --overwrite, or the interrupted sweep's with --resume,
-/// whose progress must record the same inputs) and returns the progress to go on from.
-fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunDir, Progress)> {
+/// whose progress must record the same inputs as `fresh`, the sweep not started) and returns
+/// the progress to go on from.
+fn claim(args: &EnvelopeArgs, fresh: Progress) -> Result<(RunDir, Progress)> {
     let progress_file = progress_path(&args.out);
     let (claim, progress) = if args.resume {
-        let p = Progress::read(&progress_file, &digest, conditions).with_context(|| {
+        if !progress_file.exists() {
+            let done = args.out.join("envelope.json").is_file();
+            bail!(
+                "--resume: {} {}",
+                args.out.display(),
+                if done {
+                    "holds a finished sweep (envelope.json is written and no sweep/progress.json is left): there is nothing to resume; run without --resume into a new --out, or with --overwrite to sweep it again"
+                } else {
+                    "holds no interrupted sweep (no sweep/progress.json): run without --resume"
+                }
+            );
+        }
+        let p = Progress::read(&progress_file, &fresh).with_context(|| {
             format!(
                 "--resume: the sweep in {} (run without --resume to start anew)",
                 args.out.display()
@@ -142,9 +157,9 @@ fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunD
             p,
         )
     } else if args.overwrite.overwrite {
-        (Claim::Overwrite, Progress::new(digest, conditions))
+        (Claim::Overwrite, fresh)
     } else {
-        (Claim::Fresh, Progress::new(digest, conditions))
+        (Claim::Fresh, fresh)
     };
     let run_dir = RunDir::claim(&args.out, claim, "envelope").with_context(|| {
         let hint = if progress_file.is_file() {
@@ -210,30 +225,36 @@ fn flown(s: &Sweep) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// The digest of what decides the envelope: the source's records, the geometry files, the
-/// extension, the held-out files named, the axes and the settings.
+/// The digest of what decides the envelope (the source's records, the geometry files, the
+/// extension, the held-out files named, the axes and the settings) and each of them by name: a
+/// file's SHA-256, a setting's value.
 fn digest(
     args: &EnvelopeArgs,
     from: &Path,
     aircraft: &Path,
     axes: &[(Quantity, String)],
-) -> Result<String> {
+) -> Result<(String, BTreeMap<String, String>)> {
     let read = |p: &Path| -> Result<Vec<u8>> {
         std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))
     };
     let mut parts: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut named = BTreeMap::new();
+    let mut file = |label: &str, name: String, bytes: Vec<u8>| {
+        named.insert(name, hex_sha256(&bytes));
+        parts.push((label.into(), bytes));
+    };
     for name in ["result.json", "diagnosis.json"] {
         let p = from.join(name);
         if p.is_file() {
-            parts.push((name.into(), read(&p)?));
+            file(name, format!("the source's {name}"), read(&p)?);
         }
     }
-    parts.push(("aircraft".into(), read(aircraft)?));
+    file("aircraft", "the --aircraft file".into(), read(aircraft)?);
     if let Some(p) = &args.geometry.store_shape {
-        parts.push(("store".into(), read(p)?));
+        file("store", "the --store-shape file".into(), read(p)?);
     }
     if let Some(p) = &args.extension {
-        parts.push(("extension".into(), read(p)?));
+        file("extension", "the --extension file".into(), read(p)?);
     }
     let validate: Vec<String> = args
         .validate
@@ -257,9 +278,23 @@ fn digest(
         settings.push_str(" outliers=drop");
     }
     parts.push(("settings".into(), settings.into_bytes()));
+    named.insert("--samples".into(), args.samples.to_string());
+    named.insert("--seed".into(), args.seed.to_string());
+    named.insert(
+        "--clearance-mm".into(),
+        args.geometry.clearance_mm.to_string(),
+    );
+    if !validate.is_empty() {
+        named.insert("--validate".into(), validate.join(" "));
+    }
+    for a in &axes {
+        if let Some((flag, text)) = a.split_once('=') {
+            named.insert(flag.into(), text.into());
+        }
+    }
     let refs: Vec<(&str, &[u8])> = parts
         .iter()
         .map(|(l, b)| (l.as_str(), b.as_slice()))
         .collect();
-    Ok(inputs_digest(&refs))
+    Ok((inputs_digest(&refs), named))
 }

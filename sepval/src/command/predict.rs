@@ -148,7 +148,11 @@ fn flown(
 fn summary_lines(file: &PredictionFile, out: &Path) -> String {
     let k = file.t_s.len().saturating_sub(1);
     let ch = file.channels();
-    let mut s = format!(
+    let mut s = file
+        .extrapolation
+        .as_ref()
+        .map_or(String::new(), |w| format!("warning:   {w}\n"));
+    s.push_str(&format!(
         "predict:   t = {:.3} s: x {:.3} m [{:.3}, {:.3}], z {:.3} m [{:.3}, {:.3}], pitch {:.2} deg [{:.2}, {:.2}] ({:.0} % bands)\n",
         file.t_s.get(k).copied().unwrap_or(f64::NAN),
         ch[0].mid[k],
@@ -161,7 +165,7 @@ fn summary_lines(file: &PredictionFile, out: &Path) -> String {
         ch[4].lo[k],
         ch[4].hi[k],
         100.0 * file.level
-    );
+    ));
     let src = &file.sources;
     s.push_str(&format!(
         "sources:   factors {:.0} %, model form {:.0} %, measurement {:.0} % (most: {})\n",

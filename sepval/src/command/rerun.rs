@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{Result, bail};
-use sepval_fit::checkpoint::Checkpoint;
+use sepval_fit::checkpoint::{Checkpoint, CheckpointError};
 
 use super::{evaluator_spec, inputs, notices};
 use crate::cli::RerunArgs;
@@ -33,7 +33,27 @@ pub fn run(args: RerunArgs) -> Result<()> {
         extension_path.map(PathBuf::as_path),
         given.outliers.or(recorded.outliers),
     )?;
-    checkpoint.check_job(&job, &args.checkpoint)?;
+    if let Err(e) = checkpoint.check_job(&job, &args.checkpoint) {
+        // A scenario that differs only by the extension given: say so, not "another scenario".
+        if let (Some(x), CheckpointError::OtherJob { .. }) = (&given.model.extension, &e) {
+            let recorded_x = recorded.extension.as_deref();
+            let same_but_extension = job.data_sha256() == checkpoint.data_sha256
+                && inputs::job(data_paths, scenario_path.map(PathBuf::as_path), recorded_x)
+                    .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
+            if same_but_extension {
+                bail!(
+                    "checkpoint {} was made with another extension: --extension {} is not {}; give that extension file, or leave --extension out to use the recorded one",
+                    args.checkpoint.display(),
+                    x.display(),
+                    recorded_x.map_or(
+                        "none (the checkpoint was made without an extension)".into(),
+                        |p| { format!("the one it was made with ({})", p.display()) }
+                    )
+                );
+            }
+        }
+        return Err(e.into());
+    }
     let mut evaluator = spec.start(Arc::new(job), notices())?;
     let report = sepval_fit::rerun::check(&checkpoint, &args.checkpoint, evaluator.as_mut())?;
     say!("{} ({})", report.checked(), evaluator.describe());

@@ -34,7 +34,7 @@ fn envelope(dir: &Path, out: &str, extra: &[&str]) -> Value {
         "--altitude-m",
         "3000:6000:2",
         "--samples",
-        "40",
+        "400",
         "--out",
         out,
     ];
@@ -122,7 +122,15 @@ fn bad_envelope_input_is_refused_with_nothing_written() {
     .unwrap();
     std::fs::write(p.join("empty.stl"), "").unwrap();
     let run = |out: &str, extra: &[&str]| {
-        let mut args = vec!["envelope", "--from", "fit", "--out", out, "--samples", "10"];
+        let mut args = vec![
+            "envelope",
+            "--from",
+            "fit",
+            "--out",
+            out,
+            "--samples",
+            "400",
+        ];
         args.extend(extra);
         sepval(&args, p)
     };
@@ -214,7 +222,7 @@ fn simulate_and_predict_report_the_clearance() {
             "--aircraft",
             &aircraft,
             "--samples",
-            "100",
+            "400",
             "--evaluator",
             "inproc",
             "--out",
@@ -231,7 +239,7 @@ fn simulate_and_predict_report_the_clearance() {
     assert_eq!(c["criterion_mm"], 25.4);
     assert_eq!(
         c["samples"].as_u64().unwrap() + c["diverged"].as_u64().unwrap(),
-        100
+        400
     );
     let m = &c["min_clearance_mm"];
     assert!(m["p5"].as_f64().unwrap() <= m["p50"].as_f64().unwrap());
@@ -300,7 +308,7 @@ fn the_envelope_clears_where_the_true_store_misses_a_tail_and_not_where_it_strik
             "--altitude-m",
             "1000:9000:3",
             "--samples",
-            "40",
+            "400",
             "--evaluator",
             "inproc",
             "--out",

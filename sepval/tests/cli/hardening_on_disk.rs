@@ -232,7 +232,7 @@ fn rerun_takes_each_input_not_given_from_the_checkpoint() {
             ],
             d,
         ),
-        "was made with another scenario",
+        "was made with another extension: --extension other.toml is not the one it was made with",
     );
 }
 

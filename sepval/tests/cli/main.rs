@@ -17,6 +17,7 @@ mod gust;
 mod hardening;
 mod hardening3_geometry;
 mod hardening3_releases;
+mod hardening3_records;
 mod hardening_on_disk;
 mod jobs;
 mod plan;

@@ -92,7 +92,7 @@ pub(crate) fn fixture() -> &'static Path {
 /// Runs `sepval predict` with `args` (in process unless an evaluator is given) into `out`;
 /// returns prediction.json.
 fn predict(dir: &Path, out: &str, args: &[&str]) -> Value {
-    let mut all = vec!["predict", "--out", out, "--samples", "200"];
+    let mut all = vec!["predict", "--out", out, "--samples", "400"];
     all.extend(args);
     if !args.contains(&"--evaluator") {
         all.extend(["--evaluator", "inproc", "--threads", "2"]);
@@ -131,7 +131,7 @@ fn a_fit_predicts_a_release_and_the_flown_one_is_inside_its_bands() {
     );
     assert_eq!(j["format"], "sepval-prediction/1");
     assert_eq!(j["level"], 0.95);
-    assert_eq!(j["samples"], 200);
+    assert_eq!(j["samples"], 400);
     assert_eq!(j["condition"]["mach"], 0.7);
     let t = numbers(&j["t_s"]);
     assert_eq!(t.len(), 201);
@@ -180,7 +180,7 @@ fn a_fit_predicts_a_release_and_the_flown_one_is_inside_its_bands() {
         "--scenario",
         "cond.toml",
         "--samples",
-        "20",
+        "400",
     ];
     let mut args = again.to_vec();
     args.extend(["--evaluator", "inproc", "--out", "pred"]);
@@ -190,7 +190,7 @@ fn a_fit_predicts_a_release_and_the_flown_one_is_inside_its_bands() {
     let j: Value =
         serde_json::from_str(&std::fs::read_to_string(p.join("pred/prediction.json")).unwrap())
             .unwrap();
-    assert_eq!(j["samples"], 20);
+    assert_eq!(j["samples"], 400);
     assert!(j.get("check").is_none());
 }
 
@@ -226,7 +226,7 @@ fn a_diagnosis_with_rivals_weights_them_by_their_evidence() {
     let w: f64 = models.iter().map(|m| m["weight"].as_f64().unwrap()).sum();
     assert!((w - 1.0).abs() < 1e-9);
     let drawn: u64 = models.iter().map(|m| m["samples"].as_u64().unwrap()).sum();
-    assert_eq!(drawn, 200);
+    assert_eq!(drawn, 400);
     assert_eq!(j["from_kind"], "diagnosis");
     // One release fitted, none held out: the discrepancy comes from its misfit alone.
     assert!(
@@ -299,7 +299,7 @@ fn bad_inputs_are_refused_naming_what_and_nothing_is_written() {
     run(with(&["--level", "0"]), "--level 0:");
     run(
         with(&["--samples", "0"]),
-        "--samples 0: expected at least 1",
+        "--samples 0: bands at level 0.95 need at least 400 samples (20 / (1 - level)",
     );
     run(
         with(&["--samples", "1000000000"]),
