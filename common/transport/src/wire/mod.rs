@@ -34,7 +34,7 @@ use sepval_common::propagator::Observation;
 /// indices 7 and 8) and the `wind` family's regressors (indices 24 and 25); a version-4 worker
 /// would fail such a candidate, which a diagnosis would read as a probe that does not simulate,
 /// so the handshake refuses it instead. Version 6: a request carries the values of the
-/// scenario's corrections (`sepval update`, docs/model.md section 15) after its terms.
+/// scenario's corrections (`sepval update`, docs/update.md) after its terms.
 pub const PROTOCOL_VERSION: u32 = 6;
 
 /// "SEPVAL01" as a little-endian integer: the first field of [`Hello`], [`SetupHeader`] and
@@ -126,7 +126,7 @@ pub struct WireRequest {
     pub corrections: [f64; MAX_CORRECTION_VALUES],
 }
 
-/// One extension term of a candidate (docs/model.md section 11).
+/// One extension term of a candidate (docs/discovery.md).
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
 #[type_name("sepval.WireTerm")]
 #[repr(C)]
