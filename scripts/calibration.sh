@@ -1,5 +1,5 @@
 #!/bin/sh
-# The calibration table of `sepval predict` (README, "Predicting a release not flown"): every
+# The calibration table of `sepval predict` (docs/performance.md, "Predict"): every
 # synthetic cause of predict/tests/calibration/cases.rs, two and three releases fitted, eight
 # random cases each, the 95 % bands' coverage of the noise-free truth at another condition.
 # About two minutes on two cores.

@@ -11,7 +11,12 @@
    lists them are the one intended exception (a registry);
 3. the crates depend on each other one way only, as ARCHITECTURE.md draws them: each crate's
    `sepval-*` dependencies (normal, not dev) are within the set it may use;
-4. a crate whose library or binary says `test = false` (no unit-test harness: its compile in
+4. ARCHITECTURE.md's table of crates (the fenced `crates` block: one line per crate,
+   `name (folder): the sepval crates it depends on`) is the truth: every crate it names is a
+   workspace member in that folder, every member is in it, each line's dependencies are that
+   crate's `Cargo.toml` dependencies and its MAY_USE entry, every `sepval-*` name in the page
+   is a crate, and a sentence "X depends on Y" there names a dependency in X's Cargo.toml;
+5. a crate whose library or binary says `test = false` (no unit-test harness: its compile in
    test mode is skipped, which CI's time needs) has no `#[test]` in its sources, since such a
    test would never run.
 
@@ -219,16 +224,66 @@ def strongly_connected(graph):
     return out
 
 
-def layers(root, crate, problems):
+def crate_deps(crate):
+    """(package name, its `sepval-*` normal dependencies) from `crate`/Cargo.toml."""
     toml = open(os.path.join(crate, "Cargo.toml"), encoding="utf-8").read()
     name = re.search(r'^name\s*=\s*"([^"]+)"', toml, flags=re.M).group(1)
     deps = re.search(r"^\[dependencies\]\n(.*?)(^\[|\Z)", toml, flags=re.M | re.S)
     used = set(re.findall(r"^(sepval[\w-]*)\s*[.=]", deps.group(1), flags=re.M)) if deps else set()
+    return name, used
+
+
+def layers(root, crate, problems):
+    name, used = crate_deps(crate)
     if name not in MAY_USE:
         problems.append(f"crate {name}: not in scripts/shape.py's MAY_USE (add it, and to ARCHITECTURE.md)")
         return
     for d in sorted(used - MAY_USE[name]):
         problems.append(f"crate {name} depends on {d}, which ARCHITECTURE.md does not allow")
+
+
+def members(root):
+    """{folder: (package name, its sepval dependencies)} of the workspace's members."""
+    toml = open(os.path.join(root, "Cargo.toml"), encoding="utf-8").read()
+    listed = re.search(r"^members\s*=\s*\[(.*?)\]", toml, flags=re.M | re.S).group(1)
+    listed = re.sub(r"#[^\n]*", "", listed)
+    return {f: crate_deps(os.path.join(root, f)) for f in re.findall(r'"([^"]+)"', listed)}
+
+
+def documented(root, problems):
+    """ARCHITECTURE.md's crates and dependencies against the workspace and MAY_USE."""
+    doc = "ARCHITECTURE.md"
+    text = open(os.path.join(root, doc), encoding="utf-8").read()
+    block = re.search(r"^```crates\n(.*?)^```", text, flags=re.M | re.S)
+    if not block:
+        problems.append(f"{doc}: no ```crates block (the table of crates and their dependencies)")
+        return
+    found = members(root)
+    by_name = {name: (folder, used) for folder, (name, used) in found.items()}
+    table = {}
+    for line in block.group(1).strip().split("\n"):
+        m = re.fullmatch(r"([\w-]+) \(([\w/.-]+)\): (.*)", line.strip())
+        if not m:
+            problems.append(f"{doc}: crates table line `{line}`: expected `name (folder): a, b` or `: none`")
+            continue
+        name, folder, deps = m.groups()
+        table[name] = set() if deps.strip() == "none" else {d.strip() for d in deps.split(",")}
+        if folder not in found or found[folder][0] != name:
+            problems.append(f"{doc}: crate {name} ({folder}) is not a workspace member in that folder")
+            continue
+        if table[name] != found[folder][1]:
+            problems.append(f"{doc}: crate {name} depends on {sorted(found[folder][1])} in {folder}/Cargo.toml, the table says {sorted(table[name])}")
+        if table[name] != MAY_USE.get(name):
+            problems.append(f"{doc}: crate {name}'s dependencies differ from scripts/shape.py's MAY_USE")
+    for name in sorted(set(by_name) - set(table)):
+        problems.append(f"{doc}: workspace member {name} ({by_name[name][0]}) is missing from the crates table")
+    for name in sorted(set(MAY_USE) - set(by_name)):
+        problems.append(f"scripts/shape.py: MAY_USE names {name}, which is not a workspace member")
+    for name in sorted(set(re.findall(r"\bsepval-[a-z]+\b(?![/\w-])", text)) - set(by_name)):
+        problems.append(f"{doc}: names {name}, which is not a workspace member")
+    for x, y in re.findall(r"\b(sepval[\w-]*)`?\)? depends on `?(sepval[\w-]*)", text):
+        if x in by_name and y not in by_name[x][1]:
+            problems.append(f"{doc}: says {x} depends on {y}, but {by_name[x][0]}/Cargo.toml does not")
 
 
 def untested(crate, problems):
@@ -250,9 +305,10 @@ def main():
         cycles(root, crate, problems)
         layers(root, crate, problems)
         untested(crate, problems)
+    documented(root, problems)
     for p in problems:
         print(p)
-    print(f"shape: {len(problems)} problem(s) (files <= {FILE_MAX} lines, functions <= {FN_MAX}, no module cycle, crates one way, no test left unrun)")
+    print(f"shape: {len(problems)} problem(s) (files <= {FILE_MAX} lines, functions <= {FN_MAX}, no module cycle, crates one way, ARCHITECTURE.md true to the crates, no test left unrun)")
     sys.exit(1 if problems else 0)
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Checks the README's mutual-TLS recipe for zenoh workers end to end (not part of CI: the TLS
+# Checks the guide's mutual-TLS recipe (docs/guide.md) for zenoh workers end to end (not part of CI: the TLS
 # build adds rustls and about four minutes). Builds with `--features zenoh-tls`, makes a
 # throwaway CA with a coordinator and a worker certificate, then:
 #   1. a worker holding a certificate of that CA joins a small fit over tls/ and the fit ends;

@@ -133,7 +133,7 @@ fn simulate_lanes_tables(c: &mut Criterion) {
     });
 }
 
-/// The default with the corrections of an update (docs/model.md section 15): the interference
+/// The default with the corrections of an update (docs/update.md): the interference
 /// dCZ over distance (7 breakpoints and s_end), Cm over local alpha (5) and Cm_alpha over Mach
 /// (1), values small and not zero.
 fn simulate_lanes_corrections(c: &mut Criterion) {

@@ -278,7 +278,7 @@ fn finished(sums: &GoalSums, samples: Option<Vec<Vec<Observation>>>) -> Evaluati
 }
 
 /// One point of a search: the 17 factors, the effects of the model variant with their
-/// parameter values, and extension terms (docs/model.md section 11) beyond the scenario's.
+/// parameter values, and extension terms (docs/discovery.md) beyond the scenario's.
 /// `Copy`, fixed size.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate {
@@ -288,7 +288,7 @@ pub struct Candidate {
     pub effects: EffectSet,
     /// Extension terms of this candidate (the scenario's own apply too).
     pub terms: TermSet,
-    /// The values of the scenario's corrections (docs/model.md section 15; none: every
+    /// The values of the scenario's corrections (docs/update.md; none: every
     /// correction 0).
     pub corrections: CorrectionValues,
 }

@@ -1,5 +1,5 @@
 //! The diagnosis as files hold it (DIR/diagnosis.json, format [`super::DIAGNOSIS_FORMAT`]):
-//! every record the analysis produces, documented field by field in docs/model.md section 11.7.
+//! every record the analysis produces, documented field by field in docs/discovery.md section 11.7.
 
 use std::collections::BTreeMap;
 
@@ -192,7 +192,7 @@ pub struct Diagnosis {
     pub baseline_unreliable: Option<String>,
     /// Why the first baseline fit was replaced: the catalogue's refits showed it in a local
     /// optimum of the factors, and the baseline refined again from theirs fits better
-    /// (`docs/model.md` section 11.5, step 2a).
+    /// (`docs/discovery.md` section 11.5, step 2a).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub baseline_restart: Option<String>,
     /// Why the answer may not name the cause: an alternative predicts the `--validate` events
@@ -206,7 +206,7 @@ pub struct Diagnosis {
     /// Explanations the data cannot tell from the answer, best first.
     pub rivals: Vec<RivalReport>,
     /// The clearance to the aircraft of the answer's trajectory of each release, when the
-    /// diagnosis was given `--aircraft` (docs/model.md section 14.2).
+    /// diagnosis was given `--aircraft` (docs/envelope.md section 14.2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance: Option<Vec<sepval_fit::results::ReleaseClearance>>,
     /// Models that explain part of the data but not as well as the answer (mimics).

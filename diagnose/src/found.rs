@@ -1,4 +1,4 @@
-//! What discovery reports (docs/model.md section 11.7): the gain of a model change, the terms
+//! What discovery reports (docs/discovery.md section 11.7): the gain of a model change, the terms
 //! found with their groups of indistinguishable alternatives, and each stepwise step's screening
 //! and verification.
 
@@ -95,7 +95,7 @@ pub struct DiscoveredTerm {
     /// What it brings: the refit without it against the refit with it (with one term: the
     /// baseline against the extension).
     pub gain: Gain,
-    /// A plain-language physical reading (`docs/model.md` section 11.4).
+    /// A plain-language physical reading (`docs/discovery.md` section 11.4).
     pub reading: String,
     /// Entries the data cannot tell from it (|correlation| >= 0.95).
     pub group: Vec<GroupMember>,

@@ -1,4 +1,4 @@
-//! What a discovered extension's terms give along its fitted trajectory (`docs/model.md`
+//! What a discovered extension's terms give along its fitted trajectory (`docs/discovery.md`
 //! section 11.7): per event and axis, the coefficient increments the figure of the
 //! reconstruction draws beside the reconstructed ones, and that figure.
 

@@ -12,7 +12,7 @@
 //!    among significant ones is chosen, and further effects are added while each addition is
 //!    itself significant (forward selection).
 //! 3. **Discovery** (`discover`): beyond the catalogue, the missing force and moment are
-//!    reconstructed as time histories, and terms of a documented library (docs/model.md
+//!    reconstructed as time histories, and terms of a documented library (docs/discovery.md
 //!    section 11) are selected by stepwise regression and verified by an output-error refit.
 //!    When the catalogue's answer explains the data to the noise, discovery stops as soon as
 //!    its model can no longer replace or rival that answer (`discover::reach`).

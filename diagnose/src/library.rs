@@ -1,5 +1,5 @@
 //! The library of candidate terms a diagnosis tries beyond the effect catalogue
-//! (`docs/model.md` section 11), the time windows of the model-error reconstruction, and what
+//! (`docs/discovery.md`), the time windows of the model-error reconstruction, and what
 //! each term's regressor does along the fitted trajectory (which sets the size of its probe).
 //!
 //! Grids of the families' locators: interference decay lengths 0.2 to 2 m; the same three

@@ -1,4 +1,4 @@
-//! The model-error reconstruction of docs/model.md section 11.6 for a fitted model given from
+//! The model-error reconstruction of docs/discovery.md section 11.6 for a fitted model given from
 //! outside a diagnosis (`sepval update` chooses its corrections from it): what the fitted
 //! candidate lacks, per event, as coefficient increments on time windows with their bands, and
 //! what the store saw at each sample along the fitted trajectory.

@@ -1,5 +1,5 @@
 //! Plain-language physical readings of discovered terms: one sentence per family and axis, from
-//! the table in `docs/model.md` section 11.4. A reading says what a store-separation engineer
+//! the table in `docs/discovery.md` section 11.4. A reading says what a store-separation engineer
 //! would suspect first; it is a reading of the term's shape, not a proof of the mechanism.
 //!
 //! | family | reading |
@@ -60,7 +60,7 @@ fn variable(r: Regressor) -> &'static str {
 }
 
 /// The modelled carriage increment on `axis`, signed as a term on that axis adds (a term on
-/// `CA` subtracts from CX, docs/model.md section 11.2); `None` for the ejector and for a
+/// `CA` subtracts from CX, docs/discovery.md section 11.2); `None` for the ejector and for a
 /// tabulated increment (it has no single sign).
 pub fn carriage_increment(interference: &Interference, axis: Axis) -> Option<f64> {
     // The aerodynamic axes are in the order of the increments (dCX0, dCY0, ... dCn0).

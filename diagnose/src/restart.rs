@@ -1,5 +1,5 @@
 //! A baseline caught in a local optimum, found by the catalogue and restarted
-//! (`docs/model.md` section 11.5, step 2a).
+//! (`docs/discovery.md` section 11.5, step 2a).
 //!
 //! Every test of the diagnosis measures an extension against the converged baseline. The
 //! baseline's refinement starts where the genetic search left it, and with several releases

@@ -1,6 +1,6 @@
 //! Prediction of events that took no part in the fits (`--validate`): the goals of the
 //! baseline, the answer and the alternatives on each, and the verdict's caution when an
-//! alternative predicts clearly better than the answer (docs/model.md section 11.5).
+//! alternative predicts clearly better than the answer (docs/discovery.md section 11.5).
 
 use sepval_common::evaluation::{Candidate, Job};
 use serde::{Deserialize, Serialize};

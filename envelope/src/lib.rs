@@ -1,4 +1,4 @@
-//! The separation envelope (`sepval envelope`, docs/model.md section 14.4): the store's
+//! The separation envelope (`sepval envelope`, docs/envelope.md section 14.4): the store's
 //! clearance to the aircraft predicted at every condition of a grid, from a fit or a diagnosis,
 //! each a prediction of `sepval predict` (its factor draws, model form and discrepancy) with
 //! the clearance of every sample, mapped over the two axes that matter. A condition is cleared

@@ -1,6 +1,6 @@
 //! A fitted model as files hold it, so that another command rebuilds its candidate exactly:
 //! the 17 factors, each catalogue effect with its parameter values, and each extension term
-//! with its coefficient (the records of `extension.toml`, `docs/model.md` section 11).
+//! with its coefficient (the records of `extension.toml`, `docs/discovery.md`).
 //!
 //! The terms are the model's own, beyond those of the extension file its inputs name
 //! (`InputsRecord::extension`): a job rebuilt from the same inputs applies those, and the

@@ -47,14 +47,14 @@ pub struct FitResult {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inputs: Option<InputsRecord>,
     /// The clearance to the aircraft of the best fit's trajectory of each release, when the
-    /// fit was given `--aircraft` (docs/model.md section 14.2).
+    /// fit was given `--aircraft` (docs/envelope.md section 14.2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance: Option<Vec<ReleaseClearance>>,
     /// How this run was executed (not part of the deterministic result).
     pub run: RunInfo,
 }
 
-/// The clearance of one release's trajectory (docs/model.md section 14.2), as result.json and
+/// The clearance of one release's trajectory (docs/envelope.md section 14.2), as result.json and
 /// diagnosis.json record it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReleaseClearance {

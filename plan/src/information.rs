@@ -1,4 +1,4 @@
-//! The information a release at each condition adds (docs/model.md section 12.3): the
+//! The information a release at each condition adds (docs/planning.md section 12.3): the
 //! D-optimal criterion on the answer's free parameters. The Fisher information of the
 //! normalised residuals is J^T J (J: the sensitivities of every sample's six channels over
 //! their noise, each parameter in units of its range, so that the determinant does not hang on

@@ -1,7 +1,7 @@
 //! The next release to fly (`sepval plan`): given a diagnosis whose releases cannot tell its
 //! answer from its rivals, the release condition that would best separate them, and with no
 //! rivals the one that would most shrink the uncertainty of the answer's parameters. What is
-//! computed is specified in docs/model.md section 12; the design follows M. B. Anderson's
+//! computed is specified in docs/planning.md; the design follows M. B. Anderson's
 //! observation that "many parameter combinations are capable of producing reasonable
 //! trajectories", settled, as engineers settle it, by flying another release.
 //!

@@ -1,4 +1,4 @@
-//! The ranking of the conditions (docs/model.md section 12.4): with rivals, by the number of
+//! The ranking of the conditions (docs/planning.md section 12.4): with rivals, by the number of
 //! pairs of models a release there separates (most first), then by its separation (the hardest
 //! pair's, largest first), then by information gain; without rivals, by information gain alone.
 //! Every model, the answer or a rival, may be the true one, so every pair counts alike: with

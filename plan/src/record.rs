@@ -1,5 +1,5 @@
 //! DIR/plan.json as files hold it (format [`PLAN_FORMAT`]), documented field by field in
-//! docs/model.md section 12.5, and its making from a plan.
+//! docs/planning.md section 12.5, and its making from a plan.
 
 use std::path::{Path, PathBuf};
 

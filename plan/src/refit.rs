@@ -1,4 +1,4 @@
-//! The linearised refit behind the separation and the information (docs/model.md section 12):
+//! The linearised refit behind the separation and the information (docs/planning.md):
 //! normal equations pooled over releases, the chi-square a model is left with after its
 //! parameters absorb what they can of another model's trajectories, and log det of an
 //! information matrix.

@@ -1,4 +1,4 @@
-//! The separation of each condition (docs/model.md section 12.2): how far apart a release
+//! The separation of each condition (docs/planning.md section 12.2): how far apart a release
 //! there would put every two models once each has absorbed what it can of the other.
 //!
 //! For two models a and b, "a true, b refitted": b's parameters are refitted (linearised at

@@ -1,4 +1,4 @@
-//! The bands (docs/model.md section 13.5): pointwise quantiles per channel of the samples
+//! The bands (docs/prediction.md section 13.5): pointwise quantiles per channel of the samples
 //! with every source added, and each source's share of the width.
 //!
 //! Sample s of model m_s has the trajectory y_s(t) (its factors drawn, [`crate::sampling`]);

@@ -1,4 +1,4 @@
-//! The post-flight check (docs/model.md section 13.6): a release flown at the condition
+//! The post-flight check (docs/prediction.md section 13.6): a release flown at the condition
 //! predicted (`--data FLOWN.csv`) against the bands. The bands of a check include the
 //! measurement (telemetry is compared, not the truth). Per channel: the fraction of the data's
 //! samples inside the band, and where the data first *leave* it: the start of the first run

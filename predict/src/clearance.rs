@@ -1,4 +1,4 @@
-//! The clearance of a prediction (docs/model.md section 14.3): the distribution over the
+//! The clearance of a prediction (docs/envelope.md section 14.3): the distribution over the
 //! samples of the smallest distance between the store and the aircraft, the probability that
 //! it falls below the criterion (MIL-STD-1289D, "Airborne stores ejection clearance and
 //! separation", asks for at least 25.4 mm), and when and where the store comes closest.

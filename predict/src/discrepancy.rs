@@ -1,4 +1,4 @@
-//! The model-form discrepancy (docs/model.md section 13.4): what the answer gets wrong beyond
+//! The model-form discrepancy (docs/prediction.md section 13.4): what the answer gets wrong beyond
 //! its factor bands and the noise, calibrated on releases held out of its fit, carried to the
 //! release predicted as a standard deviation per channel and time, delta_c(t).
 //!
@@ -30,7 +30,7 @@
 //!    error at another condition, which the page says).
 //!
 //! [`KAPPA`] = 2 was chosen on a first set of 128 calibration cases (1 gave a mean coverage of
-//! 0.88 there, 2 gave 0.90); the README's table, on other seeds, gives 0.93, and the CI test
+//! 0.88 there, 2 gave 0.90); docs/performance.md's table, on other seeds, gives 0.93, and the CI test
 //! runs others again.
 //!
 //! The refits and the held-out predictions are small (a few hundred simulations each) and run

@@ -1,4 +1,4 @@
-//! The models a prediction draws from and their weights (docs/model.md section 13.2): the
+//! The models a prediction draws from and their weights (docs/prediction.md section 13.2): the
 //! source's answer and each of its rivals, rebuilt from their model records
 //! (`sepval_fit::model_spec`) with the free parameters their refits move (the 17 factors, the
 //! effects' parameters, the terms' coefficients, as `sepval plan` rebuilds them), weighted by

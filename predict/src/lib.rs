@@ -1,6 +1,6 @@
 //! The trajectory of a release that was not flown (`sepval predict`), with bands that say how
 //! sure it is, and the post-flight check of a flown release against them. What is computed is
-//! specified in docs/model.md section 13. The bands have three sources, each reported with its
+//! specified in docs/prediction.md. The bands have three sources, each reported with its
 //! share of the width: the factors (drawn from the covariance of the fit), the model's form
 //! (the diagnosis's rivals weighted by their evidence, and a discrepancy calibrated on releases
 //! held out of the fit), and the measurement. The field's warning is NASA's X-43A: flight

@@ -1,5 +1,5 @@
 //! DIR/prediction.json as files hold it (format [`PREDICTION_FORMAT`]) and DIR/bands.csv,
-//! documented field by field in docs/model.md section 13.7, and their making from a
+//! documented field by field in docs/prediction.md section 13.7, and their making from a
 //! prediction.
 
 use std::path::Path;
@@ -141,7 +141,7 @@ pub struct PredictionFile {
     /// The post-flight check, when a flown release was given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub check: Option<Check>,
-    /// The clearance to the aircraft, when a geometry was given (docs/model.md section 14.3).
+    /// The clearance to the aircraft, when a geometry was given (docs/envelope.md section 14.3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance: Option<ClearanceStats>,
     /// `fit` or `diagnosis`.

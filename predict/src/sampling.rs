@@ -1,4 +1,4 @@
-//! The factor samples (docs/model.md section 13.3): the answer's parameters drawn from a
+//! The factor samples (docs/prediction.md section 13.3): the answer's parameters drawn from a
 //! multivariate normal about its estimate with the covariance of its refit,
 //! C_ij = s_i s_j rho_ij (s: the white-residual standard errors of `identifiability`, the
 //! Cramer-Rao bound of the noise, rho: its correlation matrix; a parameter whose standard error

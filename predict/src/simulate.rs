@@ -1,4 +1,4 @@
-//! The simulation of a prediction (docs/model.md section 13.3): every sample through any
+//! The simulation of a prediction (docs/prediction.md section 13.3): every sample through any
 //! [`Evaluator`] (the prediction never knows how the batches travel: in process, iceoryx2
 //! workers or zenoh), in parts of at most [`SAMPLE_BUDGET`] simulated samples, each part's
 //! trajectories reduced at once to the band's time points ([`Grid`]: every sample of a release

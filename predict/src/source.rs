@@ -1,7 +1,7 @@
 //! The source of a prediction: the `--out` directory of `sepval fit` (DIR/result.json, format
 //! [`sepval_fit::results::RESULT_FORMAT`]) or of `sepval diagnose` (DIR/diagnosis.json, format
 //! [`sepval_diagnose::DIAGNOSIS_FORMAT`]), read and checked. What a prediction needs from it
-//! (docs/model.md section 13.1): the fitted models (a fit's best refined factors; a diagnosis's
+//! (docs/prediction.md section 13.1): the fitted models (a fit's best refined factors; a diagnosis's
 //! answer and its rivals with their BIC against the answer), the covariance of the answer's
 //! parameters (`identifiability`: standard errors and correlations of the `+lm` refinement or
 //! of the diagnosis's refit of its answer), the noise, the answer's residual RMS per channel on

@@ -1,4 +1,4 @@
-//! Kept only as far as they predict (docs/model.md section 15.5): the folds of the
+//! Kept only as far as they predict (docs/update.md section 15.5): the folds of the
 //! cross-validation over releases, refits of many spaces at once, and what each fold's refit
 //! predicts on the samples it was not fitted to.
 

@@ -1,9 +1,9 @@
 //! What the releases explored, and the corrections that may be proposed over it
-//! (docs/model.md section 15.2): a correction spans only the range of its variable that the
+//! (docs/update.md section 15.2): a correction spans only the range of its variable that the
 //! releases went through along their fitted trajectories, so that nothing beyond it is
 //! presented as measured.
 //!
-//! Choices, written down in docs/model.md section 15.2:
+//! Choices, written down in docs/update.md section 15.2:
 //! - **distance from carriage**: [`DISTANCE_KNOTS`] breakpoints from 0 to the largest distance
 //!   reached, spaced quadratically (s_max (j / (n - 1))^2: dense near carriage, where the
 //!   interference changes fastest), then the scenario's `s_end_m` with its value held at 0 (the

@@ -1,5 +1,5 @@
 //! The jobs of an update and how their evaluators start: the releases as given, and with the
-//! corrections of a round in every scenario (docs/model.md section 15.1), whose values each
+//! corrections of a round in every scenario (docs/update.md section 15.1), whose values each
 //! candidate carries; and the clock of its stages.
 
 use std::sync::Arc;

@@ -1,6 +1,6 @@
 //! `sepval update`: the store's aerodynamic data updated from its releases, as corrections in
 //! the scenario's own table forms, kept only as far as they predict a release they were not
-//! fitted to (docs/model.md section 15).
+//! fitted to (docs/update.md).
 //!
 //! This is what engineers do with release data when the catalogue and the term library do not
 //! name the cause: update the store's data with smooth corrections over the states the store
@@ -14,7 +14,7 @@
 //! 1. **baseline**: the 17 factors fitted to every release (the fit pipeline, `ga+lm`, into
 //!    DIR/baseline), refined to convergence ([`Baseline`]);
 //! 2. **misfit**: the missing force and moment reconstructed per release as coefficient
-//!    increments (docs/model.md section 11.6; `sepval_diagnose::reconstruct_misfit`);
+//!    increments (docs/discovery.md section 11.6; `sepval_diagnose::reconstruct_misfit`);
 //! 3. **explored** and **screen**: the corrections the explored ranges allow, scored by how
 //!    well each predicts the reconstruction of releases left out ([`screen::Screening`]);
 //! 4. **select**: the corrections proposed refitted by output error with the factors, their

@@ -1,5 +1,5 @@
 //! DIR/update.json (`sepval-update/1`): everything an update decided and measured, for
-//! programs; docs/model.md section 15.8 lists its fields.
+//! programs; docs/update.md section 15.8 lists its fields.
 
 use std::collections::BTreeMap;
 

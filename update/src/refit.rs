@@ -1,4 +1,4 @@
-//! One output-error refit of an update (docs/model.md section 15.4): Levenberg-Marquardt over
+//! One output-error refit of an update (docs/update.md section 15.4): Levenberg-Marquardt over
 //! an [`UpdateSpace`], its residual vector the normalised residuals of the samples it is fitted
 //! to (a [`Mask`]: the releases of a fold, or the first part of one release) followed by the
 //! smoothness penalty's rows L v (each correction's weighted by its lambda). Several refits share each batch

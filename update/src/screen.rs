@@ -1,5 +1,5 @@
 //! Which coefficients need a correction, and over which variable: estimation before modelling
-//! (docs/model.md section 15.3.1). The missing force and moment are reconstructed per release
+//! (docs/update.md section 15.3.1). The missing force and moment are reconstructed per release
 //! as coefficient increments on time windows (section 11.6, `sepval_diagnose::
 //! reconstruct_misfit`), whose linear model of the residuals is r0 + J a + W u (J the free
 //! factors' sensitivities, W the windows'). A correction proposed for an axis

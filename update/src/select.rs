@@ -1,4 +1,4 @@
-//! The corrections kept, chosen by what they predict (docs/model.md section 15.5): forward
+//! The corrections kept, chosen by what they predict (docs/update.md section 15.5): forward
 //! selection in rounds. Each round screens every correction on the reconstruction of what the
 //! current model lacks (section 15.3, linearised about it, which also chooses the correction's
 //! smoothness), then refits the current model with the best one by output error, to every

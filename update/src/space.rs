@@ -1,4 +1,4 @@
-//! The parameters of an update's output-error refit (docs/model.md section 15.4): the free
+//! The parameters of an update's output-error refit (docs/update.md section 15.4): the free
 //! factors, then the free values of every correction (those not held at 0), and the smoothness
 //! penalty on the values as rows appended to the residual vector.
 

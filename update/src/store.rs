@@ -1,4 +1,4 @@
-//! The updated store (docs/model.md section 15.7): every kept correction merged into the field
+//! The updated store (docs/update.md section 15.7): every kept correction merged into the field
 //! it corrects, as a table in the scenario's own form, and the scenario written with its tables
 //! as CSV files that every command reads as they are.
 //!

@@ -1,4 +1,4 @@
-//! How sure the corrections are (docs/model.md section 15.6): the covariance of the penalised
+//! How sure the corrections are (docs/update.md section 15.6): the covariance of the penalised
 //! estimate at the final refit, its effective number of parameters, and each correction's band.
 //!
 //! With J the Jacobian of the samples' rows, P = lambda L^T L the penalty's (both from the

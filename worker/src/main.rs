@@ -5,8 +5,9 @@
 //! `sepval_transport::serve` with this process's own simulations. A worker validates every
 //! request and answers a bad one with a typed failure instead of crashing; it ends cleanly when
 //! its coordinator ends the run or goes away, or on SIGINT/SIGTERM. A panic is reported as a
-//! defect with its message and place, exit status 2 (`sepval_common::defect`). Run `iox2 service list`
-//! with the run's configuration to see its services (see the README).
+//! defect with its message and place, exit status 2 (`sepval_common::defect`). Run `iox2 service
+//! list` with the run's configuration to see its services (see docs/guide.md, "Distributed
+//! evaluation").
 
 // The doc comments here are clap's --help text, where units read `[s]`, `[m]`; rustdoc would
 // take those for links.

@@ -1,4 +1,4 @@
-//! Corrections of a store's aerodynamic data whose values a search estimates (docs/model.md
+//! Corrections of a store's aerodynamic data whose values a search estimates (docs/update.md
 //! section 15): piecewise-linear tables added to a scenario field, over one variable, with their
 //! breakpoints in the scenario (`[[correction]]`) and their values in each candidate.
 //!

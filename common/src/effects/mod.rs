@@ -63,7 +63,7 @@ pub trait Effect: Send + Sync {
     fn params(&self) -> &'static [ParamSpec];
     /// Applies the effect with parameters `p` (as many as [`Effect::params`], finite) to a run.
     fn apply(&self, p: &[f64], run: &mut RunSetup) -> Result<(), EffectError>;
-    /// The extension term it equals, when it is one term of the library (`docs/model.md`
+    /// The extension term it equals, when it is one term of the library (`docs/discovery.md`
     /// section 11): its first parameter is then that term's coefficient. A diagnosis does not
     /// call the two rivals: they are one explanation in two vocabularies.
     fn as_term(&self) -> Option<(crate::extension::Axis, crate::extension::Regressor)> {

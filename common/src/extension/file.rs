@@ -1,4 +1,4 @@
-//! Extension files (`sepval-extension/1`, docs/model.md section 11.3): a term as files write
+//! Extension files (`sepval-extension/1`, docs/discovery.md section 11.3): a term as files write
 //! it, the reader that refuses a bad field with its file, line and name, and the writer whose
 //! output reads back to the same terms bit for bit.
 

@@ -1,4 +1,4 @@
-//! The domain of each locator of the library's families (docs/model.md section 11.2): the
+//! The domain of each locator of the library's families (docs/discovery.md section 11.2): the
 //! values a term may take, chosen so that every accepted value simulates, i.e. its regressor
 //! is a finite number at every state a run reaches (issue 21, item 13: a decay length of 1e300
 //! m, a frequency of 1e308 Hz or a reference Mach number of 1e300 made NaN at the first force

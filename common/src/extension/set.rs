@@ -1,4 +1,4 @@
-//! The terms of one run (docs/model.md section 11.2): a fixed-capacity `Copy` set, the
+//! The terms of one run (docs/discovery.md section 11.2): a fixed-capacity `Copy` set, the
 //! scenario's and the candidate's together, and what the force evaluation reads from it (the
 //! coefficient increments and the ejector factor; the wind is in [`super::wind`]).
 

@@ -1,4 +1,4 @@
-//! The `wind` family (docs/model.md section 11.1): a gust, the air's velocity in the launch
+//! The `wind` family (docs/discovery.md section 11.1): a gust, the air's velocity in the launch
 //! frame L changing during the release. It is not a coefficient increment: the force
 //! evaluation subtracts it from the store's velocity relative to the air (section 11.2), so
 //! the flow angles, the airspeed, the dynamic pressure, the Mach number, the non-dimensional

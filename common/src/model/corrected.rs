@@ -1,4 +1,4 @@
-//! A run with the values of the scenario's corrections (docs/model.md section 15): those over
+//! A run with the values of the scenario's corrections (docs/update.md): those over
 //! Mach folded into the run's constants, the others kept for the force evaluation
 //! (`equations.rs`, `add_corrections`).
 
@@ -12,7 +12,7 @@ use super::Model;
 
 impl RunSetup {
     /// The run of `model` with `factors`, `effects`, the extension `terms` and the values of
-    /// the scenario's corrections (docs/model.md section 15): those over Mach folded into the
+    /// the scenario's corrections (docs/update.md): those over Mach folded into the
     /// run's constants at the flight Mach, the others kept for the force evaluation. Without
     /// values, the run of [`RunSetup::with_terms`], bit for bit.
     pub fn with_corrections(

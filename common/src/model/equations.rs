@@ -554,7 +554,7 @@ fn add_table_terms(
     k
 }
 
-/// Adds the corrections evaluated at each force evaluation (docs/model.md section 15): a static
+/// Adds the corrections evaluated at each force evaluation (docs/update.md): a static
 /// coefficient's as its table's (CX = -CA), an interference increment's times its multiplier,
 /// at the stage's local alpha and beta and distance from carriage. Out of line: only runs of
 /// an update have them.

@@ -111,7 +111,7 @@ pub struct Model {
     pub v_inf_m_s: f64,
     /// Speed of sound at the flight condition [m/s].
     pub speed_of_sound_m_s: f64,
-    /// The scenario's model extension (docs/model.md section 11), in every run.
+    /// The scenario's model extension (docs/discovery.md), in every run.
     pub extension: TermSet,
     /// Aircraft velocity relative to the air in L:
     /// V_inf (cos a cos b, sin b, sin a cos b) (docs/model.md section 2).
@@ -130,7 +130,7 @@ pub struct Model {
     pub interference_at_carriage: [f64; 6],
     /// The scenario's tables, ready for the force evaluation (docs/model.md section 3).
     pub tables: PreparedTables,
-    /// The scenario's corrections (docs/model.md section 15), whose values candidates carry.
+    /// The scenario's corrections (docs/update.md), whose values candidates carry.
     pub corrections: Vec<Correction>,
 }
 
@@ -256,11 +256,11 @@ pub struct RunSetup {
     pub attitude_bias_rad: [f64; 3],
     /// Measurement: the tracked body point relative to the CG, body axes \[m\].
     pub tracked_point_b_m: Vector3<f64>,
-    /// Model-extension terms (the scenario's and the candidate's; docs/model.md section 11).
+    /// Model-extension terms (the scenario's and the candidate's; docs/discovery.md).
     pub terms: TermSet,
     /// 1 / a, the speed of sound's reciprocal [s/m] (the store's Mach number is V / a).
     pub inv_speed_of_sound_s_m: f64,
-    /// The corrections evaluated at each force evaluation (docs/model.md section 15; none
+    /// The corrections evaluated at each force evaluation (docs/update.md; none
     /// without correction values).
     pub corrections: CorrectionRun,
 }

@@ -298,10 +298,10 @@ pub struct Scenario {
     /// Factor table overrides by factor name.
     #[serde(default, with = "factor_table_serde")]
     pub factors: FactorTable,
-    /// Model-extension terms (docs/model.md section 11), written as `[[extension]]` tables.
+    /// Model-extension terms (docs/discovery.md), written as `[[extension]]` tables.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub extension: Vec<crate::extension::TermRecord>,
-    /// Corrections whose values each candidate carries (docs/model.md section 15), written as
+    /// Corrections whose values each candidate carries (docs/update.md), written as
     /// `[[correction]]` tables; `sepval update` sets them, and the store it writes has none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub correction: Vec<crate::correction::CorrectionRecord>,

@@ -2,7 +2,7 @@
 //! ([`Trajectory::parse`], and [`Trajectory::read`] on files of arbitrary bytes, invalid UTF-8
 //! included), scenario TOML ([`Scenario::from_toml_str`]), factors JSON
 //! ([`Factors::from_json_str`]), effect specs of the command line ([`EffectSet::push_spec`])
-//! and model-extension TOML ([`parse_extension`], `docs/model.md` section 11).
+//! and model-extension TOML ([`parse_extension`], `docs/discovery.md`).
 //!
 //! Each is fed arbitrary text and structured mutations of a valid input (the embedded default
 //! flight test, the embedded default scenario, the truth factors): bytes flipped, inserted and

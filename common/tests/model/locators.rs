@@ -1,4 +1,4 @@
-//! The edges of the locators' domains (docs/model.md section 11.2,
+//! The edges of the locators' domains (docs/discovery.md section 11.2,
 //! `sepval_common::extension::locator`; issue 21, item 13): the largest (and smallest) accepted
 //! value of each locator simulates the default scenario to a finite trajectory, and the next
 //! double beyond is refused when read, naming the field and the domain.

@@ -1,4 +1,4 @@
-//! The `wind` family in the equations of motion (docs/model.md section 11.2): a steady
+//! The `wind` family in the equations of motion (docs/discovery.md section 11.2): a steady
 //! crosswind is a changed sideslip (the analytic check at release, and the whole trajectory
 //! against a scenario flown at that sideslip and airspeed), the lanes keep the bits of the
 //! scalar runs when wind and windless runs share a batch, and the edges of `rise_s` simulate.

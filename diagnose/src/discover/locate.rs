@@ -1,4 +1,4 @@
-//! The locator zoom (`docs/model.md` section 11.5): each entry to verify has its locator (step
+//! The locator zoom (`docs/discovery.md` section 11.5): each entry to verify has its locator (step
 //! or gust time, frequency, decay length) refined on a grid eight times finer than the library's, around
 //! the one screened, and its linear coefficients estimated by the regression there.
 

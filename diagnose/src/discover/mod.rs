@@ -1,6 +1,6 @@
 //! Discovery beyond the catalogue: what force and moment the fitted baseline lacks, which terms
 //! of a documented library explain it, and what the model extended by them gains
-//! (`docs/model.md` section 11).
+//! (`docs/discovery.md`).
 //!
 //! 1. **Sensitivities.** The fitted baseline is simulated with each reconstruction window, then
 //!    with each library term, added at a small probe coefficient; the change of the normalised

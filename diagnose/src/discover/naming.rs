@@ -1,4 +1,4 @@
-//! Naming the found terms (`docs/model.md` section 11.7): each entry's estimate with its
+//! Naming the found terms (`docs/discovery.md` section 11.7): each entry's estimate with its
 //! standard error (an oscillation pair as one amplitude and phase, its error propagated with the
 //! pair's correlation), its locator, its gain, its physical reading and its group; most
 //! important first.

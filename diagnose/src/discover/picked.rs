@@ -1,5 +1,5 @@
 //! The library entries discovery has taken into the model, and where their parameters sit in the
-//! parameter vector of the extended model (`docs/model.md` section 11.5): the factors first, then
+//! parameter vector of the extended model (`docs/discovery.md` section 11.5): the factors first, then
 //! each free term's coefficient followed by its locator when the locator is refitted too. This is
 //! the one place that knows that layout; the refits, F-to-remove and the naming of the found
 //! terms all read it from here.

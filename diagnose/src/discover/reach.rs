@@ -1,5 +1,5 @@
 //! When discovery stops early: its model can no longer reach the catalogue's answer
-//! (`docs/model.md` section 11.5, "Out of reach").
+//! (`docs/discovery.md` section 11.5, "Out of reach").
 //!
 //! Discovery's extension matters to the answer in two ways only: it replaces the catalogue's
 //! answer when its BIC is lower by more than [`BIC_MARGIN`](crate::BIC_MARGIN), and it is a rival of that answer

@@ -1,4 +1,4 @@
-//! F-to-remove (`docs/model.md` section 11.5): every entry of a model refitted out in turn from
+//! F-to-remove (`docs/discovery.md` section 11.5): every entry of a model refitted out in turn from
 //! the model's optimum (all refits sharing each batch); an entry whose removal is no longer
 //! significant leaves, and each entry's gain is what its removal costs. A refit without an
 //! entry that does not simulate is left out (recorded in the trail): that entry stays, and its

@@ -1,4 +1,4 @@
-//! One step's screening (`docs/model.md` section 11.3): the library's entries not yet in, their
+//! One step's screening (`docs/discovery.md` section 11.3): the library's entries not yet in, their
 //! sensitivities about the current model (and, at the first step, before them, the
 //! reconstruction windows', reduced to the reconstruction and dropped), the regression's F-to-enter against a Bonferroni threshold with the
 //! predicted square error, and the entries worth an output-error refit.

@@ -1,5 +1,5 @@
 //! What every step of discovery shares: the job, the noise, the refinement settings, the
-//! residual rows the sensitivities use, and the room left for terms (`docs/model.md` section 11).
+//! residual rows the sensitivities use, and the room left for terms (`docs/discovery.md`).
 
 use std::sync::Arc;
 

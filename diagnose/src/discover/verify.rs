@@ -1,4 +1,4 @@
-//! Verification (`docs/model.md` section 11.5): each located entry refitted by output error
+//! Verification (`docs/discovery.md` section 11.5): each located entry refitted by output error
 //! with the factors and the terms already in, the best on to convergence, its gain tested
 //! against the current model, and its group of entries the data cannot tell from it.
 

@@ -38,7 +38,7 @@ fn bands_hold_the_truth_and_are_not_too_wide() {
     assert!(coverage >= 0.9, "mean coverage {coverage:.3}");
 }
 
-/// The calibration table of the README: every cause, two and three releases fitted, eight
+/// The calibration table of docs/performance.md: every cause, two and three releases fitted, eight
 /// seeds each. `cargo test --release -p sepval-predict --test calibration -- --ignored
 /// --nocapture table`.
 #[test]

@@ -14,7 +14,7 @@ use sepval_common::telemetry::outliers::Policy;
 use super::releases::{self, Release};
 
 /// The scenario of `--scenario FILE`, or the embedded default, extended by the terms of
-/// `--extension FILE` (docs/model.md section 11).
+/// `--extension FILE` (docs/discovery.md).
 pub fn scenario(path: Option<&Path>, extension: Option<&Path>) -> Result<Scenario> {
     let mut s = match path {
         Some(p) => Scenario::load(p)?,

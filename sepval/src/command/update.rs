@@ -1,5 +1,5 @@
 //! `sepval update`: the store's aerodynamic data updated from its releases, as corrections in
-//! the scenario's own table forms kept only as far as they predict (docs/model.md section 15).
+//! the scenario's own table forms kept only as far as they predict (docs/update.md).
 
 use std::sync::Arc;
 

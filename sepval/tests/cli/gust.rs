@@ -185,7 +185,7 @@ fn a_baseline_in_a_local_optimum_is_restarted_and_names_no_effect() {
     // The short gust on two releases, the second at 1 000 m where the dynamic pressure is 3.4
     // times the first's: the baseline's refinement stops in a local optimum of the factors (12
     // sigma in position), from which each catalogue refit escapes with its effect near neutral.
-    // The restart (docs/model.md 11.5, step 2a) refits the baseline from the catalogue's factors
+    // The restart (docs/discovery.md section 11.5, step 2a) refits the baseline from the catalogue's factors
     // and the catalogue from it: no effect is then named for the factors' escape.
     let dir = tempfile::tempdir().unwrap();
     let dir = dir.path();

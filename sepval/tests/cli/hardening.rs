@@ -371,7 +371,7 @@ fn goals_printed(stdout: &str) -> [f64; 2] {
 }
 
 /// Issue 21, item 5: DIR/extension.toml holds every term of the answer's model, the one given
-/// with `--extension` included, so that the README's recipe (`simulate --factors
+/// with `--extension` included, so that the guide's recipe (`simulate --factors
 /// DIR/factors.json --extension DIR/extension.toml`) reproduces the answer's goals.
 #[test]
 fn the_extension_written_reproduces_the_answer_with_the_users_terms() {

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use sepval_tests::{ok, refused, sepval};
 
-/// A model extension of one term (docs/model.md section 11).
+/// A model extension of one term (docs/discovery.md).
 const EXTENSION: &str = "format = \"sepval-extension/1\"\n\n[[term]]\naxis = \"CY\"\nfamily = \
                          \"step\"\nregressor = \"step\"\nt_on_s = 0.4\ncoefficient = 0.05\n";
 

@@ -62,7 +62,7 @@ pub struct LmSettings {
 /// lowered the cost by less than the fraction `rel_drop` of the cost they started from. A
 /// refinement that creeps (each accepted step a gain just above the tolerance, hundreds of
 /// iterations) stops there, at the resolution its user needs: the diagnosis sets `rel_drop` to
-/// a tenth of a unit of its BIC (docs/model.md section 11.5).
+/// a tenth of a unit of its BIC (docs/discovery.md section 11.5).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Stall {
     /// The iterations looked back over.

@@ -18,7 +18,7 @@ use sepval_transport::ipc::{IpcOptions, Launch};
 use sepval_transport::link::quiet;
 use sepval_transport::spec::EvaluatorSpec;
 
-/// The truth in a gust: the air's velocity along `axis` \[m/s\] (docs/model.md section 11).
+/// The truth in a gust: the air's velocity along `axis` \[m/s\] (docs/discovery.md).
 fn gusty(axis: Axis, regressor: Regressor, locator: [f64; 2], w_m_s: f64) -> Candidate {
     let term = Term {
         axis,

@@ -34,7 +34,7 @@ use sepval_common::propagator::Observation;
 /// indices 7 and 8) and the `wind` family's regressors (indices 24 and 25); a version-4 worker
 /// would fail such a candidate, which a diagnosis would read as a probe that does not simulate,
 /// so the handshake refuses it instead. Version 6: a request carries the values of the
-/// scenario's corrections (`sepval update`, docs/model.md section 15) after its terms. Version
+/// scenario's corrections (`sepval update`, docs/update.md) after its terms. Version
 /// 7: the same messages, but a zenoh coordinator sends a worker that joined the setup of the
 /// run's next job (an envelope's next condition, an update's next round), which the worker
 /// accepts and serves, saying `Ready` again; a version-6 worker would take that setup for a
@@ -130,7 +130,7 @@ pub struct WireRequest {
     pub corrections: [f64; MAX_CORRECTION_VALUES],
 }
 
-/// One extension term of a candidate (docs/model.md section 11).
+/// One extension term of a candidate (docs/discovery.md).
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
 #[type_name("sepval.WireTerm")]
 #[repr(C)]

@@ -6,7 +6,7 @@
 //! (<https://zenoh.io>) behind the same [`Link`](crate::link::Link). The coordinator listens on
 //! one explicit endpoint (`tcp/ADDR:PORT`); every worker connects to it. Both run zenoh in peer
 //! mode with multicast scouting and gossip switched off, so a session talks only to the
-//! endpoints it is given (see the README, "Workers on other hosts").
+//! endpoints it is given (see docs/guide.md, "Workers on other hosts").
 //!
 //! Key expressions of run `R` (a run id is `[A-Za-z0-9-]`, so it is one key chunk):
 //!
