@@ -239,7 +239,7 @@ fn method(file: &PlanFile) -> String {
          trajectories at the releases flown and the new one, in units of the noise; a pair is \
          separated above {}. The information gain is the growth of ln det of the answer's Fisher \
          information (parameters in units of their ranges, a unit prior on each). {} \
-         See docs/model.md section 12.",
+         See docs/planning.md.",
         number(file.threshold),
         if file.ranked_by == "separation" {
             "The conditions are ranked by the number of pairs they separate (any model may be \

@@ -267,7 +267,7 @@ fn method(file: &PredictionFile) -> String {
          as a smooth error, and the measurement noise when it is included. The bands are the \
          pointwise {:.1} % and {:.1} % quantiles of the samples, the middle their median. A \
          source's share is its variance alone over the sum of the sources' variances, summed over \
-         time, averaged over the channels. See docs/model.md section 13.",
+         time, averaged over the channels. See docs/prediction.md.",
         50.0 * (1.0 - file.level),
         50.0 * (1.0 + file.level)
     )

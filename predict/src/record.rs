@@ -117,7 +117,7 @@ pub struct PredictionFile {
     /// The condition.
     pub condition: ConditionRecord,
     /// When the condition lies far from every release fitted, the sentence that says so
-    /// (docs/model.md section 13, "Far from the releases"); the summary's first sentence.
+    /// (docs/model.md section 1, "The model's domain"); the summary's first sentence.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extrapolation: Option<String>,
     /// Times of the band points \[s\].

@@ -13,6 +13,7 @@ mod discover;
 mod envelope;
 mod fit;
 mod fuzz;
+mod guide;
 mod gust;
 mod hardening;
 mod hardening3_geometry;
