@@ -12,7 +12,7 @@ use sepval_envelope::grid::{Axis, Grid};
 use sepval_envelope::progress::{Progress, inputs_digest, progress_path};
 use sepval_envelope::summary::summarise;
 use sepval_envelope::{EnvelopeFile, Sweep, sweep, write_outputs};
-use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
 use sepval_predict::Settings;
 use sepval_transport::link::{Notice, Notices};
@@ -58,7 +58,11 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     };
     let digest = digest(&args, &source.dir, &aircraft, &given)?;
     let inputs_sha256 = digest.clone();
-    let (run_dir, progress) = claim(&args, digest, grid.len())?;
+    let mut read = super::recorded_inputs(&args.from, &source.inputs, &source.held_out);
+    read.extend(super::input_files("--extension", &args.extension));
+    read.extend(super::input_files("--validate", &args.validate));
+    read.extend(super::geometry_inputs(&args.geometry));
+    let (run_dir, progress) = claim(&args, digest, grid.len(), &read)?;
     run_dir.prepare()?;
     let start = Instant::now();
     let sweep_inputs = Sweep {
@@ -119,7 +123,12 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
 
 /// Claims `--out` (fresh, cleared with --overwrite, or the interrupted sweep's with --resume,
 /// whose progress must record the same inputs) and returns the progress to go on from.
-fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunDir, Progress)> {
+fn claim(
+    args: &EnvelopeArgs,
+    digest: String,
+    conditions: usize,
+    read: &[Input],
+) -> Result<(RunDir, Progress)> {
     let progress_file = progress_path(&args.out);
     let (claim, progress) = if args.resume {
         let p = Progress::read(&progress_file, &digest, conditions).with_context(|| {
@@ -136,20 +145,23 @@ fn claim(args: &EnvelopeArgs, digest: String, conditions: usize) -> Result<(RunD
             },
             p,
         )
-    } else if args.overwrite.overwrite {
-        (Claim::Overwrite, Progress::new(digest, conditions))
     } else {
-        (Claim::Fresh, Progress::new(digest, conditions))
+        (
+            super::fresh_or_overwrite(&args.overwrite),
+            Progress::new(digest, conditions),
+        )
     };
-    let run_dir = RunDir::claim(&args.out, claim, "envelope").with_context(|| {
-        let hint = if progress_file.is_file() {
-            " (it holds an interrupted sweep: --resume goes on with it)"
-        } else {
-            ""
-        };
-        format!("--out {}{hint}", args.out.display())
-    })?;
-    Ok((run_dir, progress))
+    // Only an interrupted sweep (its progress file there) can be gone on with.
+    let resume = progress_file
+        .is_file()
+        .then(|| "go on with its interrupted sweep (--resume)".to_string());
+    let request = Request {
+        command: "envelope",
+        claim,
+        inputs: read,
+        resume,
+    };
+    Ok((super::claim_out(&args.out, request)?, progress))
 }
 
 /// Starts each condition's evaluator: its workers' joining is told once, the rest of what the

@@ -10,6 +10,7 @@ use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_update::{UpdateOptions, update, write_outputs};
+use sepval_fit::out_dir::Request;
 
 use super::envelope::starter;
 use super::{evaluator_spec, inputs};
@@ -20,7 +21,17 @@ use crate::cli::UpdateArgs;
 pub fn run(args: UpdateArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let (options, job) = configure(&args)?;
-    let run_dir = super::claim_out(&args.out, &args.overwrite, "update")?;
+    let mut read = super::model_inputs(&args.inputs);
+    read.extend(super::input_files("--validate", &args.validate));
+    let run_dir = super::claim_out(
+        &args.out,
+        Request {
+            command: "update",
+            claim: super::fresh_or_overwrite(&args.overwrite),
+            inputs: &read,
+            resume: None,
+        },
+    )?;
     run_dir.prepare()?;
     let mut start = starter(&spec);
     let u = update(

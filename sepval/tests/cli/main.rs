@@ -15,6 +15,7 @@ mod fit;
 mod fuzz;
 mod gust;
 mod hardening;
+mod hardening3_out;
 mod hardening_on_disk;
 mod plan;
 mod predict;
