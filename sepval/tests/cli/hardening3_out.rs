@@ -276,6 +276,39 @@ fn an_interrupted_predict_overwrite_keeps_the_earlier_prediction() {
 }
 
 #[test]
+fn update_refuses_an_empty_free_name_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    ok(&sepval(
+        &["simulate", "--noise-seed", "1", "--out", "a.csv"],
+        d,
+    ));
+    for (free, shown) in [
+        ("", "\"\""),
+        (",", ","),
+        ("cmoff,", "cmoff,"),
+        (" , cnoff", " , cnoff"),
+    ] {
+        refused(
+            &sepval(
+                &["update", "--data", "a.csv", "--free", free, "--out", "U"],
+                d,
+            ),
+            &format!("--free {shown}: an empty factor name: expected names separated by commas"),
+        );
+        assert!(!d.join("U").exists(), "--free {free:?} wrote U");
+    }
+    // A directory that is not empty: the refusal suggests only what update can do.
+    std::fs::create_dir(d.join("busy")).unwrap();
+    std::fs::write(d.join("busy/notes.txt"), "x").unwrap();
+    let stderr = refused(
+        &sepval(&["update", "--data", "a.csv", "--out", "busy"], d),
+        "busy is not empty (it holds notes.txt); give another directory, or clear it (--overwrite)",
+    );
+    assert!(!stderr.contains("resume"), "{stderr}");
+}
+
+#[test]
 fn a_lock_that_names_no_process_is_taken_over_and_said() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
