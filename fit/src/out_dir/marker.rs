@@ -246,7 +246,9 @@ fn walk(dir: &Path, descend: &dyn Fn(&str) -> bool) -> Result<Vec<(String, Kind)
 
 /// The SHA-256 (hex) of the regular file `path`, read without blocking.
 fn sha256(path: &Path) -> std::io::Result<String> {
-    let mut file = sepval_common::input_file::InputFile::open(path, "run output", u64::MAX)
+    // No limit on what a run wrote (the reader's limit plus one must not overflow).
+    const UNLIMITED: u64 = i64::MAX as u64;
+    let mut file = sepval_common::input_file::InputFile::open(path, "run output", UNLIMITED)
         .map_err(std::io::Error::other)?;
     let mut h = Sha256::new();
     let mut buf = vec![0u8; 1 << 16];
@@ -291,6 +293,13 @@ mod tests {
         );
         write_ended(d, "fit").unwrap();
         clearable(d).unwrap();
+        let marker = std::fs::read_to_string(d.join(MARKER_FILE)).unwrap();
+        // SHA-256 of `{}`.
+        let sum = "44136fa355b3678a1146ad16f7e8649e94fb4fc21fe77e8310c060f61caaff8a";
+        assert!(
+            marker.contains(&format!("\"result.json\": \"{sum}\"")),
+            "{marker}"
+        );
         // A file added, a file edited, a link: each named.
         std::fs::write(d.join("figures/mine.png"), "x").unwrap();
         std::fs::write(d.join("result.json"), "{\"x\": 1}").unwrap();

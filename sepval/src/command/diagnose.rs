@@ -5,10 +5,10 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
+use sepval_fit::out_dir::Request;
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
-use sepval_fit::out_dir::Request;
 
 use super::{clearance, evaluator_spec, inputs, notices};
 use crate::cli::DiagnoseArgs;

@@ -5,10 +5,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use sepval_fit::out_dir::Request;
 use sepval_plan::{
     PlanFile, Quantity, Range, plan, plan_file, prepare, read_diagnosis, write_outputs,
 };
-use sepval_fit::out_dir::Request;
 
 use super::{evaluator_spec, inputs, notices};
 use crate::cli::PlanArgs;

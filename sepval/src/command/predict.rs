@@ -8,11 +8,11 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{Event, Job};
 use sepval_common::telemetry::Trajectory;
+use sepval_fit::out_dir::Request;
 use sepval_predict::{
     Flown, PredictionFile, Settings, Source, predict, prediction_file, prepare, read_source,
     write_outputs,
 };
-use sepval_fit::out_dir::Request;
 
 use super::{clearance, count, evaluator_spec, input_files, inputs, notices};
 use crate::cli::PredictArgs;

@@ -6,11 +6,11 @@ use std::sync::Arc;
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_common::factors::Factor;
+use sepval_fit::out_dir::Request;
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_update::{UpdateOptions, update, write_outputs};
-use sepval_fit::out_dir::Request;
 
 use super::envelope::starter;
 use super::{evaluator_spec, inputs};
