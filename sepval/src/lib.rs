@@ -62,6 +62,11 @@ pub fn refusal(e: &clap::Error) -> Option<String> {
     if e.kind() == ErrorKind::ValueValidation {
         // A typed value that refused itself (a run id): its own message says why.
         let reason = std::error::Error::source(e)?.to_string();
+        let value = if value.is_empty() {
+            "\"\"".to_string()
+        } else {
+            value
+        };
         return Some(format!("{flag} {value}: {reason}"));
     }
     if e.kind() != ErrorKind::InvalidValue {

@@ -78,6 +78,9 @@ pub enum UpdateError {
     /// The updated store cannot be written as a scenario.
     #[error("the updated store: {0}")]
     Store(String),
+    /// A list of free factors that is empty or names no factor: refused before anything runs.
+    #[error("the free factors {0:?}: expected at least one, each the index of one of the 17")]
+    Free(Vec<usize>),
 }
 
 impl From<EvalError> for UpdateError {

@@ -50,6 +50,10 @@ pub fn update(
     start: &mut StartEvaluator<'_>,
     progress: &mut dyn ProgressObserver,
 ) -> Result<Update> {
+    let factors = Factor::ALL.len();
+    if options.free.is_empty() || options.free.iter().any(|&i| i >= factors) {
+        return Err(UpdateError::Free(options.free.clone()));
+    }
     let t0 = Instant::now();
     CLOCK.start();
     let noise = Noise {

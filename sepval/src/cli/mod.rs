@@ -386,8 +386,8 @@ pub struct UpdateArgs {
     pub validate: Vec<PathBuf>,
     /// The factors fitted with the corrections, comma-separated [default: all 17]; the others
     /// stay at the baseline fit's values.
-    #[arg(long, value_name = "NAME,...")]
-    pub free: Option<String>,
+    #[arg(long, value_name = "NAME,...", value_parser = factor_names)]
+    pub free: Option<FactorNames>,
     /// Seed of the baseline fit's genetic search.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -528,4 +528,21 @@ pub enum ZdtArg {
     Zdt2,
     /// Disconnected front.
     Zdt3,
+}
+
+/// The names of `--free NAME,...`, none of them empty (`update` checks them against the 17
+/// factors).
+#[derive(Debug, Clone)]
+pub struct FactorNames(pub Vec<String>);
+
+/// `--free`'s list, refused at parse time when a name is empty (`--free ""`, `--free ,`,
+/// `--free cmoff,`): an empty list would leave the update nothing to fit.
+fn factor_names(text: &str) -> Result<FactorNames, String> {
+    let names: Vec<String> = text.split(',').map(|n| n.trim().to_string()).collect();
+    if names.iter().any(String::is_empty) {
+        return Err(
+            "an empty factor name: expected names separated by commas, e.g. cmoff,cnoff".into(),
+        );
+    }
+    Ok(FactorNames(names))
 }

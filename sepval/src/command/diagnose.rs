@@ -5,6 +5,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
+use sepval_fit::out_dir::Request;
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
@@ -18,7 +19,18 @@ use crate::cli::DiagnoseArgs;
 pub fn run(args: DiagnoseArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     // The output directory, before anything runs (no worker is started for a refused --out).
-    let run_dir = super::claim_out(&args.out, &args.overwrite, "diagnose")?;
+    let mut read = super::model_inputs(&args.inputs);
+    read.extend(super::input_files("--validate", &args.validate));
+    read.extend(super::geometry_inputs(&args.geometry));
+    let run_dir = super::claim_out(
+        &args.out,
+        Request {
+            command: "diagnose",
+            claim: super::fresh_or_overwrite(&args.overwrite),
+            inputs: &read,
+            resume: None,
+        },
+    )?;
     let DiagnoseConfig { job, options } = configure(&args)?;
     let base = job.events()[0].simulator.scenario().clone();
     let geometry = clearance::settings(&args.geometry, &base)?;

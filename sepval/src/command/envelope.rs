@@ -14,7 +14,7 @@ use sepval_envelope::grid::{Axis, Grid};
 use sepval_envelope::progress::{Progress, inputs_digest, progress_path};
 use sepval_envelope::summary::summarise;
 use sepval_envelope::{EnvelopeFile, Sweep, sweep, write_outputs};
-use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
 use sepval_predict::Settings;
 use sepval_transport::link::{Notice, Notices};
@@ -65,7 +65,11 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     };
     let (digest, named) = digest(&args, &source.dir, &aircraft, &given)?;
     let inputs_sha256 = digest.clone();
-    let (run_dir, progress) = claim(&args, Progress::new(digest, named, grid.len()))?;
+    let mut read = super::recorded_inputs(&args.from, &source.inputs, &source.held_out);
+    read.extend(super::input_files("--extension", &args.extension));
+    read.extend(super::input_files("--validate", &args.validate));
+    read.extend(super::geometry_inputs(&args.geometry));
+    let (run_dir, progress) = claim(&args, Progress::new(digest, named, grid.len()), &read)?;
     run_dir.prepare()?;
     let start = Instant::now();
     let sweep_inputs = Sweep {
@@ -127,7 +131,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
 /// Claims `--out` (fresh, cleared with --overwrite, or the interrupted sweep's with --resume,
 /// whose progress must record the same inputs as `fresh`, the sweep not started) and returns
 /// the progress to go on from.
-fn claim(args: &EnvelopeArgs, fresh: Progress) -> Result<(RunDir, Progress)> {
+fn claim(args: &EnvelopeArgs, fresh: Progress, read: &[Input]) -> Result<(RunDir, Progress)> {
     let progress_file = progress_path(&args.out);
     let (claim, progress) = if args.resume {
         if !progress_file.exists() {
@@ -156,20 +160,20 @@ fn claim(args: &EnvelopeArgs, fresh: Progress) -> Result<(RunDir, Progress)> {
             },
             p,
         )
-    } else if args.overwrite.overwrite {
-        (Claim::Overwrite, fresh)
     } else {
-        (Claim::Fresh, fresh)
+        (super::fresh_or_overwrite(&args.overwrite), fresh)
     };
-    let run_dir = RunDir::claim(&args.out, claim, "envelope").with_context(|| {
-        let hint = if progress_file.is_file() {
-            " (it holds an interrupted sweep: --resume goes on with it)"
-        } else {
-            ""
-        };
-        format!("--out {}{hint}", args.out.display())
-    })?;
-    Ok((run_dir, progress))
+    // Only an interrupted sweep (its progress file there) can be gone on with.
+    let resume = progress_file
+        .is_file()
+        .then(|| "go on with its interrupted sweep (--resume)".to_string());
+    let request = Request {
+        command: "envelope",
+        claim,
+        inputs: read,
+        resume,
+    };
+    Ok((super::claim_out(&args.out, request)?, progress))
 }
 
 /// Starts each job's evaluator (an envelope's conditions, an update's rounds) with one

@@ -1,11 +1,12 @@
 //! `sepval fit`: the factors fitted to measured data by the study's searches (and refinement).
 
+use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_fit::checkpoint::Checkpoint;
-use sepval_fit::out_dir::{Claim, RunDir};
+use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_fit::pipeline::{FitOutput, write_fit_figures};
 use sepval_fit::sigma::Sigma;
 use sepval_fit::{FitOptions, Method, run_fit};
@@ -81,7 +82,10 @@ struct FitConfig {
 }
 
 /// The run directory, claimed before anything runs (no worker is started for a refused --out)
-/// and changed by nothing yet.
+/// and changed by nothing yet. It may be none of the run's inputs: with `--resume`, the
+/// checkpoint and its run directory too, unless the run goes on in that directory (so
+/// `--resume DIR/generations/gen-0005.json --overwrite --out DIR` is refused: it would clear
+/// the checkpoint it resumes from).
 fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
     let claim = match (&args.resume, resume, args.overwrite.overwrite) {
         (_, _, true) => Claim::Overwrite,
@@ -91,12 +95,40 @@ fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
         },
         _ => Claim::Fresh,
     };
-    RunDir::claim(&args.out, claim, "fit").with_context(|| {
-        format!(
-            "--out {} (--overwrite clears an earlier run)",
-            args.out.display()
-        )
-    })
+    let mut read = super::model_inputs(&args.inputs);
+    read.extend(super::input_files("--truth-factors", &args.truth_factors));
+    read.extend(super::geometry_inputs(&args.geometry));
+    if let (Some(path), Some(c)) = (&args.resume, resume) {
+        // DIR/generations/gen-NNNN.json: DIR is the run's directory.
+        let dir = path
+            .parent()
+            .filter(|d| d.file_name().is_some_and(|n| n == "generations"));
+        if let Some(run) = dir.and_then(Path::parent) {
+            read.push(Input::resumed_run(path, run));
+        }
+        read.push(Input::file("--resume", path));
+        let whose = format!("--resume {}", path.display());
+        let recorded = c
+            .inputs
+            .data
+            .iter()
+            .chain(&c.inputs.scenario)
+            .chain(&c.inputs.extension);
+        read.extend(recorded.map(|p| Input::recorded(&whose, p)));
+    }
+    let resume_hint = format!(
+        "resume from one of its checkpoints (--resume {})",
+        args.out.join("generations/gen-NNNN.json").display()
+    );
+    super::claim_out(
+        &args.out,
+        Request {
+            command: "fit",
+            claim,
+            inputs: &read,
+            resume: Some(resume_hint),
+        },
+    )
 }
 
 /// The flags (and the checkpoint resumed from) as a validated configuration: the inputs read

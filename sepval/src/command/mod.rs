@@ -23,12 +23,13 @@ pub mod selftest;
 pub mod simulate;
 pub mod update;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::number_text::Shown;
+use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_transport::RunId;
 use sepval_transport::dispatch::DispatchOptions;
 use sepval_transport::ipc::{IpcOptions, Launch, MAX_WORKERS};
@@ -200,25 +201,65 @@ pub fn notices() -> Notices {
     Arc::new(|n| note!("sepval: {n}"))
 }
 
-/// Claims `--out` for a run of `command`: a fresh directory, or with `--overwrite` one whose
-/// earlier sepval run it clears; a refusal names the flag.
-pub fn claim_out(
-    out: &std::path::Path,
-    overwrite: &crate::cli::OverwriteArgs,
-    command: &str,
-) -> Result<sepval_fit::out_dir::RunDir> {
-    use sepval_fit::out_dir::{Claim, RunDir};
-    let claim = if overwrite.overwrite {
+/// Claims `--out` as `request` says: the one place where every command claims its output
+/// directory, with what the run reads (the directory may be none of its inputs, hold none and
+/// lie inside none, whatever the flags). A refusal names the flag; a lock taken over because
+/// it named no process is told.
+pub fn claim_out(out: &Path, request: Request<'_>) -> Result<RunDir> {
+    let run_dir =
+        RunDir::claim(out, request).with_context(|| format!("--out {}", out.display()))?;
+    if let Some(n) = run_dir.notice() {
+        note!("sepval: {n}");
+    }
+    sepval_common::defect::inject("claimed");
+    Ok(run_dir)
+}
+
+/// The claim of a new run: `--overwrite` clears an earlier run, else the directory must be
+/// empty.
+pub fn fresh_or_overwrite(overwrite: &crate::cli::OverwriteArgs) -> Claim {
+    if overwrite.overwrite {
         Claim::Overwrite
     } else {
         Claim::Fresh
-    };
-    let dir = RunDir::claim(out, claim, command).with_context(|| {
-        format!(
-            "--out {} (--overwrite clears an earlier run)",
-            out.display()
-        )
-    })?;
-    sepval_common::defect::inject("claimed");
-    Ok(dir)
+    }
+}
+
+/// The inputs a `--from` directory records (the releases, scenario and extension it was fitted
+/// with, and the releases it held out): a run from it may not write where they are.
+pub fn recorded_inputs(
+    from: &Path,
+    record: &sepval_fit::results::InputsRecord,
+    held_out: &[PathBuf],
+) -> Vec<Input> {
+    let whose = format!("--from {}", from.display());
+    let mut out = vec![Input::directory("--from", from)];
+    let files = record
+        .data
+        .iter()
+        .chain(&record.scenario)
+        .chain(&record.extension)
+        .chain(held_out);
+    out.extend(files.map(|p| Input::recorded(&whose, p)));
+    out
+}
+
+/// The geometry files of `--aircraft` and `--store-shape`, as inputs.
+pub fn geometry_inputs(g: &crate::cli::GeometryArgs) -> Vec<Input> {
+    let mut out = input_files("--aircraft", &g.aircraft);
+    out.extend(input_files("--store-shape", &g.store_shape));
+    out
+}
+
+/// The files of `--data`, `--scenario` and `--extension`, as inputs.
+pub fn model_inputs(i: &crate::cli::InputArgs) -> Vec<Input> {
+    let mut out = input_files("--data", &i.data);
+    out.extend(input_files("--scenario", &i.model.scenario));
+    out.extend(input_files("--extension", &i.model.extension));
+    out
+}
+
+/// Input files given by `flag` (none, one or several).
+pub fn input_files<'a>(flag: &str, paths: impl IntoIterator<Item = &'a PathBuf>) -> Vec<Input> {
+    paths.into_iter().map(|p| Input::file(flag, p)).collect()
 }

@@ -5,6 +5,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use sepval_fit::out_dir::Request;
 use sepval_plan::{
     PlanFile, Quantity, Range, plan, plan_file, prepare, read_diagnosis, write_outputs,
 };
@@ -14,7 +15,7 @@ use crate::cli::PlanArgs;
 
 /// Runs `sepval plan`. Every input (the flags, the diagnosis, its releases, the ranges against
 /// its scenario) is checked before the output directory is claimed or a worker started, so a
-/// refusal writes nothing.
+/// refusal writes nothing; the directory is cleared (`--overwrite`) only once the plan is made.
 pub fn run(args: PlanArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let ranges = ranges(&args)?;
@@ -32,11 +33,19 @@ pub fn run(args: PlanArgs) -> Result<()> {
             args.from.display()
         )
     })?;
+    let read = super::recorded_inputs(&args.from, &record, &[]);
     let prepared = prepare(diagnosis, &flown, &ranges, args.points)?;
-    let run_dir = super::claim_out(&args.out, &args.overwrite, "plan")?;
+    let run_dir = super::claim_out(
+        &args.out,
+        Request {
+            command: "plan",
+            claim: super::fresh_or_overwrite(&args.overwrite),
+            inputs: &read,
+            resume: None,
+        },
+    )?;
     let start = Instant::now();
     let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
-    run_dir.prepare()?;
     let found = plan(
         &prepared,
         evaluator.as_mut(),
@@ -44,6 +53,8 @@ pub fn run(args: PlanArgs) -> Result<()> {
     )?;
     drop(evaluator);
     let file = plan_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
+    // Cleared (--overwrite) only now: a run stopped while it computed leaves the earlier one.
+    run_dir.prepare()?;
     write_outputs(&prepared, &found, &file, &args.out)?;
     crate::front::out(&summary_lines(&file, &args.out));
     drop(run_dir);

@@ -7,17 +7,19 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{Event, Job};
+use sepval_fit::out_dir::Request;
 use sepval_predict::{
     Flown, PredictionFile, Settings, Source, predict, prediction_file, prepare, read_source,
     write_outputs,
 };
 
-use super::{clearance, count, evaluator_spec, inputs, notices, releases};
+use super::{clearance, count, evaluator_spec, input_files, inputs, notices, releases};
 use crate::cli::PredictArgs;
 
 /// Runs `sepval predict`. Every input (the flags, the source, its releases, the condition, the
 /// flown release) is checked before the output directory is claimed or a worker started, so a
-/// refusal writes nothing.
+/// refusal writes nothing; the directory is cleared (`--overwrite`) only once the prediction
+/// is made, just before its files are written.
 pub fn run(args: PredictArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let settings = Settings {
@@ -35,6 +37,12 @@ pub fn run(args: PredictArgs) -> Result<()> {
         &args.validate,
         policy,
     )?;
+    let mut read = super::recorded_inputs(&args.from, &source.inputs, &source.held_out);
+    read.extend(input_files("--scenario", [&args.scenario]));
+    read.extend(input_files("--extension", &args.extension));
+    read.extend(input_files("--data", &args.data));
+    read.extend(input_files("--validate", &args.validate));
+    read.extend(super::geometry_inputs(&args.geometry));
     let extension = args.extension.clone().or(source.inputs.extension.clone());
     let condition = inputs::scenario(Some(&args.scenario), extension.as_deref())
         .with_context(|| format!("--scenario {}", args.scenario.display()))?;
@@ -50,10 +58,17 @@ pub fn run(args: PredictArgs) -> Result<()> {
         Some(c) => prepared.with_clearance(c),
         None => prepared,
     };
-    let run_dir = super::claim_out(&args.out, &args.overwrite, "predict")?;
+    let run_dir = super::claim_out(
+        &args.out,
+        Request {
+            command: "predict",
+            claim: super::fresh_or_overwrite(&args.overwrite),
+            inputs: &read,
+            resume: None,
+        },
+    )?;
     let start = Instant::now();
     let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
-    run_dir.prepare()?;
     let found = predict(
         &prepared,
         evaluator.as_mut(),
@@ -61,6 +76,8 @@ pub fn run(args: PredictArgs) -> Result<()> {
     )?;
     drop(evaluator);
     let file = prediction_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
+    // Cleared (--overwrite) only now: a run stopped while it computed leaves the earlier one.
+    run_dir.prepare()?;
     write_outputs(&found, &file, &args.out)?;
     crate::front::out(&summary_lines(&file, &args.out));
     drop(run_dir);

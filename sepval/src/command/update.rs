@@ -6,6 +6,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_common::factors::Factor;
+use sepval_fit::out_dir::Request;
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
@@ -13,7 +14,7 @@ use sepval_update::{UpdateOptions, update, write_outputs};
 
 use super::envelope::starter;
 use super::{evaluator_spec, inputs};
-use crate::cli::UpdateArgs;
+use crate::cli::{FactorNames, UpdateArgs};
 
 /// Runs `sepval update`. Every input is checked before the output directory is claimed or a
 /// worker started; a refusal deletes nothing.
@@ -21,7 +22,17 @@ pub fn run(args: UpdateArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     super::several_jobs(&args.eval, "update", "one per round")?;
     let (options, job) = configure(&args)?;
-    let run_dir = super::claim_out(&args.out, &args.overwrite, "update")?;
+    let mut read = super::model_inputs(&args.inputs);
+    read.extend(super::input_files("--validate", &args.validate));
+    let run_dir = super::claim_out(
+        &args.out,
+        Request {
+            command: "update",
+            claim: super::fresh_or_overwrite(&args.overwrite),
+            inputs: &read,
+            resume: None,
+        },
+    )?;
     run_dir.prepare()?;
     let mut start = starter(&spec);
     let u = update(
@@ -58,7 +69,7 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
             "--data FILE.csv is required (repeat it for each release): the releases that update the store's data"
         );
     }
-    let free = free_factors(args.free.as_deref())?;
+    let free = free_factors(args.free.as_ref())?;
     let given = &args.inputs;
     let (scenario_path, extension_path) = (
         given.model.scenario.as_deref(),
@@ -101,13 +112,14 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
     Ok((options, job))
 }
 
-/// The factors of `--free NAME,...` (all 17 when absent), as indices.
-fn free_factors(list: Option<&str>) -> Result<Vec<usize>> {
-    let Some(list) = list else {
+/// The factors of `--free NAME,...` (all 17 when absent), as indices; the list holds no empty
+/// name (refused as the flags were parsed).
+fn free_factors(list: Option<&FactorNames>) -> Result<Vec<usize>> {
+    let Some(FactorNames(names)) = list else {
         return Ok((0..Factor::ALL.len()).collect());
     };
     let mut out = Vec::new();
-    for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+    for name in names {
         let Some(f) = Factor::from_name(name) else {
             bail!(
                 "--free {name}: not one of the 17 factors (expected a comma-separated list of {})",

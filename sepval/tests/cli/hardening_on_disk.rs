@@ -133,6 +133,12 @@ fn a_resume_refused_over_changed_inputs_keeps_the_later_generations_byte_for_byt
             let mut resume = inputs.to_vec();
             resume.extend(["--resume", "F/generations/gen-0002.json", "--out", "F"]);
             resume.extend_from_slice(overwrite);
+            // With --overwrite, F is refused first: it is the run directory of the checkpoint.
+            let expected = if overwrite.is_empty() {
+                expected
+            } else {
+                "F is the run directory F of --resume F/generations/gen-0002.json"
+            };
             let stderr = refused(&fit(d, "4", &resume), expected);
             assert!(!stderr.contains("removed"), "{stderr}");
             assert!(

@@ -19,6 +19,7 @@ mod hardening;
 mod hardening3_geometry;
 mod hardening3_releases;
 mod hardening3_records;
+mod hardening3_out;
 mod hardening_on_disk;
 mod jobs;
 mod plan;

@@ -1,0 +1,173 @@
+//! The inputs of a run, kept apart from its output directory: an `--out` that is, holds or lies
+//! inside an input directory (`--from`, the run directory of `--resume`), or that holds an
+//! input file, is refused whatever the flags, since a run that clears or writes its directory
+//! would destroy what it reads. Paths are compared resolved: symbolic links and `..` followed
+//! as far as the path exists (the output directory usually does not yet), the rest taken as
+//! written.
+
+use std::path::{Component, Path, PathBuf};
+
+use super::error::OutDirError;
+
+/// Something a run reads, as the flag that gives it names it.
+#[derive(Debug, Clone)]
+pub struct Input {
+    /// The input in words, e.g. `--from DG` or `--data a.csv`.
+    what: String,
+    /// Its path.
+    path: PathBuf,
+    /// A directory (the output may be neither it nor inside it nor hold it), or a file (the
+    /// output may not hold it).
+    directory: bool,
+}
+
+impl Input {
+    /// An input file given by `flag` (e.g. `--data`).
+    pub fn file(flag: &str, path: &Path) -> Input {
+        Input {
+            what: format!("{flag} {}", path.display()),
+            path: path.to_path_buf(),
+            directory: false,
+        }
+    }
+
+    /// An input directory given by `flag` (e.g. `--from`).
+    pub fn directory(flag: &str, path: &Path) -> Input {
+        Input {
+            what: format!("{flag} {}", path.display()),
+            path: path.to_path_buf(),
+            directory: true,
+        }
+    }
+
+    /// An input file that another input records (e.g. the releases a `--from` directory was
+    /// fitted to): `whose` names the record.
+    pub fn recorded(whose: &str, path: &Path) -> Input {
+        Input {
+            what: format!("{} (recorded by {whose})", path.display()),
+            path: path.to_path_buf(),
+            directory: false,
+        }
+    }
+
+    /// The input directory `path`, the run directory of the checkpoint `--resume` gives.
+    pub fn resumed_run(checkpoint: &Path, path: &Path) -> Input {
+        Input {
+            what: format!(
+                "the run directory {} of --resume {}",
+                path.display(),
+                checkpoint.display()
+            ),
+            path: path.to_path_buf(),
+            directory: true,
+        }
+    }
+}
+
+/// `path` resolved: absolute, symbolic links and `..` resolved as far as it exists, the rest
+/// taken lexically.
+pub(super) fn resolved(path: &Path) -> PathBuf {
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut out = PathBuf::new();
+    // How many names at the end of `out` do not exist (taken as written).
+    let mut missing = 0usize;
+    for c in absolute.components() {
+        match c {
+            Component::CurDir => {}
+            // `out` has no symbolic link in it (resolved, or made of names that do not exist),
+            // so its parent is `..`.
+            Component::ParentDir => {
+                out.pop();
+                missing = missing.saturating_sub(1);
+            }
+            other => {
+                out.push(other);
+                if missing > 0 {
+                    missing += 1;
+                } else {
+                    match std::fs::canonicalize(&out) {
+                        Ok(c) => out = c,
+                        Err(_) => missing = 1,
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Refuses an output directory `out` that is, holds or lies inside one of `inputs` (`allowed`
+/// aside: the run directory a resumed run goes on in, and its checkpoint).
+pub(super) fn check(out: &Path, inputs: &[Input], allowed: &[PathBuf]) -> Result<(), OutDirError> {
+    let here = resolved(out);
+    for input in inputs {
+        let at = resolved(&input.path);
+        if allowed.contains(&at) {
+            continue;
+        }
+        let relation = if at == here {
+            Some("is")
+        } else if at.starts_with(&here) {
+            Some("holds")
+        } else if input.directory && here.starts_with(&at) {
+            Some("lies inside")
+        } else {
+            None
+        };
+        if let Some(relation) = relation {
+            return Err(OutDirError::IsInput {
+                path: out.to_path_buf(),
+                relation,
+                input: input.what.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_output_is_refused_when_it_is_holds_or_lies_inside_an_input() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path();
+        std::fs::create_dir_all(d.join("dg/figures")).unwrap();
+        std::fs::write(d.join("dg/diagnosis.json"), "{}").unwrap();
+        std::fs::write(d.join("a.csv"), "").unwrap();
+        std::os::unix::fs::symlink(d.join("dg"), d.join("link")).unwrap();
+        let from = [Input::directory("--from", &d.join("dg"))];
+        let refused =
+            |out: &Path, inputs: &[Input]| check(out, inputs, &[]).err().map(|e| e.to_string());
+        for (out, relation) in [
+            (d.join("dg"), "is"),
+            (d.join("link"), "is"),
+            (d.join("dg/figures/../."), "is"),
+            (d.join("dg/new/deeper"), "lies inside"),
+            (d.join("link/new"), "lies inside"),
+            (d.join("new/../dg/figures"), "lies inside"),
+            (d.join("new/../link/x"), "lies inside"),
+            (d.to_path_buf(), "holds"),
+        ] {
+            let e = refused(&out, &from).unwrap_or_else(|| panic!("{}", out.display()));
+            let expected = format!(
+                "{} {relation} --from {}",
+                out.display(),
+                d.join("dg").display()
+            );
+            assert!(e.starts_with(&expected), "{e}");
+        }
+        assert_eq!(refused(&d.join("dg2"), &from), None);
+        assert_eq!(refused(&d.join("new/dg"), &from), None);
+        // A file: only an output that holds it is refused.
+        let data = [Input::file("--data", &d.join("a.csv"))];
+        assert!(refused(d, &data).unwrap().contains("holds --data"));
+        assert_eq!(refused(&d.join("run"), &data), None);
+        // The run directory a resumed run goes on in.
+        assert_eq!(
+            check(&d.join("dg"), &from, &[resolved(&d.join("link"))]).ok(),
+            Some(())
+        );
+    }
+}

@@ -1,0 +1,438 @@
+//! Output directories of runs (`--out` of fit, diagnose, plan, predict, envelope, update),
+//! protected: a run holds a lock in its directory for its whole life, so a second run into it
+//! is refused (naming the holder's process id); the directory is never one of the run's inputs,
+//! nor holds one, nor lies inside an input directory ([`Input`]); a directory that already
+//! holds something is refused unless it is the run being resumed, or the user asked to clear
+//! it; and a directory is only ever cleared when everything in it is what a sepval run wrote,
+//! as the manifest of its marker lists it (`marker`).
+//!
+//! A claim has two steps, so that a refusal never deletes or rewrites anything: [`RunDir::claim`]
+//! takes the lock and checks the directory without changing what is in it, before anything
+//! runs (no worker is started for a refused `--out`); [`RunDir::prepare`], called once every
+//! input is checked (a resumed checkpoint re-evaluated and replayed included) and as late as
+//! the run allows, clears the directory (checking it again) or removes the abandoned
+//! continuation of a resumed run, and writes the marker. When the run ends (the [`RunDir`]
+//! dropped, on success or error), the marker gets the manifest of what the directory holds.
+//!
+//! Files: `DIR/.sepval-lock` (the holder's process id; removed when the run ends, left behind
+//! only by a killed process, and then taken over once that process is gone) and
+//! `DIR/.sepval-run` (the marker: which command made the directory, and its manifest).
+
+mod error;
+mod inputs;
+mod lock;
+mod marker;
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+pub use error::OutDirError;
+pub use inputs::Input;
+pub use lock::LOCK_FILE;
+pub use marker::MARKER_FILE;
+
+use error::io;
+
+/// How a run uses its directory.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Claim {
+    /// A new run: the directory must be absent or empty.
+    Fresh,
+    /// A new run into a directory whose contents may be cleared first.
+    Overwrite,
+    /// Resuming the run of the checkpoint whose run directory this is: its contents stay but
+    /// for the checkpoints of generations after the one resumed from.
+    Resume {
+        /// The checkpoint resumed from.
+        checkpoint: PathBuf,
+        /// Its generation.
+        generation: usize,
+    },
+}
+
+/// A run's request for its output directory.
+#[derive(Debug)]
+pub struct Request<'a> {
+    /// The command (recorded in the marker).
+    pub command: &'a str,
+    /// How the run uses the directory.
+    pub claim: Claim,
+    /// What the run reads: the directory may be none of them, hold none and lie inside none
+    /// (the run directory a resumed run goes on in, and its checkpoint, aside).
+    pub inputs: &'a [Input],
+    /// How the command goes on with an interrupted run in a directory (the refusal of a
+    /// non-empty one suggests it), e.g. "resume from one of its checkpoints (--resume ...)";
+    /// `None` for a command that cannot.
+    pub resume: Option<String>,
+}
+
+/// A claimed run directory: locked until dropped. A directory this claim created is removed
+/// again when the run ends before writing anything into it (a refused input, workers that
+/// would not start), so a failed run leaves nothing behind.
+#[derive(Debug)]
+pub struct RunDir {
+    path: PathBuf,
+    lock: PathBuf,
+    created: bool,
+    claim: Claim,
+    command: String,
+    /// Whether [`RunDir::prepare`] ran (the marker is then written again, with the manifest,
+    /// when the run ends).
+    prepared: AtomicBool,
+    /// The notice of an ill-formed lock taken over.
+    notice: Option<String>,
+}
+
+impl RunDir {
+    /// Claims `path` for a run as `request` says (created if absent): checks that it is none of
+    /// the run's inputs, takes the lock and checks that the directory may be used as the claim
+    /// says. Nothing in it is changed yet: [`RunDir::prepare`] does that once the run's inputs
+    /// are checked.
+    pub fn claim(path: &Path, request: Request<'_>) -> Result<RunDir, OutDirError> {
+        let Request {
+            command,
+            claim,
+            inputs,
+            resume,
+        } = request;
+        let expected = match &claim {
+            Claim::Resume { checkpoint, .. } => Some(run_of(checkpoint)),
+            _ => None,
+        };
+        let allowed: Vec<PathBuf> = match (&claim, &expected) {
+            // The run directory a resumed run goes on in, and the checkpoint in it.
+            (Claim::Resume { checkpoint, .. }, Some(e))
+                if inputs::resolved(path) == inputs::resolved(e) =>
+            {
+                vec![inputs::resolved(e), inputs::resolved(checkpoint)]
+            }
+            _ => Vec::new(),
+        };
+        inputs::check(path, inputs, &allowed)?;
+        let mut created = false;
+        match std::fs::metadata(path) {
+            Ok(m) if !m.is_dir() => {
+                return Err(OutDirError::NotADirectory {
+                    path: path.to_path_buf(),
+                });
+            }
+            Ok(_) => {}
+            Err(_) => {
+                std::fs::create_dir_all(path).map_err(io("cannot create", path))?;
+                created = true;
+            }
+        }
+        let lock = path.join(LOCK_FILE);
+        let notice = match lock::take_lock(path, &lock) {
+            Ok(notice) => notice,
+            Err(e) => {
+                if created {
+                    let _ = std::fs::remove_dir(path);
+                }
+                return Err(e);
+            }
+        };
+        let dir = RunDir {
+            path: path.to_path_buf(),
+            lock,
+            created,
+            claim: claim.clone(),
+            command: command.to_string(),
+            prepared: AtomicBool::new(false),
+            notice,
+        };
+        // From here on the lock is ours (released when `dir` drops, on error too).
+        let others = entries(path)?;
+        match claim {
+            Claim::Fresh => {
+                if let Some(first) = others.first() {
+                    return Err(OutDirError::NotEmpty {
+                        path: path.to_path_buf(),
+                        first: first.clone(),
+                        resume: resume.map(|r| format!(", {r}")).unwrap_or_default(),
+                    });
+                }
+            }
+            Claim::Overwrite => marker::check_clearable(path, &others)?,
+            Claim::Resume { checkpoint, .. } => {
+                let expected = expected.unwrap_or_default();
+                if !others.is_empty() && inputs::resolved(path) != inputs::resolved(&expected) {
+                    return Err(OutDirError::OtherRun {
+                        path: path.to_path_buf(),
+                        checkpoint: checkpoint.clone(),
+                        expected,
+                    });
+                }
+            }
+        }
+        Ok(dir)
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The notice of a lock taken over that named no process (`0`, a negative number, text),
+    /// for the command to tell.
+    pub fn notice(&self) -> Option<&str> {
+        self.notice.as_deref()
+    }
+
+    /// Makes the directory ready for the run, the first change to what is in it: clears it
+    /// ([`Claim::Overwrite`], after checking again that everything in it is an earlier run's),
+    /// or removes the checkpoints of generations after the one resumed from ([`Claim::Resume`]:
+    /// those of the continuation being replaced), then writes the marker. Returns the
+    /// checkpoints removed when resuming. Call it once every input is read and checked, as
+    /// late as the run allows (just before the first file is written).
+    pub fn prepare(&self) -> Result<Vec<PathBuf>, OutDirError> {
+        let removed = match &self.claim {
+            Claim::Fresh => Vec::new(),
+            Claim::Overwrite => {
+                let others = entries(&self.path)?;
+                marker::check_clearable(&self.path, &others)?;
+                for e in others {
+                    let p = self.path.join(e);
+                    let is_dir = std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_dir());
+                    if is_dir {
+                        std::fs::remove_dir_all(&p).map_err(io("cannot clear", &p))?;
+                    } else {
+                        std::fs::remove_file(&p).map_err(io("cannot clear", &p))?;
+                    }
+                }
+                Vec::new()
+            }
+            Claim::Resume { generation, .. } => self.discard_generations_after(*generation)?,
+        };
+        marker::write_started(&self.path, &self.command)?;
+        self.prepared.store(true, Ordering::Relaxed);
+        Ok(removed)
+    }
+
+    /// Removes the checkpoints of generations after `generation` (those of an abandoned
+    /// continuation, when a run is resumed from an earlier generation) and returns them.
+    fn discard_generations_after(&self, generation: usize) -> Result<Vec<PathBuf>, OutDirError> {
+        let dir = self.path.join("generations");
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return Ok(Vec::new());
+        };
+        let mut removed = Vec::new();
+        for e in entries.filter_map(Result::ok) {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let later = name
+                .strip_prefix("gen-")
+                .and_then(|n| n.strip_suffix(".json"))
+                .and_then(|n| n.parse::<usize>().ok())
+                .is_some_and(|g| g > generation);
+            if later {
+                std::fs::remove_file(e.path()).map_err(io("cannot remove", &e.path()))?;
+                removed.push(e.path());
+            }
+        }
+        removed.sort();
+        Ok(removed)
+    }
+}
+
+impl Drop for RunDir {
+    fn drop(&mut self) {
+        let untouched = entries(&self.path).is_ok_and(|e| e.is_empty());
+        if self.created && untouched {
+            let _ = std::fs::remove_file(self.path.join(MARKER_FILE));
+            let _ = std::fs::remove_file(&self.lock);
+            let _ = std::fs::remove_dir(&self.path);
+            return;
+        }
+        if self.prepared.load(Ordering::Relaxed) {
+            // The manifest of what the run wrote, before the lock goes (best effort: a marker
+            // without one only makes a later --overwrite refuse the directory).
+            let _ = marker::write_ended(&self.path, &self.command);
+        }
+        let _ = std::fs::remove_file(&self.lock);
+    }
+}
+
+/// The run directory of `checkpoint`: DIR/generations/gen-NNNN.json belongs to DIR.
+fn run_of(checkpoint: &Path) -> PathBuf {
+    checkpoint
+        .parent()
+        .and_then(Path::parent)
+        .map(Path::to_path_buf)
+        .unwrap_or_default()
+}
+
+/// The directory's entries other than the lock and the marker, sorted.
+fn entries(path: &Path) -> Result<Vec<String>, OutDirError> {
+    let mut out: Vec<String> = std::fs::read_dir(path)
+        .map_err(io("cannot read", path))?
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != LOCK_FILE && n != MARKER_FILE)
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request(command: &str, claim: Claim) -> Request<'_> {
+        Request {
+            command,
+            claim,
+            inputs: &[],
+            resume: None,
+        }
+    }
+
+    #[test]
+    fn a_directory_is_claimed_once_and_only_cleared_when_it_is_ours() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path().join("run");
+        let claim = |c: Claim| RunDir::claim(&d, request("fit", c));
+        let first = claim(Claim::Fresh).unwrap();
+        let e = claim(Claim::Overwrite).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains(&format!("in use by sepval process {}", std::process::id())),
+            "{e}"
+        );
+        first.prepare().unwrap();
+        std::fs::write(d.join("result.json"), "{}").unwrap();
+        drop(first);
+        assert!(!d.join(LOCK_FILE).exists());
+        let e = claim(Claim::Fresh).unwrap_err();
+        assert!(
+            e.to_string().contains(
+                "is not empty (it holds result.json); give another directory, or clear it (--overwrite)"
+            ),
+            "{e}"
+        );
+        // A claim refused later (an input, a worker) has cleared nothing: only prepare does.
+        drop(claim(Claim::Overwrite).unwrap());
+        assert!(d.join("result.json").exists() && !d.join(LOCK_FILE).exists());
+        let again = claim(Claim::Overwrite).unwrap();
+        assert!(d.join("result.json").exists());
+        assert_eq!(again.prepare().unwrap(), Vec::<PathBuf>::new());
+        assert!(!d.join("result.json").exists() && d.join(MARKER_FILE).exists());
+        std::fs::write(d.join("plan.json"), "{}").unwrap();
+        drop(again);
+        // The manifest of the ended run makes a directory ours, whatever it holds.
+        let marked = RunDir::claim(&d, request("plan", Claim::Overwrite)).unwrap();
+        marked.prepare().unwrap();
+        assert!(!d.join("plan.json").exists());
+        drop(marked);
+        // A directory sepval did not make is never cleared, nor one with a file of another
+        // tool beside a sepval result.
+        let other = tmp.path().join("mine");
+        std::fs::create_dir(&other).unwrap();
+        std::fs::write(other.join("thesis.tex"), "x").unwrap();
+        std::fs::write(other.join("result.json"), "{\"x\": 1}").unwrap();
+        let e = RunDir::claim(&other, request("fit", Claim::Overwrite)).unwrap_err();
+        assert!(
+            e.to_string().starts_with(&format!(
+                "not clearing {}: it is not a sepval output directory (it has no .sepval-run; it holds result.json, thesis.tex)",
+                other.display()
+            )),
+            "{e}"
+        );
+        assert!(other.join("thesis.tex").exists() && !other.join(LOCK_FILE).exists());
+        // A killed run's lock is taken over.
+        std::fs::write(d.join(LOCK_FILE), "999999999\n").unwrap();
+        claim(Claim::Fresh).unwrap();
+    }
+
+    #[test]
+    fn a_run_refused_before_it_prepared_leaves_its_directory_as_it_was() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path().join("run");
+        drop(RunDir::claim(&d, request("predict", Claim::Fresh)).unwrap());
+        assert!(!d.exists());
+        let run = RunDir::claim(&d, request("predict", Claim::Fresh)).unwrap();
+        run.prepare().unwrap();
+        std::fs::write(d.join("prediction.json"), "{}").unwrap();
+        drop(run);
+        let marker = std::fs::read_to_string(d.join(MARKER_FILE)).unwrap();
+        assert!(marker.contains("\"prediction.json\": \""), "{marker}");
+        // An overwrite that ends before prepare (a refused input, Ctrl-C while it computes)
+        // leaves the earlier run and its manifest whole.
+        drop(RunDir::claim(&d, request("predict", Claim::Overwrite)).unwrap());
+        assert_eq!(
+            std::fs::read_to_string(d.join(MARKER_FILE)).unwrap(),
+            marker
+        );
+        assert!(d.join("prediction.json").exists());
+    }
+
+    #[test]
+    fn an_output_that_is_an_input_is_refused_before_anything_is_made() {
+        let tmp = tempfile::tempdir().unwrap();
+        let run = tmp.path().join("run");
+        let generations = run.join("generations");
+        std::fs::create_dir_all(&generations).unwrap();
+        let checkpoint = generations.join("gen-0005.json");
+        std::fs::write(&checkpoint, "{}").unwrap();
+        let inputs = [
+            Input::resumed_run(&checkpoint, &run),
+            Input::file("--resume", &checkpoint),
+        ];
+        let resume = Claim::Resume {
+            checkpoint: checkpoint.clone(),
+            generation: 5,
+        };
+        let with = |claim: Claim| Request {
+            command: "fit",
+            claim,
+            inputs: &inputs,
+            resume: None,
+        };
+        // Resuming into its own run directory is what --resume is for.
+        RunDir::claim(&run, with(resume.clone())).unwrap();
+        let e = RunDir::claim(&run, with(Claim::Overwrite)).unwrap_err();
+        assert!(
+            e.to_string().starts_with(&format!(
+                "{} is the run directory {} of --resume {}, an input of this run",
+                run.display(),
+                run.display(),
+                checkpoint.display()
+            )),
+            "{e}"
+        );
+        let inside = run.join("again");
+        let e = RunDir::claim(&inside, with(resume)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("again lies inside the run directory"),
+            "{e}"
+        );
+        assert!(!inside.exists() && checkpoint.exists());
+    }
+
+    #[test]
+    fn a_resumed_run_removes_its_later_generations_only_when_prepared() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path().join("run");
+        let generations = d.join("generations");
+        std::fs::create_dir_all(&generations).unwrap();
+        for g in 1..=4 {
+            std::fs::write(generations.join(format!("gen-{g:04}.json")), "{}").unwrap();
+        }
+        let claim = || Claim::Resume {
+            checkpoint: generations.join("gen-0002.json"),
+            generation: 2,
+        };
+        drop(RunDir::claim(&d, request("fit", claim())).unwrap());
+        assert!(generations.join("gen-0004.json").exists() && !d.join(MARKER_FILE).exists());
+        let resumed = RunDir::claim(&d, request("fit", claim())).unwrap();
+        assert_eq!(
+            resumed.prepare().unwrap(),
+            vec![
+                generations.join("gen-0003.json"),
+                generations.join("gen-0004.json")
+            ]
+        );
+        assert!(generations.join("gen-0002.json").exists());
+        assert!(!generations.join("gen-0003.json").exists() && d.join(MARKER_FILE).exists());
+    }
+}
