@@ -260,11 +260,16 @@ pub struct Measured {
 
 /// Prepares case `case` with `samples` samples (a flown release to check when `flown`).
 pub fn prepared(case: &Case, samples: usize, flown: Option<Flown>) -> Prepared {
+    prepared_at(case, samples, 0.95, flown)
+}
+
+/// [`prepared`] with bands at `level`.
+pub fn prepared_at(case: &Case, samples: usize, level: f64, flown: Option<Flown>) -> Prepared {
     let job = Arc::new(fitted_job(case));
     let source = fitted_source(case, &job);
     let settings = Settings {
         samples,
-        level: 0.95,
+        level,
         seed: case.seed,
         with_noise: false,
         threads: 2,

@@ -16,7 +16,7 @@ use sepval_envelope::summary::summarise;
 use sepval_envelope::{EnvelopeFile, Sweep, sweep, write_outputs};
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
-use sepval_predict::Settings;
+use sepval_predict::{Settings, Source};
 use sepval_transport::link::{Notice, Notices};
 use sepval_transport::spec::{EvaluatorSpec, Starter};
 
@@ -65,10 +65,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     };
     let (digest, named) = digest(&args, &source.dir, &aircraft, &given)?;
     let inputs_sha256 = digest.clone();
-    let mut read = super::recorded_inputs(&args.from, &source.inputs, &source.held_out);
-    read.extend(super::input_files("--extension", &args.extension));
-    read.extend(super::input_files("--validate", &args.validate));
-    read.extend(super::geometry_inputs(&args.geometry));
+    let read = inputs_read(&args, &source);
     let (run_dir, progress) = claim(&args, Progress::new(digest, named, grid.len()), &read)?;
     run_dir.prepare()?;
     let start = Instant::now();
@@ -126,6 +123,16 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     say!("report:    {}", args.out.join("report.html").display());
     drop(run_dir);
     Ok(())
+}
+
+/// What the sweep reads, which its `--out` may not be, hold or lie inside: the source and the
+/// files it records, the extension, the releases to validate and the geometry.
+fn inputs_read(args: &EnvelopeArgs, source: &Source) -> Vec<Input> {
+    let mut read = super::recorded_inputs(&args.from, &source.inputs, &source.held_out);
+    read.extend(super::input_files("--extension", &args.extension));
+    read.extend(super::input_files("--validate", &args.validate));
+    read.extend(super::geometry_inputs(&args.geometry));
+    read
 }
 
 /// Claims `--out` (fresh, cleared with --overwrite, or the interrupted sweep's with --resume,

@@ -27,19 +27,25 @@ pub fn run(args: RerunArgs) -> Result<()> {
         .extension
         .as_ref()
         .or(recorded.extension.as_ref());
+    let policy = given.outliers.or(recorded.outliers);
     let (job, _) = inputs::job(
         data_paths,
         scenario_path.map(PathBuf::as_path),
         extension_path.map(PathBuf::as_path),
-        given.outliers.or(recorded.outliers),
+        policy,
     )?;
     if let Err(e) = checkpoint.check_job(&job, &args.checkpoint) {
         // A scenario that differs only by the extension given: say so, not "another scenario".
         if let (Some(x), CheckpointError::OtherJob { .. }) = (&given.model.extension, &e) {
             let recorded_x = recorded.extension.as_deref();
             let same_but_extension = job.data_sha256() == checkpoint.data_sha256
-                && inputs::job(data_paths, scenario_path.map(PathBuf::as_path), recorded_x)
-                    .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
+                && inputs::job(
+                    data_paths,
+                    scenario_path.map(PathBuf::as_path),
+                    recorded_x,
+                    policy,
+                )
+                .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
             if same_but_extension {
                 bail!(
                     "checkpoint {} was made with another extension: --extension {} is not {}; give that extension file, or leave --extension out to use the recorded one",

@@ -276,7 +276,7 @@ fn sigterm_while_a_million_triangle_aircraft_is_read_stops_at_once_and_writes_no
             "--aircraft",
             &mesh_arg,
             "--samples",
-            "200",
+            "400",
             "--evaluator",
             "inproc",
             "--out",

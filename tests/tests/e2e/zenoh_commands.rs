@@ -168,7 +168,7 @@ fn predict_over_zenoh_gives_the_in_process_bands() {
         "--scenario",
         "cond.toml",
         "--samples",
-        "200",
+        "400",
     ];
     inproc(p, &[&args[..], &["--out", "pred"]].concat());
     over_zenoh(p, &[&args[..], &["--out", "pred-z"]].concat());
@@ -195,7 +195,7 @@ fn an_envelope_of_two_conditions_over_zenoh_keeps_its_workers_and_the_in_process
         "--mach",
         "0.75:0.85:2",
         "--samples",
-        "40",
+        "400",
     ];
     inproc(p, &[&args[..], &["--out", "env"]].concat());
     over_zenoh(p, &[&args[..], &["--out", "env-z"]].concat());
