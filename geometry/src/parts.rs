@@ -284,7 +284,9 @@ fn indexed(triangles: &[[[f64; 3]; 3]], stop: Stop) -> Option<(Vec<Vector>, Vec<
             .map(|e| e.length_squared())
             .into_iter()
             .fold(0.0, f64::max);
-        if !((b - a).cross(c - a).length() > DEGENERATE * longest) {
+        // Twice the area against the longest edge squared (NaN counts as degenerate).
+        let area2 = (b - a).cross(c - a).length();
+        if area2.is_nan() || area2 <= DEGENERATE * longest {
             continue;
         }
         let ids = t.map(|v| {

@@ -130,7 +130,7 @@ impl StoreSpec {
             "from 0 (none) to the body's length",
         )?;
         let cylinder_m = b.length_m - b.nose_length_m - b.boattail_length_m;
-        if !(cylinder_m > 0.0) {
+        if cylinder_m.is_nan() || cylinder_m <= 0.0 {
             return Err((
                 "body".into(),
                 format!(
