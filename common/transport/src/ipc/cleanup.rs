@@ -64,7 +64,7 @@ impl Cleaned {
 
 /// Removes the iceoryx2 resources of run `run_id` if none of its nodes is alive: every dead
 /// node's (iceoryx2's own clean-up), then, once no node of the run is left, the files that
-/// remain ([`remove_leftovers`]). Returns `None` when a node of the run is alive (nothing is
+/// remain (`remove_leftovers`). Returns `None` when a node of the run is alive (nothing is
 /// touched), else what was removed.
 pub fn clean_run_if_stale(run_id: &RunId) -> Result<Option<Cleaned>, TransportError> {
     let cfg = run_config(run_id)?;
