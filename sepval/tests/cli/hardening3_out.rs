@@ -8,7 +8,7 @@
 //! lock that names no process (`0`) is taken over, said; the update's refusal of a non-empty
 //! directory suggests no `--resume`.
 
-use std::collections::BTreeMap;
+use super::hardening_on_disk::snapshot;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -33,24 +33,6 @@ fn fit(dir: &Path, generations: &str, out: &str, extra: &[&str]) -> std::process
     ];
     a.extend_from_slice(extra);
     sepval(&a, dir)
-}
-
-/// Every file under `dir` (relative path to content), the lock aside.
-fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut files = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if !p.ends_with(".sepval-lock") {
-                let name = p.strip_prefix(dir).unwrap().display().to_string();
-                files.insert(name, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    files
 }
 
 /// A copy of the directory `from` at `to`.

@@ -32,7 +32,7 @@ fn fit(dir: &Path, generations: &str, extra: &[&str]) -> std::process::Output {
 }
 
 /// Every file under `dir` (relative path to content), the lock aside.
-fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+pub(crate) fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut files = BTreeMap::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
@@ -40,7 +40,7 @@ fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
             let p = e.unwrap().path();
             if p.is_dir() {
                 stack.push(p);
-            } else {
+            } else if !p.ends_with(".sepval-lock") {
                 let name = p.strip_prefix(dir).unwrap().display().to_string();
                 files.insert(name, std::fs::read(&p).unwrap());
             }
