@@ -7,6 +7,7 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
+use super::hardening_on_disk::fit as small_fit;
 use sepval_tests::{ok, refused, sepval};
 
 /// `a.csv` and `b.csv` (two releases of the default store, noise seeds 6 and 7) in a fresh
@@ -118,26 +119,10 @@ fn releases_of_another_store_are_not_pooled_and_the_field_is_named() {
         "store.diameter_m is 0.3, not",
     );
     std::fs::write(d.join("same.csv"), format!("# mass_kg = 907.18474\n{text}")).unwrap();
-    ok(&sepval(
-        &[
-            "fit",
-            "--data",
-            "a.csv",
-            "--data",
-            "same.csv",
-            "--method",
-            "ga",
-            "--generations",
-            "2",
-            "--population",
-            "10",
-            "--evaluator",
-            "inproc",
-            "--no-figures",
-            "--out",
-            "f",
-        ],
+    ok(&small_fit(
         d,
+        "2",
+        &["--data", "a.csv", "--data", "same.csv", "--out", "f"],
     ));
 }
 
@@ -237,26 +222,17 @@ fn outliers_are_named_with_file_line_channel_and_size_then_refused_or_dropped() 
         "{stderr}"
     );
     // A fit that dropped it records so; rerun reads its data the same way.
-    ok(&sepval(
+    ok(&small_fit(
+        d,
+        "2",
         &[
-            "fit",
             "--data",
             "spiky.csv",
             "--outliers",
             "drop",
-            "--method",
-            "ga",
-            "--generations",
-            "2",
-            "--population",
-            "10",
-            "--evaluator",
-            "inproc",
-            "--no-figures",
             "--out",
             "dropped",
         ],
-        d,
     ));
     let result: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("dropped/result.json")).unwrap()).unwrap();

@@ -14,7 +14,7 @@ const EXTENSION: &str = "format = \"sepval-extension/1\"\n\n[[term]]\naxis = \"C
                          \"step\"\nregressor = \"step\"\nt_on_s = 0.4\ncoefficient = 0.05\n";
 
 /// A small in-process `fit --method ga --population 10 --generations G` with `extra` flags.
-fn fit(dir: &Path, generations: &str, extra: &[&str]) -> std::process::Output {
+pub(crate) fn fit(dir: &Path, generations: &str, extra: &[&str]) -> std::process::Output {
     let mut a = vec![
         "fit",
         "--method",
