@@ -8,7 +8,10 @@
 //!   (beyond them a table is held at its edge, so the model would fly on made-up data);
 //! - **said**: a condition within the domain but far from every release fitted ([`far`]):
 //!   beyond the box of the releases' conditions by more than [`FAR_MACH`] in Mach,
-//!   [`FAR_Q_FRACTION`] of the dynamic pressure, or [`FAR_ANGLE_DEG`] deg in alpha or beta.
+//!   [`FAR_Q_FRACTION`] of the dynamic pressure, or [`FAR_ANGLE_DEG`] deg in alpha or beta;
+//! - **measured**: how far a condition lies from the nearest release, in those same units
+//!   ([`reach`]), which widens a prediction's model-form band (docs/model.md, "Model form away
+//!   from the releases").
 
 use sepval_common::atmosphere::isa_troposphere;
 use sepval_common::scenario::{Flight, Scenario};
@@ -145,6 +148,27 @@ pub fn check(scenario: &Scenario) -> Result<(), DomainError> {
     Ok(())
 }
 
+/// The distance of `condition` from the nearest release of `releases`, each quantity in its
+/// "far" unit: sqrt((dM / [`FAR_MACH`])^2 + (ln(q / q_r) / ln(1 + [`FAR_Q_FRACTION`]))^2 +
+/// (d alpha / [`FAR_ANGLE_DEG`])^2 + (d beta / [`FAR_ANGLE_DEG`])^2), minimised over the
+/// releases r. 0 at a release; 1 is as far as 0.1 in Mach alone. The nearest release, not the
+/// box or the hull of the releases: a condition between two releases is as far as half their
+/// gap, because nothing was flown there (the conservative choice, docs/model.md).
+/// `f64::INFINITY` when nothing was flown.
+pub fn reach(releases: &[&Flight], condition: &Flight) -> f64 {
+    let q = dynamic_pressure_pa(condition);
+    releases
+        .iter()
+        .map(|r| {
+            let dm = (condition.mach - r.mach) / FAR_MACH;
+            let dq = (q / dynamic_pressure_pa(r)).ln() / (1.0 + FAR_Q_FRACTION).ln();
+            let da = (condition.alpha_deg - r.alpha_deg) / FAR_ANGLE_DEG;
+            let db = (condition.beta_deg - r.beta_deg) / FAR_ANGLE_DEG;
+            (dm * dm + dq * dq + da * da + db * db).sqrt()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Dynamic pressure of a flight condition \[Pa\].
 fn dynamic_pressure_pa(f: &Flight) -> f64 {
     let air = isa_troposphere(f.altitude_m);
@@ -271,5 +295,23 @@ mod tests {
             "{words}"
         );
         assert!(words.contains("dynamic pressure"), "{words}");
+    }
+
+    #[test]
+    fn reach_is_zero_at_a_release_one_a_far_unit_away_and_infinite_with_none() {
+        let base = Scenario::embedded_default().flight;
+        assert!(reach(&[&base], &base).abs() < 1e-12);
+        assert!(reach(&[], &base).is_infinite());
+        let mut a = base.clone();
+        a.alpha_deg += 5.0;
+        assert!((reach(&[&base], &a) - 1.0).abs() < 1e-12);
+        let mut b = base.clone();
+        b.alpha_deg += 10.0;
+        // The nearest release decides: b is one unit from a, two from base.
+        assert!((reach(&[&base, &a], &b) - 1.0).abs() < 1e-12);
+        // Between two releases: half the gap, not zero.
+        let mut mid = base.clone();
+        mid.alpha_deg += 2.5;
+        assert!((reach(&[&base, &a], &mid) - 0.5).abs() < 1e-12);
     }
 }

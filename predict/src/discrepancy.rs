@@ -115,6 +115,9 @@ pub struct Discrepancy {
     pub fitted_floor: [f64; 6],
     /// Simulations run.
     pub evaluations: u64,
+    /// The reach of the condition predicted, by which [`crate::reach`] widened `sd` (0 until
+    /// it is applied).
+    pub reach: f64,
 }
 
 /// What the calibration needs.
@@ -288,6 +291,7 @@ pub fn carry(
         held_out,
         fitted_floor,
         evaluations,
+        reach: 0.0,
     })
 }
 

@@ -32,6 +32,7 @@ pub mod discrepancy;
 pub mod ensemble;
 pub mod outputs;
 mod page;
+pub mod reach;
 pub mod record;
 pub mod sampling;
 pub mod simulate;
@@ -129,6 +130,9 @@ pub struct Prepared {
     /// When the condition lies far from every release fitted ([`sepval_fit::domain::far`]),
     /// the sentence that says so: the first of the prediction's summary.
     pub extrapolation: Option<String>,
+    /// How far the condition lies from the nearest release fitted
+    /// ([`sepval_fit::domain::reach`]), which widens the model-form band ([`reach`]).
+    pub reach: f64,
 }
 
 impl Prepared {
@@ -194,6 +198,7 @@ pub fn prepare(
         .map(|e| &e.simulator.scenario().flight)
         .collect();
     let extrapolation = sepval_fit::domain::far(&releases, &condition.flight);
+    let reach = sepval_fit::domain::reach(&releases, &condition.flight);
     Ok(Prepared {
         source,
         ensemble,
@@ -207,6 +212,7 @@ pub fn prepare(
         settings,
         clearance: None,
         extrapolation,
+        reach,
     })
 }
 
@@ -268,10 +274,13 @@ pub fn predict_with(
         return Err(PredictError::AllDiverged { samples: n, first });
     }
     let calibration = prepared.calibration();
-    let discrepancy = match evidence {
+    let mut discrepancy = match evidence {
         Some(ev) => discrepancy::carry(&calibration, ev, &prepared.grid)?,
         None => discrepancy::calibrate(&calibration, &prepared.grid)?,
     };
+    let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
+    discrepancy.reach = prepared.reach;
+    reach::widen(&mut discrepancy.sd, &reach::motion(&ran), prepared.reach);
     let clearance = prepared
         .clearance
         .as_ref()

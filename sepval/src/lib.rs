@@ -39,6 +39,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Predict(args) => command::predict::run(*args),
         Command::Envelope(args) => command::envelope::run(*args),
         Command::Update(args) => command::update::run(*args),
+        Command::Campaign(c) => command::campaign::run(c),
         Command::Bench(args) => command::bench::run(args),
         Command::Gateway(args) => command::gateway::run(args),
         Command::Selftest(c) => command::selftest::run(c),

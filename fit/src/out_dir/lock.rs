@@ -97,6 +97,30 @@ pub(super) fn take_lock(dir: &Path, lock: &Path) -> Result<Option<String>, OutDi
     })
 }
 
+/// A directory held by this process ([`DirLock::take`]) until the guard drops: the same lock
+/// file and rules as a run directory's, for a directory that is a record kept across commands
+/// (a campaign), which is not claimed anew by each command.
+#[derive(Debug)]
+pub struct DirLock {
+    lock: std::path::PathBuf,
+}
+
+impl DirLock {
+    /// Locks `dir` (which must exist); returns the guard and the notice of an ill-formed lock
+    /// taken over.
+    pub fn take(dir: &Path) -> Result<(DirLock, Option<String>), OutDirError> {
+        let lock = dir.join(LOCK_FILE);
+        let notice = take_lock(dir, &lock)?;
+        Ok((DirLock { lock }, notice))
+    }
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.lock);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

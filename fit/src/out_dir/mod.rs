@@ -28,7 +28,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 pub use error::OutDirError;
 pub use inputs::Input;
-pub use lock::LOCK_FILE;
+pub use lock::{DirLock, LOCK_FILE};
 pub use marker::MARKER_FILE;
 
 use error::io;

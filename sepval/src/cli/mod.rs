@@ -5,7 +5,11 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+mod campaign;
 mod shared;
+pub use campaign::{
+    CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignStatusArgs,
+};
 use sepval_transport::RunId;
 pub use shared::{
     EvalArgs, GeometryArgs, InputArgs, ModelArgs, NoiseArgs, OutlierArg, OutlierArgs,
@@ -56,6 +60,10 @@ pub enum Command {
     /// Update the store's aerodynamic data from its releases: corrections as tables in the
     /// scenario's own form, kept only as far as they predict a release they were not fitted to.
     Update(Box<UpdateArgs>),
+    /// Run a test program as one record: the envelope before any release, the next release to
+    /// fly, each release flown added, until the envelope is settled (docs/campaign.md).
+    #[command(subcommand)]
+    Campaign(CampaignCommand),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
     /// Check the Pareto machinery on problems with known fronts.

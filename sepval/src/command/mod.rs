@@ -5,6 +5,7 @@
 //! front end ([`crate::front`]: `say!`, `note!`, `front::progress()`), never to stdout directly.
 
 pub mod bench;
+pub mod campaign;
 pub mod clean_ipc;
 pub mod clearance;
 pub mod diagnose;

@@ -1,0 +1,242 @@
+//! `sepval campaign add`: releases flown, recorded (docs/campaign.md, "Adding releases"). Each
+//! is first checked against what the campaign predicted at its condition (the post-flight
+//! check of `sepval predict --data`, [`sepval_predict::check`]); then the model is fitted
+//! again to every release flown (the study's GA then Levenberg-Marquardt, `ga+lm`, the fit a
+//! diagnosis starts from), and the envelope is predicted again from that fit (round N). A
+//! release already in the campaign (the same bytes, or the same samples at the same
+//! condition) is refused with nothing changed.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use sepval_common::evaluation::Job;
+use sepval_common::scenario::Scenario;
+use sepval_common::telemetry::Trajectory;
+use sepval_fit::checkpoint::InputsRecord;
+use sepval_fit::sigma::Sigma;
+use sepval_fit::{FitOptions, Method, run_fit};
+use sepval_predict::bands::{BandInputs, bands};
+use sepval_predict::check::{Check, check};
+use sepval_predict::record::ConditionRecord;
+use sepval_predict::sampling::{STREAM_PARAMETERS, sample_rng};
+use sepval_predict::simulate::{self, GridTrajectory, data_on_grid};
+use sepval_solve::ga::GaSettings;
+use sepval_solve::hill::HillSettings;
+use sepval_solve::lm::LmSettings;
+use sepval_solve::run::{NoProgress, ProgressObserver};
+
+use crate::CampaignError;
+use crate::assess::{AssessSettings, Model, StartEvaluator};
+use crate::program::{Campaign, NewRelease, STAGING, fitted_model};
+use crate::record::{ReleaseRecord, record_error};
+
+/// The noise of a prediction's bands before any release was fitted: the synthetic flight
+/// tests' (docs/model.md section 6).
+fn prior_noise() -> sepval_fit::space::Noise {
+    sepval_fit::space::Noise {
+        pos_m: sepval_common::noise::SIGMA_POS_M,
+        att_deg: sepval_common::noise::SIGMA_ATT_DEG,
+    }
+}
+
+/// Adds `releases` to the campaign (module docs); returns each one's check.
+pub fn add(
+    c: &mut Campaign,
+    releases: Vec<NewRelease>,
+    start: &mut StartEvaluator<'_>,
+    observer: &mut dyn ProgressObserver,
+) -> Result<Vec<Check>, CampaignError> {
+    refuse_known(c, &releases)?;
+    let model = c.model()?;
+    let settings = c.assess_settings();
+    let mut checks = Vec::new();
+    for r in &releases {
+        let name = r.given.display().to_string();
+        checks.push(check_release(
+            &model,
+            &r.scenario,
+            &r.data,
+            &name,
+            &settings,
+            start,
+        )?);
+    }
+    let round = c.file.rounds.len();
+    std::fs::create_dir_all(c.dir.join("releases")).map_err(|e| record_error(&c.dir, e))?;
+    for (r, k) in releases.iter().zip(&checks) {
+        let file = format!("releases/{:02}.csv", c.file.releases.len() + 1);
+        let path = c.dir.join(&file);
+        r.data.write(&path).map_err(|e| record_error(&path, e))?;
+        c.file.releases.push(ReleaseRecord {
+            file,
+            given: r.given.display().to_string(),
+            sha256: r.sha256.clone(),
+            condition: ConditionRecord::of(&r.scenario.flight),
+            round,
+            inside: k.inside,
+            check: k.verdict.clone(),
+        });
+    }
+    let job = c.job()?.expect("releases were added");
+    let fit_dir = c.dir.join(STAGING).join("fit");
+    fit(c, &job, &fit_dir, start, observer)?;
+    let model = fitted_model(&fit_dir, job)?;
+    c.round(&model, start, observer)?;
+    Ok(checks)
+}
+
+/// Refuses a release the campaign holds, or one given twice.
+fn refuse_known(c: &Campaign, releases: &[NewRelease]) -> Result<(), CampaignError> {
+    let known = c.job()?;
+    for (i, r) in releases.iter().enumerate() {
+        let name = r.given.display();
+        if let Some(k) = c.file.releases.iter().find(|k| k.sha256 == r.sha256) {
+            return Err(CampaignError::Refused(format!(
+                "{name} is already in the campaign as {} (given as {}): each release is added once",
+                k.file, k.given
+            )));
+        }
+        if let Some(j) = known.as_ref().and_then(|j| {
+            j.events()
+                .iter()
+                .position(|e| same(&e.data, &e.simulator.scenario().flight, r))
+        }) {
+            return Err(CampaignError::Refused(format!(
+                "{name} holds the same samples at the same condition as {}: each release is added once",
+                c.file.releases[j].file
+            )));
+        }
+        if let Some(o) = releases[..i]
+            .iter()
+            .find(|o| o.sha256 == r.sha256 || same(&o.data, &o.scenario.flight, r))
+        {
+            return Err(CampaignError::Refused(format!(
+                "{name} is the same release as {}: give each release once",
+                o.given.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Whether `r` holds `data`'s samples bit for bit at `flight`.
+fn same(data: &Trajectory, flight: &sepval_common::scenario::Flight, r: &NewRelease) -> bool {
+    let bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let f = |f: &sepval_common::scenario::Flight| {
+        [f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg]
+    };
+    let d = &r.data;
+    data.len() == d.len()
+        && bits(&f(flight), &f(&r.scenario.flight))
+        && bits(&data.times_s, &d.times_s)
+        && bits(data.pos_m.as_flattened(), d.pos_m.as_flattened())
+        && bits(data.att_deg.as_flattened(), d.att_deg.as_flattened())
+}
+
+/// The fit of every release flown (`ga+lm`) into `out`.
+fn fit(
+    c: &Campaign,
+    job: &Job,
+    out: &Path,
+    start: &mut StartEvaluator<'_>,
+    observer: &mut dyn ProgressObserver,
+) -> Result<(), CampaignError> {
+    let s = &c.file.settings;
+    let sigma = Sigma::resolve(job, None, None)
+        .map_err(|e| CampaignError::Refused(format!("the noise of the releases: {e}")))?;
+    let options = FitOptions {
+        method: Method::GaLm,
+        ga: GaSettings {
+            generations: s.generations,
+            seed: s.seed,
+            ..GaSettings::default()
+        },
+        hill: HillSettings::default(),
+        sigma,
+        truth: None,
+        out: out.to_path_buf(),
+        resume: None,
+        inputs: InputsRecord {
+            data: c
+                .file
+                .releases
+                .iter()
+                .map(|r| c.dir.join(&r.file))
+                .collect(),
+            scenario: s.scenario.as_ref().map(|r| r.path.clone().into()),
+            extension: None,
+            outliers: Default::default(),
+        },
+        lm: LmSettings::default(),
+        lm_probe: LmSettings {
+            budget: 800,
+            ..LmSettings::default()
+        },
+    };
+    let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
+    run_fit(&options, evaluator.as_mut(), observer).map_err(|e| match e {
+        sepval_fit::FitError::Run(sepval_solve::run::RunError::Interrupted) => {
+            CampaignError::Interrupted
+        }
+        e => CampaignError::Fit(Box::new(e)),
+    })?;
+    Ok(())
+}
+
+/// The post-flight check of `data` (flown at `scenario`) against the bands `model` predicts
+/// there at the 95 % level, with the measurement noise.
+pub fn check_release(
+    model: &Model,
+    scenario: &Scenario,
+    data: &Trajectory,
+    name: &str,
+    settings: &AssessSettings,
+    start: &mut StartEvaluator<'_>,
+) -> Result<Check, CampaignError> {
+    let points = simulate::Grid::of(&data.times_s);
+    let job = simulate::release_job(scenario, &data.times_s, "check")
+        .map_err(|e| CampaignError::Condition(Box::new(simulate::SimulateError::from(e).into())))?;
+    let candidates: Vec<_> = (0..settings.samples)
+        .map(|s| {
+            let mut rng = sample_rng(settings.seed, s as u64, STREAM_PARAMETERS);
+            model
+                .space
+                .candidate(&model.distribution.draw(&mut rng))
+                .map_err(|e| CampaignError::Model(e.to_string()))
+        })
+        .collect::<Result<_, _>>()?;
+    let mut evaluator = start(Arc::new(job)).map_err(CampaignError::from_eval)?;
+    let runs = simulate::run_candidates(
+        evaluator.as_mut(),
+        candidates.len(),
+        &|i| candidates[i].clone(),
+        &points,
+        &mut NoProgress,
+    )
+    .map_err(|e| CampaignError::Condition(Box::new(e.into())))?;
+    drop(evaluator);
+    let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
+    let flights: Vec<_> = model.flown();
+    let refs: Vec<_> = flights.iter().collect();
+    let r = sepval_fit::domain::reach(&refs, &scenario.flight);
+    let mut sd = vec![[0.0; 6]; points.len()];
+    sepval_predict::reach::widen(&mut sd, &sepval_predict::reach::motion(&ran), r);
+    let noise = model
+        .fitted
+        .as_ref()
+        .map_or_else(prior_noise, |f| f.source.noise);
+    let per_sample = runs.trajectories.into_iter().map(|t| (0, t.ok())).collect();
+    let b = bands(
+        &BandInputs {
+            weights: &[1.0],
+            discrepancy: &sd,
+            noise: Some(noise),
+            level: 0.95,
+            seed: settings.seed,
+            points: points.len(),
+        },
+        per_sample,
+    );
+    let flown = data_on_grid(data, &points);
+    Ok(check(name, &flown, &points.t_s, &b.channels))
+}

@@ -1,0 +1,197 @@
+//! One envelope of the campaign: every condition of the grid predicted from what the campaign
+//! believes in a round ([`Model`]: the prior, or the fit of every release flown), with the
+//! clearance of every sample (docs/campaign.md, "An envelope of the campaign").
+//!
+//! At condition k: `samples` draws of the factors (sample s from its own generator,
+//! [`sepval_predict::sampling::sample_rng`], the same draws at every condition: common random
+//! numbers), each flown through the evaluator; the model-form band at the releases (none for
+//! the prior; the fit's discrepancy calibrated on its releases otherwise,
+//! [`sepval_predict::discrepancy`], as `sepval envelope` does), widened with the condition's
+//! reach ([`sepval_predict::reach`]); the clearance of every sample
+//! ([`sepval_predict::clearance::assess`]) twice: with the model-form band (the condition's
+//! probability of failing, its state) and without it (the factors' share of the spread, which
+//! the planning needs to tell what a release would settle). The assessment is the same bits
+//! whatever the evaluator and its worker count.
+
+use std::sync::Arc;
+
+use sepval_common::cancel;
+use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
+use sepval_common::scenario::{Flight, Scenario};
+use sepval_common::simulation::sample_times;
+use sepval_envelope::{Grid, Row};
+use sepval_fit::space::ParamSpace;
+use sepval_predict::discrepancy::{self, Calibration, Evidence};
+use sepval_predict::ensemble::Ensemble;
+use sepval_predict::record::ConditionRecord;
+use sepval_predict::sampling::{ParameterDistribution, STREAM_PARAMETERS, sample_rng};
+use sepval_predict::simulate::{self, GridTrajectory};
+use sepval_predict::{ClearanceSettings, PredictError, Source, clearance, reach};
+use sepval_solve::run::{NoProgress, Progress as Step, ProgressObserver};
+
+use crate::CampaignError;
+use crate::state::{Assessed, State, spread};
+
+/// Starts an evaluator for a job (a condition's release).
+pub type StartEvaluator<'a> = dyn FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + 'a;
+
+/// What a round believes: the factors' distribution and the model form at the releases.
+pub struct Model {
+    /// The free parameters (the 17 factors).
+    pub space: ParamSpace,
+    /// Their distribution.
+    pub distribution: ParameterDistribution,
+    /// The releases flown so far, with the fit of all of them (none: the prior).
+    pub fitted: Option<Fitted>,
+}
+
+/// The fit of every release flown.
+pub struct Fitted {
+    /// The fit as `sepval predict` reads it.
+    pub source: Source,
+    /// Its answer.
+    pub ensemble: Ensemble,
+    /// The releases.
+    pub job: Job,
+}
+
+impl Model {
+    /// The conditions of the releases flown.
+    pub fn flown(&self) -> Vec<Flight> {
+        self.fitted.as_ref().map_or_else(Vec::new, |f| {
+            f.job
+                .events()
+                .iter()
+                .map(|e| e.simulator.scenario().flight.clone())
+                .collect()
+        })
+    }
+}
+
+/// How an envelope is assessed.
+#[derive(Debug, Clone)]
+pub struct AssessSettings {
+    /// Samples per condition.
+    pub samples: usize,
+    /// The seed of the draws.
+    pub seed: u64,
+    /// Threads of the clearance and the calibration.
+    pub threads: usize,
+    /// The largest probability of failing at which a condition is cleared.
+    pub allowed: f64,
+    /// The clearance.
+    pub clearance: ClearanceSettings,
+}
+
+/// Every condition of `grid` (flown from `base`) assessed with `model`; `observer` hears one
+/// step per condition.
+pub fn assess(
+    model: &Model,
+    grid: &Grid,
+    base: &Scenario,
+    settings: &AssessSettings,
+    start: &mut StartEvaluator<'_>,
+    observer: &mut dyn ProgressObserver,
+) -> Result<Vec<Assessed>, CampaignError> {
+    let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
+    let points = simulate::Grid::of(&times);
+    let candidates = draws(model, settings)?;
+    let flown = model.flown();
+    let flown_refs: Vec<&Flight> = flown.iter().collect();
+    let mut evidence: Option<Evidence> = None;
+    let mut out = Vec::with_capacity(grid.len());
+    observer.start("envelope", Some(grid.len()));
+    for k in 0..grid.len() {
+        cancel::check()?;
+        let scenario = grid.scenario(base, k);
+        let job = simulate::release_job(&scenario, &times, "campaign")
+            .map_err(|e| condition(simulate::SimulateError::from(e).into()))?;
+        let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
+        let runs = simulate::run_candidates(
+            evaluator.as_mut(),
+            candidates.len(),
+            &|i| candidates[i].clone(),
+            &points,
+            &mut NoProgress,
+        )
+        .map_err(|e| condition(e.into()))?;
+        drop(evaluator);
+        let mut sd = match &model.fitted {
+            None => vec![[0.0; 6]; points.len()],
+            Some(f) => {
+                let cal = calibration(f, &job, settings);
+                if evidence.is_none() {
+                    evidence = Some(discrepancy::evidence(&cal).map_err(|e| condition(e.into()))?);
+                }
+                let ev = evidence.as_ref().expect("computed above");
+                discrepancy::carry(&cal, ev, &points)
+                    .map_err(|e| condition(e.into()))?
+                    .sd
+            }
+        };
+        let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
+        let r = sepval_fit::domain::reach(&flown_refs, &scenario.flight);
+        reach::widen(&mut sd, &reach::motion(&ran), r);
+        let trajectories: Vec<Option<&GridTrajectory>> =
+            runs.trajectories.iter().map(|t| t.as_ref().ok()).collect();
+        let (seed, threads) = (settings.seed, settings.threads);
+        let c = &settings.clearance;
+        let full = clearance::assess(c, &trajectories, &sd, &points, seed, threads)?;
+        let none = vec![[0.0; 6]; points.len()];
+        let factors = clearance::assess(c, &trajectories, &none, &points, seed, threads)?;
+        let record = ConditionRecord::of(grid.flight(k));
+        let row = if full.samples == 0 {
+            Row::all_diverged(k, record)
+        } else {
+            Row::of(k, record, &full)
+        };
+        out.push(Assessed {
+            state: State::of(row.p_fail, settings.allowed),
+            reach: r,
+            spread_mm: spread(full.min_clearance_mm.p5, full.min_clearance_mm.p95),
+            factor_spread_mm: spread(factors.min_clearance_mm.p5, factors.min_clearance_mm.p95),
+            row,
+        });
+        observer.progress(&Step {
+            step: k + 1,
+            steps: Some(grid.len()),
+            evaluations: ((k + 1) * candidates.len()) as u64,
+            best: [f64::NAN; 2],
+        });
+    }
+    observer.finish();
+    Ok(out)
+}
+
+/// The samples' candidates: draw s from its own generator.
+fn draws(model: &Model, settings: &AssessSettings) -> Result<Vec<Candidate>, CampaignError> {
+    (0..settings.samples)
+        .map(|s| {
+            let mut rng = sample_rng(settings.seed, s as u64, STREAM_PARAMETERS);
+            let x = model.distribution.draw(&mut rng);
+            model
+                .space
+                .candidate(&x)
+                .map_err(|e| CampaignError::Model(e.to_string()))
+        })
+        .collect()
+}
+
+/// The calibration of the fit's discrepancy at the release of `job`.
+fn calibration<'a>(f: &'a Fitted, job: &'a Job, s: &AssessSettings) -> Calibration<'a> {
+    Calibration {
+        answer: f.ensemble.answer(),
+        identifiability: &f.source.identifiability,
+        fitted: &f.job,
+        held_out: &[],
+        target: &job.events()[0],
+        noise: f.source.noise,
+        fitted_rms: f.source.fitted_rms,
+        threads: s.threads,
+        seed: s.seed,
+    }
+}
+
+fn condition(e: PredictError) -> CampaignError {
+    CampaignError::Condition(Box::new(e))
+}

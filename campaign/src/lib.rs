@@ -1,0 +1,95 @@
+//! The test program as one record (`sepval campaign`, docs/campaign.md): the separation
+//! envelope predicted before any release from a prior, the next release to fly chosen among
+//! the conditions predicted safe by what it is expected to settle, each release flown checked
+//! against its prediction and the model fitted again to every release, until no condition is
+//! undecided or no safe release is expected to settle any. The field's practice, a few
+//! releases validating the simulation and the rest of the envelope cleared by prediction, is
+//! M. B. Anderson's purpose ("a tenth of the test assets"); sequential planning for the
+//! envelope decision itself is this crate's.
+//!
+//! The campaign is a pipeline of named stages over one directory:
+//! 1. [`prior`]: the factors before any release ([`Prior`]);
+//! 2. [`assess`]: an envelope of the campaign, every condition's clearance predicted from what
+//!    a round believes ([`Model`] to [`Assessed`]), its [`state`];
+//! 3. [`next`]: the releases to fly next ([`Plan`]);
+//! 4. [`program`] and [`add`]: `init`, `add`, `next` and `status` over the directory
+//!    ([`record`]: campaign.json, status.json, next.json), each change staged and committed
+//!    whole;
+//! 5. [`page`]: report.html and the figures;
+
+#![deny(clippy::float_cmp)]
+
+pub mod add;
+pub mod assess;
+pub mod next;
+pub mod page;
+pub mod prior;
+pub mod program;
+pub mod record;
+pub mod state;
+
+pub use assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};
+pub use next::{Plan, Planned, plan};
+pub use prior::{Prior, PriorError};
+pub use record::{CAMPAIGN_FORMAT, CampaignFile, NEXT_FORMAT, NextFile, StatusFile};
+pub use state::{Assessed, Counts, State};
+
+use sepval_common::evaluation::EvalError;
+
+/// A campaign command that could not be carried out. Nothing in the campaign's directory
+/// changed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CampaignError {
+    /// A condition's prediction.
+    #[error("the prediction of a condition")]
+    Condition(#[source] Box<sepval_predict::PredictError>),
+    /// The model could not be made of its parameters.
+    #[error("the model: {0}")]
+    Model(String),
+    /// An evaluator that could not be started.
+    #[error("cannot start the evaluator")]
+    Start(#[source] EvalError),
+    /// The fit of the releases.
+    #[error("the fit of the releases flown")]
+    Fit(#[source] Box<sepval_fit::FitError>),
+    /// The fit's record as a prediction reads it.
+    #[error("the fit of the releases flown")]
+    Source(#[source] Box<sepval_predict::PredictError>),
+    /// The campaign's directory or one of its records.
+    #[error("{path}: {message}")]
+    Record {
+        /// The file or directory.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A release refused.
+    #[error("{0}")]
+    Refused(String),
+    /// The directory is locked by another command.
+    #[error(transparent)]
+    Locked(#[from] sepval_fit::out_dir::OutDirError),
+    /// The outputs.
+    #[error(transparent)]
+    Outputs(#[from] sepval_report::OutputError),
+    /// A signal asked the process to stop.
+    #[error("interrupted by a signal: the campaign is as it was before the command")]
+    Interrupted,
+}
+
+impl From<sepval_common::cancel::Cancelled> for CampaignError {
+    fn from(_: sepval_common::cancel::Cancelled) -> Self {
+        CampaignError::Interrupted
+    }
+}
+
+impl CampaignError {
+    /// The error of an evaluator that could not be started (a signal's is an interruption).
+    pub fn from_eval(e: EvalError) -> CampaignError {
+        match e {
+            EvalError::Interrupted => CampaignError::Interrupted,
+            e => CampaignError::Start(e),
+        }
+    }
+}

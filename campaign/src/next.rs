@@ -1,0 +1,285 @@
+//! The next release(s) to fly (docs/campaign.md, "The next release"). Only conditions whose
+//! probability of failing to clear is at most the fly risk are candidates: a program never
+//! flies where the prediction says the store may hit the aircraft. Among them, a release at c
+//! is ranked by the expected number of undecided conditions it settles, a preposterior
+//! analysis under a normal approximation of each condition's smallest clearance:
+//!
+//! - at undecided condition u, m_u the median smallest clearance less the criterion, s_u its
+//!   spread, s_f,u the factors' part of it and s_m,u = sqrt(max(0, s_u^2 - s_f,u^2)) the model
+//!   form's;
+//! - a release at c brings u's reach down to r'_u = min(r_u, reach(c, u)): the model form's
+//!   part scales with the reach ([`sepval_predict::reach`]), s'_m,u = s_m,u e(r'_u) / e(r_u),
+//!   e the reach the band uses;
+//! - it informs the factors where they act alike, w = exp(-reach(c, u)^2 / 2): with n releases
+//!   flown, s'_f,u = s_f,u sqrt(n / (n + w)); with none, s'_f,u = s_f,u (1 - w (1 -
+//!   [`FIRST_RELEASE_SHARE`])), the share of the prior's spread a first release leaves;
+//! - the median moves by what is learnt, a normal of variance tau^2 = s_u^2 - s'_u^2, and u is
+//!   settled when it ends more than z s'_u from the criterion (z the normal quantile of 1 -
+//!   allowed): P(settled) = Phi((m_u - z s'_u) / tau) + Phi((-m_u - z s'_u) / tau).
+//!
+//! `expected_settled(c)` sums P(settled) over the undecided conditions. A batch of K is chosen
+//! greedily: each release chosen is taken as flown (the spreads it leaves, one more release)
+//! before the next is ranked, so that the batch's releases complement each other rather than
+//! settle the same conditions. Ties go to the lower risk, then to grid order.
+
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ContinuousCDF, Normal};
+
+use sepval_common::scenario::Flight;
+use sepval_envelope::Grid;
+use sepval_fit::domain::reach;
+use sepval_predict::reach::effective;
+
+use crate::state::{Assessed, State};
+
+/// The share of the prior's spread of the factors that a first release at the condition
+/// leaves: a release of 1 s determines the factors that act there to a few per cent of their
+/// prior range (docs/performance.md, the study's comparison: standard errors of 0.02 to 0.16
+/// against ranges of 0.2 to 1.75), so a quarter is a cautious reading.
+pub const FIRST_RELEASE_SHARE: f64 = 0.25;
+/// A release expected to settle fewer conditions than this settles nothing.
+pub const SETTLES_NOTHING: f64 = 0.5;
+
+/// One release planned.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Planned {
+    /// Its index in the grid.
+    pub index: usize,
+    /// Mach.
+    pub mach: f64,
+    /// Altitude \[m\].
+    pub altitude_m: f64,
+    /// Aircraft angle of attack \[deg\].
+    pub alpha_deg: f64,
+    /// Sideslip \[deg\].
+    pub beta_deg: f64,
+    /// Flight-path angle \[deg\].
+    pub gamma_deg: f64,
+    /// The predicted probability of failing to clear there.
+    pub p_fail: f64,
+    /// How many undecided conditions it is expected to settle.
+    pub expected_settled: f64,
+    /// Why, in words.
+    pub why: String,
+}
+
+/// What the planning found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// The releases to fly, best first (empty when none is safe, or none settles anything).
+    pub releases: Vec<Planned>,
+    /// When no condition is safe to fly: the least risky, with its risk.
+    pub least_risky: Option<Planned>,
+    /// Whether the envelope is settled: nothing undecided, or no safe release expected to
+    /// settle any.
+    pub settled: bool,
+    /// In words.
+    pub words: String,
+}
+
+/// What decides a plan.
+#[derive(Debug, Clone, Copy)]
+pub struct Criteria {
+    /// The clearance criterion \[mm\].
+    pub criterion_mm: f64,
+    /// The allowed probability of failing (a condition's state).
+    pub allowed: f64,
+    /// The largest probability of failing at which a release may be flown.
+    pub fly_risk: f64,
+}
+
+/// The plan of `count` releases over `assessed` (the current envelope of `grid`), with
+/// `flown` releases so far.
+pub fn plan(
+    grid: &Grid,
+    assessed: &[Assessed],
+    flown: &[Flight],
+    criteria: Criteria,
+    count: usize,
+) -> Plan {
+    let Criteria {
+        criterion_mm,
+        allowed,
+        fly_risk,
+    } = criteria;
+    let undecided: Vec<usize> = (0..assessed.len())
+        .filter(|&u| assessed[u].state == State::Undecided)
+        .collect();
+    let safe: Vec<usize> = (0..assessed.len())
+        .filter(|&c| assessed[c].row.p_fail <= fly_risk)
+        .collect();
+    if safe.is_empty() {
+        return no_safe(grid, assessed, fly_risk, undecided.is_empty());
+    }
+    let z = normal().inverse_cdf(1.0 - allowed);
+    let mut spreads: Vec<(f64, f64)> = assessed
+        .iter()
+        .map(|a| {
+            let s = finite_or_zero(a.spread_mm);
+            let f = finite_or_zero(a.factor_spread_mm).min(s);
+            (f, (s * s - f * f).max(0.0).sqrt())
+        })
+        .collect();
+    // Each condition's spread before any release of the batch: what is learnt is measured
+    // from it.
+    let start: Vec<f64> = spreads.iter().map(|(f, m)| f.hypot(*m)).collect();
+    let mut reaches: Vec<f64> = assessed.iter().map(|a| a.reach).collect();
+    let mut n = flown.len();
+    let at = |c: usize, u: usize| Pair {
+        reach: reach(&[grid.flight(c)], grid.flight(u)),
+        margin_mm: assessed[u].row.clearance_p50_mm - criterion_mm,
+        z,
+    };
+    let mut chosen: Vec<Planned> = Vec::new();
+    for _ in 0..count.max(1) {
+        let best = safe
+            .iter()
+            .filter(|c| !chosen.iter().any(|p| p.index == **c))
+            .map(|&c| {
+                let e: f64 = undecided
+                    .iter()
+                    .map(|&u| {
+                        let (f, m, _) = settle(&at(c, u), &spreads[u], reaches[u], n);
+                        let pair = at(c, u);
+                        let now = spreads[u].0.hypot(spreads[u].1);
+                        p_settle(&pair, start[u], f.hypot(m)) - p_settle(&pair, start[u], now)
+                    })
+                    .sum();
+                (c, e)
+            })
+            .max_by(|a, b| {
+                a.1.total_cmp(&b.1)
+                    .then(
+                        assessed[b.0]
+                            .row
+                            .p_fail
+                            .total_cmp(&assessed[a.0].row.p_fail),
+                    )
+                    .then(b.0.cmp(&a.0))
+            });
+        let Some((c, e)) = best else { break };
+        if e < SETTLES_NOTHING {
+            break;
+        }
+        let why = format!(
+            "expected to settle {e:.1} of the {} undecided conditions; P(fail) here {:.4}, within the fly risk {fly_risk}",
+            undecided.len(),
+            assessed[c].row.p_fail
+        );
+        chosen.push(planned(grid, assessed, c, e, why));
+        // Taken as flown: the spreads it leaves, one release more.
+        for u in 0..assessed.len() {
+            let (f, m, r) = settle(&at(c, u), &spreads[u], reaches[u], n);
+            spreads[u] = (f, m);
+            reaches[u] = r;
+        }
+        n += 1;
+    }
+    let settled = undecided.is_empty() || chosen.is_empty();
+    let words = if undecided.is_empty() {
+        "settled: no condition is undecided".to_string()
+    } else if chosen.is_empty() {
+        format!(
+            "settled: {} condition(s) stay undecided, and no release safe to fly is expected to settle any of them",
+            undecided.len()
+        )
+    } else {
+        format!(
+            "{} release(s) planned for the {} undecided condition(s)",
+            chosen.len(),
+            undecided.len()
+        )
+    };
+    Plan {
+        releases: chosen,
+        least_risky: None,
+        settled,
+        words,
+    }
+}
+
+/// The plan when no condition is safe to fly: none, and the least risky named.
+fn no_safe(grid: &Grid, assessed: &[Assessed], fly_risk: f64, settled: bool) -> Plan {
+    let least = (0..assessed.len())
+        .min_by(|&a, &b| assessed[a].row.p_fail.total_cmp(&assessed[b].row.p_fail))
+        .map(|c| {
+            let why = format!(
+                "the least risky condition: P(fail) {:.3} there, above the fly risk {fly_risk}",
+                assessed[c].row.p_fail
+            );
+            planned(grid, assessed, c, 0.0, why)
+        });
+    Plan {
+        releases: Vec::new(),
+        least_risky: least,
+        settled,
+        words: format!(
+            "no condition is safe to fly: every one has a probability of failing to clear above {fly_risk}"
+        ),
+    }
+}
+
+fn normal() -> Normal {
+    Normal::new(0.0, 1.0).expect("the standard normal")
+}
+
+fn finite_or_zero(v: f64) -> f64 {
+    if v.is_finite() { v.max(0.0) } else { 0.0 }
+}
+
+/// A release at c as condition u sees it.
+struct Pair {
+    /// reach(c, u).
+    reach: f64,
+    /// u's median smallest clearance less the criterion \[mm\].
+    margin_mm: f64,
+    /// The normal quantile of 1 - allowed.
+    z: f64,
+}
+
+/// What a release does to a condition (`pair`) whose factor and model-form spreads are
+/// `spread` and reach `r`, with `n` releases flown: its factor spread, model-form spread and
+/// reach afterwards.
+fn settle(pair: &Pair, spread: &(f64, f64), r: f64, n: usize) -> (f64, f64, f64) {
+    let d = pair.reach;
+    let (f, m) = *spread;
+    let r_after = r.min(d);
+    let (e0, e1) = (effective(r), effective(r_after));
+    let m_after = if e0 > 0.0 { m * e1 / e0 } else { m };
+    let w = (-0.5 * d * d).exp();
+    let f_after = if n == 0 {
+        f * (1.0 - w * (1.0 - FIRST_RELEASE_SHARE))
+    } else {
+        f * (n as f64 / (n as f64 + w)).sqrt()
+    };
+    (f_after, m_after, r_after)
+}
+
+/// The probability that a condition whose spread goes from `s` to `s_after` ends settled: its
+/// median moves by a normal of variance s^2 - s_after^2 and must end more than z s_after from
+/// the criterion (module docs). 0 when nothing is learnt or the median is unknown.
+fn p_settle(pair: &Pair, s: f64, s_after: f64) -> f64 {
+    let (margin, z) = (pair.margin_mm, pair.z);
+    if !margin.is_finite() {
+        return 0.0;
+    }
+    let tau = (s * s - s_after * s_after).max(1e-12).sqrt();
+    let nd = normal();
+    (nd.cdf((margin - z * s_after) / tau) + nd.cdf((-margin - z * s_after) / tau)).min(1.0)
+}
+
+/// The planned release at condition `c`.
+fn planned(grid: &Grid, assessed: &[Assessed], c: usize, e: f64, why: String) -> Planned {
+    let f = grid.flight(c);
+    Planned {
+        index: c,
+        mach: f.mach,
+        altitude_m: f.altitude_m,
+        alpha_deg: f.alpha_deg,
+        beta_deg: f.beta_deg,
+        gamma_deg: f.gamma_deg,
+        p_fail: assessed[c].row.p_fail,
+        expected_settled: e,
+        why,
+    }
+}

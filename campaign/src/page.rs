@@ -1,0 +1,204 @@
+//! The campaign's derived files, written from its records after every command: CAMP/envelope.csv
+//! (the current round's, the columns of `sepval envelope` and `state`), CAMP/status.json,
+//! CAMP/figures/state-NN.png (each round's map of states, the releases flown by then marked
+//! in the title) and CAMP/report.html (the answer first, then the map, the history of the
+//! counts per round, the releases and what is left undecided).
+
+use std::path::Path;
+
+use sepval_common::atomic_file::write_atomically;
+use sepval_envelope::row::CSV_HEADER;
+use sepval_report::figures::{MapAxis, condition_map};
+use sepval_report::html::escape_html;
+
+use sepval_envelope::Grid;
+
+use crate::CampaignError;
+use crate::record::{CampaignFile, STATUS_FORMAT, StatusFile, record_error, write_json};
+use crate::state::{Assessed, Counts, State};
+
+/// What the derived files are made of: the campaign's directory, its record and its grid.
+pub struct View<'a> {
+    /// The directory.
+    pub dir: &'a Path,
+    /// campaign.json.
+    pub file: &'a CampaignFile,
+    /// The grid.
+    pub grid: &'a Grid,
+}
+
+impl View<'_> {
+    /// The envelope of round `dir` (`rounds/NN`).
+    pub fn round(&self, dir: &str) -> Result<Vec<Assessed>, CampaignError> {
+        let path = self.dir.join(dir).join("assessment.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| record_error(&path, e))?;
+        serde_json::from_str(&text).map_err(|e| record_error(&path, e))
+    }
+
+    /// The current round's envelope.
+    pub fn current(&self) -> Result<Vec<Assessed>, CampaignError> {
+        let last = self.file.rounds.last().ok_or_else(|| {
+            record_error(
+                self.dir,
+                "holds no round: the campaign's init did not finish",
+            )
+        })?;
+        self.round(&last.dir)
+    }
+}
+
+/// Writes an envelope of the campaign as CSV: `sepval envelope`'s columns and `state`.
+pub fn write_envelope_csv(path: &Path, assessed: &[Assessed]) -> Result<(), CampaignError> {
+    let mut s = format!("{CSV_HEADER},state\n");
+    for a in assessed {
+        s.push_str(&a.row.csv_line());
+        s.push(',');
+        s.push_str(a.state.name());
+        s.push('\n');
+    }
+    write_atomically(path, s.as_bytes()).map_err(|e| record_error(path, e))
+}
+
+/// The status of the campaign.
+pub fn status(c: &CampaignFile) -> StatusFile {
+    let counts = c.rounds.last().map_or(Counts::default(), |r| r.counts);
+    StatusFile {
+        format: STATUS_FORMAT.into(),
+        releases_flown: c.releases.len(),
+        conditions: counts.conditions,
+        cleared: counts.cleared,
+        fails: counts.fails,
+        undecided: counts.undecided,
+        settled: c.settled,
+    }
+}
+
+/// The answer in one sentence.
+pub fn headline(c: &CampaignFile) -> String {
+    let s = status(c);
+    let n = s.releases_flown;
+    let after = match n {
+        0 => "before any release".to_string(),
+        1 => "after 1 release".to_string(),
+        n => format!("after {n} releases"),
+    };
+    format!(
+        "{} {after}: cleared {} of {} conditions, {} fail, {} undecided",
+        if s.settled { "settled" } else { "not settled" },
+        s.cleared,
+        s.conditions,
+        s.fails,
+        s.undecided
+    )
+}
+
+/// Writes every derived file.
+pub fn render(c: &View<'_>) -> Result<(), CampaignError> {
+    let current = c.current()?;
+    write_envelope_csv(&c.dir.join("envelope.csv"), &current)?;
+    write_json(&c.dir.join("status.json"), &status(c.file))?;
+    let figures = c.dir.join("figures");
+    std::fs::create_dir_all(&figures).map_err(|e| record_error(&figures, e))?;
+    for r in &c.file.rounds {
+        let path = figures.join(format!("state-{:02}.png", r.round));
+        let assessed = c.round(&r.dir)?;
+        state_map(c, &assessed, r.round, r.releases_flown, &path)?;
+    }
+    let html = page(c, &current);
+    let path = c.dir.join("report.html");
+    write_atomically(&path, html.as_bytes()).map_err(|e| record_error(&path, e))
+}
+
+/// A round's map of states (0 cleared, 1 undecided, 2 fails; the worst over the axes not
+/// shown).
+fn state_map(
+    c: &View<'_>,
+    assessed: &[Assessed],
+    round: usize,
+    flown: usize,
+    path: &Path,
+) -> Result<(), CampaignError> {
+    let axes = c.grid.map_axes();
+    let one = [c.grid.flight(0).mach];
+    let (xq, xv) = axes
+        .first()
+        .copied()
+        .unwrap_or((sepval_plan::conditions::Quantity::Mach, &one));
+    let ny = axes.get(1).map_or(1, |(_, v)| v.len());
+    let mut cells = vec![vec![f64::NAN; xv.len()]; ny];
+    for a in assessed {
+        let (ix, iy) = c.grid.cell(a.row.index);
+        let v = match a.state {
+            State::Cleared => 0.0,
+            State::Undecided => 1.0,
+            State::Fails => 2.0,
+        };
+        let cell = &mut cells[iy][ix];
+        if !(cell.is_finite() && *cell >= v) {
+            *cell = v;
+        }
+    }
+    let (xl, yl) = (xq.label(), axes.get(1).map(|(q, _)| q.label()));
+    let y = axes.get(1).zip(yl).map(|((_, v), l)| MapAxis {
+        label: l,
+        values: v,
+    });
+    condition_map(
+        path,
+        &format!("Round {round}: states after {flown} release(s)"),
+        MapAxis {
+            label: xl,
+            values: xv,
+        },
+        y,
+        &cells,
+        "0 cleared, 1 undecided, 2 fails",
+        None,
+    )
+    .map_err(|e| record_error(path, e))
+}
+
+/// report.html.
+fn page(c: &View<'_>, current: &[Assessed]) -> String {
+    let e = escape_html;
+    let mut h = String::from(
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>sepval campaign</title>\
+         <style>body{font-family:sans-serif;max-width:1100px;margin:2em auto}table{border-collapse:collapse}\
+         td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}img{max-width:100%}</style></head><body>",
+    );
+    h.push_str(&format!("<h1>{}</h1>", e(&headline(c.file))));
+    h.push_str(&format!("<p>{}</p>", e(&c.file.words)));
+    if let Some(r) = c.file.rounds.last() {
+        h.push_str(&format!(
+            "<img src=\"figures/state-{:02}.png\" alt=\"the map of states\">",
+            r.round
+        ));
+    }
+    h.push_str("<h2>Rounds</h2><table><tr><th>round</th><th>releases flown</th><th>cleared</th><th>fails</th><th>undecided</th><th>settled</th></tr>");
+    for r in &c.file.rounds {
+        let k = &r.counts;
+        h.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            r.round, r.releases_flown, k.cleared, k.fails, k.undecided, r.settled
+        ));
+    }
+    h.push_str("</table><h2>Releases flown, in order</h2><table><tr><th>file</th><th>given</th><th>Mach</th><th>altitude [m]</th><th>alpha [deg]</th><th>check</th></tr>");
+    for r in &c.file.releases {
+        let k = &r.condition;
+        h.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td style=\"text-align:left\">{}</td></tr>",
+            e(&r.file), e(&r.given), k.mach, k.altitude_m, k.alpha_deg, e(&r.check)
+        ));
+    }
+    h.push_str("</table><h2>Undecided, and why</h2><ul>");
+    for a in current.iter().filter(|a| a.state == State::Undecided) {
+        let k = &a.row.condition;
+        h.push_str(&format!(
+            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'), reach {:.2} from the releases</li>",
+            k.mach, k.altitude_m, k.alpha_deg, a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
+            100.0 * (a.factor_spread_mm / a.spread_mm).min(1.0), a.reach
+        ));
+    }
+    h.push_str("</ul></body></html>\n");
+    h
+}

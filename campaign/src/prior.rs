@@ -1,0 +1,224 @@
+//! The prior: what is believed of the 17 factors before any release is flown (docs/campaign.md,
+//! "The prior"). By default each factor is normal about its nominal value (the model as built,
+//! docs/model.md section 4) with a standard deviation of a sixth of the study's range, the
+//! range read as +-3 sigma (M. B. Anderson's Table 1 bounds what the factors may be); the draws
+//! are truncated to the range ([`sepval_predict::sampling`]). Why the nominal and not the
+//! range's middle: the model as built is the engineer's estimate before the test, and it is
+//! what makes the most benign conditions safe to fly first (the middle of `fwdfac`'s range is a
+//! stronger ejector than the nominal, `czintfac`'s a weaker interference, neither of them
+//! anybody's belief).
+//!
+//! `--prior FILE` gives means and standard deviations (format `sepval-prior/1`):
+//!
+//! ```json
+//! { "format": "sepval-prior/1",
+//!   "factors": { "fwdfac": { "mean": 0.5, "sd": 0.1 }, "czintfac": { "mean": 1.2, "sd": 0.2 } } }
+//! ```
+//!
+//! A factor the file does not name keeps the default; a mean outside the factor's range, a
+//! standard deviation that is negative or not finite, or an unknown name is refused. A standard
+//! deviation of 0 holds the factor at its mean.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use sepval_common::effects::EffectSet;
+use sepval_common::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
+use sepval_fit::space::ParamSpace;
+use sepval_predict::sampling::ParameterDistribution;
+
+/// The format of a prior file.
+pub const PRIOR_FORMAT: &str = "sepval-prior/1";
+/// The standard deviations of the default prior: this share of each factor's range.
+pub const RANGE_SHARE: f64 = 1.0 / 6.0;
+/// The largest prior file read \[bytes\].
+const MAX_PRIOR_BYTES: u64 = 1 << 20;
+
+/// A prior that cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PriorError {
+    /// The file cannot be read or is not the format.
+    #[error("--prior {path}: {message}")]
+    File {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// One factor's belief.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Belief {
+    /// The mean.
+    pub mean: f64,
+    /// The standard deviation (0: held at the mean).
+    pub sd: f64,
+}
+
+/// The prior of the 17 factors, in table order.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Prior {
+    /// Where it came from: `default` or the file.
+    pub source: String,
+    /// Each factor's mean and standard deviation, by name.
+    pub factors: BTreeMap<String, Belief>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PriorFile {
+    format: String,
+    factors: BTreeMap<String, Belief>,
+}
+
+impl Prior {
+    /// The default prior of `table` (module docs).
+    pub fn default_of(table: &FactorTable) -> Prior {
+        let factors = Factor::NAMES
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let spec = &table.0[i];
+                let mean = Factors::NOMINAL.0[i].clamp(spec.min, spec.max);
+                (
+                    (*name).to_string(),
+                    Belief {
+                        mean,
+                        sd: RANGE_SHARE * spec.range(),
+                    },
+                )
+            })
+            .collect();
+        Prior {
+            source: "default".into(),
+            factors,
+        }
+    }
+
+    /// The default prior of `table` with the factors `path` names replaced, checked.
+    pub fn read(path: &Path, table: &FactorTable) -> Result<Prior, PriorError> {
+        let bad = |message: String| PriorError::File {
+            path: path.display().to_string(),
+            message,
+        };
+        let text = sepval_common::input_file::read_string(path, "prior file", MAX_PRIOR_BYTES)
+            .map_err(|e| bad(e.to_string()))?;
+        let file: PriorFile = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        if file.format != PRIOR_FORMAT {
+            return Err(bad(format!(
+                "format `{}`, expected `{PRIOR_FORMAT}`",
+                file.format
+            )));
+        }
+        let mut prior = Prior::default_of(table);
+        prior.source = path.display().to_string();
+        for (name, b) in file.factors {
+            let Some(f) = Factor::from_name(&name) else {
+                return Err(bad(format!(
+                    "`{name}` is not a factor (expected one of {})",
+                    Factor::NAMES.join(", ")
+                )));
+            };
+            let spec = table.spec(f);
+            if !(b.mean.is_finite() && spec.contains(b.mean)) {
+                return Err(bad(format!(
+                    "{name}.mean = {}: outside the factor's range {} to {}",
+                    b.mean, spec.min, spec.max
+                )));
+            }
+            if !(b.sd.is_finite() && b.sd >= 0.0) {
+                return Err(bad(format!(
+                    "{name}.sd = {}: expected a finite number, 0 or more",
+                    b.sd
+                )));
+            }
+            prior.factors.insert(name, b);
+        }
+        Ok(prior)
+    }
+
+    /// The factor-only parameter space of `table` and the prior as its distribution (the
+    /// factors independent, truncated to their ranges).
+    pub fn distribution(&self, table: &FactorTable) -> (ParamSpace, ParameterDistribution) {
+        let space = ParamSpace::new(table, &EffectSet::NONE);
+        let at = |name: &str| self.factors.get(name).copied();
+        let mean: Vec<f64> = space
+            .params
+            .names
+            .iter()
+            .zip(&space.params.lo)
+            .map(|(n, lo)| at(n).map_or(*lo, |b| b.mean))
+            .collect();
+        let std: Vec<f64> = space
+            .params
+            .names
+            .iter()
+            .map(|n| at(n).map_or(0.0, |b| b.sd))
+            .collect();
+        debug_assert_eq!(mean.len(), FACTOR_COUNT);
+        let distribution = ParameterDistribution {
+            mean,
+            factor: DMatrix::from_diagonal(&nalgebra::DVector::from_vec(std.clone())),
+            lo: space.params.lo.clone(),
+            hi: space.params.hi.clone(),
+            std,
+        };
+        (space, distribution)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_is_the_nominal_with_a_sixth_of_the_range() {
+        let t = FactorTable::default();
+        let p = Prior::default_of(&t);
+        let f = p.factors["fwdfac"];
+        assert!((f.mean - 0.5).abs() < 1e-12 && (f.sd - 0.8 / 6.0).abs() < 1e-12);
+        let (space, d) = p.distribution(&t);
+        assert_eq!(space.len(), FACTOR_COUNT);
+        assert!((d.std[0] - 0.8 / 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_prior_file_replaces_what_it_names_and_refuses_what_is_wrong() {
+        let t = FactorTable::default();
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("p.json");
+        std::fs::write(
+            &p,
+            r#"{"format":"sepval-prior/1","factors":{"czintfac":{"mean":1.2,"sd":0.1}}}"#,
+        )
+        .unwrap();
+        let prior = Prior::read(&p, &t).unwrap();
+        assert_eq!(prior.factors["czintfac"], Belief { mean: 1.2, sd: 0.1 });
+        assert_eq!(prior.factors["fwdfac"].mean, 0.5);
+        for (text, says) in [
+            (r#"{"format":"x","factors":{}}"#, "format `x`"),
+            (
+                r#"{"format":"sepval-prior/1","factors":{"nope":{"mean":1,"sd":0}}}"#,
+                "`nope` is not a factor",
+            ),
+            (
+                r#"{"format":"sepval-prior/1","factors":{"fwdfac":{"mean":3,"sd":0}}}"#,
+                "outside the factor's range",
+            ),
+            (
+                r#"{"format":"sepval-prior/1","factors":{"fwdfac":{"mean":0.5,"sd":-1}}}"#,
+                "fwdfac.sd = -1",
+            ),
+        ] {
+            std::fs::write(&p, text).unwrap();
+            let e = Prior::read(&p, &t).unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        }
+    }
+}

@@ -1,0 +1,455 @@
+//! The campaign's commands over its directory (docs/campaign.md): `init` (the envelope under
+//! the prior, round 0), `add` (releases flown: each checked against its prediction, the model
+//! fitted again to every release, the envelope predicted again), `next` (the plan written to
+//! next.json) and `status`.
+//!
+//! Every change is staged and committed whole: `add` writes the releases' copies and the new
+//! round under `CAMP/.staging/`, renames the round into `rounds/NN` and writes campaign.json
+//! last (the commit). A command interrupted before that commit leaves campaign.json as it was;
+//! whatever it left (a staging directory, a round or a release copy that campaign.json does not
+//! name) is removed by the next command that opens the campaign. The derived files
+//! (envelope.csv, status.json, report.html, figures/) are written after the commit from the
+//! records, and again by every command, so that they always follow campaign.json.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use sepval_common::evaluation::{Event, Job};
+use sepval_common::scenario::{Scenario, hex_sha256};
+use sepval_common::simulation::Simulator;
+use sepval_common::telemetry::Trajectory;
+use sepval_envelope::grid::{Axis, Grid};
+use sepval_fit::out_dir::DirLock;
+use sepval_plan::conditions::Quantity;
+use sepval_predict::ClearanceSettings;
+use sepval_predict::ensemble::Ensemble;
+use sepval_predict::record::ConditionRecord;
+use sepval_solve::run::ProgressObserver;
+
+use crate::assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};
+use crate::next::{Criteria, Plan, plan};
+use crate::record::record_error;
+use crate::record::{
+    CAMPAIGN_FORMAT, CampaignFile, InputRecord, NEXT_FORMAT, NextFile, RoundRecord, SettingsRecord,
+    read_json, write_json,
+};
+use crate::state::{Assessed, Counts};
+use crate::{CampaignError, page};
+
+/// The directory of staged changes.
+pub(crate) const STAGING: &str = ".staging";
+
+/// What every command of a campaign works with: its record read and its inputs loaded.
+pub struct Campaign {
+    /// The directory.
+    pub dir: PathBuf,
+    /// campaign.json.
+    pub file: CampaignFile,
+    /// The scenario.
+    pub scenario: Scenario,
+    /// The grid.
+    pub grid: Grid,
+    /// The clearance.
+    pub clearance: ClearanceSettings,
+    /// How the commands run: threads of this process.
+    pub threads: usize,
+    _lock: DirLock,
+}
+
+/// The inputs of `init`, loaded and checked by the caller.
+pub struct Init {
+    /// The settings.
+    pub settings: SettingsRecord,
+    /// The scenario.
+    pub scenario: Scenario,
+    /// The clearance.
+    pub clearance: ClearanceSettings,
+    /// Threads of this process.
+    pub threads: usize,
+}
+
+/// A release to add, read and screened by the caller.
+pub struct NewRelease {
+    /// The file given.
+    pub given: PathBuf,
+    /// The SHA-256 of its bytes.
+    pub sha256: String,
+    /// Its samples (outliers dropped when asked).
+    pub data: Trajectory,
+    /// The campaign's scenario flown at its condition.
+    pub scenario: Scenario,
+}
+
+/// The file of `path` as the campaign records it.
+pub fn input_record(path: &Path) -> Result<InputRecord, CampaignError> {
+    let bytes = std::fs::read(path).map_err(|e| record_error(path, e))?;
+    let absolute = std::fs::canonicalize(path).map_err(|e| record_error(path, e))?;
+    Ok(InputRecord {
+        path: absolute.display().to_string(),
+        sha256: hex_sha256(&bytes),
+    })
+}
+
+/// The grid of the settings' axes about `scenario`.
+pub fn grid_of(settings: &SettingsRecord, scenario: &Scenario) -> Result<Grid, CampaignError> {
+    let quantities = [
+        Quantity::Mach,
+        Quantity::AltitudeM,
+        Quantity::AlphaDeg,
+        Quantity::BetaDeg,
+        Quantity::GammaDeg,
+    ];
+    let axes: Vec<Axis> = settings
+        .axes
+        .iter()
+        .map(|(flag, text)| {
+            let q = quantities
+                .iter()
+                .find(|q| q.flag() == flag)
+                .ok_or_else(|| CampaignError::Refused(format!("{flag}: not an axis")))?;
+            Axis::parse(*q, text).map_err(|e| CampaignError::Refused(e.to_string()))
+        })
+        .collect::<Result<_, _>>()?;
+    Grid::of(scenario, &axes).map_err(|e| CampaignError::Refused(e.to_string()))
+}
+
+/// Starts a campaign in `dir` (absent or empty): round 0, the envelope under the prior.
+pub fn init(
+    dir: &Path,
+    init: Init,
+    start: &mut StartEvaluator<'_>,
+    observer: &mut dyn ProgressObserver,
+) -> Result<Campaign, CampaignError> {
+    let grid = grid_of(&init.settings, &init.scenario)?;
+    if dir.exists() {
+        let empty = std::fs::read_dir(dir)
+            .map_err(|e| record_error(dir, e))?
+            .next()
+            .is_none();
+        if !empty {
+            return Err(record_error(
+                dir,
+                "not empty: a campaign begins in a new or empty directory (give another --out)",
+            ));
+        }
+    }
+    std::fs::create_dir_all(dir).map_err(|e| record_error(dir, e))?;
+    let (lock, _) = DirLock::take(dir)?;
+    let file = CampaignFile {
+        format: CAMPAIGN_FORMAT.into(),
+        grid: grid
+            .conditions
+            .list
+            .iter()
+            .map(|c| ConditionRecord::of(&c.flight))
+            .collect(),
+        settings: init.settings,
+        releases: Vec::new(),
+        rounds: Vec::new(),
+        settled: false,
+        words: String::new(),
+        version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let mut c = Campaign {
+        dir: dir.to_path_buf(),
+        file,
+        scenario: init.scenario,
+        grid,
+        clearance: init.clearance,
+        threads: init.threads,
+        _lock: lock,
+    };
+    let model = c.model()?;
+    c.round(&model, start, observer)?;
+    Ok(c)
+}
+
+impl Campaign {
+    /// Opens the campaign in `dir`: its record read, its inputs loaded and checked unchanged
+    /// (`load` reads the scenario and the geometry of the settings), what an interrupted
+    /// command left removed, the directory locked.
+    pub fn open(
+        dir: &Path,
+        threads: usize,
+        load: &dyn Fn(&SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError>,
+    ) -> Result<Campaign, CampaignError> {
+        let path = dir.join("campaign.json");
+        if !path.is_file() {
+            return Err(record_error(
+                dir,
+                "holds no campaign (no campaign.json): begin one with `sepval campaign init`",
+            ));
+        }
+        let (lock, _) = DirLock::take(dir)?;
+        let file: CampaignFile = read_json(&path, CAMPAIGN_FORMAT)?;
+        let inputs = [
+            Some(&file.settings.aircraft),
+            file.settings.scenario.as_ref(),
+            file.settings.store_shape.as_ref(),
+        ];
+        for r in inputs.into_iter().flatten() {
+            let now = input_record(Path::new(&r.path))?;
+            if now.sha256 != r.sha256 {
+                return Err(record_error(
+                    Path::new(&r.path),
+                    "changed since the campaign began (its SHA-256 differs): a campaign's scenario and geometry stay as they were; begin a new campaign for new ones",
+                ));
+            }
+        }
+        let (scenario, clearance) = load(&file.settings)?;
+        let grid = grid_of(&file.settings, &scenario)?;
+        let c = Campaign {
+            dir: dir.to_path_buf(),
+            file,
+            scenario,
+            grid,
+            clearance,
+            threads,
+            _lock: lock,
+        };
+        c.tidy()?;
+        Ok(c)
+    }
+
+    /// Removes what an interrupted command left: the staging directory, rounds and release
+    /// copies campaign.json does not name.
+    fn tidy(&self) -> Result<(), CampaignError> {
+        let staging = self.dir.join(STAGING);
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging).map_err(|e| record_error(&staging, e))?;
+        }
+        for (sub, named) in [
+            (
+                "rounds",
+                self.file
+                    .rounds
+                    .iter()
+                    .map(|r| r.dir.clone())
+                    .collect::<Vec<_>>(),
+            ),
+            (
+                "releases",
+                self.file.releases.iter().map(|r| r.file.clone()).collect(),
+            ),
+        ] {
+            let Ok(entries) = std::fs::read_dir(self.dir.join(sub)) else {
+                continue;
+            };
+            for e in entries.flatten() {
+                let rel = format!("{sub}/{}", e.file_name().to_string_lossy());
+                if !named.contains(&rel) {
+                    let p = e.path();
+                    let _ = if p.is_dir() {
+                        std::fs::remove_dir_all(&p)
+                    } else {
+                        std::fs::remove_file(&p)
+                    };
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// What the derived files are made of.
+    pub fn view(&self) -> page::View<'_> {
+        page::View {
+            dir: &self.dir,
+            file: &self.file,
+            grid: &self.grid,
+        }
+    }
+
+    /// The assessment settings.
+    pub(crate) fn assess_settings(&self) -> AssessSettings {
+        let s = &self.file.settings;
+        AssessSettings {
+            samples: s.samples,
+            seed: s.seed,
+            threads: self.threads,
+            allowed: s.allowed,
+            clearance: self.clearance.clone(),
+        }
+    }
+
+    /// The planning's criteria.
+    pub fn criteria(&self) -> Criteria {
+        let s = &self.file.settings;
+        Criteria {
+            criterion_mm: s.clearance_mm,
+            allowed: s.allowed,
+            fly_risk: s.fly_risk,
+        }
+    }
+
+    /// The releases flown as a job (their copies in the campaign).
+    pub(crate) fn job(&self) -> Result<Option<Job>, CampaignError> {
+        if self.file.releases.is_empty() {
+            return Ok(None);
+        }
+        let mut events = Vec::new();
+        for r in &self.file.releases {
+            let path = self.dir.join(&r.file);
+            let data = Trajectory::read(&path).map_err(|e| record_error(&path, e))?;
+            let mut s = self.scenario.clone();
+            let c = &r.condition;
+            s.flight.mach = c.mach;
+            s.flight.altitude_m = c.altitude_m;
+            s.flight.alpha_deg = c.alpha_deg;
+            s.flight.beta_deg = c.beta_deg;
+            s.flight.gamma_deg = c.gamma_deg;
+            events.push(Event {
+                name: r.file.clone(),
+                simulator: Simulator::new(&s),
+                data,
+            });
+        }
+        Job::new(events)
+            .map(Some)
+            .map_err(|e| CampaignError::Refused(e.to_string()))
+    }
+
+    /// What the current round believes: the prior, or the fit in the last round's directory.
+    pub fn model(&self) -> Result<Model, CampaignError> {
+        let table = &self.scenario.factors;
+        match (self.job()?, self.file.rounds.last()) {
+            (Some(job), Some(last)) if last.releases_flown > 0 => {
+                fitted_model(&self.dir.join(&last.dir).join("fit"), job)
+            }
+            _ => {
+                let (space, distribution) = self.file.settings.prior.distribution(table);
+                Ok(Model {
+                    space,
+                    distribution,
+                    fitted: None,
+                })
+            }
+        }
+    }
+
+    /// The current round's envelope.
+    pub fn current(&self) -> Result<Vec<Assessed>, CampaignError> {
+        let last = self.file.rounds.last().ok_or_else(|| {
+            record_error(
+                &self.dir,
+                "holds no round: the campaign's init did not finish",
+            )
+        })?;
+        let path = self.dir.join(&last.dir).join("assessment.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| record_error(&path, e))?;
+        serde_json::from_str(&text).map_err(|e| record_error(&path, e))
+    }
+
+    /// The plan of `count` releases from the current round.
+    pub fn plan(&self, count: usize) -> Result<Plan, CampaignError> {
+        let flown: Vec<_> = self
+            .file
+            .releases
+            .iter()
+            .map(|r| {
+                let mut f = self.scenario.flight.clone();
+                let c = &r.condition;
+                (f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg) =
+                    (c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg);
+                f
+            })
+            .collect();
+        Ok(plan(
+            &self.grid,
+            &self.current()?,
+            &flown,
+            self.criteria(),
+            count,
+        ))
+    }
+
+    /// Plans `count` releases and writes next.json.
+    pub fn next(&self, count: usize) -> Result<NextFile, CampaignError> {
+        let p = self.plan(count)?;
+        let next = NextFile {
+            format: NEXT_FORMAT.into(),
+            round: self.file.rounds.len() - 1,
+            releases: p.releases,
+            least_risky: p.least_risky,
+            settled: p.settled,
+            words: p.words,
+        };
+        write_json(&self.dir.join("next.json"), &next)?;
+        page::render(&self.view())?;
+        Ok(next)
+    }
+
+    /// A new round from `model`: the envelope assessed and staged, then committed.
+    pub(crate) fn round(
+        &mut self,
+        model: &Model,
+        start: &mut StartEvaluator<'_>,
+        observer: &mut dyn ProgressObserver,
+    ) -> Result<(), CampaignError> {
+        let t0 = Instant::now();
+        let n = self.file.rounds.len();
+        let staged = self.dir.join(STAGING).join("round");
+        std::fs::create_dir_all(&staged).map_err(|e| record_error(&staged, e))?;
+        let assessed = assess(
+            model,
+            &self.grid,
+            &self.scenario,
+            &self.assess_settings(),
+            start,
+            observer,
+        )?;
+        write_json(&staged.join("assessment.json"), &assessed)?;
+        page::write_envelope_csv(&staged.join("envelope.csv"), &assessed)?;
+        // The fit of an add's model was staged beside the round.
+        let fit = self.dir.join(STAGING).join("fit");
+        if fit.is_dir() {
+            std::fs::rename(&fit, staged.join("fit")).map_err(|e| record_error(&fit, e))?;
+        }
+        sepval_common::cancel::check()?;
+        let dir = format!("rounds/{n:02}");
+        let target = self.dir.join(&dir);
+        std::fs::create_dir_all(self.dir.join("rounds")).map_err(|e| record_error(&target, e))?;
+        std::fs::rename(&staged, &target).map_err(|e| record_error(&target, e))?;
+        let counts = Counts::of(&assessed);
+        self.file.rounds.push(RoundRecord {
+            round: n,
+            releases_flown: self.file.releases.len(),
+            counts,
+            settled: false,
+            dir,
+            evaluations: (self.grid.len() * self.file.settings.samples) as u64,
+            wall_s: t0.elapsed().as_secs_f64(),
+        });
+        let p = self.plan(1)?;
+        let last = self.file.rounds.last_mut().expect("pushed above");
+        last.settled = p.settled;
+        self.file.settled = p.settled;
+        self.file.words = p.words;
+        write_json(&self.dir.join("campaign.json"), &self.file)?;
+        let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
+        let _ = std::fs::remove_file(self.dir.join("next.json"));
+        page::render(&self.view())
+    }
+}
+
+/// The model of the fit written in `dir` to the releases of `job`.
+pub(crate) fn fitted_model(dir: &Path, job: Job) -> Result<Model, CampaignError> {
+    let source =
+        sepval_predict::read_source(dir).map_err(|e| CampaignError::Source(Box::new(e.into())))?;
+    let ensemble = Ensemble::of(&source, job.factor_table())
+        .map_err(|e| CampaignError::Source(Box::new(e.into())))?;
+    let answer = ensemble.answer();
+    let distribution = sepval_predict::sampling::ParameterDistribution::of(
+        &answer.space,
+        &answer.x,
+        &source.identifiability,
+    );
+    Ok(Model {
+        space: answer.space.clone(),
+        distribution,
+        fitted: Some(Fitted {
+            source,
+            ensemble,
+            job,
+        }),
+    })
+}

@@ -1,0 +1,100 @@
+//! `sepval campaign`'s subcommands and flags (docs/campaign.md).
+
+use std::path::PathBuf;
+
+use clap::Subcommand;
+
+use super::{EvalArgs, GeometryArgs, OutlierArgs};
+
+#[derive(Subcommand)]
+pub enum CampaignCommand {
+    /// Begin a campaign: the grid, the criterion and the envelope predicted from the prior.
+    Init(Box<CampaignInitArgs>),
+    /// The next release(s) to fly: safe to fly, ranked by what they are expected to settle.
+    Next(CampaignNextArgs),
+    /// Record flown releases: each checked against its prediction, the model fitted again, the
+    /// envelope predicted again.
+    Add(CampaignAddArgs),
+    /// The campaign's state in a few lines.
+    Status(CampaignStatusArgs),
+}
+
+#[derive(clap::Args)]
+pub struct CampaignInitArgs {
+    /// The store's scenario (TOML) [default: the embedded default].
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    /// Mach values: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub mach: Option<String>,
+    /// Altitudes [m]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub altitude_m: Option<String>,
+    /// Aircraft angles of attack [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub alpha_deg: Option<String>,
+    /// Aircraft sideslip angles [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub beta_deg: Option<String>,
+    /// Flight-path angles [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub gamma_deg: Option<String>,
+    /// The largest probability of failing to clear at which a condition is cleared (and of
+    /// clearing at which it fails).
+    #[arg(long, default_value_t = 0.05, value_name = "P")]
+    pub allowed: f64,
+    /// The largest probability of failing to clear at which a release may be flown.
+    #[arg(long, default_value_t = 0.01, value_name = "P")]
+    pub fly_risk: f64,
+    /// The factors before any release (JSON, format sepval-prior/1) [default: each factor's
+    /// nominal value, a sixth of the study's range as its standard deviation].
+    #[arg(long, value_name = "FILE")]
+    pub prior: Option<PathBuf>,
+    /// Samples per condition.
+    #[arg(long, default_value_t = 1000, value_name = "N")]
+    pub samples: usize,
+    /// Seed of every draw and of each round's fit.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Generations of each round's genetic search (then Levenberg-Marquardt).
+    #[arg(long, default_value_t = 20)]
+    pub generations: usize,
+    #[command(flatten)]
+    pub geometry: GeometryArgs,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// The campaign's directory (new or empty).
+    #[arg(long, value_name = "CAMP")]
+    pub out: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct CampaignNextArgs {
+    /// The campaign's directory.
+    #[arg(value_name = "CAMP")]
+    pub campaign: PathBuf,
+    /// Releases to plan together (complementary, not neighbours).
+    #[arg(long, default_value_t = 1, value_name = "K")]
+    pub count: usize,
+}
+
+#[derive(clap::Args)]
+pub struct CampaignAddArgs {
+    /// The campaign's directory.
+    #[arg(value_name = "CAMP")]
+    pub campaign: PathBuf,
+    /// A release flown (CSV with its condition in its metadata; repeatable).
+    #[arg(long, value_name = "FILE.csv", required = true)]
+    pub data: Vec<PathBuf>,
+    #[command(flatten)]
+    pub outliers: OutlierArgs,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+}
+
+#[derive(clap::Args)]
+pub struct CampaignStatusArgs {
+    /// The campaign's directory.
+    #[arg(value_name = "CAMP")]
+    pub campaign: PathBuf,
+}

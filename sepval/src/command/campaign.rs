@@ -1,0 +1,188 @@
+//! `sepval campaign`: a test program as one record (docs/campaign.md). Each subcommand parses
+//! its flags, loads the inputs, runs `sepval-campaign` and prints what it found.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use sepval_campaign::prior::Prior;
+use sepval_campaign::program::{Campaign, Init, NewRelease, input_record};
+use sepval_campaign::record::SettingsRecord;
+use sepval_campaign::{CampaignError, page};
+use sepval_common::scenario::{Scenario, hex_sha256};
+use sepval_predict::ClearanceSettings;
+
+use super::envelope::starter;
+use super::{clearance, count, evaluator_spec, inputs, releases};
+use crate::cli::{
+    CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignStatusArgs,
+    GeometryArgs,
+};
+
+/// Runs `sepval campaign SUBCOMMAND`.
+pub fn run(c: CampaignCommand) -> Result<()> {
+    match c {
+        CampaignCommand::Init(a) => init(*a),
+        CampaignCommand::Next(a) => next(a),
+        CampaignCommand::Add(a) => add(a),
+        CampaignCommand::Status(a) => status(a),
+    }
+}
+
+/// A probability flag in (0, 0.5).
+fn probability(flag: &str, p: f64) -> Result<f64> {
+    if !(p > 0.0 && p < 0.5) {
+        bail!("{flag} {p}: expected a probability above 0 and below 0.5");
+    }
+    Ok(p)
+}
+
+fn init(a: CampaignInitArgs) -> Result<()> {
+    let spec = evaluator_spec(&a.eval)?;
+    let threads = count("--threads", a.eval.threads)?;
+    let allowed = probability("--allowed", a.allowed)?;
+    let fly_risk = probability("--fly-risk", a.fly_risk)?;
+    if a.samples < 20 {
+        bail!("--samples {}: at least 20 samples per condition", a.samples);
+    }
+    let Some(aircraft) = a.geometry.aircraft.clone() else {
+        bail!(
+            "--aircraft FILE is required: the aircraft's geometry (e.g. examples/geometry/aircraft.toml)"
+        );
+    };
+    let scenario = inputs::scenario(a.scenario.as_deref(), None)?;
+    let axes: Vec<(String, String)> = [
+        ("--mach", &a.mach),
+        ("--altitude-m", &a.altitude_m),
+        ("--alpha-deg", &a.alpha_deg),
+        ("--beta-deg", &a.beta_deg),
+        ("--gamma-deg", &a.gamma_deg),
+    ]
+    .into_iter()
+    .filter_map(|(f, v)| v.clone().map(|v| (f.to_string(), v)))
+    .collect();
+    if axes.is_empty() {
+        bail!(
+            "give at least one axis: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N"
+        );
+    }
+    let prior = match &a.prior {
+        Some(p) => Prior::read(p, &scenario.factors)?,
+        None => Prior::default_of(&scenario.factors),
+    };
+    let Some(clearance) = clearance::settings(&a.geometry, &scenario)? else {
+        bail!("--aircraft FILE is required");
+    };
+    let settings = SettingsRecord {
+        scenario: a.scenario.as_deref().map(input_record).transpose()?,
+        aircraft: input_record(&aircraft)?,
+        store_shape: a
+            .geometry
+            .store_shape
+            .as_deref()
+            .map(input_record)
+            .transpose()?,
+        axes,
+        clearance_mm: a.geometry.clearance_mm,
+        allowed,
+        fly_risk,
+        samples: a.samples,
+        seed: a.seed,
+        generations: a.generations,
+        prior,
+    };
+    let init = Init {
+        settings,
+        scenario,
+        clearance,
+        threads,
+    };
+    let mut start = starter(&spec);
+    let c =
+        sepval_campaign::program::init(&a.out, init, &mut start, &mut *crate::front::progress())?;
+    say!("campaign:  {}", page::headline(&c.file));
+    say!("report:    {}", a.out.join("report.html").display());
+    Ok(())
+}
+
+/// Loads the scenario and the geometry a campaign's settings record.
+fn load(s: &SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError> {
+    let wrap = |e: anyhow::Error| CampaignError::Refused(format!("{e:#}"));
+    let scenario =
+        inputs::scenario(s.scenario.as_ref().map(|r| Path::new(&r.path)), None).map_err(wrap)?;
+    let geometry = GeometryArgs {
+        aircraft: Some(s.aircraft.path.clone().into()),
+        store_shape: s.store_shape.as_ref().map(|r| r.path.clone().into()),
+        clearance_mm: s.clearance_mm,
+    };
+    let c = clearance::settings(&geometry, &scenario)
+        .map_err(wrap)?
+        .ok_or_else(|| CampaignError::Refused("no aircraft".into()))?;
+    Ok((scenario, c))
+}
+
+fn open(dir: &Path, threads: usize) -> Result<Campaign> {
+    Campaign::open(dir, threads, &load).with_context(|| format!("campaign {}", dir.display()))
+}
+
+fn next(a: CampaignNextArgs) -> Result<()> {
+    if a.count == 0 {
+        bail!("--count 0: plan at least one release");
+    }
+    let c = open(&a.campaign, count("--threads", None)?)?;
+    let n = c.next(a.count)?;
+    let text = serde_json::to_string_pretty(&n)?;
+    println!("{text}");
+    note!("next:      {}", a.campaign.join("next.json").display());
+    Ok(())
+}
+
+fn add(a: CampaignAddArgs) -> Result<()> {
+    let spec = evaluator_spec(&a.eval)?;
+    let threads = count("--threads", a.eval.threads)?;
+    let mut c = open(&a.campaign, threads)?;
+    let policy = a.outliers.policy();
+    let mut new = Vec::new();
+    for p in &a.data {
+        let name = p.display().to_string();
+        let bytes = std::fs::read(p).with_context(|| format!("--data {name}"))?;
+        let data = releases::read(p, policy).with_context(|| format!("--data {name}"))?;
+        let scenario = inputs::event_scenario(&c.scenario, &data, &name)?;
+        releases::check_store(&c.scenario, &data, &name, "the campaign's scenario")?;
+        new.push(NewRelease {
+            given: p.clone(),
+            sha256: hex_sha256(&bytes),
+            data,
+            scenario,
+        });
+    }
+    let mut start = starter(&spec);
+    let checks =
+        sepval_campaign::add::add(&mut c, new, &mut start, &mut *crate::front::progress())?;
+    for k in &checks {
+        say!("check:     {}", k.verdict);
+    }
+    say!("campaign:  {}", page::headline(&c.file));
+    say!("report:    {}", a.campaign.join("report.html").display());
+    Ok(())
+}
+
+fn status(a: CampaignStatusArgs) -> Result<()> {
+    let c = open(&a.campaign, 1)?;
+    say!("{}", page::headline(&c.file));
+    say!("{}", c.file.words);
+    let next = a.campaign.join("next.json");
+    if next.is_file() {
+        let n: sepval_campaign::NextFile =
+            sepval_campaign::record::read_json(&next, sepval_campaign::NEXT_FORMAT)?;
+        for r in &n.releases {
+            say!(
+                "next:      Mach {}, altitude {} m, alpha {} deg: {}",
+                r.mach,
+                r.altitude_m,
+                r.alpha_deg,
+                r.why
+            );
+        }
+    }
+    Ok(())
+}

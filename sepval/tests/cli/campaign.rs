@@ -1,0 +1,238 @@
+//! `sepval campaign` end to end: init under the prior, next (never an unsafe condition, a
+//! batch of distinct conditions, none safe said with the least risky), add (a release checked,
+//! fitted, round 1), the refusals (a release twice, a broken file) with nothing changed, and the
+//! same bits whatever the thread count. Reduced samples; release build.
+
+use std::path::{Path, PathBuf};
+
+use sepval_tests::{ok, refused, sepval};
+use serde_json::Value;
+
+fn aircraft() -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/geometry/aircraft.toml")
+        .canonicalize()
+        .unwrap()
+        .display()
+        .to_string()
+}
+
+/// `campaign init` of a 5 x 5 grid in `dir`/`out` with `criterion` mm and `threads`.
+fn init(dir: &Path, out: &str, criterion: &str, threads: &str) {
+    let a = aircraft();
+    ok(&sepval(
+        &[
+            "campaign",
+            "init",
+            "--aircraft",
+            &a,
+            "--mach",
+            "0.6:1.0:5",
+            "--alpha-deg",
+            "-4:8:5",
+            "--samples",
+            "100",
+            "--clearance-mm",
+            criterion,
+            "--evaluator",
+            "inproc",
+            "--threads",
+            threads,
+            "--generations",
+            "5",
+            "--out",
+            out,
+        ],
+        dir,
+    ));
+}
+
+fn json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn next_plans_only_safe_distinct_conditions_and_says_when_none_is_safe() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    init(dir, "c", "108", "2");
+    let env = std::fs::read_to_string(dir.join("c/envelope.csv")).unwrap();
+    assert!(env.lines().next().unwrap().ends_with(",state"), "{env}");
+    ok(&sepval(&["campaign", "next", "c", "--count", "3"], dir));
+    let next = json(&dir.join("c/next.json"));
+    assert_eq!(next["format"], "sepval-campaign-next/1");
+    let releases = next["releases"].as_array().unwrap();
+    assert!(!releases.is_empty(), "{next}");
+    let mut seen = Vec::new();
+    for r in releases {
+        assert!(r["p_fail"].as_f64().unwrap() <= 0.01, "unsafe planned: {r}");
+        let at = (r["mach"].to_string(), r["alpha_deg"].to_string());
+        assert!(!seen.contains(&at), "the same condition twice: {next}");
+        seen.push(at);
+        assert!(r["why"].as_str().unwrap().contains("expected to settle"));
+    }
+    // A criterion that nothing meets with the fly risk: nothing planned, the least risky named.
+    init(dir, "d", "125", "2");
+    let out = sepval(&["campaign", "next", "d"], dir);
+    ok(&out);
+    let next = json(&dir.join("d/next.json"));
+    assert_eq!(next["releases"].as_array().unwrap().len(), 0, "{next}");
+    assert!(
+        next["least_risky"]["p_fail"].as_f64().unwrap() > 0.01,
+        "{next}"
+    );
+}
+
+#[test]
+fn the_envelope_is_the_same_bits_on_one_thread_and_two() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    init(dir, "one", "25.4", "1");
+    init(dir, "two", "25.4", "2");
+    let read = |d: &str| std::fs::read(dir.join(d).join("envelope.csv")).unwrap();
+    assert_eq!(read("one"), read("two"));
+    let status = json(&dir.join("one/status.json"));
+    assert_eq!(status["conditions"], 25);
+    assert_eq!(status["releases_flown"], 0);
+}
+
+/// A release flown at Mach 0.8, alpha 2 deg with the truth factors and noise, in `dir`.
+fn release(dir: &Path, name: &str, noise_seed: &str) -> String {
+    ok(&sepval(&["scenario", "--out", "base.toml"], dir));
+    let text = std::fs::read_to_string(dir.join("base.toml")).unwrap();
+    let mut done = (false, false);
+    let text: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("mach = ") && !done.0 {
+                done.0 = true;
+                "mach = 0.8".to_string()
+            } else if l.starts_with("alpha_deg = ") && !done.1 {
+                done.1 = true;
+                "alpha_deg = 2.0".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(dir.join("r.toml"), text).unwrap();
+    ok(&sepval(
+        &[
+            "simulate",
+            "--scenario",
+            "r.toml",
+            "--factors",
+            "truth",
+            "--noise-seed",
+            noise_seed,
+            "--out",
+            name,
+        ],
+        dir,
+    ));
+    name.to_string()
+}
+
+/// Every file under `dir` with its bytes (the lock aside).
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push((p.clone(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn add_records_a_round_and_refuses_a_release_twice_or_broken_with_nothing_changed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    init(dir, "c", "25.4", "2");
+    let r = release(dir, "r1.csv", "5");
+    let eval = ["--evaluator", "inproc", "--threads", "2"];
+    let mut args = vec!["campaign", "add", "c", "--data", &r];
+    args.extend(eval);
+    ok(&sepval(&args, dir));
+    let camp = json(&dir.join("c/campaign.json"));
+    assert_eq!(camp["format"], "sepval-campaign/1");
+    assert_eq!(camp["releases"].as_array().unwrap().len(), 1);
+    assert_eq!(camp["rounds"].as_array().unwrap().len(), 2);
+    assert!(dir.join("c/rounds/01/fit/result.json").is_file());
+    assert!(dir.join("c/figures/state-01.png").is_file());
+    let status = sepval(&["campaign", "status", "c"], dir);
+    ok(&status);
+    assert!(String::from_utf8_lossy(&status.stdout).contains("after 1 release"));
+    let before = snapshot(&dir.join("c"));
+    // The same release under another name.
+    std::fs::copy(dir.join(&r), dir.join("copy.csv")).unwrap();
+    let mut args = vec!["campaign", "add", "c", "--data", "copy.csv"];
+    args.extend(eval);
+    refused(&sepval(&args, dir), "already in the campaign");
+    // A file that does not read.
+    std::fs::write(dir.join("broken.csv"), "t_s,x_m\n0,1,2,3\n").unwrap();
+    let mut args = vec!["campaign", "add", "c", "--data", "broken.csv"];
+    args.extend(eval);
+    refused(&sepval(&args, dir), "broken.csv");
+    assert_eq!(
+        snapshot(&dir.join("c")),
+        before,
+        "a refusal changed the campaign"
+    );
+}
+
+#[test]
+fn init_refuses_a_directory_that_is_not_empty_and_bad_probabilities() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::create_dir(dir.join("c")).unwrap();
+    std::fs::write(dir.join("c/thesis.tex"), "mine").unwrap();
+    let a = aircraft();
+    refused(
+        &sepval(
+            &[
+                "campaign",
+                "init",
+                "--aircraft",
+                &a,
+                "--mach",
+                "0.6:1.0:2",
+                "--out",
+                "c",
+            ],
+            dir,
+        ),
+        "not empty",
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("c/thesis.tex")).unwrap(),
+        "mine"
+    );
+    refused(
+        &sepval(
+            &[
+                "campaign",
+                "init",
+                "--aircraft",
+                &a,
+                "--mach",
+                "0.6:1.0:2",
+                "--allowed",
+                "0.7",
+                "--out",
+                "d",
+            ],
+            dir,
+        ),
+        "--allowed 0.7",
+    );
+    assert!(!dir.join("d").exists());
+}
