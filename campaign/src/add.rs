@@ -218,7 +218,10 @@ pub fn check_release(
     let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
     let flights: Vec<_> = model.flown();
     let refs: Vec<_> = flights.iter().collect();
-    let r = sepval_fit::domain::reach(&refs, &scenario.flight);
+    let r = sepval_predict::reach::uncovered(
+        sepval_fit::domain::reach(&refs, &scenario.flight),
+        sepval_fit::domain::covered_reach(&refs, &[]),
+    );
     let mut sd = vec![[0.0; 6]; points.len()];
     sepval_predict::reach::widen(&mut sd, &sepval_predict::reach::motion(&ran), r);
     let noise = model

@@ -98,6 +98,7 @@ pub fn assess(
     let candidates = draws(model, settings)?;
     let flown = model.flown();
     let flown_refs: Vec<&Flight> = flown.iter().collect();
+    let covered = sepval_fit::domain::covered_reach(&flown_refs, &[]);
     let mut evidence: Option<Evidence> = None;
     let mut out = Vec::with_capacity(grid.len());
     observer.start("envelope", Some(grid.len()));
@@ -130,7 +131,10 @@ pub fn assess(
             }
         };
         let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
-        let r = sepval_fit::domain::reach(&flown_refs, &scenario.flight);
+        let r = reach::uncovered(
+            sepval_fit::domain::reach(&flown_refs, &scenario.flight),
+            covered,
+        );
         reach::widen(&mut sd, &reach::motion(&ran), r);
         let trajectories: Vec<Option<&GridTrajectory>> =
             runs.trajectories.iter().map(|t| t.as_ref().ok()).collect();

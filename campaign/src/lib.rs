@@ -16,6 +16,7 @@
 //!    ([`record`]: campaign.json, status.json, next.json), each change staged and committed
 //!    whole;
 //! 5. [`page`]: report.html and the figures;
+//! 6. [`rehearse`]: a virtual test program flown against a stated truth.
 
 #![deny(clippy::float_cmp)]
 
@@ -26,6 +27,7 @@ pub mod page;
 pub mod prior;
 pub mod program;
 pub mod record;
+pub mod rehearse;
 pub mod state;
 
 pub use assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};

@@ -4,15 +4,18 @@
 //! is ranked by the expected number of undecided conditions it settles, a preposterior
 //! analysis under a normal approximation of each condition's smallest clearance:
 //!
-//! - at undecided condition u, m_u the median smallest clearance less the criterion, s_u its
-//!   spread, s_f,u the factors' part of it and s_m,u = sqrt(max(0, s_u^2 - s_f,u^2)) the model
-//!   form's;
+//! - at undecided condition u, m_u the median smallest clearance less the criterion, s_u the
+//!   spread of the normal about m_u that fails as often as its samples did (s_u = m_u /
+//!   Phi^-1(1 - p_fail): the tail, divergences included, decides a state, not the body), split
+//!   as the samples' spread is between the factors (s_f,u, the spread without the model-form
+//!   band) and the model form (s_m,u = sqrt(max(0, s_u^2 - s_f,u^2)));
 //! - a release at c brings u's reach down to r'_u = min(r_u, reach(c, u)): the model form's
 //!   part scales with the reach ([`sepval_predict::reach`]), s'_m,u = s_m,u e(r'_u) / e(r_u),
 //!   e the reach the band uses;
-//! - it informs the factors where they act alike, w = exp(-reach(c, u)^2 / 2): with n releases
-//!   flown, s'_f,u = s_f,u sqrt(n / (n + w)); with none, s'_f,u = s_f,u (1 - w (1 -
-//!   [`FIRST_RELEASE_SHARE`])), the share of the prior's spread a first release leaves;
+//! - it informs the factors, which are the same at every condition (the model's form is what
+//!   differs from one condition to another, and the reach carries it): with n releases flown,
+//!   s'_f,u = s_f,u sqrt(n / (n + 1)); with none, s'_f,u = [`FIRST_RELEASE_SHARE`] s_f,u, the
+//!   share of the prior's spread a first release leaves;
 //! - the median moves by what is learnt, a normal of variance tau^2 = s_u^2 - s'_u^2, and u is
 //!   settled when it ends more than z s'_u from the criterion (z the normal quantile of 1 -
 //!   allowed): P(settled) = Phi((m_u - z s'_u) / tau) + Phi((-m_u - z s'_u) / tau).
@@ -20,7 +23,10 @@
 //! `expected_settled(c)` sums P(settled) over the undecided conditions. A batch of K is chosen
 //! greedily: each release chosen is taken as flown (the spreads it leaves, one more release)
 //! before the next is ranked, so that the batch's releases complement each other rather than
-//! settle the same conditions. Ties go to the lower risk, then to grid order.
+//! settle the same conditions; once the releases chosen are expected to settle all that can be
+//! settled, the batch's others go where the model's form is least known (the safe condition of
+//! the largest reach from every release flown or planned). Ties go to the lower risk, then to
+//! grid order.
 
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, Normal};
@@ -117,7 +123,13 @@ pub fn plan(
         .map(|a| {
             let s = finite_or_zero(a.spread_mm);
             let f = finite_or_zero(a.factor_spread_mm).min(s);
-            (f, (s * s - f * f).max(0.0).sqrt())
+            let m = (s * s - f * f).max(0.0).sqrt();
+            // The spread of the normal that fails as often as the samples did (their tail,
+            // divergences included, decides the state, not their body), shared in the same
+            // proportions.
+            let k = effective_spread(a.row.clearance_p50_mm - criterion_mm, a.row.p_fail)
+                .map_or(1.0, |e| if s > 0.0 { e / s } else { 1.0 });
+            (k * f, k * m)
         })
         .collect();
     // Each condition's spread before any release of the batch: what is learnt is measured
@@ -132,40 +144,50 @@ pub fn plan(
     };
     let mut chosen: Vec<Planned> = Vec::new();
     for _ in 0..count.max(1) {
-        let best = safe
+        let open: Vec<(usize, f64)> = safe
             .iter()
             .filter(|c| !chosen.iter().any(|p| p.index == **c))
             .map(|&c| {
-                let e: f64 = undecided
-                    .iter()
-                    .map(|&u| {
-                        let (f, m, _) = settle(&at(c, u), &spreads[u], reaches[u], n);
-                        let pair = at(c, u);
-                        let now = spreads[u].0.hypot(spreads[u].1);
-                        p_settle(&pair, start[u], f.hypot(m)) - p_settle(&pair, start[u], now)
-                    })
-                    .sum();
-                (c, e)
+                let gain = |u: usize| {
+                    let pair = at(c, u);
+                    let (f, m, _) = settle(&pair, &spreads[u], reaches[u], n);
+                    let now = spreads[u].0.hypot(spreads[u].1);
+                    p_settle(&pair, start[u], f.hypot(m)) - p_settle(&pair, start[u], now)
+                };
+                (c, undecided.iter().map(|&u| gain(u)).sum())
             })
-            .max_by(|a, b| {
-                a.1.total_cmp(&b.1)
-                    .then(
-                        assessed[b.0]
-                            .row
-                            .p_fail
-                            .total_cmp(&assessed[a.0].row.p_fail),
-                    )
+            .collect();
+        let risk = |c: usize| assessed[c].row.p_fail;
+        let by = |key: &dyn Fn(&(usize, f64)) -> f64| {
+            open.iter().copied().max_by(|a, b| {
+                key(a)
+                    .total_cmp(&key(b))
+                    .then(risk(b.0).total_cmp(&risk(a.0)))
                     .then(b.0.cmp(&a.0))
-            });
-        let Some((c, e)) = best else { break };
-        if e < SETTLES_NOTHING {
+            })
+        };
+        let Some((mut c, mut e)) = by(&|x| x.1) else {
             break;
-        }
-        let why = format!(
-            "expected to settle {e:.1} of the {} undecided conditions; P(fail) here {:.4}, within the fly risk {fly_risk}",
-            undecided.len(),
-            assessed[c].row.p_fail
+        };
+        let mut why = format!(
+            "expected to settle {e:.1} of the {} undecided conditions",
+            undecided.len()
         );
+        if e < SETTLES_NOTHING {
+            if chosen.is_empty() {
+                break;
+            }
+            // The batch's others: where the model's form is least known.
+            (c, e) = by(&|x| effective(reaches[x.0])).expect("open is not empty");
+            why = format!(
+                "adds {e:.1} to what the releases before it in the batch settle; chosen as the safe condition farthest from every release flown or planned (reach {:.1}), where the model's form is least known",
+                reaches[c]
+            );
+        }
+        why.push_str(&format!(
+            "; P(fail) here {:.4}, within the fly risk {fly_risk}",
+            risk(c)
+        ));
         chosen.push(planned(grid, assessed, c, e, why));
         // Taken as flown: the spreads it leaves, one release more.
         for u in 0..assessed.len() {
@@ -219,6 +241,18 @@ fn no_safe(grid: &Grid, assessed: &[Assessed], fly_risk: f64, settled: bool) -> 
     }
 }
 
+/// The standard deviation of a normal about a median `margin` above the criterion that
+/// falls below it with probability `p_fail`; `None` when that says nothing (no margin, or a
+/// probability of 0, 1 or not finite).
+fn effective_spread(margin: f64, p_fail: f64) -> Option<f64> {
+    if !(margin.is_finite() && margin.abs() > 0.0 && p_fail > 0.0 && p_fail < 1.0) {
+        return None;
+    }
+    let z = normal().inverse_cdf(1.0 - p_fail);
+    let s = margin / z;
+    (s.is_finite() && s > 0.0).then_some(s)
+}
+
 fn normal() -> Normal {
     Normal::new(0.0, 1.0).expect("the standard normal")
 }
@@ -246,11 +280,10 @@ fn settle(pair: &Pair, spread: &(f64, f64), r: f64, n: usize) -> (f64, f64, f64)
     let r_after = r.min(d);
     let (e0, e1) = (effective(r), effective(r_after));
     let m_after = if e0 > 0.0 { m * e1 / e0 } else { m };
-    let w = (-0.5 * d * d).exp();
     let f_after = if n == 0 {
-        f * (1.0 - w * (1.0 - FIRST_RELEASE_SHARE))
+        f * FIRST_RELEASE_SHARE
     } else {
-        f * (n as f64 / (n as f64 + w)).sqrt()
+        f * (n as f64 / (n as f64 + 1.0)).sqrt()
     };
     (f_after, m_after, r_after)
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use sepval_common::atomic_file::write_atomically;
 use sepval_envelope::row::CSV_HEADER;
-use sepval_report::figures::{MapAxis, condition_map};
+use sepval_report::figures::MapAxis;
 use sepval_report::html::escape_html;
 
 use sepval_envelope::Grid;
@@ -109,8 +109,8 @@ pub fn render(c: &View<'_>) -> Result<(), CampaignError> {
     write_atomically(&path, html.as_bytes()).map_err(|e| record_error(&path, e))
 }
 
-/// A round's map of states (0 cleared, 1 undecided, 2 fails; the worst over the axes not
-/// shown).
+/// A round's map of states (the worst over the axes not shown), with the releases flown by
+/// then.
 fn state_map(
     c: &View<'_>,
     assessed: &[Assessed],
@@ -125,37 +125,48 @@ fn state_map(
         .copied()
         .unwrap_or((sepval_plan::conditions::Quantity::Mach, &one));
     let ny = axes.get(1).map_or(1, |(_, v)| v.len());
-    let mut cells = vec![vec![f64::NAN; xv.len()]; ny];
+    let mut cells = vec![vec![0u8; xv.len()]; ny];
     for a in assessed {
         let (ix, iy) = c.grid.cell(a.row.index);
         let v = match a.state {
-            State::Cleared => 0.0,
-            State::Undecided => 1.0,
-            State::Fails => 2.0,
+            State::Cleared => 0,
+            State::Undecided => 1,
+            State::Fails => 2,
         };
-        let cell = &mut cells[iy][ix];
-        if !(cell.is_finite() && *cell >= v) {
-            *cell = v;
-        }
+        cells[iy][ix] = cells[iy][ix].max(v);
     }
-    let (xl, yl) = (xq.label(), axes.get(1).map(|(q, _)| q.label()));
-    let y = axes.get(1).zip(yl).map(|((_, v), l)| MapAxis {
-        label: l,
+    let yq = axes.get(1).map(|(q, _)| *q);
+    let releases: Vec<(f64, f64)> = c.file.releases[..flown.min(c.file.releases.len())]
+        .iter()
+        .map(|r| {
+            let f = flight_of(&r.condition);
+            (xq.get(&f), yq.map_or(0.0, |q| q.get(&f)))
+        })
+        .collect();
+    let y = axes.get(1).map(|(q, v)| MapAxis {
+        label: q.label(),
         values: v,
     });
-    condition_map(
+    sepval_report::figures::state_map(
         path,
-        &format!("Round {round}: states after {flown} release(s)"),
+        &format!("Round {round}: the envelope's states after {flown} release(s)"),
         MapAxis {
-            label: xl,
+            label: xq.label(),
             values: xv,
         },
         y,
         &cells,
-        "0 cleared, 1 undecided, 2 fails",
-        None,
+        &releases,
     )
     .map_err(|e| record_error(path, e))
+}
+
+/// The flight condition of a record.
+fn flight_of(c: &sepval_predict::record::ConditionRecord) -> sepval_common::scenario::Flight {
+    let mut f = sepval_common::scenario::Scenario::embedded_default().flight;
+    (f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg) =
+        (c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg);
+    f
 }
 
 /// report.html.

@@ -25,7 +25,7 @@ impl State {
     pub fn of(p_fail: f64, allowed: f64) -> State {
         if p_fail <= allowed {
             State::Cleared
-        } else if 1.0 - p_fail <= allowed {
+        } else if p_fail >= 1.0 - allowed {
             State::Fails
         } else {
             State::Undecided
@@ -50,8 +50,9 @@ pub struct Assessed {
     pub row: Row,
     /// Its state.
     pub state: State,
-    /// Its reach: how far it lies from the nearest release flown
-    /// ([`sepval_fit::domain::reach`]; null when nothing was flown).
+    /// Its reach: how far it lies from the nearest release flown beyond what the releases
+    /// held out in turn cover ([`sepval_predict::reach::uncovered`]; null when nothing was
+    /// flown).
     #[serde(with = "sepval_common::nonfinite")]
     pub reach: f64,
     /// The spread of the smallest clearance over the samples \[mm\]: (p95 - p5) / 3.29, the

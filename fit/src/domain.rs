@@ -10,8 +10,9 @@
 //!   beyond the box of the releases' conditions by more than [`FAR_MACH`] in Mach,
 //!   [`FAR_Q_FRACTION`] of the dynamic pressure, or [`FAR_ANGLE_DEG`] deg in alpha or beta;
 //! - **measured**: how far a condition lies from the nearest release, in those same units
-//!   ([`reach`]), which widens a prediction's model-form band (docs/model.md, "Model form away
-//!   from the releases").
+//!   ([`reach`]), and how far the held-out releases were predicted ([`covered_reach`]); the
+//!   reach beyond what they cover widens a prediction's model-form band (docs/model.md section
+//!   10a).
 
 use sepval_common::atmosphere::isa_troposphere;
 use sepval_common::scenario::{Flight, Scenario};
@@ -169,6 +170,26 @@ pub fn reach(releases: &[&Flight], condition: &Flight) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The reach the held-out evidence covers: the largest reach at which a release was predicted
+/// without being fitted, each of `releases` from the others (left out in turn, when there are
+/// at least two) and each of `validate` from all of `releases`; 0 when there is none. A
+/// prediction's model-form band grows only with its reach beyond this (docs/model.md section
+/// 10a): within it, the held-out releases measured how the model's form carries.
+pub fn covered_reach(releases: &[&Flight], validate: &[&Flight]) -> f64 {
+    let left_out = (0..releases.len()).filter(|_| releases.len() >= 2).map(|j| {
+        let others: Vec<&Flight> = (0..releases.len())
+            .filter(|&i| i != j)
+            .map(|i| releases[i])
+            .collect();
+        reach(&others, releases[j])
+    });
+    let validated = validate.iter().map(|v| reach(releases, v));
+    left_out
+        .chain(validated)
+        .filter(|r| r.is_finite())
+        .fold(0.0, f64::max)
+}
+
 /// Dynamic pressure of a flight condition \[Pa\].
 fn dynamic_pressure_pa(f: &Flight) -> f64 {
     let air = isa_troposphere(f.altitude_m);
@@ -313,5 +334,9 @@ mod tests {
         let mut mid = base.clone();
         mid.alpha_deg += 2.5;
         assert!((reach(&[&base, &a], &mid) - 0.5).abs() < 1e-12);
+        // Two releases a unit apart, each predicted from the other, cover a unit of reach.
+        assert!((covered_reach(&[&base, &a], &[]) - 1.0).abs() < 1e-12);
+        assert!(covered_reach(&[&base], &[]).abs() < 1e-15);
+        assert!((covered_reach(&[&base], &[&b]) - 2.0).abs() < 1e-12);
     }
 }

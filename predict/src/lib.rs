@@ -130,8 +130,9 @@ pub struct Prepared {
     /// When the condition lies far from every release fitted ([`sepval_fit::domain::far`]),
     /// the sentence that says so: the first of the prediction's summary.
     pub extrapolation: Option<String>,
-    /// How far the condition lies from the nearest release fitted
-    /// ([`sepval_fit::domain::reach`]), which widens the model-form band ([`reach`]).
+    /// How far the condition lies from the nearest release fitted beyond the reach the
+    /// held-out releases cover ([`reach::uncovered`]), which widens the model-form band
+    /// ([`reach`]).
     pub reach: f64,
 }
 
@@ -198,7 +199,14 @@ pub fn prepare(
         .map(|e| &e.simulator.scenario().flight)
         .collect();
     let extrapolation = sepval_fit::domain::far(&releases, &condition.flight);
-    let reach = sepval_fit::domain::reach(&releases, &condition.flight);
+    let validated: Vec<&sepval_common::scenario::Flight> = held_out
+        .iter()
+        .map(|e| &e.simulator.scenario().flight)
+        .collect();
+    let reach = reach::uncovered(
+        sepval_fit::domain::reach(&releases, &condition.flight),
+        sepval_fit::domain::covered_reach(&releases, &validated),
+    );
     Ok(Prepared {
         source,
         ensemble,

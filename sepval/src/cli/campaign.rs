@@ -17,6 +17,33 @@ pub enum CampaignCommand {
     Add(CampaignAddArgs),
     /// The campaign's state in a few lines.
     Status(CampaignStatusArgs),
+    /// A virtual test program for sizing one: init, then plan, fly the planned release with a
+    /// stated truth (sepval's simulator, with noise) and add it, until settled.
+    Rehearse(Box<CampaignRehearseArgs>),
+}
+
+#[derive(clap::Args)]
+pub struct CampaignRehearseArgs {
+    #[command(flatten)]
+    pub init: CampaignInitArgs,
+    /// The truth's scenario (TOML) [default: the embedded default].
+    #[arg(long, value_name = "FILE")]
+    pub truth_scenario: Option<PathBuf>,
+    /// A model extension of the truth (TOML).
+    #[arg(long, value_name = "FILE")]
+    pub truth_extension: Option<PathBuf>,
+    /// An effect of the truth, ID=V (repeatable; `sepval effects` lists them).
+    #[arg(long, value_name = "ID=V")]
+    pub truth_effect: Vec<String>,
+    /// The truth's factors: `truth`, `nominal` or a JSON file.
+    #[arg(long, default_value = "truth", value_name = "truth|nominal|FILE")]
+    pub truth_factors: String,
+    /// The noise seed of the first release flown (the k-th: this plus k - 1).
+    #[arg(long, default_value_t = 1)]
+    pub noise_seed: u64,
+    /// The most releases to fly.
+    #[arg(long, default_value_t = 6, value_name = "MAX")]
+    pub releases: usize,
 }
 
 #[derive(clap::Args)]

@@ -8,7 +8,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 mod campaign;
 mod shared;
 pub use campaign::{
-    CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignStatusArgs,
+    CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignRehearseArgs,
+    CampaignStatusArgs,
 };
 use sepval_transport::RunId;
 pub use shared::{

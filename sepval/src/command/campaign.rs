@@ -14,8 +14,8 @@ use sepval_predict::ClearanceSettings;
 use super::envelope::starter;
 use super::{clearance, count, evaluator_spec, inputs, releases};
 use crate::cli::{
-    CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignStatusArgs,
-    GeometryArgs,
+    CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignRehearseArgs,
+    CampaignStatusArgs, GeometryArgs,
 };
 
 /// Runs `sepval campaign SUBCOMMAND`.
@@ -25,6 +25,7 @@ pub fn run(c: CampaignCommand) -> Result<()> {
         CampaignCommand::Next(a) => next(a),
         CampaignCommand::Add(a) => add(a),
         CampaignCommand::Status(a) => status(a),
+        CampaignCommand::Rehearse(a) => rehearse(*a),
     }
 }
 
@@ -38,6 +39,18 @@ fn probability(flag: &str, p: f64) -> Result<f64> {
 
 fn init(a: CampaignInitArgs) -> Result<()> {
     let spec = evaluator_spec(&a.eval)?;
+    let mut start = starter(&spec);
+    let c = begin(&a, &mut start)?;
+    say!("campaign:  {}", page::headline(&c.file));
+    say!("report:    {}", a.out.join("report.html").display());
+    Ok(())
+}
+
+/// Checks the init flags and begins the campaign in --out.
+fn begin(
+    a: &CampaignInitArgs,
+    start: &mut sepval_campaign::StartEvaluator<'_>,
+) -> Result<Campaign> {
     let threads = count("--threads", a.eval.threads)?;
     let allowed = probability("--allowed", a.allowed)?;
     let fly_risk = probability("--fly-risk", a.fly_risk)?;
@@ -96,11 +109,57 @@ fn init(a: CampaignInitArgs) -> Result<()> {
         clearance,
         threads,
     };
+    let c = sepval_campaign::program::init(&a.out, init, start, &mut *crate::front::progress())?;
+    Ok(c)
+}
+
+fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
+    let spec = evaluator_spec(&a.init.eval)?;
+    let scenario = inputs::scenario(a.truth_scenario.as_deref(), a.truth_extension.as_deref())
+        .context("--truth-scenario")?;
+    let factors =
+        inputs::factors(&a.truth_factors, &scenario.factors).context("--truth-factors")?;
+    let effects = inputs::effects(&a.truth_effect)?;
+    let truth = sepval_campaign::rehearse::Truth {
+        scenario,
+        factors,
+        effects,
+        noise_seed: a.noise_seed,
+    };
     let mut start = starter(&spec);
-    let c =
-        sepval_campaign::program::init(&a.out, init, &mut start, &mut *crate::front::progress())?;
-    say!("campaign:  {}", page::headline(&c.file));
-    say!("report:    {}", a.out.join("report.html").display());
+    let mut c = begin(&a.init, &mut start)?;
+    say!("round 0:   {}", page::headline(&c.file));
+    let r = sepval_campaign::rehearse::rehearse(
+        &mut c,
+        &truth,
+        a.releases,
+        &mut start,
+        &mut *crate::front::progress(),
+    )?;
+    for (k, f) in r.flown.iter().enumerate() {
+        say!(
+            "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {})",
+            k + 1,
+            f.condition.mach,
+            f.condition.altitude_m,
+            f.condition.alpha_deg,
+            f.p_fail_planned,
+            if f.truly_safe { "safe" } else { "UNSAFE" }
+        );
+    }
+    for round in &r.rounds {
+        say!(
+            "round {}:   cleared {}, fails {}, undecided {}; false clears {}, false fails {}",
+            round.round,
+            round.counts.cleared,
+            round.counts.fails,
+            round.counts.undecided,
+            round.false_clears,
+            round.false_fails
+        );
+    }
+    say!("rehearsal: {}", r.words);
+    say!("report:    {}", a.init.out.join("report.html").display());
     Ok(())
 }
 

@@ -69,7 +69,11 @@ fn next_plans_only_safe_distinct_conditions_and_says_when_none_is_safe() {
         let at = (r["mach"].to_string(), r["alpha_deg"].to_string());
         assert!(!seen.contains(&at), "the same condition twice: {next}");
         seen.push(at);
-        assert!(r["why"].as_str().unwrap().contains("expected to settle"));
+        let why = r["why"].as_str().unwrap();
+        assert!(
+            why.contains("expected to settle") || why.contains("farthest from every release"),
+            "{why}"
+        );
     }
     // A criterion that nothing meets with the fly risk: nothing planned, the least risky named.
     init(dir, "d", "125", "2");
@@ -235,4 +239,95 @@ fn init_refuses_a_directory_that_is_not_empty_and_bad_probabilities() {
         "--allowed 0.7",
     );
     assert!(!dir.join("d").exists());
+}
+
+/// `campaign rehearse` over a 3 x 3 grid with `extra` truth flags; returns rehearsal.json.
+fn rehearse(dir: &Path, out: &str, criterion: &str, extra: &[&str]) -> Value {
+    let a = aircraft();
+    let mut args = vec![
+        "campaign",
+        "rehearse",
+        "--aircraft",
+        &a,
+        "--mach",
+        "0.6:1.2:3",
+        "--alpha-deg",
+        "-6:10:3",
+        "--samples",
+        "100",
+        "--clearance-mm",
+        criterion,
+        "--evaluator",
+        "inproc",
+        "--threads",
+        "2",
+        "--generations",
+        "10",
+        "--releases",
+        "3",
+        "--truth-factors",
+        "nominal",
+        "--out",
+        out,
+    ];
+    args.extend(extra);
+    ok(&sepval(&args, dir));
+    json(&dir.join(out).join("rehearsal.json"))
+}
+
+#[test]
+fn a_rehearsal_of_a_null_truth_settles_with_no_false_clear_or_fail() {
+    let tmp = tempfile::tempdir().unwrap();
+    let r = rehearse(tmp.path(), "null", "25.4", &[]);
+    assert_eq!(r["format"], "sepval-campaign-rehearsal/1");
+    assert_eq!(r["settled"], true, "{r}");
+    for round in r["rounds"].as_array().unwrap() {
+        assert_eq!(round["false_clears"], 0, "{round}");
+        assert_eq!(round["false_fails"], 0, "{round}");
+    }
+}
+
+#[test]
+fn a_rehearsal_with_a_hidden_cause_flies_only_truly_safe_releases_and_stays_conservative() {
+    let tmp = tempfile::tempdir().unwrap();
+    let r = rehearse(
+        tmp.path(),
+        "hidden",
+        "100",
+        &["--truth-effect", "pitch_stiffness_cubic=-1000"],
+    );
+    let truth_fails = r["truth"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|t| t["fails"] == true)
+        .count();
+    assert!(
+        truth_fails > 0,
+        "the truth must fail somewhere in the grid: {r}"
+    );
+    assert!(!r["flown"].as_array().unwrap().is_empty(), "{r}");
+    for f in r["flown"].as_array().unwrap() {
+        assert_eq!(f["truly_safe"], true, "an unsafe release was flown: {f}");
+    }
+}
+
+/// The known gap of issue 35: the reach rule widens the band in proportion to the model's own
+/// motion, and a hidden cubic pitch stiffness 8 deg of alpha from the release makes the store
+/// come back to the pylon late in the release, which no sample approaches (truth 97.6 mm
+/// against 100 at Mach 0.9, alpha 10 deg; the campaign clears it, before and after one
+/// release). Run with `--ignored` to see it.
+#[test]
+#[ignore = "known gap, issue 35: a hidden nonlinear cause far in alpha is cleared (see the doc)"]
+fn a_rehearsal_with_a_hidden_cause_clears_nothing_the_truth_fails() {
+    let tmp = tempfile::tempdir().unwrap();
+    let r = rehearse(
+        tmp.path(),
+        "hidden",
+        "100",
+        &["--truth-effect", "pitch_stiffness_cubic=-1000"],
+    );
+    for round in r["rounds"].as_array().unwrap() {
+        assert_eq!(round["false_clears"], 0, "{round}");
+    }
 }

@@ -1,0 +1,241 @@
+//! `sepval campaign rehearse`: a virtual test program, for sizing one before it is flown
+//! (docs/campaign.md, "Rehearsal"). The campaign begun with `init` is run against a stated
+//! truth (a scenario with its factors, effects and extension): `next` plans one release, the
+//! truth flies it through sepval's own simulator with the instrument's noise (seed
+//! `noise_seed + k` for the k-th release), `add` records it, until the envelope is settled or
+//! `max_releases` were flown. Each round's envelope is compared with the truth's, computed at
+//! every grid condition from the truth without noise: a condition the campaign clears where the
+//! truth fails is a false clear, one it fails where the truth clears a false fail, and every
+//! release planned is checked to have been truly safe.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use sepval_common::cancel;
+use sepval_common::effects::EffectSet;
+use sepval_common::factors::Factors;
+use sepval_common::scenario::{Scenario, hex_sha256};
+use sepval_common::simulation::{Simulator, sample_times};
+use sepval_common::synthetic::synthetic_flight_test;
+use sepval_geometry::Pose;
+use sepval_predict::record::ConditionRecord;
+use sepval_solve::run::ProgressObserver;
+
+use crate::CampaignError;
+use crate::assess::StartEvaluator;
+use crate::program::{Campaign, NewRelease};
+use crate::record::{record_error, write_json};
+use crate::state::{Counts, State};
+
+/// The format of CAMP/rehearsal.json.
+pub const REHEARSAL_FORMAT: &str = "sepval-campaign-rehearsal/1";
+
+/// The truth a rehearsal flies.
+pub struct Truth {
+    /// The store and its model (flown at each condition of the grid).
+    pub scenario: Scenario,
+    /// Its factors.
+    pub factors: Factors,
+    /// Its effects.
+    pub effects: EffectSet,
+    /// The noise seed of the first release.
+    pub noise_seed: u64,
+}
+
+/// The truth at one condition.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TruthCondition {
+    /// The condition.
+    pub condition: ConditionRecord,
+    /// Its smallest clearance without noise \[mm\] (null: it diverged).
+    #[serde(with = "sepval_common::nonfinite")]
+    pub min_clearance_mm: f64,
+    /// Whether it fails to clear (below the criterion, or diverged).
+    pub fails: bool,
+}
+
+/// One round against the truth.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RoundAgainstTruth {
+    /// The round.
+    pub round: usize,
+    /// Releases flown by then.
+    pub releases_flown: usize,
+    /// Its counts.
+    pub counts: Counts,
+    /// Conditions cleared that the truth fails.
+    pub false_clears: usize,
+    /// Conditions failed that the truth clears.
+    pub false_fails: usize,
+}
+
+/// One release flown in the rehearsal.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlownRelease {
+    /// Its condition.
+    pub condition: ConditionRecord,
+    /// The planned probability of failing there.
+    pub p_fail_planned: f64,
+    /// Whether the truth clears there.
+    pub truly_safe: bool,
+}
+
+/// CAMP/rehearsal.json.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Rehearsal {
+    /// [`REHEARSAL_FORMAT`].
+    pub format: String,
+    /// The truth at every grid condition.
+    pub truth: Vec<TruthCondition>,
+    /// The releases flown, in order.
+    pub flown: Vec<FlownRelease>,
+    /// Every round against the truth.
+    pub rounds: Vec<RoundAgainstTruth>,
+    /// Whether the campaign settled within the releases allowed.
+    pub settled: bool,
+    /// In words.
+    pub words: String,
+}
+
+/// The truth at every condition of the campaign's grid.
+pub fn truth_envelope(c: &Campaign, truth: &Truth) -> Result<Vec<TruthCondition>, CampaignError> {
+    let base = &truth.scenario;
+    let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
+    let criterion_m = c.clearance.criterion_m;
+    (0..c.grid.len())
+        .map(|k| {
+            cancel::check()?;
+            let s = c.grid.scenario(base, k);
+            let min_m = synthetic_flight_test(
+                &Simulator::new(&s),
+                &truth.factors,
+                &truth.effects,
+                &times,
+                None,
+            )
+            .ok()
+            .and_then(|t| {
+                let poses: Vec<Pose> = t
+                    .pos_m
+                    .iter()
+                    .zip(&t.att_deg)
+                    .map(|(p, a)| Pose {
+                        position_m: *p,
+                        euler_deg: *a,
+                    })
+                    .collect();
+                c.clearance
+                    .geometry
+                    .trace_until(
+                        &t.times_s,
+                        &poses,
+                        c.clearance.free_after_m,
+                        &cancel::requested,
+                    )
+                    .ok()
+                    .map(|tr| tr.min.distance_m)
+            })
+            .unwrap_or(f64::NAN);
+            Ok(TruthCondition {
+                condition: ConditionRecord::of(&s.flight),
+                min_clearance_mm: 1e3 * min_m,
+                fails: !(min_m >= criterion_m),
+            })
+        })
+        .collect()
+}
+
+/// The current round against the truth.
+fn against(c: &Campaign, truth: &[TruthCondition]) -> Result<RoundAgainstTruth, CampaignError> {
+    let current = c.current()?;
+    let count = |state: State, truth_fails: bool| {
+        current
+            .iter()
+            .zip(truth)
+            .filter(|(a, t)| a.state == state && t.fails == truth_fails)
+            .count()
+    };
+    Ok(RoundAgainstTruth {
+        round: c.file.rounds.len() - 1,
+        releases_flown: c.file.releases.len(),
+        counts: Counts::of(&current),
+        false_clears: count(State::Cleared, true),
+        false_fails: count(State::Fails, false),
+    })
+}
+
+/// Runs the rehearsal on the campaign `c` (begun with `init`); writes CAMP/rehearsal.json after
+/// every round.
+pub fn rehearse(
+    c: &mut Campaign,
+    truth: &Truth,
+    max_releases: usize,
+    start: &mut StartEvaluator<'_>,
+    observer: &mut dyn ProgressObserver,
+) -> Result<Rehearsal, CampaignError> {
+    let mut r = Rehearsal {
+        format: REHEARSAL_FORMAT.into(),
+        truth: truth_envelope(c, truth)?,
+        flown: Vec::new(),
+        rounds: Vec::new(),
+        settled: c.file.settled,
+        words: String::new(),
+    };
+    r.rounds.push(against(c, &r.truth)?);
+    let flown_dir = c.dir.join("rehearsal");
+    std::fs::create_dir_all(&flown_dir).map_err(|e| record_error(&flown_dir, e))?;
+    let base = &truth.scenario;
+    let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
+    for k in 0..max_releases {
+        if c.file.settled {
+            break;
+        }
+        let next = c.next(1)?;
+        let Some(p) = next.releases.first() else {
+            break;
+        };
+        let s = c.grid.scenario(base, p.index);
+        let data = synthetic_flight_test(
+            &Simulator::new(&s),
+            &truth.factors,
+            &truth.effects,
+            &times,
+            Some(truth.noise_seed.wrapping_add(k as u64)),
+        )
+        .map_err(|e| CampaignError::Refused(format!("the truth at release {}: {e}", k + 1)))?;
+        let path: PathBuf = flown_dir.join(format!("flown-{:02}.csv", k + 1));
+        data.write(&path).map_err(|e| record_error(&path, e))?;
+        let bytes = std::fs::read(&path).map_err(|e| record_error(&path, e))?;
+        r.flown.push(FlownRelease {
+            condition: ConditionRecord::of(&s.flight),
+            p_fail_planned: p.p_fail,
+            truly_safe: !r.truth[p.index].fails,
+        });
+        let release = NewRelease {
+            given: path,
+            sha256: hex_sha256(&bytes),
+            data,
+            scenario: c.grid.scenario(&c.scenario, p.index),
+        };
+        crate::add::add(c, vec![release], start, observer)?;
+        r.rounds.push(against(c, &r.truth)?);
+        r.settled = c.file.settled;
+        write_json(&c.dir.join("rehearsal.json"), &r)?;
+    }
+    let last = r.rounds.last().expect("round 0 is there");
+    r.words = format!(
+        "{} after {} release(s): cleared {}, fails {}, undecided {}; against the truth {} false clear(s), {} false fail(s); {} of the {} releases flown truly safe",
+        if r.settled { "settled" } else { "not settled" },
+        last.releases_flown,
+        last.counts.cleared,
+        last.counts.fails,
+        last.counts.undecided,
+        last.false_clears,
+        last.false_fails,
+        r.flown.iter().filter(|f| f.truly_safe).count(),
+        r.flown.len()
+    );
+    write_json(&c.dir.join("rehearsal.json"), &r)?;
+    Ok(r)
+}
