@@ -21,9 +21,8 @@ use sepval_common::synthetic::synthetic_flight_test;
 use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::sigma::Sigma;
 use sepval_fit::space::ParamSpace;
-use sepval_fit::{FitOptions, Method, run_fit};
+use sepval_fit::{FitOptions, run_fit};
 use sepval_solve::ga::GaSettings;
-use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_solve::run::NoProgress;
 
@@ -121,30 +120,19 @@ fn main() {
             .expect("a job");
             let out =
                 std::env::temp_dir().join(format!("sepval-reach-{}-{seed}", std::process::id()));
-            let options = FitOptions {
-                method: Method::GaLm,
-                ga: GaSettings {
-                    generations: 10,
-                    seed,
-                    ..GaSettings::default()
-                },
-                hill: HillSettings::default(),
-                sigma: Sigma::resolve(&job, None, None).expect("sigma"),
-                truth: None,
-                out: out.clone(),
-                resume: None,
-                inputs: InputsRecord {
-                    data: Vec::new(),
-                    scenario: None,
-                    extension: None,
-                    outliers: Default::default(),
-                },
-                lm: LmSettings::default(),
-                lm_probe: LmSettings {
-                    budget: 800,
-                    ..LmSettings::default()
-                },
+            let inputs = InputsRecord {
+                data: Vec::new(),
+                scenario: None,
+                extension: None,
+                outliers: Default::default(),
             };
+            let ga = GaSettings {
+                generations: 10,
+                seed,
+                ..GaSettings::default()
+            };
+            let sigma = Sigma::resolve(&job, None, None).expect("sigma");
+            let options = FitOptions::baseline(ga, sigma, &LmSettings::default(), &out, inputs);
             let mut ev = InProcess::new(Arc::new(job.clone()), 2);
             let fit = run_fit(&options, &mut ev, &mut NoProgress).expect("the fit runs");
             let _ = std::fs::remove_dir_all(&out);
@@ -178,16 +166,16 @@ fn main() {
                         tr.att_deg[k][c - 3]
                     }
                 };
-                for c in 0..6 {
+                for (c, channel) in per_channel.iter_mut().enumerate() {
                     let motion: Vec<f64> = (0..times.len())
                         .map(|k| (ch(&y, k, c) - ch(&y, 0, c)).abs())
                         .collect();
                     let top = motion.iter().copied().fold(0.0, f64::max);
-                    for k in 0..times.len() {
-                        if motion[k] >= 0.05 * top && motion[k] > 0.0 {
+                    for (k, &m) in motion.iter().enumerate() {
+                        if m >= 0.05 * top && m > 0.0 {
                             let e = (ch(&t, k, c) - ch(&y, k, c)).abs();
-                            needed.push((r, e / (1.96 * r * motion[k])));
-                            per_channel[c].push(e / (1.96 * r * motion[k]));
+                            needed.push((r, e / (1.96 * r * m)));
+                            channel.push(e / (1.96 * r * m));
                         }
                     }
                 }

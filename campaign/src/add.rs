@@ -14,21 +14,19 @@ use sepval_common::scenario::Scenario;
 use sepval_common::telemetry::Trajectory;
 use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::sigma::Sigma;
-use sepval_fit::{FitOptions, Method, run_fit};
+use sepval_fit::{FitOptions, run_fit};
 use sepval_predict::bands::{BandInputs, bands};
 use sepval_predict::check::{Check, check};
 use sepval_predict::record::ConditionRecord;
-use sepval_predict::sampling::{STREAM_PARAMETERS, sample_rng};
 use sepval_predict::simulate::{self, GridTrajectory, data_on_grid};
 use sepval_solve::ga::GaSettings;
-use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_solve::run::{NoProgress, ProgressObserver};
 
 use crate::CampaignError;
 use crate::assess::{AssessSettings, Model, StartEvaluator};
 use crate::program::{Campaign, NewRelease, STAGING, fitted_model};
-use crate::record::{ReleaseRecord, record_error};
+use crate::record::{CAMPAIGN_FORMAT, ReleaseRecord, read_json, record_error};
 
 /// The noise of a prediction's bands before any release was fitted: the synthetic flight
 /// tests' (docs/model.md section 6).
@@ -39,8 +37,30 @@ fn prior_noise() -> sepval_fit::space::Noise {
     }
 }
 
-/// Adds `releases` to the campaign (module docs); returns each one's check.
+/// Adds `releases` to the campaign (module docs); returns each one's check. On an error (a
+/// signal's included) the campaign is left as it was: campaign.json untouched, and what was
+/// written for the releases removed.
 pub fn add(
+    c: &mut Campaign,
+    releases: Vec<NewRelease>,
+    start: &mut StartEvaluator<'_>,
+    observer: &mut dyn ProgressObserver,
+) -> Result<Vec<Check>, CampaignError> {
+    let done = add_all(c, releases, start, observer);
+    if done.is_err() {
+        // campaign.json on disk says what was committed (an error after the commit, in the
+        // derived files, keeps the round); what it does not name is removed, best effort: the
+        // next command that opens the campaign removes what is left.
+        let path = c.dir.join("campaign.json");
+        if let Ok(on_disk) = read_json(&path, CAMPAIGN_FORMAT) {
+            c.file = on_disk;
+            let _ = c.tidy();
+        }
+    }
+    done
+}
+
+fn add_all(
     c: &mut Campaign,
     releases: Vec<NewRelease>,
     start: &mut StartEvaluator<'_>,
@@ -144,35 +164,23 @@ fn fit(
     let s = &c.file.settings;
     let sigma = Sigma::resolve(job, None, None)
         .map_err(|e| CampaignError::Refused(format!("the noise of the releases: {e}")))?;
-    let options = FitOptions {
-        method: Method::GaLm,
-        ga: GaSettings {
-            generations: s.generations,
-            seed: s.seed,
-            ..GaSettings::default()
-        },
-        hill: HillSettings::default(),
-        sigma,
-        truth: None,
-        out: out.to_path_buf(),
-        resume: None,
-        inputs: InputsRecord {
-            data: c
-                .file
-                .releases
-                .iter()
-                .map(|r| c.dir.join(&r.file))
-                .collect(),
-            scenario: s.scenario.as_ref().map(|r| r.path.clone().into()),
-            extension: None,
-            outliers: Default::default(),
-        },
-        lm: LmSettings::default(),
-        lm_probe: LmSettings {
-            budget: 800,
-            ..LmSettings::default()
-        },
+    let inputs = InputsRecord {
+        data: c
+            .file
+            .releases
+            .iter()
+            .map(|r| c.dir.join(&r.file))
+            .collect(),
+        scenario: s.scenario.as_ref().map(|r| r.path.clone().into()),
+        extension: None,
+        outliers: Default::default(),
     };
+    let ga = GaSettings {
+        generations: s.generations,
+        seed: s.seed,
+        ..GaSettings::default()
+    };
+    let options = FitOptions::baseline(ga, sigma, &LmSettings::default(), out, inputs);
     let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
     run_fit(&options, evaluator.as_mut(), observer).map_err(|e| match e {
         sepval_fit::FitError::Run(sepval_solve::run::RunError::Interrupted) => {
@@ -196,20 +204,12 @@ pub fn check_release(
     let points = simulate::Grid::of(&data.times_s);
     let job = simulate::release_job(scenario, &data.times_s, "check")
         .map_err(|e| CampaignError::Condition(Box::new(simulate::SimulateError::from(e).into())))?;
-    let candidates: Vec<_> = (0..settings.samples)
-        .map(|s| {
-            let mut rng = sample_rng(settings.seed, s as u64, STREAM_PARAMETERS);
-            model
-                .space
-                .candidate(&model.distribution.draw(&mut rng))
-                .map_err(|e| CampaignError::Model(e.to_string()))
-        })
-        .collect::<Result<_, _>>()?;
+    let candidates = crate::assess::draws(model, settings)?;
     let mut evaluator = start(Arc::new(job)).map_err(CampaignError::from_eval)?;
     let runs = simulate::run_candidates(
         evaluator.as_mut(),
         candidates.len(),
-        &|i| candidates[i].clone(),
+        &|i| candidates[i],
         &points,
         &mut NoProgress,
     )

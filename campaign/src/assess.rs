@@ -111,7 +111,7 @@ pub fn assess(
         let runs = simulate::run_candidates(
             evaluator.as_mut(),
             candidates.len(),
-            &|i| candidates[i].clone(),
+            &|i| candidates[i],
             &points,
             &mut NoProgress,
         )
@@ -168,7 +168,10 @@ pub fn assess(
 }
 
 /// The samples' candidates: draw s from its own generator.
-fn draws(model: &Model, settings: &AssessSettings) -> Result<Vec<Candidate>, CampaignError> {
+pub(crate) fn draws(
+    model: &Model,
+    settings: &AssessSettings,
+) -> Result<Vec<Candidate>, CampaignError> {
     (0..settings.samples)
         .map(|s| {
             let mut rng = sample_rng(settings.seed, s as u64, STREAM_PARAMETERS);

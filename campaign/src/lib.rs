@@ -9,7 +9,7 @@
 //!
 //! The campaign is a pipeline of named stages over one directory:
 //! 1. [`prior`]: the factors before any release ([`Prior`]);
-//! 2. [`assess`]: an envelope of the campaign, every condition's clearance predicted from what
+//! 2. [`mod@assess`]: an envelope of the campaign, every condition's clearance predicted from what
 //!    a round believes ([`Model`] to [`Assessed`]), its [`state`];
 //! 3. [`next`]: the releases to fly next ([`Plan`]);
 //! 4. [`program`] and [`add`]: `init`, `add`, `next` and `status` over the directory

@@ -118,32 +118,18 @@ pub fn plan(
         return no_safe(grid, assessed, fly_risk, undecided.is_empty());
     }
     let z = normal().inverse_cdf(1.0 - allowed);
-    let mut spreads: Vec<(f64, f64)> = assessed
-        .iter()
-        .map(|a| {
-            let s = finite_or_zero(a.spread_mm);
-            let f = finite_or_zero(a.factor_spread_mm).min(s);
-            let m = (s * s - f * f).max(0.0).sqrt();
-            // The spread of the normal that fails as often as the samples did (their tail,
-            // divergences included, decides the state, not their body), shared in the same
-            // proportions.
-            let k = effective_spread(a.row.clearance_p50_mm - criterion_mm, a.row.p_fail)
-                .map_or(1.0, |e| if s > 0.0 { e / s } else { 1.0 });
-            (k * f, k * m)
-        })
-        .collect();
+    let mut spreads = tail_spreads(assessed, criterion_mm);
     // Each condition's spread before any release of the batch: what is learnt is measured
     // from it.
     let start: Vec<f64> = spreads.iter().map(|(f, m)| f.hypot(*m)).collect();
     let mut reaches: Vec<f64> = assessed.iter().map(|a| a.reach).collect();
-    let mut n = flown.len();
     let at = |c: usize, u: usize| Pair {
         reach: reach(&[grid.flight(c)], grid.flight(u)),
         margin_mm: assessed[u].row.clearance_p50_mm - criterion_mm,
         z,
     };
     let mut chosen: Vec<Planned> = Vec::new();
-    for _ in 0..count.max(1) {
+    for n in flown.len()..flown.len() + count.max(1) {
         let open: Vec<(usize, f64)> = safe
             .iter()
             .filter(|c| !chosen.iter().any(|p| p.index == **c))
@@ -195,29 +181,44 @@ pub fn plan(
             spreads[u] = (f, m);
             reaches[u] = r;
         }
-        n += 1;
     }
-    let settled = undecided.is_empty() || chosen.is_empty();
-    let words = if undecided.is_empty() {
-        "settled: no condition is undecided".to_string()
-    } else if chosen.is_empty() {
-        format!(
-            "settled: {} condition(s) stay undecided, and no release safe to fly is expected to settle any of them",
-            undecided.len()
-        )
-    } else {
-        format!(
-            "{} release(s) planned for the {} undecided condition(s)",
-            chosen.len(),
-            undecided.len()
-        )
-    };
+    let words = words(undecided.len(), chosen.len());
     Plan {
+        settled: undecided.is_empty() || chosen.is_empty(),
         releases: chosen,
         least_risky: None,
-        settled,
         words,
     }
+}
+
+/// The plan in words, from the undecided conditions and the releases chosen.
+fn words(undecided: usize, chosen: usize) -> String {
+    if undecided == 0 {
+        "settled: no condition is undecided".to_string()
+    } else if chosen == 0 {
+        format!(
+            "settled: {undecided} condition(s) stay undecided, and no release safe to fly is expected to settle any of them"
+        )
+    } else {
+        format!("{chosen} release(s) planned for the {undecided} undecided condition(s)")
+    }
+}
+
+/// Each condition's (factor, model-form) spread: the spread of the normal that fails as often
+/// as its samples did (their tail, divergences included, decides the state, not their body),
+/// shared as the samples' spread is.
+fn tail_spreads(assessed: &[Assessed], criterion_mm: f64) -> Vec<(f64, f64)> {
+    assessed
+        .iter()
+        .map(|a| {
+            let s = finite_or_zero(a.spread_mm);
+            let f = finite_or_zero(a.factor_spread_mm).min(s);
+            let m = (s * s - f * f).max(0.0).sqrt();
+            let k = effective_spread(a.row.clearance_p50_mm - criterion_mm, a.row.p_fail)
+                .map_or(1.0, |e| if s > 0.0 { e / s } else { 1.0 });
+            (k * f, k * m)
+        })
+        .collect()
 }
 
 /// The plan when no condition is safe to fly: none, and the least risky named.

@@ -169,6 +169,22 @@ fn flight_of(c: &sepval_predict::record::ConditionRecord) -> sepval_common::scen
     f
 }
 
+/// A number for a reader: at most six significant digits, no trailing zeros (a grid's
+/// 0.6 + 2 x 0.15 reads 0.9, not 0.8999999999999999).
+pub fn shown(v: f64) -> String {
+    if !v.is_finite() {
+        return "-".into();
+    }
+    let digits = (5 - v.abs().max(1e-12).log10().floor() as i32).clamp(0, 12) as usize;
+    let t = format!("{v:.digits$}");
+    let t = if t.contains('.') {
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        t
+    };
+    if t == "-0" { "0".into() } else { t }
+}
+
 /// report.html.
 fn page(c: &View<'_>, current: &[Assessed]) -> String {
     let e = escape_html;
@@ -198,18 +214,32 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
         let k = &r.condition;
         h.push_str(&format!(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td style=\"text-align:left\">{}</td></tr>",
-            e(&r.file), e(&r.given), k.mach, k.altitude_m, k.alpha_deg, e(&r.check)
+            e(&r.file), e(&r.given), shown(k.mach), shown(k.altitude_m), shown(k.alpha_deg), e(&r.check)
         ));
     }
     h.push_str("</table><h2>Undecided, and why</h2><ul>");
     for a in current.iter().filter(|a| a.state == State::Undecided) {
         let k = &a.row.condition;
         h.push_str(&format!(
-            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'), reach {:.2} from the releases</li>",
-            k.mach, k.altitude_m, k.alpha_deg, a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
+            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'), reach {:.2} beyond what the releases showed</li>",
+            shown(k.mach), shown(k.altitude_m), shown(k.alpha_deg), a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
             100.0 * (a.factor_spread_mm / a.spread_mm).min(1.0), a.reach
         ));
     }
     h.push_str("</ul></body></html>\n");
     h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shown;
+
+    #[test]
+    fn numbers_are_shown_as_a_reader_writes_them() {
+        assert_eq!(shown(0.6 + 2.0 * 0.15), "0.9");
+        assert_eq!(shown(7924.8), "7924.8");
+        assert_eq!(shown(-6.0), "-6");
+        assert_eq!(shown(0.0125), "0.0125");
+        assert_eq!(shown(f64::NAN), "-");
+    }
 }

@@ -56,6 +56,10 @@ pub struct Campaign {
     _lock: DirLock,
 }
 
+/// Loads the scenario and the clearance a campaign's settings name (the caller's readers).
+pub type Load<'a> =
+    dyn Fn(&SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError> + 'a;
+
 /// The inputs of `init`, loaded and checked by the caller.
 pub struct Init {
     /// The settings.
@@ -168,11 +172,7 @@ impl Campaign {
     /// Opens the campaign in `dir`: its record read, its inputs loaded and checked unchanged
     /// (`load` reads the scenario and the geometry of the settings), what an interrupted
     /// command left removed, the directory locked.
-    pub fn open(
-        dir: &Path,
-        threads: usize,
-        load: &dyn Fn(&SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError>,
-    ) -> Result<Campaign, CampaignError> {
+    pub fn open(dir: &Path, threads: usize, load: &Load<'_>) -> Result<Campaign, CampaignError> {
         let path = dir.join("campaign.json");
         if !path.is_file() {
             return Err(record_error(
@@ -213,7 +213,7 @@ impl Campaign {
 
     /// Removes what an interrupted command left: the staging directory, rounds and release
     /// copies campaign.json does not name.
-    fn tidy(&self) -> Result<(), CampaignError> {
+    pub(crate) fn tidy(&self) -> Result<(), CampaignError> {
         let staging = self.dir.join(STAGING);
         if staging.exists() {
             std::fs::remove_dir_all(&staging).map_err(|e| record_error(&staging, e))?;

@@ -140,7 +140,7 @@ pub fn truth_envelope(c: &Campaign, truth: &Truth) -> Result<Vec<TruthCondition>
             Ok(TruthCondition {
                 condition: ConditionRecord::of(&s.flight),
                 min_clearance_mm: 1e3 * min_m,
-                fails: !(min_m >= criterion_m),
+                fails: min_m.is_nan() || min_m < criterion_m,
             })
         })
         .collect()

@@ -176,13 +176,15 @@ pub fn reach(releases: &[&Flight], condition: &Flight) -> f64 {
 /// prediction's model-form band grows only with its reach beyond this (docs/model.md section
 /// 10a): within it, the held-out releases measured how the model's form carries.
 pub fn covered_reach(releases: &[&Flight], validate: &[&Flight]) -> f64 {
-    let left_out = (0..releases.len()).filter(|_| releases.len() >= 2).map(|j| {
-        let others: Vec<&Flight> = (0..releases.len())
-            .filter(|&i| i != j)
-            .map(|i| releases[i])
-            .collect();
-        reach(&others, releases[j])
-    });
+    let left_out = (0..releases.len())
+        .filter(|_| releases.len() >= 2)
+        .map(|j| {
+            let others: Vec<&Flight> = (0..releases.len())
+                .filter(|&i| i != j)
+                .map(|i| releases[i])
+                .collect();
+            reach(&others, releases[j])
+        });
     let validated = validate.iter().map(|v| reach(releases, v));
     left_out
         .chain(validated)

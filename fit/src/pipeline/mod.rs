@@ -66,6 +66,35 @@ pub struct FitOptions {
     pub lm_probe: LmSettings,
 }
 
+impl FitOptions {
+    /// The baseline fit a diagnosis, an update and a campaign's round start from: the study's
+    /// GA with `ga`, then Levenberg-Marquardt with `lm` (the GA's probes refined within 800
+    /// simulations), written to `out`.
+    pub fn baseline(
+        ga: GaSettings,
+        sigma: Sigma,
+        lm: &LmSettings,
+        out: &std::path::Path,
+        inputs: InputsRecord,
+    ) -> FitOptions {
+        FitOptions {
+            method: Method::GaLm,
+            ga,
+            hill: HillSettings::default(),
+            sigma,
+            truth: None,
+            out: out.to_path_buf(),
+            resume: None,
+            inputs,
+            lm: lm.clone(),
+            lm_probe: LmSettings {
+                budget: lm.budget.min(800),
+                ..LmSettings::default()
+            },
+        }
+    }
+}
+
 /// The floor is reached when both goals are within this factor of their noise sigma.
 pub const FLOOR_FACTOR: f64 = 1.1;
 

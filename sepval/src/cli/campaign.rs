@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Subcommand;
 
-use super::{EvalArgs, GeometryArgs, OutlierArgs};
+use super::{EvalArgs, GeometryArgs, GridArgs, OutlierArgs};
 
 #[derive(Subcommand)]
 pub enum CampaignCommand {
@@ -51,21 +51,8 @@ pub struct CampaignInitArgs {
     /// The store's scenario (TOML) [default: the embedded default].
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
-    /// Mach values: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub mach: Option<String>,
-    /// Altitudes [m]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub altitude_m: Option<String>,
-    /// Aircraft angles of attack [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub alpha_deg: Option<String>,
-    /// Aircraft sideslip angles [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub beta_deg: Option<String>,
-    /// Flight-path angles [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub gamma_deg: Option<String>,
+    #[command(flatten)]
+    pub grid: GridArgs,
     /// The largest probability of failing to clear at which a condition is cleared (and of
     /// clearing at which it fails).
     #[arg(long, default_value_t = 0.05, value_name = "P")]

@@ -13,7 +13,7 @@ pub use campaign::{
 };
 use sepval_transport::RunId;
 pub use shared::{
-    EvalArgs, GeometryArgs, InputArgs, ModelArgs, NoiseArgs, OutlierArg, OutlierArgs,
+    EvalArgs, GeometryArgs, GridArgs, InputArgs, ModelArgs, NoiseArgs, OutlierArg, OutlierArgs,
     OverwriteArgs, TablesArgs,
 };
 
@@ -342,21 +342,8 @@ pub struct EnvelopeArgs {
     /// diagnose` to predict from.
     #[arg(long, value_name = "DIR")]
     pub from: PathBuf,
-    /// Mach values: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub mach: Option<String>,
-    /// Altitudes [m]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub altitude_m: Option<String>,
-    /// Aircraft angles of attack [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub alpha_deg: Option<String>,
-    /// Aircraft sideslip angles [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub beta_deg: Option<String>,
-    /// Flight-path angles [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub gamma_deg: Option<String>,
+    #[command(flatten)]
+    pub grid: GridArgs,
     /// Model extension (TOML) the source was fitted with [default: the one its inputs record].
     #[arg(long, value_name = "FILE")]
     pub extension: Option<PathBuf>,

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use sepval_common::telemetry::outliers::Policy;
+use sepval_plan::conditions::Quantity;
 use sepval_transport::RunId;
 
 use super::EvaluatorKind;
@@ -98,6 +99,43 @@ pub struct GeometryArgs {
         requires = "aircraft"
     )]
     pub clearance_mm: f64,
+}
+
+/// The axes of a grid of flight conditions (`sepval envelope`, `sepval campaign`), each
+/// `LO:HI:N`.
+#[derive(clap::Args)]
+pub struct GridArgs {
+    /// Mach values: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub mach: Option<String>,
+    /// Altitudes [m]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub altitude_m: Option<String>,
+    /// Aircraft angles of attack [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub alpha_deg: Option<String>,
+    /// Aircraft sideslip angles [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub beta_deg: Option<String>,
+    /// Flight-path angles [deg]: LO:HI:N.
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
+    pub gamma_deg: Option<String>,
+}
+
+impl GridArgs {
+    /// The axes given, in the order of `[flight]`.
+    pub fn given(&self) -> Vec<(Quantity, String)> {
+        [
+            (Quantity::Mach, &self.mach),
+            (Quantity::AltitudeM, &self.altitude_m),
+            (Quantity::AlphaDeg, &self.alpha_deg),
+            (Quantity::BetaDeg, &self.beta_deg),
+            (Quantity::GammaDeg, &self.gamma_deg),
+        ]
+        .into_iter()
+        .filter_map(|(q, v)| v.clone().map(|v| (q, v)))
+        .collect()
+    }
 }
 
 /// Whether an earlier run in `--out` may be cleared (fit, diagnose, plan).

@@ -63,16 +63,12 @@ fn begin(
         );
     };
     let scenario = inputs::scenario(a.scenario.as_deref(), None)?;
-    let axes: Vec<(String, String)> = [
-        ("--mach", &a.mach),
-        ("--altitude-m", &a.altitude_m),
-        ("--alpha-deg", &a.alpha_deg),
-        ("--beta-deg", &a.beta_deg),
-        ("--gamma-deg", &a.gamma_deg),
-    ]
-    .into_iter()
-    .filter_map(|(f, v)| v.clone().map(|v| (f.to_string(), v)))
-    .collect();
+    let axes: Vec<(String, String)> = a
+        .grid
+        .given()
+        .into_iter()
+        .map(|(q, text)| (q.flag().to_string(), text))
+        .collect();
     if axes.is_empty() {
         bail!(
             "give at least one axis: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N"
@@ -140,9 +136,9 @@ fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
         say!(
             "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {})",
             k + 1,
-            f.condition.mach,
-            f.condition.altitude_m,
-            f.condition.alpha_deg,
+            page::shown(f.condition.mach),
+            page::shown(f.condition.altitude_m),
+            page::shown(f.condition.alpha_deg),
             f.p_fail_planned,
             if f.truly_safe { "safe" } else { "UNSAFE" }
         );
@@ -236,9 +232,9 @@ fn status(a: CampaignStatusArgs) -> Result<()> {
         for r in &n.releases {
             say!(
                 "next:      Mach {}, altitude {} m, alpha {} deg: {}",
-                r.mach,
-                r.altitude_m,
-                r.alpha_deg,
+                page::shown(r.mach),
+                page::shown(r.altitude_m),
+                page::shown(r.alpha_deg),
                 r.why
             );
         }

@@ -42,7 +42,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
             "--aircraft FILE is required: the aircraft's geometry (e.g. examples/geometry/aircraft.toml)"
         );
     };
-    let given = axes_given(&args);
+    let given = args.grid.given();
     if given.is_empty() {
         bail!(
             "give at least one axis to sweep: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N"
@@ -204,20 +204,6 @@ pub(super) fn starter(
         started = true;
         evaluators.start(job, told).map_err(EvalError::transport)
     }
-}
-
-/// The axes given, in the order of `[flight]`.
-fn axes_given(args: &EnvelopeArgs) -> Vec<(Quantity, String)> {
-    [
-        (Quantity::Mach, &args.mach),
-        (Quantity::AltitudeM, &args.altitude_m),
-        (Quantity::AlphaDeg, &args.alpha_deg),
-        (Quantity::BetaDeg, &args.beta_deg),
-        (Quantity::GammaDeg, &args.gamma_deg),
-    ]
-    .into_iter()
-    .filter_map(|(q, v)| v.clone().map(|v| (q, v)))
-    .collect()
 }
 
 /// The releases flown, on the map's axes.

@@ -265,8 +265,8 @@ pub fn validation_job(
     Ok(Some(Job::new(events)?))
 }
 
-/// The baseline fit of a diagnosis or an update: the study's GA, then Levenberg-Marquardt
-/// with `lm` (its probes' refinements within 800 simulations), written to `out`/baseline.
+/// The baseline fit of a diagnosis or an update ([`sepval_fit::FitOptions::baseline`]),
+/// written to `out`/baseline.
 pub fn baseline_fit(
     ga: sepval_solve::ga::GaSettings,
     sigma: sepval_fit::sigma::Sigma,
@@ -274,20 +274,5 @@ pub fn baseline_fit(
     out: &Path,
     inputs: sepval_fit::checkpoint::InputsRecord,
 ) -> sepval_fit::FitOptions {
-    use sepval_solve::lm::LmSettings;
-    sepval_fit::FitOptions {
-        method: sepval_fit::Method::GaLm,
-        ga,
-        hill: sepval_solve::hill::HillSettings::default(),
-        sigma,
-        truth: None,
-        out: out.join("baseline"),
-        resume: None,
-        inputs,
-        lm: lm.clone(),
-        lm_probe: LmSettings {
-            budget: lm.budget.min(800),
-            ..LmSettings::default()
-        },
-    }
+    sepval_fit::FitOptions::baseline(ga, sigma, lm, &out.join("baseline"), inputs)
 }

@@ -162,10 +162,21 @@ fn add_records_a_round_and_refuses_a_release_twice_or_broken_with_nothing_change
     let dir = tmp.path();
     init(dir, "c", "25.4", "2");
     let r = release(dir, "r1.csv", "5");
-    let eval = ["--evaluator", "inproc", "--threads", "2"];
-    let mut args = vec!["campaign", "add", "c", "--data", &r];
-    args.extend(eval);
-    ok(&sepval(&args, dir));
+    let add = |file: &str| {
+        let args = [
+            "campaign",
+            "add",
+            "c",
+            "--data",
+            file,
+            "--evaluator",
+            "inproc",
+            "--threads",
+            "2",
+        ];
+        sepval(&args, dir)
+    };
+    ok(&add(&r));
     let camp = json(&dir.join("c/campaign.json"));
     assert_eq!(camp["format"], "sepval-campaign/1");
     assert_eq!(camp["releases"].as_array().unwrap().len(), 1);
@@ -178,14 +189,10 @@ fn add_records_a_round_and_refuses_a_release_twice_or_broken_with_nothing_change
     let before = snapshot(&dir.join("c"));
     // The same release under another name.
     std::fs::copy(dir.join(&r), dir.join("copy.csv")).unwrap();
-    let mut args = vec!["campaign", "add", "c", "--data", "copy.csv"];
-    args.extend(eval);
-    refused(&sepval(&args, dir), "already in the campaign");
+    refused(&add("copy.csv"), "already in the campaign");
     // A file that does not read.
     std::fs::write(dir.join("broken.csv"), "t_s,x_m\n0,1,2,3\n").unwrap();
-    let mut args = vec!["campaign", "add", "c", "--data", "broken.csv"];
-    args.extend(eval);
-    refused(&sepval(&args, dir), "broken.csv");
+    refused(&add("broken.csv"), "broken.csv");
     assert_eq!(
         snapshot(&dir.join("c")),
         before,
@@ -200,44 +207,18 @@ fn init_refuses_a_directory_that_is_not_empty_and_bad_probabilities() {
     std::fs::create_dir(dir.join("c")).unwrap();
     std::fs::write(dir.join("c/thesis.tex"), "mine").unwrap();
     let a = aircraft();
-    refused(
-        &sepval(
-            &[
-                "campaign",
-                "init",
-                "--aircraft",
-                &a,
-                "--mach",
-                "0.6:1.0:2",
-                "--out",
-                "c",
-            ],
-            dir,
-        ),
-        "not empty",
-    );
+    let init = |extra: &[&str], out: &str| {
+        let mut args = vec!["campaign", "init", "--aircraft", &a, "--mach", "0.6:1.0:2"];
+        args.extend(extra);
+        args.extend(["--out", out]);
+        sepval(&args, dir)
+    };
+    refused(&init(&[], "c"), "not empty");
     assert_eq!(
         std::fs::read_to_string(dir.join("c/thesis.tex")).unwrap(),
         "mine"
     );
-    refused(
-        &sepval(
-            &[
-                "campaign",
-                "init",
-                "--aircraft",
-                &a,
-                "--mach",
-                "0.6:1.0:2",
-                "--allowed",
-                "0.7",
-                "--out",
-                "d",
-            ],
-            dir,
-        ),
-        "--allowed 0.7",
-    );
+    refused(&init(&["--allowed", "0.7"], "d"), "--allowed 0.7");
     assert!(!dir.join("d").exists());
 }
 
@@ -330,4 +311,75 @@ fn a_rehearsal_with_a_hidden_cause_clears_nothing_the_truth_fails() {
     for round in r["rounds"].as_array().unwrap() {
         assert_eq!(round["false_clears"], 0, "{round}");
     }
+}
+
+#[test]
+fn an_add_interrupted_by_sigterm_leaves_the_campaign_as_it_was() {
+    use sepval_tests::{signal, spawn_sepval, wait_exit, wait_for};
+    use std::time::Duration;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let a = aircraft();
+    // Enough samples that the new round's envelope takes seconds.
+    ok(&sepval(
+        &[
+            "campaign",
+            "init",
+            "--aircraft",
+            &a,
+            "--mach",
+            "0.6:1.0:5",
+            "--alpha-deg",
+            "-4:8:5",
+            "--samples",
+            "2000",
+            "--evaluator",
+            "inproc",
+            "--threads",
+            "2",
+            "--generations",
+            "5",
+            "--out",
+            "c",
+        ],
+        dir,
+    ));
+    let r = release(dir, "r1.csv", "5");
+    let before = snapshot(&dir.join("c"));
+    let mut child = spawn_sepval(
+        &[
+            "campaign",
+            "add",
+            "c",
+            "--data",
+            &r,
+            "--evaluator",
+            "inproc",
+            "--threads",
+            "2",
+        ],
+        dir,
+    );
+    // The round is being assessed once its staging directory is there.
+    let staged = dir.join("c/.staging/round");
+    wait_for("the round's staging", Duration::from_secs(120), || {
+        staged.exists()
+    });
+    signal(child.id() as i32, libc::SIGTERM);
+    let out = wait_exit(
+        &mut child,
+        "campaign add after SIGTERM",
+        Duration::from_secs(30),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        snapshot(&dir.join("c")),
+        before,
+        "the interrupted add changed the campaign"
+    );
 }
