@@ -1,8 +1,9 @@
 //! `sepval campaign add`: releases flown, recorded (docs/campaign.md, "Adding releases"). Each
 //! is first checked against what the campaign predicted at its condition (the post-flight
-//! check of `sepval predict --data`, [`sepval_predict::check`]); then the model is fitted
-//! again to every release flown (the study's GA then Levenberg-Marquardt, `ga+lm`, the fit a
-//! diagnosis starts from), and the envelope is predicted again from that fit (round N). A
+//! check of `sepval predict --data`, [`sepval_predict::check`]); then every release flown is
+//! diagnosed again (`sepval diagnose`: the baseline fit, the effect catalogue, discovery beyond
+//! it; its answer and rivals), and the envelope is predicted again from that diagnosis (round
+//! N). A
 //! release already in the campaign (the same bytes, or the same samples at the same
 //! condition) is refused with nothing changed.
 
@@ -12,9 +13,10 @@ use std::sync::Arc;
 use sepval_common::evaluation::Job;
 use sepval_common::scenario::Scenario;
 use sepval_common::telemetry::Trajectory;
+use sepval_diagnose::DiagnoseOptions;
+use sepval_fit::FitOptions;
 use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::sigma::Sigma;
-use sepval_fit::{FitOptions, run_fit};
 use sepval_predict::bands::{BandInputs, bands};
 use sepval_predict::check::{Check, check};
 use sepval_predict::record::ConditionRecord;
@@ -98,9 +100,9 @@ fn add_all(
         });
     }
     let job = c.job()?.expect("releases were added");
-    let fit_dir = c.dir.join(STAGING).join("fit");
-    fit(c, &job, &fit_dir, start, observer)?;
-    let model = fitted_model(&fit_dir, job)?;
+    let dir = c.dir.join(STAGING).join("diagnosis");
+    diagnose(c, &job, &dir, start, observer)?;
+    let model = fitted_model(&dir, job)?;
     c.round(&model, start, observer)?;
     Ok(checks)
 }
@@ -153,8 +155,10 @@ fn same(data: &Trajectory, flight: &sepval_common::scenario::Flight, r: &NewRele
         && bits(data.att_deg.as_flattened(), d.att_deg.as_flattened())
 }
 
-/// The fit of every release flown (`ga+lm`) into `out`.
-fn fit(
+/// The diagnosis of every release flown into `out` (DIR/diagnosis.json, its baseline fit in
+/// DIR/baseline): the study's GA for the campaign's generations then Levenberg-Marquardt, the
+/// effect catalogue and discovery beyond it, as `sepval diagnose` runs them.
+fn diagnose(
     c: &Campaign,
     job: &Job,
     out: &Path,
@@ -180,13 +184,26 @@ fn fit(
         seed: s.seed,
         ..GaSettings::default()
     };
-    let options = FitOptions::baseline(ga, sigma, &LmSettings::default(), out, inputs);
+    let lm = LmSettings::default();
+    let options = DiagnoseOptions {
+        fit: FitOptions::baseline(ga, sigma, &lm, &out.join("baseline"), inputs),
+        out: out.to_path_buf(),
+        candidate_lm: LmSettings {
+            max_iterations: 400,
+            budget: 10_000,
+            ..lm
+        },
+        validation: None,
+        given_terms: Vec::new(),
+        strict_tables: false,
+    };
     let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
-    run_fit(&options, evaluator.as_mut(), observer).map_err(|e| match e {
-        sepval_fit::FitError::Run(sepval_solve::run::RunError::Interrupted) => {
+    sepval_diagnose::diagnose(&options, evaluator.as_mut(), observer).map_err(|e| {
+        if sepval_common::cancel::requested() {
             CampaignError::Interrupted
+        } else {
+            CampaignError::Diagnose(Box::new(e))
         }
-        e => CampaignError::Fit(Box::new(e)),
     })?;
     Ok(())
 }

@@ -1,11 +1,11 @@
 //! One envelope of the campaign: every condition of the grid predicted from what the campaign
-//! believes in a round ([`Model`]: the prior, or the fit of every release flown), with the
+//! believes in a round ([`Model`]: the prior, or the diagnosis of every release flown), with the
 //! clearance of every sample (docs/campaign.md, "An envelope of the campaign").
 //!
 //! At condition k: `samples` draws of the factors (sample s from its own generator,
 //! [`sepval_predict::sampling::sample_rng`], the same draws at every condition: common random
 //! numbers), each flown through the evaluator; the model-form band at the releases (none for
-//! the prior; the fit's discrepancy calibrated on its releases otherwise,
+//! the prior; the diagnosis's discrepancy calibrated on its releases otherwise,
 //! [`sepval_predict::discrepancy`], as `sepval envelope` does), widened with the condition's
 //! reach ([`sepval_predict::reach`]); the clearance of every sample
 //! ([`sepval_predict::clearance::assess`]) twice: with the model-form band (the condition's
@@ -26,7 +26,7 @@ use sepval_predict::ensemble::Ensemble;
 use sepval_predict::record::ConditionRecord;
 use sepval_predict::sampling::{ParameterDistribution, STREAM_PARAMETERS, sample_rng};
 use sepval_predict::simulate::{self, GridTrajectory};
-use sepval_predict::{ClearanceSettings, PredictError, Source, clearance, reach};
+use sepval_predict::{ClearanceSettings, PredictError, Sampler, Source, clearance, reach};
 use sepval_solve::run::{NoProgress, Progress as Step, ProgressObserver};
 
 use crate::CampaignError;
@@ -35,7 +35,8 @@ use crate::state::{Assessed, State, spread};
 /// Starts an evaluator for a job (a condition's release).
 pub type StartEvaluator<'a> = dyn FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + 'a;
 
-/// What a round believes: the factors' distribution and the model form at the releases.
+/// What a round believes: the factors' distribution (the prior's, or the diagnosis's answer's
+/// with its rivals) and the model form at the releases.
 pub struct Model {
     /// The free parameters (the 17 factors).
     pub space: ParamSpace,
@@ -45,11 +46,11 @@ pub struct Model {
     pub fitted: Option<Fitted>,
 }
 
-/// The fit of every release flown.
+/// The diagnosis of every release flown.
 pub struct Fitted {
-    /// The fit as `sepval predict` reads it.
+    /// The diagnosis as `sepval predict` reads it.
     pub source: Source,
-    /// Its answer.
+    /// Its answer and rivals.
     pub ensemble: Ensemble,
     /// The releases.
     pub job: Job,
@@ -167,11 +168,22 @@ pub fn assess(
     Ok(out)
 }
 
-/// The samples' candidates: draw s from its own generator.
+/// The samples' candidates: draw s from its own generator; with releases flown, its model
+/// chosen among the diagnosis's answer and rivals by their weights first
+/// ([`sepval_predict::Sampler`]).
 pub(crate) fn draws(
     model: &Model,
     settings: &AssessSettings,
 ) -> Result<Vec<Candidate>, CampaignError> {
+    if let Some(f) = &model.fitted {
+        let sampler = Sampler {
+            answer: model.distribution.clone(),
+            seed: settings.seed,
+        };
+        return Ok((0..settings.samples)
+            .map(|s| sampler.sample(&f.ensemble, s as u64).candidate)
+            .collect());
+    }
     (0..settings.samples)
         .map(|s| {
             let mut rng = sample_rng(settings.seed, s as u64, STREAM_PARAMETERS);
@@ -184,7 +196,7 @@ pub(crate) fn draws(
         .collect()
 }
 
-/// The calibration of the fit's discrepancy at the release of `job`.
+/// The calibration of the diagnosis's discrepancy at the release of `job`.
 fn calibration<'a>(f: &'a Fitted, job: &'a Job, s: &AssessSettings) -> Calibration<'a> {
     Calibration {
         answer: f.ensemble.answer(),

@@ -1,7 +1,7 @@
 //! The test program as one record (`sepval campaign`, docs/campaign.md): the separation
 //! envelope predicted before any release from a prior, the next release to fly chosen among
 //! the conditions predicted safe by what it is expected to settle, each release flown checked
-//! against its prediction and the model fitted again to every release, until no condition is
+//! against its prediction and every release diagnosed again, until no condition is
 //! undecided or no safe release is expected to settle any. The field's practice, a few
 //! releases validating the simulation and the rest of the envelope cleared by prediction, is
 //! M. B. Anderson's purpose ("a tenth of the test assets"); sequential planning for the
@@ -52,11 +52,11 @@ pub enum CampaignError {
     /// An evaluator that could not be started.
     #[error("cannot start the evaluator")]
     Start(#[source] EvalError),
-    /// The fit of the releases.
-    #[error("the fit of the releases flown")]
-    Fit(#[source] Box<sepval_fit::FitError>),
-    /// The fit's record as a prediction reads it.
-    #[error("the fit of the releases flown")]
+    /// The diagnosis of the releases.
+    #[error("the diagnosis of the releases flown")]
+    Diagnose(#[source] Box<sepval_diagnose::DiagnoseError>),
+    /// The diagnosis's record as a prediction reads it.
+    #[error("the diagnosis of the releases flown")]
     Source(#[source] Box<sepval_predict::PredictError>),
     /// The campaign's directory or one of its records.
     #[error("{path}: {message}")]

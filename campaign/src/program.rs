@@ -308,12 +308,13 @@ impl Campaign {
             .map_err(|e| CampaignError::Refused(e.to_string()))
     }
 
-    /// What the current round believes: the prior, or the fit in the last round's directory.
+    /// What the current round believes: the prior, or the diagnosis in the last round's
+    /// directory.
     pub fn model(&self) -> Result<Model, CampaignError> {
         let table = &self.scenario.factors;
         match (self.job()?, self.file.rounds.last()) {
             (Some(job), Some(last)) if last.releases_flown > 0 => {
-                fitted_model(&self.dir.join(&last.dir).join("fit"), job)
+                fitted_model(&self.dir.join(&last.dir).join("diagnosis"), job)
             }
             _ => {
                 let (space, distribution) = self.file.settings.prior.distribution(table);
@@ -399,10 +400,11 @@ impl Campaign {
         )?;
         write_json(&staged.join("assessment.json"), &assessed)?;
         page::write_envelope_csv(&staged.join("envelope.csv"), &assessed)?;
-        // The fit of an add's model was staged beside the round.
-        let fit = self.dir.join(STAGING).join("fit");
-        if fit.is_dir() {
-            std::fs::rename(&fit, staged.join("fit")).map_err(|e| record_error(&fit, e))?;
+        // The diagnosis of an add's model was staged beside the round.
+        let diagnosis = self.dir.join(STAGING).join("diagnosis");
+        if diagnosis.is_dir() {
+            std::fs::rename(&diagnosis, staged.join("diagnosis"))
+                .map_err(|e| record_error(&diagnosis, e))?;
         }
         sepval_common::cancel::check()?;
         let dir = format!("rounds/{n:02}");
@@ -431,7 +433,8 @@ impl Campaign {
     }
 }
 
-/// The model of the fit written in `dir` to the releases of `job`.
+/// The model of the diagnosis (or fit) written in `dir` of the releases of `job`: its answer's
+/// distribution and its rivals with their weights.
 pub(crate) fn fitted_model(dir: &Path, job: Job) -> Result<Model, CampaignError> {
     let source =
         sepval_predict::read_source(dir).map_err(|e| CampaignError::Source(Box::new(e.into())))?;

@@ -12,8 +12,8 @@ pub enum CampaignCommand {
     Init(Box<CampaignInitArgs>),
     /// The next release(s) to fly: safe to fly, ranked by what they are expected to settle.
     Next(CampaignNextArgs),
-    /// Record flown releases: each checked against its prediction, the model fitted again, the
-    /// envelope predicted again.
+    /// Record flown releases: each checked against its prediction, every release diagnosed
+    /// again, the envelope predicted again.
     Add(CampaignAddArgs),
     /// The campaign's state in a few lines.
     Status(CampaignStatusArgs),
@@ -70,7 +70,8 @@ pub struct CampaignInitArgs {
     /// Seed of every draw and of each round's fit.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Generations of each round's genetic search (then Levenberg-Marquardt).
+    /// Generations of the genetic search of each round's baseline fit (then
+    /// Levenberg-Marquardt, then the diagnosis).
     #[arg(long, default_value_t = 20)]
     pub generations: usize,
     #[command(flatten)]
