@@ -88,13 +88,36 @@ fn next_plans_only_safe_distinct_conditions_and_says_when_none_is_safe() {
 }
 
 #[test]
-fn the_envelope_is_the_same_bits_on_one_thread_and_two() {
+fn the_envelope_is_the_same_bits_on_one_thread_two_and_two_iceoryx2_workers() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     init(dir, "one", "25.4", "1");
     init(dir, "two", "25.4", "2");
+    let a = aircraft();
+    ok(&sepval(
+        &[
+            "campaign",
+            "init",
+            "--aircraft",
+            &a,
+            "--mach",
+            "0.6:1.0:5",
+            "--alpha-deg",
+            "-4:8:5",
+            "--samples",
+            "100",
+            "--evaluator",
+            "ipc",
+            "--workers",
+            "2",
+            "--out",
+            "ipc",
+        ],
+        dir,
+    ));
     let read = |d: &str| std::fs::read(dir.join(d).join("envelope.csv")).unwrap();
     assert_eq!(read("one"), read("two"));
+    assert_eq!(read("one"), read("ipc"));
     let status = json(&dir.join("one/status.json"));
     assert_eq!(status["conditions"], 25);
     assert_eq!(status["releases_flown"], 0);
