@@ -317,3 +317,64 @@ fn planned(grid: &Grid, assessed: &[Assessed], c: usize, e: f64, why: String) ->
         why,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sepval_common::scenario::Scenario;
+    use sepval_envelope::Row;
+    use sepval_envelope::grid::Axis;
+    use sepval_plan::conditions::Quantity;
+    use sepval_predict::record::ConditionRecord;
+
+    /// A grid of five Mach numbers whose conditions fail with `p_fail`, median clearance `p50`.
+    fn envelope(p_fail: [f64; 5], p50: [f64; 5]) -> (Grid, Vec<Assessed>) {
+        let base = Scenario::embedded_default();
+        let grid = Grid::of(&base, &[Axis::parse(Quantity::Mach, "0.6:1.0:5").unwrap()]).unwrap();
+        let assessed = (0..5)
+            .map(|k| {
+                let mut row = Row::all_diverged(k, ConditionRecord::of(grid.flight(k)));
+                (row.p_fail, row.clearance_p50_mm, row.diverged_share) = (p_fail[k], p50[k], 0.0);
+                Assessed {
+                    state: State::of(p_fail[k], 0.05),
+                    reach: f64::INFINITY,
+                    spread_mm: 10.0,
+                    factor_spread_mm: 8.0,
+                    row,
+                }
+            })
+            .collect();
+        (grid, assessed)
+    }
+
+    const CRITERIA: Criteria = Criteria {
+        criterion_mm: 25.4,
+        allowed: 0.05,
+        fly_risk: 0.01,
+    };
+
+    #[test]
+    fn only_safe_conditions_are_planned_and_a_batch_is_distinct() {
+        let (grid, a) = envelope([0.0, 0.005, 0.2, 0.3, 0.4], [60.0, 55.0, 33.0, 30.0, 28.0]);
+        let p = plan(&grid, &a, &[], CRITERIA, 3);
+        assert!(!p.settled, "{p:?}");
+        assert_eq!(p.releases.len(), 2, "only two conditions are safe: {p:?}");
+        let mut seen: Vec<usize> = p.releases.iter().map(|r| r.index).collect();
+        assert!(seen.iter().all(|&k| a[k].row.p_fail <= 0.01), "{p:?}");
+        seen.dedup();
+        assert_eq!(seen.len(), 2);
+        assert!(p.releases[0].expected_settled > 0.0, "{p:?}");
+    }
+
+    #[test]
+    fn no_safe_condition_names_the_least_risky_and_nothing_undecided_is_settled() {
+        let (grid, a) = envelope([0.2, 0.3, 0.02, 0.4, 0.5], [40.0, 35.0, 45.0, 30.0, 25.0]);
+        let p = plan(&grid, &a, &[], CRITERIA, 1);
+        assert!(p.releases.is_empty());
+        assert_eq!(p.least_risky.as_ref().map(|r| r.index), Some(2));
+        let (grid, a) = envelope([0.0; 5], [90.0; 5]);
+        let p = plan(&grid, &a, &[], CRITERIA, 1);
+        assert!(p.settled && p.releases.is_empty(), "{p:?}");
+        assert_eq!(p.words, "settled: no condition is undecided");
+    }
+}
