@@ -23,7 +23,7 @@ use sepval_predict::record::ConditionRecord;
 use sepval_predict::simulate::{self, GridTrajectory, data_on_grid};
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
-use sepval_solve::run::{NoProgress, ProgressObserver};
+use sepval_solve::run::ProgressObserver;
 
 use crate::CampaignError;
 use crate::assess::{AssessSettings, Model, StartEvaluator};
@@ -219,19 +219,8 @@ pub fn check_release(
     start: &mut StartEvaluator<'_>,
 ) -> Result<Check, CampaignError> {
     let points = simulate::Grid::of(&data.times_s);
-    let job = simulate::release_job(scenario, &data.times_s, "check")
-        .map_err(|e| CampaignError::Condition(Box::new(simulate::SimulateError::from(e).into())))?;
     let candidates = crate::assess::draws(model, settings)?;
-    let mut evaluator = start(Arc::new(job)).map_err(CampaignError::from_eval)?;
-    let runs = simulate::run_candidates(
-        evaluator.as_mut(),
-        candidates.len(),
-        &|i| candidates[i],
-        &points,
-        &mut NoProgress,
-    )
-    .map_err(|e| CampaignError::Condition(Box::new(e.into())))?;
-    drop(evaluator);
+    let (_, runs) = crate::assess::fly(scenario, &data.times_s, &points, &candidates, start)?;
     let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
     let flights: Vec<_> = model.flown();
     let refs: Vec<_> = flights.iter().collect();

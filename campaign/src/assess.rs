@@ -106,18 +106,7 @@ pub fn assess(
     for k in 0..grid.len() {
         cancel::check()?;
         let scenario = grid.scenario(base, k);
-        let job = simulate::release_job(&scenario, &times, "campaign")
-            .map_err(|e| condition(simulate::SimulateError::from(e).into()))?;
-        let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
-        let runs = simulate::run_candidates(
-            evaluator.as_mut(),
-            candidates.len(),
-            &|i| candidates[i],
-            &points,
-            &mut NoProgress,
-        )
-        .map_err(|e| condition(e.into()))?;
-        drop(evaluator);
+        let (job, runs) = fly(&scenario, &times, &points, &candidates, start)?;
         let mut sd = match &model.fitted {
             None => vec![[0.0; 6]; points.len()],
             Some(f) => {
@@ -166,6 +155,29 @@ pub fn assess(
     }
     observer.finish();
     Ok(out)
+}
+
+/// The release of `scenario` at `times` (its job) and `candidates` flown there through an
+/// evaluator started for it, at the band's `points`.
+pub(crate) fn fly(
+    scenario: &Scenario,
+    times: &[f64],
+    points: &simulate::Grid,
+    candidates: &[Candidate],
+    start: &mut StartEvaluator<'_>,
+) -> Result<(Job, simulate::Runs), CampaignError> {
+    let job = simulate::release_job(scenario, times, "campaign")
+        .map_err(|e| condition(simulate::SimulateError::from(e).into()))?;
+    let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
+    let runs = simulate::run_candidates(
+        evaluator.as_mut(),
+        candidates.len(),
+        &|i| candidates[i],
+        points,
+        &mut NoProgress,
+    )
+    .map_err(|e| condition(e.into()))?;
+    Ok((job, runs))
 }
 
 /// The samples' candidates: draw s from its own generator; with releases flown, its model

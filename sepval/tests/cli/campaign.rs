@@ -3,48 +3,50 @@
 //! fitted, round 1), the refusals (a release twice, a broken file) with nothing changed, and the
 //! same bits whatever the thread count. Reduced samples; release build.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use super::hardening_on_disk::snapshot;
 
 use sepval_tests::{ok, refused, sepval};
 use serde_json::Value;
 
 fn aircraft() -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples/geometry/aircraft.toml")
-        .canonicalize()
-        .unwrap()
-        .display()
-        .to_string()
+    super::envelope::example("aircraft.toml")
 }
 
-/// `campaign init` of a 5 x 5 grid in `dir`/`out` with `criterion` mm and `threads`.
+/// `campaign init` of a 5 x 5 grid in `dir`/`out` with `criterion` mm on `threads` threads.
 fn init(dir: &Path, out: &str, criterion: &str, threads: &str) {
-    let a = aircraft();
-    ok(&sepval(
-        &[
-            "campaign",
-            "init",
-            "--aircraft",
-            &a,
-            "--mach",
-            "0.6:1.0:5",
-            "--alpha-deg",
-            "-4:8:5",
-            "--samples",
-            "100",
-            "--clearance-mm",
-            criterion,
-            "--evaluator",
-            "inproc",
-            "--threads",
-            threads,
-            "--generations",
-            "5",
-            "--out",
-            out,
-        ],
+    init_with(
         dir,
-    ));
+        out,
+        criterion,
+        &["--evaluator", "inproc", "--threads", threads],
+    );
+}
+
+/// `campaign init` of a 5 x 5 grid in `dir`/`out` with `criterion` mm and `evaluator` flags.
+fn init_with(dir: &Path, out: &str, criterion: &str, evaluator: &[&str]) {
+    let a = aircraft();
+    let mut args = vec![
+        "campaign",
+        "init",
+        "--aircraft",
+        &a,
+        "--mach",
+        "0.6:1.0:5",
+        "--alpha-deg",
+        "-4:8:5",
+        "--samples",
+        "100",
+        "--clearance-mm",
+        criterion,
+        "--generations",
+        "5",
+        "--out",
+        out,
+    ];
+    args.extend(evaluator);
+    ok(&sepval(&args, dir));
 }
 
 fn json(path: &Path) -> Value {
@@ -93,28 +95,12 @@ fn the_envelope_is_the_same_bits_on_one_thread_two_and_two_iceoryx2_workers() {
     let dir = tmp.path();
     init(dir, "one", "25.4", "1");
     init(dir, "two", "25.4", "2");
-    let a = aircraft();
-    ok(&sepval(
-        &[
-            "campaign",
-            "init",
-            "--aircraft",
-            &a,
-            "--mach",
-            "0.6:1.0:5",
-            "--alpha-deg",
-            "-4:8:5",
-            "--samples",
-            "100",
-            "--evaluator",
-            "ipc",
-            "--workers",
-            "2",
-            "--out",
-            "ipc",
-        ],
+    init_with(
         dir,
-    ));
+        "ipc",
+        "25.4",
+        &["--evaluator", "ipc", "--workers", "2"],
+    );
     let read = |d: &str| std::fs::read(dir.join(d).join("envelope.csv")).unwrap();
     assert_eq!(read("one"), read("two"));
     assert_eq!(read("one"), read("ipc"));
@@ -159,24 +145,6 @@ fn release(dir: &Path, name: &str, noise_seed: &str) -> String {
         dir,
     ));
     name.to_string()
-}
-
-/// Every file under `dir` with its bytes (the lock aside).
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push((p.clone(), std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 #[test]

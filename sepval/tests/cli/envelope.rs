@@ -12,7 +12,7 @@ use serde_json::Value;
 use super::predict::fixture;
 
 /// The example aircraft and store of the repository.
-fn example(name: &str) -> String {
+pub(crate) fn example(name: &str) -> String {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/geometry")
         .join(name);
