@@ -68,8 +68,9 @@ fn add_all(
     start: &mut StartEvaluator<'_>,
     observer: &mut dyn ProgressObserver,
 ) -> Result<Vec<Check>, CampaignError> {
-    refuse_known(c, &releases)?;
-    let model = c.model()?;
+    let flown = c.job()?;
+    refuse_known(c, flown.as_ref(), &releases)?;
+    let model = c.model_of(flown)?;
     let settings = c.assess_settings();
     let mut checks = Vec::new();
     for r in &releases {
@@ -107,9 +108,12 @@ fn add_all(
     Ok(checks)
 }
 
-/// Refuses a release the campaign holds, or one given twice.
-fn refuse_known(c: &Campaign, releases: &[NewRelease]) -> Result<(), CampaignError> {
-    let known = c.job()?;
+/// Refuses a release the campaign holds (`known`: its releases flown), or one given twice.
+fn refuse_known(
+    c: &Campaign,
+    known: Option<&Job>,
+    releases: &[NewRelease],
+) -> Result<(), CampaignError> {
     for (i, r) in releases.iter().enumerate() {
         let name = r.given.display();
         if let Some(k) = c.file.releases.iter().find(|k| k.sha256 == r.sha256) {
@@ -118,7 +122,7 @@ fn refuse_known(c: &Campaign, releases: &[NewRelease]) -> Result<(), CampaignErr
                 k.file, k.given
             )));
         }
-        if let Some(j) = known.as_ref().and_then(|j| {
+        if let Some(j) = known.and_then(|j| {
             j.events()
                 .iter()
                 .position(|e| same(&e.data, &e.simulator.scenario().flight, r))

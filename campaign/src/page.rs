@@ -139,7 +139,7 @@ fn state_map(
     let releases: Vec<(f64, f64)> = c.file.releases[..flown.min(c.file.releases.len())]
         .iter()
         .map(|r| {
-            let f = flight_of(&r.condition);
+            let f = r.condition.flight();
             (xq.get(&f), yq.map_or(0.0, |q| q.get(&f)))
         })
         .collect();
@@ -159,14 +159,6 @@ fn state_map(
         &releases,
     )
     .map_err(|e| record_error(path, e))
-}
-
-/// The flight condition of a record.
-fn flight_of(c: &sepval_predict::record::ConditionRecord) -> sepval_common::scenario::Flight {
-    let mut f = sepval_common::scenario::Scenario::embedded_default().flight;
-    (f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg) =
-        (c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg);
-    f
 }
 
 /// A number for a reader: at most six significant digits, no trailing zeros (a grid's

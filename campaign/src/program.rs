@@ -291,12 +291,7 @@ impl Campaign {
             let path = self.dir.join(&r.file);
             let data = Trajectory::read(&path).map_err(|e| record_error(&path, e))?;
             let mut s = self.scenario.clone();
-            let c = &r.condition;
-            s.flight.mach = c.mach;
-            s.flight.altitude_m = c.altitude_m;
-            s.flight.alpha_deg = c.alpha_deg;
-            s.flight.beta_deg = c.beta_deg;
-            s.flight.gamma_deg = c.gamma_deg;
+            s.flight = r.condition.flight();
             events.push(Event {
                 name: r.file.clone(),
                 simulator: Simulator::new(&s),
@@ -311,8 +306,13 @@ impl Campaign {
     /// What the current round believes: the prior, or the diagnosis in the last round's
     /// directory.
     pub fn model(&self) -> Result<Model, CampaignError> {
+        self.model_of(self.job()?)
+    }
+
+    /// [`Campaign::model`] of `flown`, the releases flown as [`Campaign::job`] reads them.
+    pub(crate) fn model_of(&self, flown: Option<Job>) -> Result<Model, CampaignError> {
         let table = &self.scenario.factors;
-        match (self.job()?, self.file.rounds.last()) {
+        match (flown, self.file.rounds.last()) {
             (Some(job), Some(last)) if last.releases_flown > 0 => {
                 fitted_model(&self.dir.join(&last.dir).join("diagnosis"), job)
             }
@@ -346,13 +346,7 @@ impl Campaign {
             .file
             .releases
             .iter()
-            .map(|r| {
-                let mut f = self.scenario.flight.clone();
-                let c = &r.condition;
-                (f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg) =
-                    (c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg);
-                f
-            })
+            .map(|r| r.condition.flight())
             .collect();
         Ok(plan(
             &self.grid,

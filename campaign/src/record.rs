@@ -92,7 +92,8 @@ pub struct RoundRecord {
     pub settled: bool,
     /// Its directory in the campaign (`rounds/NN`).
     pub dir: String,
-    /// Simulations run by the round.
+    /// Samples its envelope flew: conditions times samples (the diagnosis's, the discrepancy's
+    /// calibration's and the post-flight check's simulations are not counted).
     pub evaluations: u64,
     /// Wall time \[s\].
     pub wall_s: f64,

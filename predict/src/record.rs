@@ -41,6 +41,17 @@ impl ConditionRecord {
             gamma_deg: f.gamma_deg,
         }
     }
+
+    /// The flight condition it records.
+    pub fn flight(&self) -> sepval_common::scenario::Flight {
+        sepval_common::scenario::Flight {
+            mach: self.mach,
+            altitude_m: self.altitude_m,
+            alpha_deg: self.alpha_deg,
+            beta_deg: self.beta_deg,
+            gamma_deg: self.gamma_deg,
+        }
+    }
 }
 
 /// One source's share of the band.

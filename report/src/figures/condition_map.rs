@@ -58,6 +58,28 @@ pub(super) fn edges(values: &[f64]) -> Vec<f64> {
     }
 }
 
+/// Refuses `cells` (`cells[iy][ix]`) that are not one row per value of `y` (one row without
+/// it) of one cell per value of `x`.
+pub(super) fn check_cells<T>(
+    path: &Path,
+    x: MapAxis<'_>,
+    y: Option<MapAxis<'_>>,
+    cells: &[Vec<T>],
+) -> Result<(), FigureError> {
+    let rows = y.map_or(1, |y| y.values.len());
+    if cells.len() != rows || cells.iter().any(|r| r.len() != x.values.len()) {
+        return Err(FigureError::Input {
+            path: path.to_path_buf(),
+            message: format!(
+                "the map must be {rows} rows of {} cells, found {} rows",
+                x.values.len(),
+                cells.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// A map of `cells` (`cells[iy][ix]`, one row when `y` is `None`; a value that is not finite is
 /// a grey cell) over the values of `x` and `y`, coloured from the smallest value (dark) to the
 /// largest (yellow), the value written in each cell when the grid is at most 12 × 12, the cell
@@ -71,17 +93,8 @@ pub fn condition_map(
     value_label: &str,
     best: Option<(usize, usize)>,
 ) -> Result<(), FigureError> {
-    let rows = y.map_or(1, |y| y.values.len());
-    if cells.len() != rows || cells.iter().any(|r| r.len() != x.values.len()) {
-        return Err(FigureError::Input {
-            path: path.to_path_buf(),
-            message: format!(
-                "the map must be {rows} rows of {} cells, found {} rows",
-                x.values.len(),
-                cells.len()
-            ),
-        });
-    }
+    check_cells(path, x, y, cells)?;
+    let rows = cells.len();
     let finite: Vec<f64> = cells
         .iter()
         .flatten()

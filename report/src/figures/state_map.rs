@@ -1,14 +1,13 @@
 //! The states of a campaign's envelope as a map (docs/campaign.md): each condition a cell in
-//! one of three fixed colours (cleared green, undecided amber, fails red; grey when the grid's
-//! other axes disagree is not needed: the worst state of the cell is drawn), the releases flown
-//! numbered in the order flown, and a legend.
+//! one of three fixed colours (cleared green, undecided amber, fails red; grey for a value that
+//! is none of them), the releases flown numbered in the order flown, and a legend.
 
 use std::path::Path;
 
 use plotters::prelude::*;
 
 use super::FigureError;
-use super::condition_map::{MapAxis, edges};
+use super::condition_map::{MapAxis, NO_VALUE_GREY, check_cells, edges};
 use super::kit::{LegendMark, draw_legend_strip, draw_mesh, fmt_tick, render, text};
 
 /// A cell's state: 0 cleared, 1 undecided, 2 fails (anything else: no value, grey).
@@ -30,17 +29,7 @@ pub fn state_map(
     states: &[Vec<u8>],
     flown: &[(f64, f64)],
 ) -> Result<(), FigureError> {
-    let rows = y.map_or(1, |y| y.values.len());
-    if states.len() != rows || states.iter().any(|r| r.len() != x.values.len()) {
-        return Err(FigureError::Input {
-            path: path.to_path_buf(),
-            message: format!(
-                "the map must be {rows} rows of {} cells, found {} rows",
-                x.values.len(),
-                states.len()
-            ),
-        });
-    }
+    check_cells(path, x, y, states)?;
     let (xe, ye) = (
         edges(x.values),
         y.map_or(vec![0.0, 1.0], |y| edges(y.values)),
@@ -75,7 +64,7 @@ pub fn state_map(
                 let colour = COLOURS
                     .get(usize::from(s))
                     .copied()
-                    .unwrap_or(RGBColor(170, 170, 170));
+                    .unwrap_or(NO_VALUE_GREY);
                 let rect = [(xe[ix], ye[iy]), (xe[ix + 1], ye[iy + 1])];
                 chart.draw_series(std::iter::once(Rectangle::new(rect, colour.filled())))?;
                 chart.draw_series(std::iter::once(Rectangle::new(rect, WHITE.stroke_width(2))))?;
