@@ -224,6 +224,20 @@ pub fn workers_of_run(run: &str) -> Vec<i32> {
         .collect()
 }
 
+/// Sends `sig` to `child`, waits for it to exit within `deadline` and checks that it exited
+/// 130, as an interrupted command does; returns its output.
+pub fn interrupt(child: &mut Child, sig: i32, what: &str, deadline: Duration) -> Output {
+    signal(child.id() as i32, sig);
+    let out = wait_exit(child, what, deadline);
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Sends `signal` to `pid`.
 pub fn signal(pid: i32, signal: i32) {
     // SAFETY: kill(2) on a process id we found; a vanished process only makes it fail.

@@ -20,12 +20,14 @@ fn init(dir: &Path, out: &str, criterion: &str, threads: &str) {
         dir,
         out,
         criterion,
+        "100",
         &["--evaluator", "inproc", "--threads", threads],
     );
 }
 
-/// `campaign init` of a 5 x 5 grid in `dir`/`out` with `criterion` mm and `evaluator` flags.
-fn init_with(dir: &Path, out: &str, criterion: &str, evaluator: &[&str]) {
+/// `campaign init` of a 5 x 5 grid in `dir`/`out` with `criterion` mm, `samples` per condition
+/// and `evaluator` flags.
+fn init_with(dir: &Path, out: &str, criterion: &str, samples: &str, evaluator: &[&str]) {
     let a = aircraft();
     let mut args = vec![
         "campaign",
@@ -37,7 +39,7 @@ fn init_with(dir: &Path, out: &str, criterion: &str, evaluator: &[&str]) {
         "--alpha-deg",
         "-4:8:5",
         "--samples",
-        "100",
+        samples,
         "--clearance-mm",
         criterion,
         "--generations",
@@ -99,6 +101,7 @@ fn the_envelope_is_the_same_bits_on_one_thread_two_and_two_iceoryx2_workers() {
         dir,
         "ipc",
         "25.4",
+        "100",
         &["--evaluator", "ipc", "--workers", "2"],
     );
     let read = |d: &str| std::fs::read(dir.join(d).join("envelope.csv")).unwrap();
@@ -315,35 +318,18 @@ fn a_rehearsal_with_a_hidden_cause_clears_nothing_the_truth_fails_even_before_a_
 
 #[test]
 fn an_add_interrupted_by_sigterm_leaves_the_campaign_as_it_was() {
-    use sepval_tests::{signal, spawn_sepval, wait_exit, wait_for};
+    use sepval_tests::{interrupt, spawn_sepval, wait_for};
     use std::time::Duration;
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let a = aircraft();
     // Enough samples that the new round's envelope takes seconds.
-    ok(&sepval(
-        &[
-            "campaign",
-            "init",
-            "--aircraft",
-            &a,
-            "--mach",
-            "0.6:1.0:5",
-            "--alpha-deg",
-            "-4:8:5",
-            "--samples",
-            "2000",
-            "--evaluator",
-            "inproc",
-            "--threads",
-            "2",
-            "--generations",
-            "5",
-            "--out",
-            "c",
-        ],
+    init_with(
         dir,
-    ));
+        "c",
+        "25.4",
+        "2000",
+        &["--evaluator", "inproc", "--threads", "2"],
+    );
     let r = release(dir, "r1.csv", "5");
     let before = snapshot(&dir.join("c"));
     let mut child = spawn_sepval(
@@ -365,17 +351,11 @@ fn an_add_interrupted_by_sigterm_leaves_the_campaign_as_it_was() {
     wait_for("the round's staging", Duration::from_secs(120), || {
         staged.exists()
     });
-    signal(child.id() as i32, libc::SIGTERM);
-    let out = wait_exit(
+    interrupt(
         &mut child,
+        libc::SIGTERM,
         "campaign add after SIGTERM",
         Duration::from_secs(30),
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(130),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     assert_eq!(
         snapshot(&dir.join("c")),
