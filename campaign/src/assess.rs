@@ -10,7 +10,8 @@
 //! reach ([`sepval_predict::reach`]); the clearance of every sample
 //! ([`sepval_predict::clearance::assess`]) twice: with the model-form band (the condition's
 //! probability of failing, its state) and without it (the factors' share of the spread, which
-//! the planning needs to tell what a release would settle). The assessment is the same bits
+//! the planning needs to tell what a release would settle). Before any release nothing is
+//! cleared ([`State::before_release`]). The assessment is the same bits
 //! whatever the evaluator and its worker count.
 
 use std::sync::Arc;
@@ -140,7 +141,10 @@ pub fn assess(
             Row::of(k, record, &full)
         };
         out.push(Assessed {
-            state: State::of(row.p_fail, settings.allowed),
+            state: match model.fitted {
+                Some(_) => State::of(row.p_fail, settings.allowed),
+                None => State::before_release(row.p_fail, settings.allowed),
+            },
             reach: r,
             spread_mm: spread(full.min_clearance_mm.p5, full.min_clearance_mm.p95),
             factor_spread_mm: spread(factors.min_clearance_mm.p5, factors.min_clearance_mm.p95),

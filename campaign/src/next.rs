@@ -20,7 +20,11 @@
 //!   settled when it ends more than z s'_u from the criterion (z the normal quantile of 1 -
 //!   allowed): P(settled) = Phi((m_u - z s'_u) / tau) + Phi((-m_u - z s'_u) / tau).
 //!
-//! `expected_settled(c)` sums P(settled) over the undecided conditions. A batch of K is chosen
+//! `expected_settled(c)` sums P(settled) over the undecided conditions, less what they would be
+//! without the release (the batch's releases before it). With nothing flown that is nothing:
+//! the prior clears nothing ([`crate::state::State::before_release`]), so a condition the
+//! prior would clear is settled by the first release when it stays more than z s'_u above the
+//! criterion afterwards. A batch of K is chosen
 //! greedily: each release chosen is taken as flown (the spreads it leaves, one more release)
 //! before the next is ranked, so that the batch's releases complement each other rather than
 //! settle the same conditions; once the releases chosen are expected to settle all that can be
@@ -138,7 +142,14 @@ pub fn plan(
                     let pair = at(c, u);
                     let (f, m, _) = settle(&pair, &spreads[u], reaches[u], n);
                     let now = spreads[u].0.hypot(spreads[u].1);
-                    p_settle(&pair, start[u], f.hypot(m)) - p_settle(&pair, start[u], now)
+                    // Before the first release nothing is cleared (`State::before_release`):
+                    // whatever the prior would settle, the first release settles.
+                    let before = if n == 0 {
+                        0.0
+                    } else {
+                        p_settle(&pair, start[u], now)
+                    };
+                    p_settle(&pair, start[u], f.hypot(m)) - before
                 };
                 (c, undecided.iter().map(|&u| gain(u)).sum())
             })
@@ -376,5 +387,23 @@ mod tests {
         let p = plan(&grid, &a, &[], CRITERIA, 1);
         assert!(p.settled && p.releases.is_empty(), "{p:?}");
         assert_eq!(p.words, "settled: no condition is undecided");
+    }
+
+    #[test]
+    fn before_any_release_the_first_settles_what_the_prior_would_clear() {
+        let (grid, mut a) = envelope([0.0, 0.001, 0.002, 0.003, 0.004], [90.0; 5]);
+        for c in &mut a {
+            c.state = State::before_release(c.row.p_fail, 0.05);
+        }
+        let p = plan(&grid, &a, &[], CRITERIA, 2);
+        assert!(!p.settled, "{p:?}");
+        let first = &p.releases[0];
+        assert!(first.expected_settled > 4.9, "{p:?}");
+        assert!(first.why.starts_with("expected to settle"), "{p:?}");
+        // The batch's second settles nothing more: it goes where the model's form is least known.
+        assert!(
+            p.releases[1].why.contains("farthest from every release"),
+            "{p:?}"
+        );
     }
 }

@@ -1,14 +1,14 @@
 //! The campaign's derived files, written from its records after every command: CAMP/envelope.csv
 //! (the current round's, the columns of `sepval envelope` and `state`), CAMP/status.json,
 //! CAMP/figures/state-NN.png (each round's map of states, the releases flown by then marked
-//! in the title) and CAMP/report.html (the answer first, then the map, the history of the
+//! in the title), CAMP/figures/counts.png (the counts of states against the releases flown) and CAMP/report.html (the answer first, then the map, the history of the
 //! counts per round, the releases and what is left undecided).
 
 use std::path::Path;
 
 use sepval_common::atomic_file::write_atomically;
 use sepval_envelope::row::CSV_HEADER;
-use sepval_report::figures::MapAxis;
+use sepval_report::figures::{MapAxis, RoundCounts, state_counts_figure};
 use sepval_report::html::escape_html;
 
 use sepval_envelope::Grid;
@@ -104,6 +104,17 @@ pub fn render(c: &View<'_>) -> Result<(), CampaignError> {
         let assessed = c.round(&r.dir)?;
         state_map(c, &assessed, r.round, r.releases_flown, &path)?;
     }
+    let path = figures.join("counts.png");
+    let rounds: Vec<RoundCounts> = c
+        .file
+        .rounds
+        .iter()
+        .map(|r| RoundCounts {
+            releases_flown: r.releases_flown,
+            counts: [r.counts.cleared, r.counts.undecided, r.counts.fails],
+        })
+        .collect();
+    state_counts_figure(&path, &rounds, c.grid.len()).map_err(|e| record_error(&path, e))?;
     let html = page(c, &current);
     let path = c.dir.join("report.html");
     write_atomically(&path, html.as_bytes()).map_err(|e| record_error(&path, e))
@@ -193,7 +204,7 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
             r.round
         ));
     }
-    h.push_str("<h2>Rounds</h2><table><tr><th>round</th><th>releases flown</th><th>cleared</th><th>fails</th><th>undecided</th><th>settled</th></tr>");
+    h.push_str("<h2>Rounds</h2><img src=\"figures/counts.png\" alt=\"the counts of states against the releases flown\"><table><tr><th>round</th><th>releases flown</th><th>cleared</th><th>fails</th><th>undecided</th><th>settled</th></tr>");
     for r in &c.file.rounds {
         let k = &r.counts;
         h.push_str(&format!(
@@ -209,13 +220,28 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
             e(&r.file), e(&r.given), shown(k.mach), shown(k.altitude_m), shown(k.alpha_deg), e(&r.check)
         ));
     }
-    h.push_str("</table><h2>Undecided, and why</h2><ul>");
+    h.push_str("</table><h2>Undecided, and why</h2>");
+    if c.file.releases.is_empty() {
+        h.push_str(
+            "<p>No release has checked the model yet: nothing is cleared before the first \
+             release, whatever the prior predicts (docs/campaign.md, \"States\").</p>",
+        );
+    }
+    if !current.iter().any(|a| a.state == State::Undecided) {
+        h.push_str("<p>None: every condition is cleared or fails.</p>");
+    }
+    h.push_str("<ul>");
     for a in current.iter().filter(|a| a.state == State::Undecided) {
         let k = &a.row.condition;
+        let reach = if a.reach.is_finite() {
+            format!("reach {:.2} beyond what the releases showed", a.reach)
+        } else {
+            "no release flown".to_string()
+        };
         h.push_str(&format!(
-            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'), reach {:.2} beyond what the releases showed</li>",
+            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'), {reach}</li>",
             shown(k.mach), shown(k.altitude_m), shown(k.alpha_deg), a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
-            100.0 * (a.factor_spread_mm / a.spread_mm).min(1.0), a.reach
+            100.0 * (a.factor_spread_mm / a.spread_mm).min(1.0)
         ));
     }
     h.push_str("</ul></body></html>\n");

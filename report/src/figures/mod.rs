@@ -76,6 +76,7 @@ mod increments;
 mod kit;
 mod pareto;
 mod residuals;
+mod state_counts;
 mod state_map;
 #[cfg(test)]
 mod testing;
@@ -96,6 +97,7 @@ pub use factors::factor_figure;
 pub use increments::{IncrementPanel, IncrementSeries, increment_figure};
 pub use pareto::pareto_figure;
 pub use residuals::residual_figure;
+pub use state_counts::{RoundCounts, state_counts_figure};
 pub use state_map::state_map;
 pub use throughput::throughput_figure;
 pub use trajectory::trajectory_figures;

@@ -11,12 +11,13 @@ use super::condition_map::{MapAxis, NO_VALUE_GREY, check_cells, edges};
 use super::kit::{LegendMark, draw_legend_strip, draw_mesh, fmt_tick, render, text};
 
 /// A cell's state: 0 cleared, 1 undecided, 2 fails (anything else: no value, grey).
-const COLOURS: [RGBColor; 3] = [
+pub(super) const COLOURS: [RGBColor; 3] = [
     RGBColor(46, 160, 67),
     RGBColor(240, 173, 0),
     RGBColor(214, 39, 40),
 ];
-const NAMES: [&str; 3] = ["cleared", "undecided", "fails"];
+/// The states' names, in the order of [`COLOURS`].
+pub(super) const NAMES: [&str; 3] = ["cleared", "undecided", "fails"];
 
 /// Draws the map of `states` (`states[iy][ix]`, one row when `y` is `None`) with the releases
 /// `flown` ((x, y) in the axes' units, in the order flown) to `path`, 1200 × 900 px. A shape
