@@ -138,19 +138,7 @@ pub fn plan(
             .iter()
             .filter(|c| !chosen.iter().any(|p| p.index == **c))
             .map(|&c| {
-                let gain = |u: usize| {
-                    let pair = at(c, u);
-                    let (f, m, _) = settle(&pair, &spreads[u], reaches[u], n);
-                    let now = spreads[u].0.hypot(spreads[u].1);
-                    // Before the first release nothing is cleared (`State::before_release`):
-                    // whatever the prior would settle, the first release settles.
-                    let before = if n == 0 {
-                        0.0
-                    } else {
-                        p_settle(&pair, start[u], now)
-                    };
-                    p_settle(&pair, start[u], f.hypot(m)) - before
-                };
+                let gain = |u: usize| gain(&at(c, u), spreads[u], reaches[u], start[u], n);
                 (c, undecided.iter().map(|&u| gain(u)).sum())
             })
             .collect();
@@ -298,6 +286,21 @@ fn settle(pair: &Pair, spread: &(f64, f64), r: f64, n: usize) -> (f64, f64, f64)
         f * (n as f64 / (n as f64 + 1.0)).sqrt()
     };
     (f_after, m_after, r_after)
+}
+
+/// What a release (`pair`) adds to the probability that a condition ends settled, its spreads
+/// `spread` and reach `r` now, its spread `start` before the batch, with `n` releases flown or
+/// chosen.
+fn gain(pair: &Pair, spread: (f64, f64), r: f64, start: f64, n: usize) -> f64 {
+    let (f, m, _) = settle(pair, &spread, r, n);
+    // Before the first release nothing is cleared (`State::before_release`): whatever the
+    // prior would settle, the first release settles.
+    let before = if n == 0 {
+        0.0
+    } else {
+        p_settle(pair, start, spread.0.hypot(spread.1))
+    };
+    p_settle(pair, start, f.hypot(m)) - before
 }
 
 /// The probability that a condition whose spread goes from `s` to `s_after` ends settled: its

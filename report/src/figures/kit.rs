@@ -431,6 +431,20 @@ pub(super) fn draw_legend_strip(area: &Root<'_>, entries: &[(String, LegendMark)
     Ok(())
 }
 
+/// A figure's title and one-row legend at the top of `root`; the area below them, for the
+/// chart.
+pub(super) fn titled_with_legend<'b>(
+    root: &Root<'b>,
+    title: &str,
+    entries: &[(String, LegendMark)],
+) -> Result<Root<'b>, Box<dyn Error>> {
+    let (_, body) = root.split_vertically(8);
+    let body = body.titled(title, text(26.0))?;
+    let (legend, main) = body.split_vertically(44);
+    draw_legend_strip(&legend, entries)?;
+    Ok(main)
+}
+
 /// The legend mark of a line.
 pub(super) fn line_mark(style: ShapeStyle) -> impl Fn(Px) -> PathElement<Px> {
     move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], style)

@@ -6,7 +6,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::FigureError;
-use super::kit::{LegendMark, draw_legend_strip, draw_mesh, fmt_count_tick, render, text};
+use super::kit::{LegendMark, draw_mesh, fmt_count_tick, render, titled_with_legend};
 use super::state_map::{COLOURS, NAMES};
 
 /// One round: the releases flown by then and its counts of cleared, undecided and failing
@@ -37,10 +37,7 @@ pub fn state_counts_figure(
     let x = (-0.2, most.max(1) as f64 + 0.2);
     let y_top = conditions.max(1) as f64 * 1.05;
     render(path, (1000, 650), |root| {
-        let (_, body) = root.split_vertically(8);
-        let body = body.titled("The envelope's states, round by round", text(26.0))?;
-        let (legend, main) = body.split_vertically(44);
-        draw_legend_strip(&legend, &entries)?;
+        let main = titled_with_legend(root, "The envelope's states, round by round", &entries)?;
         let mut chart = ChartBuilder::on(&main)
             .margin(18)
             .x_label_area_size(55)

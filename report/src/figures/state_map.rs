@@ -8,7 +8,7 @@ use plotters::prelude::*;
 
 use super::FigureError;
 use super::condition_map::{MapAxis, NO_VALUE_GREY, check_cells, edges};
-use super::kit::{LegendMark, draw_legend_strip, draw_mesh, fmt_tick, render, text};
+use super::kit::{LegendMark, draw_mesh, fmt_tick, render, text, titled_with_legend};
 
 /// A cell's state: 0 cleared, 1 undecided, 2 fails (anything else: no value, grey).
 pub(super) const COLOURS: [RGBColor; 3] = [
@@ -44,10 +44,7 @@ pub fn state_map(
         entries.push(("releases flown, in order".into(), LegendMark::Ring(BLUE)));
     }
     render(path, (1200, 900), |root| {
-        let (_, body) = root.split_vertically(8);
-        let body = body.titled(title, text(26.0))?;
-        let (legend, main) = body.split_vertically(44);
-        draw_legend_strip(&legend, &entries)?;
+        let main = titled_with_legend(root, title, &entries)?;
         let mut chart = ChartBuilder::on(&main)
             .margin(18)
             .x_label_area_size(55)

@@ -25,8 +25,8 @@ use super::contour::{
 };
 use super::envelope_scale::{Safety, Scale, criterion_styles, draw_scale_bar};
 use super::kit::{
-    Chart2d, DrawResult, LegendMark, RING_RADIUS_PX, draw_legend_strip, draw_mesh, fmt_tick,
-    plottable, plottable_point, render, ring_style, text,
+    Chart2d, DrawResult, LegendMark, RING_RADIUS_PX, draw_mesh, fmt_tick, plottable,
+    plottable_point, render, ring_style, text, titled_with_legend,
 };
 use plotters::coord::types::RangedCoordf64;
 
@@ -97,10 +97,7 @@ pub fn envelope_map(path: &Path, map: &EnvelopeMap<'_>) -> Result<(), FigureErro
         contour(map, &checked, &extent).map_err(|e| input(format!("envelope map: {e}")))?;
     let entries = legend(map, &checked, &contour, &flown);
     render(path, (1200, 900), |root| {
-        let (_, body) = root.split_vertically(8);
-        let body = body.titled(map.title, text(26.0))?;
-        let (legend_area, rest) = body.split_vertically(44);
-        draw_legend_strip(&legend_area, &entries)?;
+        let rest = titled_with_legend(root, map.title, &entries)?;
         let (main, bar) = rest.split_horizontally(1040);
         let mut chart = ChartBuilder::on(&main)
             .margin(18)
