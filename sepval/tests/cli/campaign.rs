@@ -1,7 +1,9 @@
 //! `sepval campaign` end to end: init under the prior, next (never an unsafe condition, a
 //! batch of distinct conditions, none safe said with the least risky), add (a release checked,
-//! fitted, round 1), the refusals (a release twice, a broken file) with nothing changed, and the
-//! same bits whatever the thread count. Reduced samples; release build.
+//! fitted, round 1), the refusals (a release twice, a broken file) with nothing changed, the
+//! same bits on threads and on iceoryx2 workers (the prior's envelope and an added round), no
+//! false clear in any round of a rehearsal, and an interrupted add undone. Reduced samples;
+//! release build.
 
 use std::path::Path;
 
@@ -151,7 +153,7 @@ fn release(dir: &Path, name: &str, noise_seed: &str) -> String {
 }
 
 #[test]
-fn add_records_a_round_and_refuses_a_release_twice_or_broken_with_nothing_changed() {
+fn add_records_a_round_the_same_on_threads_and_workers_and_refuses_a_release_twice_or_broken() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     init(dir, "c", "25.4", "2");
@@ -196,6 +198,33 @@ fn add_records_a_round_and_refuses_a_release_twice_or_broken_with_nothing_change
         before,
         "a refusal changed the campaign"
     );
+    // The same release added over two iceoryx2 workers: the same round, bit for bit.
+    init_with(
+        dir,
+        "w",
+        "25.4",
+        "100",
+        &["--evaluator", "ipc", "--workers", "2"],
+    );
+    let args = [
+        "campaign",
+        "add",
+        "w",
+        "--data",
+        &r,
+        "--evaluator",
+        "ipc",
+        "--workers",
+        "2",
+    ];
+    ok(&sepval(&args, dir));
+    for file in ["envelope.csv", "rounds/01/assessment.json"] {
+        let read = |c: &str| std::fs::read(dir.join(c).join(file)).unwrap();
+        assert!(
+            read("c") == read("w"),
+            "{file} differs between 2 threads and 2 workers"
+        );
+    }
 }
 
 #[test]
