@@ -1,8 +1,9 @@
 //! The campaign's derived files, written from its records after every command: CAMP/envelope.csv
 //! (the current round's, the columns of `sepval envelope` and `state`), CAMP/status.json,
 //! CAMP/figures/state-NN.png (each round's map of states, the releases flown by then marked
-//! in the title), CAMP/figures/counts.png (the counts of states against the releases flown) and CAMP/report.html (the answer first, then the map, the history of the
-//! counts per round, the releases and what is left undecided).
+//! in the title), CAMP/figures/counts.png (the counts of states against the releases flown)
+//! and CAMP/report.html (the answer first, then the map, the history of the counts per round,
+//! the releases and what is left undecided).
 
 use std::path::Path;
 
@@ -111,13 +112,22 @@ pub fn render(c: &View<'_>) -> Result<(), CampaignError> {
         .iter()
         .map(|r| RoundCounts {
             releases_flown: r.releases_flown,
-            counts: [r.counts.cleared, r.counts.undecided, r.counts.fails],
+            counts: MAP_ORDER.map(|s| r.counts.of_state(s)),
         })
         .collect();
     state_counts_figure(&path, &rounds, c.grid.len()).map_err(|e| record_error(&path, e))?;
     let html = page(c, &current);
     let path = c.dir.join("report.html");
     write_atomically(&path, html.as_bytes()).map_err(|e| record_error(&path, e))
+}
+
+/// The states in the order of `sepval_report`'s state map and counts figure, best to worst:
+/// the largest index over a cell is its worst state.
+const MAP_ORDER: [State; 3] = [State::Cleared, State::Undecided, State::Fails];
+
+/// A state's index in [`MAP_ORDER`].
+fn map_index(s: State) -> u8 {
+    MAP_ORDER.iter().position(|&m| m == s).unwrap_or(0) as u8
 }
 
 /// A round's map of states (the worst over the axes not shown), with the releases flown by
@@ -139,12 +149,7 @@ fn state_map(
     let mut cells = vec![vec![0u8; xv.len()]; ny];
     for a in assessed {
         let (ix, iy) = c.grid.cell(a.row.index);
-        let v = match a.state {
-            State::Cleared => 0,
-            State::Undecided => 1,
-            State::Fails => 2,
-        };
-        cells[iy][ix] = cells[iy][ix].max(v);
+        cells[iy][ix] = cells[iy][ix].max(map_index(a.state));
     }
     let yq = axes.get(1).map(|(q, _)| *q);
     let releases: Vec<(f64, f64)> = c.file.releases[..flown.min(c.file.releases.len())]

@@ -104,6 +104,15 @@ impl Counts {
             undecided: n(State::Undecided),
         }
     }
+
+    /// How many conditions are in state `s`.
+    pub fn of_state(&self, s: State) -> usize {
+        match s {
+            State::Cleared => self.cleared,
+            State::Fails => self.fails,
+            State::Undecided => self.undecided,
+        }
+    }
 }
 
 /// The spread of a normal whose 5th and 95th percentiles are `p5` and `p95`.

@@ -158,20 +158,11 @@ fn add_records_a_round_the_same_on_threads_and_workers_and_refuses_a_release_twi
     let dir = tmp.path();
     init(dir, "c", "25.4", "2");
     let r = release(dir, "r1.csv", "5");
-    let add = |file: &str| {
-        let args = [
-            "campaign",
-            "add",
-            "c",
-            "--data",
-            file,
-            "--evaluator",
-            "inproc",
-            "--threads",
-            "2",
-        ];
+    let add_to = |camp: &str, file: &str, evaluator: &[&str]| {
+        let args = [&["campaign", "add", camp, "--data", file][..], evaluator].concat();
         sepval(&args, dir)
     };
+    let add = |file: &str| add_to("c", file, &["--evaluator", "inproc", "--threads", "2"]);
     ok(&add(&r));
     let camp = json(&dir.join("c/campaign.json"));
     assert_eq!(camp["format"], "sepval-campaign/1");
@@ -206,18 +197,7 @@ fn add_records_a_round_the_same_on_threads_and_workers_and_refuses_a_release_twi
         "100",
         &["--evaluator", "ipc", "--workers", "2"],
     );
-    let args = [
-        "campaign",
-        "add",
-        "w",
-        "--data",
-        &r,
-        "--evaluator",
-        "ipc",
-        "--workers",
-        "2",
-    ];
-    ok(&sepval(&args, dir));
+    ok(&add_to("w", &r, &["--evaluator", "ipc", "--workers", "2"]));
     for file in ["envelope.csv", "rounds/01/assessment.json"] {
         let read = |c: &str| std::fs::read(dir.join(c).join(file)).unwrap();
         assert!(
