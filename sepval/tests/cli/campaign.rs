@@ -277,6 +277,10 @@ fn a_rehearsal_of_a_null_truth_settles_with_no_false_clear_or_fail() {
 
 #[test]
 fn a_rehearsal_with_a_hidden_cause_flies_only_truly_safe_releases_and_stays_conservative() {
+    // A diagnosis per round with discovery at work: 122 s of the fast tier's 167 (2026-11-27).
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
     let tmp = tempfile::tempdir().unwrap();
     let r = rehearse(
         tmp.path(),
