@@ -223,7 +223,7 @@ pub fn check_release(
     start: &mut StartEvaluator<'_>,
 ) -> Result<Check, CampaignError> {
     let points = simulate::Grid::of(&data.times_s);
-    let candidates = crate::assess::draws(model, settings)?;
+    let (candidates, _) = crate::assess::draws(model, settings)?;
     let (_, runs) = crate::assess::fly(scenario, &data.times_s, &points, &candidates, start)?;
     let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
     let flights: Vec<_> = model.flown();

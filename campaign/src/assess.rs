@@ -31,6 +31,7 @@ use sepval_predict::{ClearanceSettings, PredictError, Sampler, Source, clearance
 use sepval_solve::run::{NoProgress, Progress as Step, ProgressObserver};
 
 use crate::CampaignError;
+use crate::rivals;
 use crate::state::{Assessed, State, spread};
 
 /// Starts an evaluator for a job (a condition's release).
@@ -97,7 +98,8 @@ pub fn assess(
 ) -> Result<Vec<Assessed>, CampaignError> {
     let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
     let points = simulate::Grid::of(&times);
-    let candidates = draws(model, settings)?;
+    let (candidates, models) = draws(model, settings)?;
+    let noise = model.fitted.as_ref().map(|f| f.source.noise);
     let flown = model.flown();
     let flown_refs: Vec<&Flight> = flown.iter().collect();
     let covered = sepval_fit::domain::covered_reach(&flown_refs, &[]);
@@ -133,7 +135,8 @@ pub fn assess(
         let c = &settings.clearance;
         let full = clearance::assess(c, &trajectories, &sd, &points, seed, threads)?;
         let none = vec![[0.0; 6]; points.len()];
-        let factors = clearance::assess(c, &trajectories, &none, &points, seed, threads)?;
+        let (factors, each) =
+            clearance::assess_each(c, &trajectories, &none, &points, seed, threads)?;
         let record = ConditionRecord::of(grid.flight(k));
         let row = if full.samples == 0 {
             Row::all_diverged(k, record)
@@ -148,6 +151,8 @@ pub fn assess(
             reach: r,
             spread_mm: spread(full.min_clearance_mm.p5, full.min_clearance_mm.p95),
             factor_spread_mm: spread(factors.min_clearance_mm.p5, factors.min_clearance_mm.p95),
+            rival_spread_mm: rivals::clearance_spread(&models, &each),
+            rival_separation: noise.map_or(0.0, |n| rivals::separation(&models, &trajectories, n)),
             row,
         });
         observer.progress(&Step {
@@ -184,23 +189,26 @@ pub(crate) fn fly(
     Ok((job, runs))
 }
 
-/// The samples' candidates: draw s from its own generator; with releases flown, its model
-/// chosen among the diagnosis's answer and rivals by their weights first
-/// ([`sepval_predict::Sampler`]).
+/// The samples' candidates and the model each was drawn from (0: the answer, or the prior):
+/// draw s from its own generator; with releases flown, its model chosen among the diagnosis's
+/// answer and rivals by their weights first ([`sepval_predict::Sampler`]).
 pub(crate) fn draws(
     model: &Model,
     settings: &AssessSettings,
-) -> Result<Vec<Candidate>, CampaignError> {
+) -> Result<(Vec<Candidate>, Vec<usize>), CampaignError> {
     if let Some(f) = &model.fitted {
         let sampler = Sampler {
             answer: model.distribution.clone(),
             seed: settings.seed,
         };
         return Ok((0..settings.samples)
-            .map(|s| sampler.sample(&f.ensemble, s as u64).candidate)
-            .collect());
+            .map(|s| {
+                let sample = sampler.sample(&f.ensemble, s as u64);
+                (sample.candidate, sample.model)
+            })
+            .unzip());
     }
-    (0..settings.samples)
+    let candidates = (0..settings.samples)
         .map(|s| {
             let mut rng = sample_rng(settings.seed, s as u64, STREAM_PARAMETERS);
             let x = model.distribution.draw(&mut rng);
@@ -209,7 +217,8 @@ pub(crate) fn draws(
                 .candidate(&x)
                 .map_err(|e| CampaignError::Model(e.to_string()))
         })
-        .collect()
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((candidates, vec![0; settings.samples]))
 }
 
 /// The calibration of the diagnosis's discrepancy at the release of `job`.

@@ -11,7 +11,8 @@
 //! 1. [`prior`]: the factors before any release ([`Prior`]);
 //! 2. [`mod@assess`]: an envelope of the campaign, every condition's clearance predicted from what
 //!    a round believes ([`Model`] to [`Assessed`]), its [`state`];
-//! 3. [`next`]: the releases to fly next ([`Plan`]);
+//! 3. [`next`]: the releases to fly next ([`Plan`]), with what a release would tell the
+//!    [`rivals`] apart;
 //! 4. [`program`] and [`add`]: `init`, `add`, `next` and `status` over the directory
 //!    ([`record`]: campaign.json, status.json, next.json), each change staged and committed
 //!    whole;
@@ -28,6 +29,7 @@ pub mod prior;
 pub mod program;
 pub mod record;
 pub mod rehearse;
+pub mod rivals;
 pub mod state;
 
 pub use assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};

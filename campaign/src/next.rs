@@ -12,10 +12,17 @@
 //! - a release at c brings u's reach down to r'_u = min(r_u, reach(c, u)): the model form's
 //!   part scales with the reach ([`sepval_predict::reach`]), s'_m,u = s_m,u e(r'_u) / e(r_u),
 //!   e the reach the band uses;
-//! - it informs the factors, which are the same at every condition (the model's form is what
-//!   differs from one condition to another, and the reach carries it): with n releases flown,
-//!   s'_f,u = s_f,u sqrt(n / (n + 1)); with none, s'_f,u = [`FIRST_RELEASE_SHARE`] s_f,u, the
-//!   share of the prior's spread a first release leaves;
+//! - the factors' part is split again into the rivals' disagreement s_r,u (the spread of their
+//!   median clearances, [`crate::rivals`]) and the spread within a model s_w,u =
+//!   sqrt(max(0, s_f,u^2 - s_r,u^2));
+//! - it tells the rivals apart as well as their trajectories differ at c against the noise and
+//!   their own spread there (the separation S_c, [`crate::rivals::separation`]); the same model
+//!   holds everywhere, so s'_r,u = s_r,u sqrt(1 / (1 + S_c^2)) at every u: a release where the
+//!   rivals disagree settles the conditions whose decision hangs on them;
+//! - it informs the factors within a model, which are the same at every condition (the model's
+//!   form is what differs from one condition to another, and the reach carries it): with n
+//!   releases flown, s'_w,u = s_w,u sqrt(n / (n + 1)); with none, s'_w,u =
+//!   [`FIRST_RELEASE_SHARE`] s_w,u, the share of the prior's spread a first release leaves;
 //! - the median moves by what is learnt, a normal of variance tau^2 = s_u^2 - s'_u^2, and u is
 //!   settled when it ends more than z s'_u from the criterion (z the normal quantile of 1 -
 //!   allowed): P(settled) = Phi((m_u - z s'_u) / tau) + Phi((-m_u - z s'_u) / tau).
@@ -40,6 +47,7 @@ use sepval_envelope::Grid;
 use sepval_fit::domain::reach;
 use sepval_predict::reach::effective;
 
+use crate::rivals;
 use crate::state::{Assessed, State};
 
 /// The share of the prior's spread of the factors that a first release at the condition
@@ -125,11 +133,12 @@ pub fn plan(
     let mut spreads = tail_spreads(assessed, criterion_mm);
     // Each condition's spread before any release of the batch: what is learnt is measured
     // from it.
-    let start: Vec<f64> = spreads.iter().map(|(f, m)| f.hypot(*m)).collect();
+    let start: Vec<f64> = spreads.iter().map(Spread::total).collect();
     let mut reaches: Vec<f64> = assessed.iter().map(|a| a.reach).collect();
     let at = |c: usize, u: usize| Pair {
         reach: reach(&[grid.flight(c)], grid.flight(u)),
         margin_mm: assessed[u].row.clearance_p50_mm - criterion_mm,
+        rivals_left: rivals::left_after(assessed[c].rival_separation),
         z,
     };
     let mut chosen: Vec<Planned> = Vec::new();
@@ -176,9 +185,7 @@ pub fn plan(
         chosen.push(planned(grid, assessed, c, e, why));
         // Taken as flown: the spreads it leaves, one release more.
         for u in 0..assessed.len() {
-            let (f, m, r) = settle(&at(c, u), &spreads[u], reaches[u], n);
-            spreads[u] = (f, m);
-            reaches[u] = r;
+            (spreads[u], reaches[u]) = settle(&at(c, u), &spreads[u], reaches[u], n);
         }
     }
     let words = words(undecided.len(), chosen.len());
@@ -203,19 +210,41 @@ fn words(undecided: usize, chosen: usize) -> String {
     }
 }
 
-/// Each condition's (factor, model-form) spread: the spread of the normal that fails as often
-/// as its samples did (their tail, divergences included, decides the state, not their body),
-/// shared as the samples' spread is.
-fn tail_spreads(assessed: &[Assessed], criterion_mm: f64) -> Vec<(f64, f64)> {
+/// A condition's spread of the smallest clearance in its three parts \[mm\] (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Spread {
+    /// The rivals' disagreement.
+    rivals: f64,
+    /// The factors' within a model.
+    within: f64,
+    /// The model form's.
+    form: f64,
+}
+
+impl Spread {
+    fn total(&self) -> f64 {
+        self.rivals.hypot(self.within).hypot(self.form)
+    }
+}
+
+/// Each condition's spread: the spread of the normal that fails as often as its samples did
+/// (their tail, divergences included, decides the state, not their body), shared as the
+/// samples' spread is between the rivals, the factors within a model and the model form.
+fn tail_spreads(assessed: &[Assessed], criterion_mm: f64) -> Vec<Spread> {
     assessed
         .iter()
         .map(|a| {
             let s = finite_or_zero(a.spread_mm);
             let f = finite_or_zero(a.factor_spread_mm).min(s);
-            let m = (s * s - f * f).max(0.0).sqrt();
+            let r = finite_or_zero(a.rival_spread_mm).min(f);
+            let part = |of: f64, less: f64| (of * of - less * less).max(0.0).sqrt();
             let k = effective_spread(a.row.clearance_p50_mm - criterion_mm, a.row.p_fail)
                 .map_or(1.0, |e| if s > 0.0 { e / s } else { 1.0 });
-            (k * f, k * m)
+            Spread {
+                rivals: k * r,
+                within: k * part(f, r),
+                form: k * part(s, f),
+            }
         })
         .collect()
 }
@@ -267,40 +296,51 @@ struct Pair {
     reach: f64,
     /// u's median smallest clearance less the criterion \[mm\].
     margin_mm: f64,
+    /// The share of the rivals' variance a release at c leaves ([`rivals::left_after`]).
+    rivals_left: f64,
     /// The normal quantile of 1 - allowed.
     z: f64,
 }
 
-/// What a release does to a condition (`pair`) whose factor and model-form spreads are
-/// `spread` and reach `r`, with `n` releases flown: its factor spread, model-form spread and
-/// reach afterwards.
-fn settle(pair: &Pair, spread: &(f64, f64), r: f64, n: usize) -> (f64, f64, f64) {
-    let d = pair.reach;
-    let (f, m) = *spread;
-    let r_after = r.min(d);
+/// What a release does to a condition (`pair`) of spread `spread` and reach `r`, with `n`
+/// releases flown: its spread and reach afterwards.
+fn settle(pair: &Pair, spread: &Spread, r: f64, n: usize) -> (Spread, f64) {
+    let r_after = r.min(pair.reach);
     let (e0, e1) = (effective(r), effective(r_after));
-    let m_after = if e0 > 0.0 { m * e1 / e0 } else { m };
-    let f_after = if n == 0 {
-        f * FIRST_RELEASE_SHARE
+    let form = if e0 > 0.0 {
+        spread.form * e1 / e0
     } else {
-        f * (n as f64 / (n as f64 + 1.0)).sqrt()
+        spread.form
     };
-    (f_after, m_after, r_after)
+    let within = if n == 0 {
+        spread.within * FIRST_RELEASE_SHARE
+    } else {
+        spread.within * (n as f64 / (n as f64 + 1.0)).sqrt()
+    };
+    let rivals = spread.rivals * pair.rivals_left.clamp(0.0, 1.0).sqrt();
+    (
+        Spread {
+            rivals,
+            within,
+            form,
+        },
+        r_after,
+    )
 }
 
-/// What a release (`pair`) adds to the probability that a condition ends settled, its spreads
+/// What a release (`pair`) adds to the probability that a condition ends settled, its spread
 /// `spread` and reach `r` now, its spread `start` before the batch, with `n` releases flown or
 /// chosen.
-fn gain(pair: &Pair, spread: (f64, f64), r: f64, start: f64, n: usize) -> f64 {
-    let (f, m, _) = settle(pair, &spread, r, n);
+fn gain(pair: &Pair, spread: Spread, r: f64, start: f64, n: usize) -> f64 {
+    let (after, _) = settle(pair, &spread, r, n);
     // Before the first release nothing is cleared (`State::before_release`): whatever the
     // prior would settle, the first release settles.
     let before = if n == 0 {
         0.0
     } else {
-        p_settle(pair, start, spread.0.hypot(spread.1))
+        p_settle(pair, start, spread.total())
     };
-    p_settle(pair, start, f.hypot(m)) - before
+    p_settle(pair, start, after.total()) - before
 }
 
 /// The probability that a condition whose spread goes from `s` to `s_after` ends settled: its
@@ -354,6 +394,8 @@ mod tests {
                     reach: f64::INFINITY,
                     spread_mm: 10.0,
                     factor_spread_mm: 8.0,
+                    rival_spread_mm: 0.0,
+                    rival_separation: 0.0,
                     row,
                 }
             })
@@ -408,5 +450,26 @@ mod tests {
             p.releases[1].why.contains("farthest from every release"),
             "{p:?}"
         );
+    }
+
+    #[test]
+    fn a_release_where_the_rivals_part_ways_settles_what_hangs_on_them() {
+        // Three undecided conditions whose factors' spread is mostly the rivals' disagreement;
+        // two safe ones, Mach 0.7 nearer them than Mach 0.6.
+        let (grid, mut a) = envelope([0.0, 0.0, 0.3, 0.3, 0.3], [60.0, 60.0, 30.0, 30.0, 30.0]);
+        for c in &mut a[2..] {
+            (c.factor_spread_mm, c.rival_spread_mm) = (9.9, 9.8);
+        }
+        let flown = [grid.flight(4).clone()];
+        // No release tells the rivals apart: none is expected to settle anything.
+        let p = plan(&grid, &a, &flown, CRITERIA, 1);
+        assert!(p.releases.is_empty() && p.settled, "{p:?}");
+        // At Mach 0.6, the farther, a release tells them apart (their trajectories 20 noise
+        // apart there): it is planned, for the conditions whose decision hangs on them.
+        a[0].rival_separation = 20.0;
+        let p = plan(&grid, &a, &flown, CRITERIA, 1);
+        assert_eq!(p.releases.len(), 1, "{p:?}");
+        assert_eq!(p.releases[0].index, 0, "{p:?}");
+        assert!(p.releases[0].expected_settled > 1.0, "{p:?}");
     }
 }

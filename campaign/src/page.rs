@@ -243,10 +243,19 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
         } else {
             "no release flown".to_string()
         };
+        let share = |part: f64| 100.0 * (part / a.spread_mm).min(1.0);
+        let rivals = if a.rival_spread_mm > 0.0 {
+            format!(
+                ", {:.0} % the rivals' disagreement",
+                share(a.rival_spread_mm)
+            )
+        } else {
+            String::new()
+        };
         h.push_str(&format!(
-            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'), {reach}</li>",
+            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'{rivals}), {reach}</li>",
             shown(k.mach), shown(k.altitude_m), shown(k.alpha_deg), a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
-            100.0 * (a.factor_spread_mm / a.spread_mm).min(1.0)
+            share(a.factor_spread_mm)
         ));
     }
     h.push_str("</ul></body></html>\n");

@@ -78,6 +78,14 @@ pub struct Assessed {
     /// The same spread with the factors' draws alone (no model form).
     #[serde(with = "sepval_common::nonfinite")]
     pub factor_spread_mm: f64,
+    /// The part of the factors' spread that is the rivals' disagreement: the spread of their
+    /// median smallest clearances \[mm\] ([`crate::rivals::clearance_spread`]; 0 with no rival).
+    #[serde(default)]
+    pub rival_spread_mm: f64,
+    /// How well a release here tells the rivals apart ([`crate::rivals::separation`]; 0 with no
+    /// rival).
+    #[serde(default)]
+    pub rival_separation: f64,
 }
 
 /// The counts of an envelope's states.

@@ -124,6 +124,20 @@ pub fn assess(
     seed: u64,
     threads: usize,
 ) -> Result<ClearanceStats, Cancelled> {
+    assess_each(settings, samples, discrepancy, grid, seed, threads).map(|(stats, _)| stats)
+}
+
+/// [`assess`], with each sample's smallest clearance \[mm\] (`None`: it did not run or
+/// cannot be placed), for a caller that groups the samples (the campaign's planning, by the
+/// model each was drawn from).
+pub fn assess_each(
+    settings: &ClearanceSettings,
+    samples: &[Option<&GridTrajectory>],
+    discrepancy: &[[f64; 6]],
+    grid: &Grid,
+    seed: u64,
+    threads: usize,
+) -> Result<(ClearanceStats, Vec<Option<f64>>), Cancelled> {
     let n = samples.len();
     let chunk = n.div_ceil(threads.max(1)).max(1);
     let mut closest: Vec<Option<SampleClosest>> = vec![None; n];
@@ -145,7 +159,11 @@ pub fn assess(
     });
     // A sample stopped by the flag reads as one that did not run: nothing of it is kept.
     cancel::check()?;
-    Ok(stats(settings, &closest))
+    let each = closest
+        .iter()
+        .map(|c| c.map(|c| 1e3 * c.distance_m))
+        .collect();
+    Ok((stats(settings, &closest), each))
 }
 
 /// Sample `s`'s closest approach (`None` when its trajectory cannot be placed: a value that
