@@ -26,7 +26,7 @@ use sepval_solve::lm::LmSettings;
 use sepval_solve::run::ProgressObserver;
 
 use crate::CampaignError;
-use crate::assess::{AssessSettings, Model, StartEvaluator};
+use crate::assess::{AssessSettings, FormBand, Model, StartEvaluator};
 use crate::program::{Campaign, NewRelease, STAGING, fitted_model};
 use crate::record::{CAMPAIGN_FORMAT, ReleaseRecord, read_json, record_error};
 
@@ -213,7 +213,8 @@ fn diagnose(
 }
 
 /// The post-flight check of `data` (flown at `scenario`) against the bands `model` predicts
-/// there at the 95 % level, with the measurement noise.
+/// there at the 95 % level, with the measurement noise: the same model-form band as the
+/// round's envelope ([`FormBand`]: the discrepancy at the releases, the reach beyond them).
 pub fn check_release(
     model: &Model,
     scenario: &Scenario,
@@ -224,16 +225,9 @@ pub fn check_release(
 ) -> Result<Check, CampaignError> {
     let points = simulate::Grid::of(&data.times_s);
     let (candidates, _) = crate::assess::draws(model, settings)?;
-    let (_, runs) = crate::assess::fly(scenario, &data.times_s, &points, &candidates, start)?;
+    let (job, runs) = crate::assess::fly(scenario, &data.times_s, &points, &candidates, start)?;
     let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
-    let flights: Vec<_> = model.flown();
-    let refs: Vec<_> = flights.iter().collect();
-    let r = sepval_predict::reach::uncovered(
-        sepval_fit::domain::reach(&refs, &scenario.flight),
-        sepval_fit::domain::covered_reach(&refs, &[]),
-    );
-    let mut sd = vec![[0.0; 6]; points.len()];
-    sepval_predict::reach::widen(&mut sd, &sepval_predict::reach::motion(&ran), r);
+    let (sd, _) = FormBand::of(model).at(&job, &points, &ran, settings)?;
     let noise = model
         .fitted
         .as_ref()

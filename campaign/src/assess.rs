@@ -100,35 +100,15 @@ pub fn assess(
     let points = simulate::Grid::of(&times);
     let (candidates, models) = draws(model, settings)?;
     let noise = model.fitted.as_ref().map(|f| f.source.noise);
-    let flown = model.flown();
-    let flown_refs: Vec<&Flight> = flown.iter().collect();
-    let covered = sepval_fit::domain::covered_reach(&flown_refs, &[]);
-    let mut evidence: Option<Evidence> = None;
+    let mut form = FormBand::of(model);
     let mut out = Vec::with_capacity(grid.len());
     observer.start("envelope", Some(grid.len()));
     for k in 0..grid.len() {
         cancel::check()?;
         let scenario = grid.scenario(base, k);
         let (job, runs) = fly(&scenario, &times, &points, &candidates, start)?;
-        let mut sd = match &model.fitted {
-            None => vec![[0.0; 6]; points.len()],
-            Some(f) => {
-                let cal = calibration(f, &job, settings);
-                if evidence.is_none() {
-                    evidence = Some(discrepancy::evidence(&cal).map_err(|e| condition(e.into()))?);
-                }
-                let ev = evidence.as_ref().expect("computed above");
-                discrepancy::carry(&cal, ev, &points)
-                    .map_err(|e| condition(e.into()))?
-                    .sd
-            }
-        };
         let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
-        let r = reach::uncovered(
-            sepval_fit::domain::reach(&flown_refs, &scenario.flight),
-            covered,
-        );
-        reach::widen(&mut sd, &reach::motion(&ran), r);
+        let (sd, r) = form.at(&job, &points, &ran, settings)?;
         let trajectories: Vec<Option<&GridTrajectory>> =
             runs.trajectories.iter().map(|t| t.as_ref().ok()).collect();
         let (seed, threads) = (settings.seed, settings.threads);
@@ -219,6 +199,61 @@ pub(crate) fn draws(
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok((candidates, vec![0; settings.samples]))
+}
+
+/// The model-form band of a round at a release: the diagnosis's discrepancy calibrated on its
+/// releases (none for the prior), widened with the release's reach beyond what the releases
+/// held out in turn cover ([`sepval_predict::reach`]). The held-out evidence is computed once,
+/// at the first release asked for, and kept.
+pub(crate) struct FormBand<'m> {
+    model: &'m Model,
+    flown: Vec<Flight>,
+    covered: f64,
+    evidence: Option<Evidence>,
+}
+
+impl<'m> FormBand<'m> {
+    pub(crate) fn of(model: &'m Model) -> FormBand<'m> {
+        let flown = model.flown();
+        let refs: Vec<&Flight> = flown.iter().collect();
+        let covered = sepval_fit::domain::covered_reach(&refs, &[]);
+        FormBand {
+            model,
+            flown,
+            covered,
+            evidence: None,
+        }
+    }
+
+    /// The band's standard deviation at each of `points` of the release `job` (its first
+    /// event's condition), `ran` the samples flown there, and the release's reach.
+    pub(crate) fn at(
+        &mut self,
+        job: &Job,
+        points: &simulate::Grid,
+        ran: &[&GridTrajectory],
+        settings: &AssessSettings,
+    ) -> Result<(Vec<[f64; 6]>, f64), CampaignError> {
+        let mut sd = match &self.model.fitted {
+            None => vec![[0.0; 6]; points.len()],
+            Some(f) => {
+                let cal = calibration(f, job, settings);
+                if self.evidence.is_none() {
+                    let ev = discrepancy::evidence(&cal).map_err(|e| condition(e.into()))?;
+                    self.evidence = Some(ev);
+                }
+                let ev = self.evidence.as_ref().expect("computed above");
+                discrepancy::carry(&cal, ev, points)
+                    .map_err(|e| condition(e.into()))?
+                    .sd
+            }
+        };
+        let refs: Vec<&Flight> = self.flown.iter().collect();
+        let flight = &job.events()[0].simulator.scenario().flight;
+        let r = reach::uncovered(sepval_fit::domain::reach(&refs, flight), self.covered);
+        reach::widen(&mut sd, &reach::motion(ran), r);
+        Ok((sd, r))
+    }
 }
 
 /// The calibration of the diagnosis's discrepancy at the release of `job`.
