@@ -21,6 +21,9 @@
 //! 7. [`check`]: the post-flight check of a flown release ([`Check`]);
 //! 8. [`record`] and [`outputs`]: DIR/prediction.json, DIR/bands.csv, DIR/report.html and
 //!    DIR/figures/prediction.png, written atomically.
+//!
+//! Beside it, [`releases`]: the clearance of the releases a fit or a diagnosis answers with, a
+//! stage of those pipelines.
 
 #![deny(clippy::float_cmp)]
 
@@ -34,6 +37,7 @@ pub mod outputs;
 mod page;
 pub mod reach;
 pub mod record;
+pub mod releases;
 pub mod sampling;
 pub mod simulate;
 pub mod source;

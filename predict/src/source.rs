@@ -156,43 +156,52 @@ fn chain(e: &dyn std::error::Error) -> String {
 }
 
 fn diagnosis_source(dir: &Path) -> Result<Source, SourceError> {
-    let file = "diagnosis.json";
-    let d: sepval_diagnose::Diagnosis = read(dir, file, "diagnosis")?;
-    let bad = |message: String| SourceError::File {
-        path: dir.to_path_buf(),
-        file,
-        message,
-    };
-    let identifiability = d.identifiability.clone().ok_or_else(|| {
-        bad("records no covariance of the answer's parameters (`identifiability`, written by sepval since predict): diagnose again with this sepval".into())
-    })?;
-    let mut models = vec![SourceModel {
-        spec: d.model.clone(),
-        delta_bic: 0.0,
-    }];
-    models.extend(d.rivals.iter().map(|r| SourceModel {
-        spec: r.model.clone(),
-        delta_bic: r.delta_bic,
-    }));
-    let held_out = d
-        .validation
-        .iter()
-        .map(|v| PathBuf::from(&v.event))
-        .filter(|p| p.is_file())
-        .collect();
-    Ok(Source {
-        kind: SourceKind::Diagnosis,
-        dir: dir.to_path_buf(),
-        models,
-        identifiability,
-        noise: Noise {
-            pos_m: d.sigma_pos_m,
-            att_deg: d.sigma_att_deg,
-        },
-        fitted_rms: d.extended.channel_rms.as_array(),
-        inputs: d.inputs,
-        held_out,
-    })
+    let d: sepval_diagnose::Diagnosis = read(dir, "diagnosis.json", "diagnosis")?;
+    Source::of_diagnosis(d, dir)
+}
+
+impl Source {
+    /// The source of diagnosis `d`, written to `dir` (its diagnosis.json, read or just
+    /// written): its answer and rivals, their covariance, its noise and its held-out releases
+    /// whose files still open.
+    pub fn of_diagnosis(d: sepval_diagnose::Diagnosis, dir: &Path) -> Result<Source, SourceError> {
+        let file = "diagnosis.json";
+        let bad = |message: String| SourceError::File {
+            path: dir.to_path_buf(),
+            file,
+            message,
+        };
+        let identifiability = d.identifiability.clone().ok_or_else(|| {
+            bad("records no covariance of the answer's parameters (`identifiability`, written by sepval since predict): diagnose again with this sepval".into())
+        })?;
+        let mut models = vec![SourceModel {
+            spec: d.model.clone(),
+            delta_bic: 0.0,
+        }];
+        models.extend(d.rivals.iter().map(|r| SourceModel {
+            spec: r.model.clone(),
+            delta_bic: r.delta_bic,
+        }));
+        let held_out = d
+            .validation
+            .iter()
+            .map(|v| PathBuf::from(&v.event))
+            .filter(|p| p.is_file())
+            .collect();
+        Ok(Source {
+            kind: SourceKind::Diagnosis,
+            dir: dir.to_path_buf(),
+            models,
+            identifiability,
+            noise: Noise {
+                pos_m: d.sigma_pos_m,
+                att_deg: d.sigma_att_deg,
+            },
+            fitted_rms: d.extended.channel_rms.as_array(),
+            inputs: d.inputs,
+            held_out,
+        })
+    }
 }
 
 fn fit_source(dir: &Path) -> Result<Source, SourceError> {

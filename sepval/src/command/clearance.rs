@@ -1,19 +1,17 @@
-//! `--aircraft`, `--store-shape` and `--clearance-mm`: the geometry read and checked, and the
-//! clearance of one trajectory (docs/geometry.md).
+//! `--aircraft`, `--store-shape` and `--clearance-mm`: the geometry read and checked
+//! (docs/geometry.md), and the clearance of a fit's or a diagnosis's releases asked of
+//! [`sepval_predict::releases`] and said.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
-use sepval_common::atomic_file::write_atomically;
 use sepval_common::cancel;
-use sepval_common::evaluation::{Candidate, Evaluator, InProcess, Job};
+use sepval_common::evaluation::{Candidate, Job};
 use sepval_common::scenario::Scenario;
-use sepval_common::telemetry::Trajectory;
 use sepval_fit::results::ReleaseClearance;
-use sepval_geometry::{Body, Geometry, Pose, Role, Trace};
-use sepval_predict::ClearanceSettings;
-use sepval_report::figures::{ClearanceSeries, clearance_figure};
+use sepval_geometry::{Body, Geometry, Role};
+use sepval_predict::{ClearanceSettings, releases};
 
 use crate::cli::GeometryArgs;
 
@@ -64,156 +62,25 @@ pub fn geometry(
     })
 }
 
-/// The clearance of `traj` along its samples.
-pub fn trace(c: &ClearanceSettings, traj: &Trajectory) -> Result<Trace> {
-    let poses: Vec<Pose> = traj
-        .pos_m
-        .iter()
-        .zip(&traj.att_deg)
-        .map(|(p, a)| Pose {
-            position_m: *p,
-            euler_deg: *a,
-        })
-        .collect();
-    c.geometry
-        .trace_until(&traj.times_s, &poses, c.free_after_m, &cancel::requested)
-        .context("the clearance of the trajectory")
-}
-
-/// The clearance of a trace in one line.
-pub fn words(c: &ClearanceSettings, t: &Trace) -> String {
-    let g = &c.geometry;
-    let criterion_mm = 1e3 * c.criterion_m;
-    let verdict = if t.min.distance_m >= c.criterion_m {
-        format!("clears the {criterion_mm} mm criterion")
-    } else if t.min.distance_m > 0.0 {
-        format!("below the {criterion_mm} mm criterion")
-    } else {
-        "the store touches the aircraft".to_string()
-    };
-    format!(
-        "smallest clearance {:.1} mm at t = {:.3} s, between the store's {} and the aircraft's {}: {verdict}",
-        1e3 * t.min.distance_m,
-        t.t_min_s,
-        g.store_part(t.min.store_part),
-        g.aircraft_part(t.min.aircraft_part)
-    )
-}
-
-/// The clearance of each release's trajectory (`releases`: name, sample times and samples),
-/// written to `out/clearance.csv` (`release, t_s, clearance_m`, one row per sample) and
-/// `out/figures/clearance.png`, and returned as the records of result.json and diagnosis.json.
-pub fn of_releases(
-    c: &ClearanceSettings,
-    releases: &[(String, Trajectory)],
-    out: &Path,
-) -> Result<Vec<ReleaseClearance>> {
-    let mut records = Vec::with_capacity(releases.len());
-    let mut traces = Vec::with_capacity(releases.len());
-    let mut csv = String::from("release,t_s,clearance_m\n");
-    for (name, traj) in releases {
-        let t = trace(c, traj).with_context(|| format!("release {name}"))?;
-        let quoted = if name.contains([',', '"']) {
-            format!("\"{}\"", name.replace('"', "\"\""))
-        } else {
-            name.clone()
-        };
-        for (ts, d) in traj.times_s.iter().zip(&t.distance_m) {
-            csv.push_str(&format!("{quoted},{ts},{d}\n"));
-        }
-        records.push(ReleaseClearance {
-            release: name.clone(),
-            criterion_mm: 1e3 * c.criterion_m,
-            min_clearance_mm: 1e3 * t.min.distance_m,
-            t_min_s: t.t_min_s,
-            store_part: c.geometry.store_part(t.min.store_part).to_string(),
-            aircraft_part: c.geometry.aircraft_part(t.min.aircraft_part).to_string(),
-            clears: t.min.distance_m >= c.criterion_m,
-            free_flight_reached: t.free_flight_reached,
-        });
-        traces.push(t);
-    }
-    write_atomically(&out.join("clearance.csv"), csv.as_bytes())?;
-    let figures = out.join("figures");
-    std::fs::create_dir_all(&figures)
-        .with_context(|| format!("cannot create {}", figures.display()))?;
-    let series: Vec<ClearanceSeries> = releases
-        .iter()
-        .zip(&traces)
-        .map(|((name, traj), t)| ClearanceSeries {
-            label: name,
-            t_s: &traj.times_s,
-            clearance_m: &t.distance_m,
-            free_from_s: traj.times_s.get(t.assessed_from).copied().unwrap_or(0.0),
-            min_t_s: t.t_min_s,
-            min_m: t.min.distance_m,
-        })
-        .collect();
-    clearance_figure(
-        &figures.join("clearance.png"),
-        "Clearance to the aircraft along each release",
-        &series,
-        c.criterion_m,
-    )?;
-    Ok(records)
-}
-
-/// Each release of `job` simulated by `candidate` in this process, as trajectories.
-pub fn simulate_releases(
-    job: &Arc<Job>,
-    candidate: Candidate,
-    threads: usize,
-) -> Result<Vec<(String, Trajectory)>> {
-    let mut evaluator = InProcess::new(Arc::clone(job), threads);
-    let e = evaluator
-        .evaluate(&[candidate], true)
-        .context("the best trajectories")?
-        .pop()
-        .context("no evaluation")?;
-    let Some(samples) = e.samples else {
-        bail!(
-            "the best model does not simulate every release: {:?}",
-            e.outcome
-        );
-    };
-    Ok(job
-        .events()
-        .iter()
-        .zip(samples)
-        .map(|(ev, s)| {
-            let traj = Trajectory {
-                times_s: ev.data.times_s.clone(),
-                pos_m: s.iter().map(|o| o.pos_m).collect(),
-                att_deg: s.iter().map(|o| o.att_deg).collect(),
-                ..Trajectory::default()
-            };
-            (ev.name.clone(), traj)
-        })
-        .collect())
-}
-
-/// The clearance of the best trajectories of a fit or diagnosis in `out`, for `--aircraft`
-/// given: rewrites `record` (result.json or diagnosis.json) with its `clearance` and prints
-/// one line per release.
+/// The clearance of the answer's trajectories of a fit or diagnosis in `out`, for
+/// `--aircraft` given ([`sepval_predict::releases`]): `candidate` flies each release of `job`
+/// on `threads` threads; clearance.csv and figures/clearance.png are written, `record`
+/// (result.json or diagnosis.json, named `file`) is rewritten with its `clearance`, and one
+/// line per release is printed.
 pub fn record_releases<T: serde::Serialize>(
     c: &ClearanceSettings,
-    releases: &[(String, Trajectory)],
+    (job, candidate, threads): (&Arc<Job>, Candidate, usize),
     out: &Path,
     file: &str,
     record: &mut T,
     set: impl FnOnce(&mut T, Vec<ReleaseClearance>),
 ) -> Result<()> {
-    let records = of_releases(c, releases, out)?;
+    let flown = releases::simulate(job, candidate, threads)?;
+    let of = releases::of_releases(c, &flown)?;
+    releases::write(c, &flown, &of, out)?;
+    let records: Vec<ReleaseClearance> = of.into_iter().map(|(r, _)| r).collect();
     for r in &records {
-        say!(
-            "clearance: {}: smallest {:.1} mm at t = {:.3} s ({} / {}): {}",
-            r.release,
-            r.min_clearance_mm,
-            r.t_min_s,
-            r.store_part,
-            r.aircraft_part,
-            if r.clears { "clears" } else { "does not clear" }
-        );
+        say!("clearance: {}", releases::line(r));
     }
     set(record, records);
     sepval_fit::record::write_record(&out.join(file), record)?;

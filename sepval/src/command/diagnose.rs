@@ -38,14 +38,12 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     run_dir.prepare()?;
     let mut d = diagnose(&options, evaluator.as_mut(), &mut *crate::front::progress())?;
     if let Some(c) = &geometry {
-        // The answer's trajectories: the model diagnosis.json records, rebuilt as predict does.
-        let source = sepval_predict::read_source(&args.out)?;
-        let ensemble = sepval_predict::Ensemble::of(&source, evaluator.job().factor_table())
-            .context("the answer of the diagnosis")?;
+        // The answer's trajectories: its model rebuilt as predict rebuilds it.
+        let job = evaluator.job();
+        let answer = sepval_predict::releases::diagnosis_answer(&d, &args.out, job)?;
         let threads = super::count("--threads", args.eval.threads)?;
-        let releases =
-            clearance::simulate_releases(evaluator.job(), ensemble.answer().candidate, threads)?;
-        clearance::record_releases(c, &releases, &args.out, "diagnosis.json", &mut d, |d, v| {
+        let flown = (job, answer, threads);
+        clearance::record_releases(c, flown, &args.out, "diagnosis.json", &mut d, |d, v| {
             d.clearance = Some(v)
         })?;
     }

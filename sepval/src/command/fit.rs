@@ -269,10 +269,9 @@ fn best_clearance(
     };
     let candidate = sepval_common::evaluation::Candidate::baseline(best.best.factors);
     let threads = super::count("--threads", args.eval.threads)?;
-    let releases = clearance::simulate_releases(job, candidate, threads)?;
     clearance::record_releases(
         c,
-        &releases,
+        (job, candidate, threads),
         &args.out,
         "result.json",
         &mut output.result,

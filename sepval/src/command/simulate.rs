@@ -5,6 +5,7 @@ use sepval_common::limits::{check_sampling, check_steps};
 use sepval_common::number_text::Shown;
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test_logged;
+use sepval_predict::releases;
 
 use super::{clearance, inputs, positive};
 use crate::cli::SimulateArgs;
@@ -58,8 +59,8 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     match &clearance {
         Some(c) => {
             // The clearance of the trajectory written (its noise included, with --noise-seed).
-            let trace = clearance::trace(c, &traj)?;
-            let line = clearance::words(c, &trace);
+            let trace = releases::trace(c, &traj).context("the clearance of the trajectory")?;
+            let line = releases::words(c, &trace);
             traj.push_metadata("clearance", &line);
             traj.write_with_columns(&args.out, &[("clearance_m", &trace.distance_m)])?;
             note!("clearance: {line}");
