@@ -13,7 +13,8 @@
 //!    ([`Row`]), the rows saved after each condition so an interrupted sweep resumes
 //!    ([`progress`]);
 //! 3. [`summary`]: the conditions cleared and not, in words, per row of the map;
-//! 4. [`record`] and [`outputs`]: DIR/envelope.csv, DIR/envelope.json, DIR/figures/envelope.png and
+//! 4. [`record`] ([`EnvelopeFile::of`]: the sweep's record with its summary and where it came
+//!    from, [`Provenance`]) and [`outputs`]: DIR/envelope.csv, DIR/envelope.json, DIR/figures/envelope.png and
 //!    DIR/report.html, written atomically.
 //!
 //! Every condition uses the same seed: sample s draws the same factors at every condition
@@ -37,6 +38,6 @@ pub mod sweep;
 pub use grid::{Axis, Grid, GridError};
 pub use outputs::write_outputs;
 pub use progress::{Progress, ProgressError};
-pub use record::{ENVELOPE_FORMAT, EnvelopeFile};
+pub use record::{ENVELOPE_FORMAT, EnvelopeFile, Provenance};
 pub use row::Row;
-pub use sweep::{Sweep, SweepError, sweep};
+pub use sweep::{Sweep, SweepError, Swept, sweep};

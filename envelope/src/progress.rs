@@ -27,6 +27,17 @@ pub fn progress_path(out: &Path) -> PathBuf {
     out.join("sweep").join("progress.json")
 }
 
+/// Removes the progress of the sweep in `out` (its file and its directory when empty) once
+/// the envelope is written: a finished sweep has nothing to resume. What cannot be removed is
+/// left as it is (the envelope is written already).
+pub fn remove_progress(out: &Path) {
+    let file = progress_path(out);
+    let _ = std::fs::remove_file(&file);
+    if let Some(dir) = file.parent() {
+        let _ = std::fs::remove_dir(dir);
+    }
+}
+
 /// A progress file that cannot be used.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

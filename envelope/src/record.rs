@@ -7,7 +7,8 @@ use sepval_predict::clearance::ALLOWED_PROBABILITY;
 
 use crate::grid::Grid;
 use crate::row::Row;
-use crate::summary::Summary;
+use crate::summary::{Summary, summarise};
+use crate::sweep::{Sweep, Swept};
 
 /// The format of DIR/envelope.json.
 pub const ENVELOPE_FORMAT: &str = "sepval-envelope/1";
@@ -64,8 +65,61 @@ pub struct EnvelopeFile {
     pub wall_s: f64,
 }
 
+/// Where an envelope came from, as its record says: the files and settings the caller read
+/// (the binary's flags, or a campaign's record).
+#[derive(Debug, Clone, Default)]
+pub struct Provenance {
+    /// Samples per condition.
+    pub samples: usize,
+    /// The seed.
+    pub seed: u64,
+    /// The SHA-256 of the sweep's inputs ([`crate::progress::inputs_digest`]).
+    pub inputs_sha256: String,
+    /// The fit or diagnosis predicted from.
+    pub from: String,
+    /// The aircraft's geometry.
+    pub aircraft: String,
+    /// The store's shape (`default` for the scenario's store of revolution).
+    pub store_shape: String,
+}
+
 impl EnvelopeFile {
-    /// The record of a sweep.
+    /// The record of a finished sweep (`sweep`, its result `swept`) with the criterion
+    /// `criterion_mm`, from `provenance`, in `wall_s` seconds: its summary in words, its axes,
+    /// rows and the releases flown on the map's axes.
+    pub fn of(
+        sweep: &Sweep,
+        swept: Swept,
+        criterion_mm: f64,
+        provenance: Provenance,
+        wall_s: f64,
+    ) -> (Self, Summary) {
+        let summary = summarise(&sweep.grid, &swept.rows, criterion_mm);
+        let mut file = EnvelopeFile::new(&sweep.grid, swept.rows, &summary, criterion_mm);
+        let Provenance {
+            samples,
+            seed,
+            inputs_sha256,
+            from,
+            aircraft,
+            store_shape,
+        } = provenance;
+        (
+            file.samples,
+            file.seed,
+            file.inputs_sha256,
+            file.from,
+            file.aircraft,
+            file.store_shape,
+        ) = (samples, seed, inputs_sha256, from, aircraft, store_shape);
+        file.flown = flown(sweep);
+        file.evaluations = swept.evaluations;
+        file.resumed = swept.resumed;
+        file.wall_s = wall_s;
+        (file, summary)
+    }
+
+    /// The record of a sweep, its provenance left empty (filled by [`EnvelopeFile::of`]).
     pub fn new(grid: &Grid, rows: Vec<Row>, summary: &Summary, criterion_mm: f64) -> Self {
         EnvelopeFile {
             format: ENVELOPE_FORMAT.into(),
@@ -97,4 +151,20 @@ impl EnvelopeFile {
             wall_s: f64::NAN,
         }
     }
+}
+
+/// The releases flown, on the map's axes.
+fn flown(s: &Sweep) -> Vec<(f64, f64)> {
+    let axes = s.grid.map_axes();
+    s.fitted
+        .events()
+        .iter()
+        .map(|e| {
+            let f = &e.simulator.scenario().flight;
+            (
+                axes.first().map_or(f.mach, |(q, _)| q.get(f)),
+                axes.get(1).map_or(0.0, |(q, _)| q.get(f)),
+            )
+        })
+        .collect()
 }

@@ -11,9 +11,8 @@ use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{EvalError, Evaluator, Job};
 use sepval_common::scenario::hex_sha256;
 use sepval_envelope::grid::{Axis, Grid};
-use sepval_envelope::progress::{Progress, inputs_digest, progress_path};
-use sepval_envelope::summary::summarise;
-use sepval_envelope::{EnvelopeFile, Sweep, sweep, write_outputs};
+use sepval_envelope::progress::{Progress, inputs_digest, progress_path, remove_progress};
+use sepval_envelope::{EnvelopeFile, Provenance, Sweep, sweep, write_outputs};
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
 use sepval_predict::{Settings, Source};
@@ -85,29 +84,23 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         &mut start_evaluator,
         &mut *crate::front::progress(),
     )?;
+    let provenance = Provenance {
+        samples: args.samples,
+        seed: args.seed,
+        inputs_sha256,
+        from: args.from.display().to_string(),
+        aircraft: aircraft.display().to_string(),
+        store_shape: args
+            .geometry
+            .store_shape
+            .as_ref()
+            .map_or("default".into(), |p| p.display().to_string()),
+    };
+    let wall_s = start.elapsed().as_secs_f64();
     let criterion_mm = args.geometry.clearance_mm;
-    let summary = summarise(&sweep_inputs.grid, &swept.rows, criterion_mm);
-    let mut file = EnvelopeFile::new(&sweep_inputs.grid, swept.rows, &summary, criterion_mm);
-    file.samples = args.samples;
-    file.seed = args.seed;
-    file.inputs_sha256 = inputs_sha256;
-    file.from = args.from.display().to_string();
-    file.aircraft = aircraft.display().to_string();
-    file.store_shape = args
-        .geometry
-        .store_shape
-        .as_ref()
-        .map_or("default".into(), |p| p.display().to_string());
-    file.flown = flown(&sweep_inputs);
-    file.evaluations = swept.evaluations;
-    file.resumed = swept.resumed;
-    file.wall_s = start.elapsed().as_secs_f64();
+    let (file, summary) = EnvelopeFile::of(&sweep_inputs, swept, criterion_mm, provenance, wall_s);
     write_outputs(&sweep_inputs.grid, &file, &args.out)?;
-    let progress_file = progress_path(&args.out);
-    let _ = std::fs::remove_file(&progress_file);
-    if let Some(dir) = progress_file.parent() {
-        let _ = std::fs::remove_dir(dir);
-    }
+    remove_progress(&args.out);
     say!("envelope:  {}", summary.headline);
     for l in &summary.lines {
         say!("           {l}");
@@ -204,22 +197,6 @@ pub(super) fn starter(
         started = true;
         evaluators.start(job, told).map_err(EvalError::transport)
     }
-}
-
-/// The releases flown, on the map's axes.
-fn flown(s: &Sweep) -> Vec<(f64, f64)> {
-    let axes = s.grid.map_axes();
-    s.fitted
-        .events()
-        .iter()
-        .map(|e| {
-            let f = &e.simulator.scenario().flight;
-            (
-                axes.first().map_or(f.mach, |(q, _)| q.get(f)),
-                axes.get(1).map_or(0.0, |(q, _)| q.get(f)),
-            )
-        })
-        .collect()
 }
 
 /// The digest of what decides the envelope (the source's records, the geometry files, the
