@@ -11,7 +11,7 @@ use sepval_campaign::{CampaignError, page};
 use sepval_common::scenario::{Scenario, hex_sha256};
 use sepval_predict::ClearanceSettings;
 
-use super::envelope::starter;
+use super::starter;
 use super::{clearance, count, evaluator_spec, inputs, releases};
 use crate::cli::{
     CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignRehearseArgs,

@@ -4,11 +4,9 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use sepval_common::evaluation::{EvalError, Evaluator, Job};
 use sepval_common::scenario::hex_sha256;
 use sepval_envelope::grid::{Axis, Grid};
 use sepval_envelope::progress::{Progress, inputs_digest, progress_path, remove_progress};
@@ -16,11 +14,9 @@ use sepval_envelope::{EnvelopeFile, Provenance, Sweep, sweep, write_outputs};
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
 use sepval_predict::{Settings, Source};
-use sepval_transport::link::{Notice, Notices};
-use sepval_transport::spec::{EvaluatorSpec, Starter};
 
-use super::predict::source_inputs;
-use super::{clearance, count, evaluator_spec, notices};
+use super::inputs::source_inputs;
+use super::{clearance, count, evaluator_spec, starter};
 use crate::cli::EnvelopeArgs;
 
 /// Runs `sepval envelope`. Every input (the flags, the source, the geometry, the grid) is
@@ -174,29 +170,6 @@ fn claim(args: &EnvelopeArgs, fresh: Progress, read: &[Input]) -> Result<(RunDir
         resume,
     };
     Ok((super::claim_out(&args.out, request)?, progress))
-}
-
-/// Starts each job's evaluator (an envelope's conditions, an update's rounds) with one
-/// [`Starter`], so that zenoh hosts that joined serve every job: their joining is told once, the
-/// rest of what the transport says (a worker lost, refused) every time.
-pub(super) fn starter(
-    spec: &EvaluatorSpec,
-) -> impl FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + '_ {
-    let mut started = false;
-    let mut evaluators = Starter::new(spec.clone());
-    move |job| {
-        let told: Notices = if started {
-            Arc::new(|n: Notice| {
-                if !matches!(n, Notice::Joined { .. }) {
-                    note!("sepval: {n}");
-                }
-            })
-        } else {
-            notices()
-        };
-        started = true;
-        evaluators.start(job, told).map_err(EvalError::transport)
-    }
 }
 
 /// The digest of what decides the envelope (the source's records, the geometry files, the

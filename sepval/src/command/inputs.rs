@@ -1,15 +1,17 @@
 //! Reading the inputs the flags name (scenario, factors, effects, data files) into validated
 //! values, with errors that name the file and the problem.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use sepval_common::effects::EffectSet;
+use sepval_common::evaluation::{Event, Job};
 use sepval_common::factors::{FactorTable, Factors};
 use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
 use sepval_common::telemetry::Trajectory;
 use sepval_common::telemetry::outliers::Policy;
+use sepval_predict::{Source, read_source};
 
 use super::releases::{self, Release};
 
@@ -275,4 +277,44 @@ pub fn baseline_fit(
     inputs: sepval_fit::checkpoint::InputsRecord,
 ) -> sepval_fit::FitOptions {
     sepval_fit::FitOptions::baseline(ga, sigma, lm, &out.join("baseline"), inputs)
+}
+
+/// The source of `--from` read and checked, the releases it was fitted to, and the releases held
+/// out (`--validate`, read with `policy`, then those the source records, read as its fit read
+/// its data).
+pub fn source_inputs(
+    from: &Path,
+    extension: Option<&Path>,
+    validate: &[PathBuf],
+    policy: sepval_common::telemetry::outliers::Policy,
+) -> Result<(Source, Job, Vec<Event>)> {
+    let source = read_source(from)?;
+    let record = source.inputs.clone();
+    let extension = extension
+        .map(Path::to_path_buf)
+        .or(record.extension.clone());
+    let (fitted, _) = job(
+        &record.data,
+        record.scenario.as_deref(),
+        extension.as_deref(),
+        record.outliers,
+    )
+    .with_context(|| format!("--from {}: the releases it was fitted to", from.display()))?;
+    let mut held = with_policy(validate, policy);
+    let recorded = source
+        .held_out
+        .iter()
+        .filter(|p| !validate.contains(p))
+        .map(|p| (p.clone(), record.outliers));
+    held.extend(recorded.collect::<Vec<_>>());
+    let held_out: Vec<Event> = validation_job(
+        &held,
+        &record.data,
+        &fitted,
+        record.scenario.as_deref(),
+        extension.as_deref(),
+    )?
+    .map(|j| j.events().to_vec())
+    .unwrap_or_default();
+    Ok((source, fitted, held_out))
 }

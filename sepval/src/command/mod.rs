@@ -29,13 +29,14 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
+use sepval_common::evaluation::{EvalError, Evaluator, Job};
 use sepval_common::number_text::Shown;
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_transport::RunId;
 use sepval_transport::dispatch::DispatchOptions;
 use sepval_transport::ipc::{IpcOptions, Launch, MAX_WORKERS};
-use sepval_transport::link::Notices;
-use sepval_transport::spec::EvaluatorSpec;
+use sepval_transport::link::{Notice, Notices};
+use sepval_transport::spec::{EvaluatorSpec, Starter};
 
 use crate::cli::{EvalArgs, EvaluatorKind};
 /// The terminal's progress bar, where commands used to find it; a command shows progress with
@@ -263,4 +264,27 @@ pub fn model_inputs(i: &crate::cli::InputArgs) -> Vec<Input> {
 /// Input files given by `flag` (none, one or several).
 pub fn input_files<'a>(flag: &str, paths: impl IntoIterator<Item = &'a PathBuf>) -> Vec<Input> {
     paths.into_iter().map(|p| Input::file(flag, p)).collect()
+}
+
+/// Starts each job's evaluator (an envelope's conditions, an update's rounds) with one
+/// [`Starter`], so that zenoh hosts that joined serve every job: their joining is told once, the
+/// rest of what the transport says (a worker lost, refused) every time.
+pub fn starter(
+    spec: &EvaluatorSpec,
+) -> impl FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + '_ {
+    let mut started = false;
+    let mut evaluators = Starter::new(spec.clone());
+    move |job| {
+        let told: Notices = if started {
+            Arc::new(|n: Notice| {
+                if !matches!(n, Notice::Joined { .. }) {
+                    note!("sepval: {n}");
+                }
+            })
+        } else {
+            notices()
+        };
+        started = true;
+        evaluators.start(job, told).map_err(EvalError::transport)
+    }
 }

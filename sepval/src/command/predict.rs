@@ -1,16 +1,14 @@
 //! `sepval predict`: a release not flown, with its bands, from a fit or a diagnosis; with
 //! `--data`, the post-flight check of a flown release against them.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use sepval_common::evaluation::{Event, Job};
 use sepval_fit::out_dir::Request;
 use sepval_predict::{
-    Flown, PredictionFile, Settings, Source, predict, prediction_file, prepare, read_source,
-    write_outputs,
+    Flown, PredictionFile, Settings, predict, prediction_file, prepare, write_outputs,
 };
 
 use super::{clearance, count, evaluator_spec, input_files, inputs, notices, releases};
@@ -31,7 +29,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
     };
     settings.check()?;
     let policy = args.outliers.policy();
-    let (source, fitted, held_out) = source_inputs(
+    let (source, fitted, held_out) = inputs::source_inputs(
         &args.from,
         args.extension.as_deref(),
         &args.validate,
@@ -82,46 +80,6 @@ pub fn run(args: PredictArgs) -> Result<()> {
     crate::front::out(&summary_lines(&file, &args.out));
     drop(run_dir);
     Ok(())
-}
-
-/// The source of `--from` read and checked, the releases it was fitted to, and the releases held
-/// out (`--validate`, read with `policy`, then those the source records, read as its fit read
-/// its data).
-pub fn source_inputs(
-    from: &Path,
-    extension: Option<&Path>,
-    validate: &[PathBuf],
-    policy: sepval_common::telemetry::outliers::Policy,
-) -> Result<(Source, Job, Vec<Event>)> {
-    let source = read_source(from)?;
-    let record = source.inputs.clone();
-    let extension = extension
-        .map(Path::to_path_buf)
-        .or(record.extension.clone());
-    let (fitted, _) = inputs::job(
-        &record.data,
-        record.scenario.as_deref(),
-        extension.as_deref(),
-        record.outliers,
-    )
-    .with_context(|| format!("--from {}: the releases it was fitted to", from.display()))?;
-    let mut held = inputs::with_policy(validate, policy);
-    let recorded = source
-        .held_out
-        .iter()
-        .filter(|p| !validate.contains(p))
-        .map(|p| (p.clone(), record.outliers));
-    held.extend(recorded.collect::<Vec<_>>());
-    let held_out: Vec<Event> = inputs::validation_job(
-        &held,
-        &record.data,
-        &fitted,
-        record.scenario.as_deref(),
-        extension.as_deref(),
-    )?
-    .map(|j| j.events().to_vec())
-    .unwrap_or_default();
-    Ok((source, fitted, held_out))
 }
 
 /// The flown release of `--data`, whose metadata (when it names one) must give the condition

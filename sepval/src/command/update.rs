@@ -12,7 +12,7 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
-use super::envelope::starter;
+use super::starter;
 use super::{evaluator_spec, inputs};
 use crate::cli::{FactorNames, UpdateArgs};
 
