@@ -17,7 +17,7 @@
 use std::sync::Arc;
 
 use sepval_common::cancel;
-use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
+use sepval_common::evaluation::{Candidate, Job};
 use sepval_common::scenario::{Flight, Scenario};
 use sepval_common::simulation::sample_times;
 use sepval_envelope::{Grid, Row};
@@ -34,8 +34,7 @@ use crate::CampaignError;
 use crate::rivals;
 use crate::state::{Assessed, State, spread};
 
-/// Starts an evaluator for a job (a condition's release).
-pub type StartEvaluator<'a> = dyn FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + 'a;
+pub use sepval_common::evaluation::StartEvaluator;
 
 /// What a round believes: the factors' distribution (the prior's, or the diagnosis's answer's
 /// with its rivals) and the model form at the releases.

@@ -445,6 +445,12 @@ impl EvalError {
     }
 }
 
+/// Starts an evaluator for a job: how a pipeline that runs several jobs (an envelope's
+/// conditions, an update's two rounds, a campaign's conditions and releases) asks the caller
+/// for each one's evaluator, whatever the transport.
+pub type StartEvaluator<'a> =
+    dyn FnMut(std::sync::Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + 'a;
+
 /// Evaluates batches of candidates for one job.
 pub trait Evaluator {
     /// Evaluates `batch` and returns one evaluation per candidate, in order. With

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use sepval_common::cancel;
-use sepval_common::evaluation::{EvalError, Evaluator, Event, Job};
+use sepval_common::evaluation::{EvalError, Event, Job};
 use sepval_predict::discrepancy::{self, Evidence};
 use sepval_predict::{ClearanceSettings, PredictError, Settings, Source, predict_with, prepare};
 use sepval_solve::run::{NoProgress, Progress as Step, ProgressObserver};
@@ -64,8 +64,7 @@ pub struct Sweep {
     pub progress_path: PathBuf,
 }
 
-/// Starts an evaluator for a job.
-pub type StartEvaluator<'a> = dyn FnMut(Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + 'a;
+pub use sepval_common::evaluation::StartEvaluator;
 
 /// What a sweep found.
 #[derive(Debug, Clone)]

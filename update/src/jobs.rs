@@ -2,10 +2,9 @@
 //! corrections of a round in every scenario (docs/update.md section 15.1), whose values each
 //! candidate carries; and the clock of its stages.
 
-use std::sync::Arc;
 
 use sepval_common::correction::CorrectionRecord;
-use sepval_common::evaluation::{EvalError, Evaluator, Event, Job};
+use sepval_common::evaluation::{Event, Job};
 use sepval_common::simulation::Simulator;
 
 use crate::explored::Proposal;
@@ -13,8 +12,7 @@ use crate::{Result, UpdateError};
 
 /// Starts an evaluator for a job (the update needs two: the releases as given for the
 /// baseline, then with the corrections proposed).
-pub type StartEvaluator<'a> =
-    dyn FnMut(Arc<Job>) -> std::result::Result<Box<dyn Evaluator>, EvalError> + 'a;
+pub use sepval_common::evaluation::StartEvaluator;
 
 /// Each stage's wall time on stderr when `SEPVAL_UPDATE_TIMING` is set (never in the outputs).
 pub static CLOCK: sepval_common::stage_clock::StageClock =
