@@ -11,6 +11,7 @@ use sepval_common::atomic_file::write_atomically;
 use sepval_envelope::row::CSV_HEADER;
 use sepval_report::figures::{MapAxis, RoundCounts, state_counts_figure};
 use sepval_report::html::escape_html;
+use sepval_report::words::significant;
 
 use sepval_envelope::Grid;
 
@@ -177,22 +178,6 @@ fn state_map(
     .map_err(|e| record_error(path, e))
 }
 
-/// A number for a reader: at most six significant digits, no trailing zeros (a grid's
-/// 0.6 + 2 x 0.15 reads 0.9, not 0.8999999999999999).
-pub fn shown(v: f64) -> String {
-    if !v.is_finite() {
-        return "-".into();
-    }
-    let digits = (5 - v.abs().max(1e-12).log10().floor() as i32).clamp(0, 12) as usize;
-    let t = format!("{v:.digits$}");
-    let t = if t.contains('.') {
-        t.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        t
-    };
-    if t == "-0" { "0".into() } else { t }
-}
-
 /// report.html.
 fn page(c: &View<'_>, current: &[Assessed]) -> String {
     let e = escape_html;
@@ -222,7 +207,7 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
         let k = &r.condition;
         h.push_str(&format!(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td style=\"text-align:left\">{}</td></tr>",
-            e(&r.file), e(&r.given), shown(k.mach), shown(k.altitude_m), shown(k.alpha_deg), e(&r.check)
+            e(&r.file), e(&r.given), number(k.mach), number(k.altitude_m), number(k.alpha_deg), e(&r.check)
         ));
     }
     h.push_str("</table><h2>Undecided, and why</h2>");
@@ -254,7 +239,7 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
         };
         h.push_str(&format!(
             "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'{rivals}), {reach}</li>",
-            shown(k.mach), shown(k.altitude_m), shown(k.alpha_deg), a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
+            number(k.mach), number(k.altitude_m), number(k.alpha_deg), a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
             share(a.factor_spread_mm)
         ));
     }
@@ -262,16 +247,7 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
     h
 }
 
-#[cfg(test)]
-mod tests {
-    use super::shown;
-
-    #[test]
-    fn numbers_are_shown_as_a_reader_writes_them() {
-        assert_eq!(shown(0.6 + 2.0 * 0.15), "0.9");
-        assert_eq!(shown(7924.8), "7924.8");
-        assert_eq!(shown(-6.0), "-6");
-        assert_eq!(shown(0.0125), "0.0125");
-        assert_eq!(shown(f64::NAN), "-");
-    }
+/// A number for a reader: six significant digits at most ([`significant`]).
+pub fn number(v: f64) -> String {
+    significant(v, 6)
 }

@@ -177,11 +177,10 @@ fn gust(term: &Term) -> String {
     )
 }
 
-/// A number with at most three decimals and no trailing zeros.
+/// A number with at most three decimals and no trailing zeros
+/// ([`sepval_report::words::decimals`]).
 pub fn fmt_num(v: f64) -> String {
-    let s = format!("{v:.3}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    s.to_string()
+    sepval_report::words::decimals(v, 3)
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@
 //! module turns a [`PlanFile`] into that template's context, every number written as the page
 //! shows it.
 
+use sepval_report::words::{condition, decimals};
 use std::path::{Path, PathBuf};
 
 use sepval_report::html::{HtmlError, PageTemplate, render_page};
@@ -68,30 +69,18 @@ struct PairRow {
     separation: String,
 }
 
-/// A number as the page shows it: at most three decimals, trailing zeros dropped.
+/// A number as the page shows it: at most three decimals ([`decimals`]).
 pub(crate) fn number(v: f64) -> String {
-    if !v.is_finite() {
-        return "-".into();
-    }
-    let s = format!("{v:.3}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.into() }
+    decimals(v, 3)
 }
 
 fn opt(v: Option<f64>) -> String {
     v.map_or("-".into(), number)
 }
 
-/// A condition in words: "Mach 0.8, 3000 m, alpha 2 deg, beta 4 deg, gamma 0 deg".
+/// A condition in words ([`sepval_report::words::condition`]).
 pub(crate) fn condition_words(c: &ConditionRecord) -> String {
-    format!(
-        "Mach {}, altitude {} m, aircraft alpha {} deg, beta {} deg, flight-path angle {} deg",
-        number(c.mach),
-        number(c.altitude_m),
-        number(c.alpha_deg),
-        number(c.beta_deg),
-        number(c.gamma_deg)
-    )
+    condition(c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg)
 }
 
 fn row(c: &ConditionRecord, total_pairs: usize) -> Row {

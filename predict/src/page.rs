@@ -5,6 +5,7 @@
 //! (`sepval_report::html`); this module turns a [`PredictionFile`] into its context.
 
 use sepval_report::html::{HtmlError, PageTemplate, render_page};
+use sepval_report::words::{condition, decimals};
 use serde::Serialize;
 
 use crate::check::CHANNEL_WORDS;
@@ -76,38 +77,27 @@ struct HeldRow {
     note: String,
 }
 
-/// A number as the page shows it: four significant digits at most, trailing zeros dropped.
+/// A number as the page shows it: one decimal from 100, three from 1, four below
+/// ([`decimals`]).
 pub(crate) fn number(v: f64) -> String {
-    if !v.is_finite() {
-        return "-".into();
-    }
-    let decimals = if v.abs() >= 100.0 {
+    let n = if v.abs() >= 100.0 {
         1
     } else if v.abs() >= 1.0 {
         3
     } else {
         4
     };
-    let s = format!("{v:.decimals$}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.into() }
+    decimals(v, n)
 }
 
 fn percent(v: f64) -> String {
     format!("{:.0} %", 100.0 * v)
 }
 
-/// The condition in words.
+/// The condition in words ([`sepval_report::words::condition`]).
 pub(crate) fn condition_words(f: &PredictionFile) -> String {
     let c = &f.condition;
-    format!(
-        "Mach {}, altitude {} m, aircraft alpha {} deg, beta {} deg, flight-path angle {} deg",
-        number(c.mach),
-        number(c.altitude_m),
-        number(c.alpha_deg),
-        number(c.beta_deg),
-        number(c.gamma_deg)
-    )
+    condition(c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg)
 }
 
 /// The answer in one sentence: where the store is at the end, with the band.

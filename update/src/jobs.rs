@@ -2,7 +2,6 @@
 //! corrections of a round in every scenario (docs/update.md section 15.1), whose values each
 //! candidate carries; and the clock of its stages.
 
-
 use sepval_common::correction::CorrectionRecord;
 use sepval_common::evaluation::{Event, Job};
 use sepval_common::simulation::Simulator;

@@ -136,9 +136,9 @@ fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
         say!(
             "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {})",
             k + 1,
-            page::shown(f.condition.mach),
-            page::shown(f.condition.altitude_m),
-            page::shown(f.condition.alpha_deg),
+            page::number(f.condition.mach),
+            page::number(f.condition.altitude_m),
+            page::number(f.condition.alpha_deg),
             f.p_fail_planned,
             if f.truly_safe { "safe" } else { "UNSAFE" }
         );
@@ -232,9 +232,9 @@ fn status(a: CampaignStatusArgs) -> Result<()> {
         for r in &n.releases {
             say!(
                 "next:      Mach {}, altitude {} m, alpha {} deg: {}",
-                page::shown(r.mach),
-                page::shown(r.altitude_m),
-                page::shown(r.alpha_deg),
+                page::number(r.mach),
+                page::number(r.altitude_m),
+                page::number(r.alpha_deg),
                 r.why
             );
         }
