@@ -214,7 +214,7 @@ fn diagnose(
 
 /// The post-flight check of `data` (flown at `scenario`) against the bands `model` predicts
 /// there at the 95 % level, with the measurement noise: the same model-form band as the
-/// round's envelope ([`FormBand`]: the discrepancy at the releases, the reach beyond them).
+/// round's envelope (the discrepancy at the releases, the reach beyond them).
 pub fn check_release(
     model: &Model,
     scenario: &Scenario,

@@ -3,8 +3,8 @@
 //! ([`simulate`]), the store's distance to the aircraft along it ([`trace`], the geometry's
 //! swept distance), one [`ReleaseClearance`] per release for result.json and diagnosis.json,
 //! and `clearance.csv` and `figures/clearance.png` written into the run's directory
-//! ([`write`]). A stage of the fit and the diagnosis: the binary only asks for it when
-//! `--aircraft` is given and prints its lines ([`line`]).
+//! ([`write()`]). A stage of the fit and the diagnosis: the binary only asks for it when
+//! `--aircraft` is given and prints its lines ([`line()`]).
 
 use std::path::Path;
 use std::sync::Arc;
