@@ -35,7 +35,10 @@ pub fn with_corrections(job: &Job, proposals: &[Proposal]) -> Result<Job> {
             let mut s = e.simulator.scenario().clone();
             s.correction = records.clone();
             s.validate(&e.name)
-                .map_err(|err| UpdateError::Job(err.to_string()))?;
+                .map_err(|source| UpdateError::Corrected {
+                    release: e.name.clone(),
+                    source,
+                })?;
             Ok(Event {
                 name: e.name.clone(),
                 simulator: Simulator::new(&s),
@@ -43,5 +46,5 @@ pub fn with_corrections(job: &Job, proposals: &[Proposal]) -> Result<Job> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    Job::new(events).map_err(|e| UpdateError::Job(e.to_string()))
+    Job::new(events).map_err(UpdateError::Releases)
 }

@@ -72,12 +72,38 @@ pub enum UpdateError {
     /// A search or an evaluation.
     #[error(transparent)]
     Run(#[from] RunError),
-    /// A job that cannot be built.
-    #[error("the releases with the corrections proposed: {0}")]
-    Job(String),
-    /// The updated store cannot be written as a scenario.
-    #[error("the updated store: {0}")]
-    Store(String),
+    /// A release's scenario with the corrections proposed.
+    #[error("release {release} with the corrections proposed")]
+    Corrected {
+        /// The release.
+        release: String,
+        /// Why.
+        #[source]
+        source: sepval_common::scenario::ScenarioError,
+    },
+    /// The releases with the corrections proposed, as one job.
+    #[error("the releases with the corrections proposed")]
+    Releases(#[source] sepval_common::evaluation::JobError),
+    /// The baseline fit ended without a refined optimum to correct from.
+    #[error("the baseline fit produced no refined optimum")]
+    NoRefinedOptimum,
+    /// The baseline's joint refinement failed.
+    #[error("the baseline's refinement: {0}")]
+    Refinement(String),
+    /// `--validate` named no release that could be read.
+    #[error("--validate gave no release")]
+    NoValidation,
+    /// A correction that does not merge into the store's coefficient.
+    #[error("the updated store: `{field}` {message}")]
+    Merge {
+        /// The scenario's field.
+        field: String,
+        /// Why.
+        message: String,
+    },
+    /// The updated store is not a valid scenario.
+    #[error("the updated store")]
+    Store(#[source] sepval_common::scenario::ScenarioError),
     /// A list of free factors that is empty or names no factor: refused before anything runs.
     #[error("the free factors {0:?}: expected at least one, each the index of one of the 17")]
     Free(Vec<usize>),

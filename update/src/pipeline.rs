@@ -116,9 +116,7 @@ fn baseline(
         FitError::Run(RunError::Interrupted) => UpdateError::Run(RunError::Interrupted),
         other => UpdateError::Baseline(other),
     })?;
-    let refined = out
-        .refined
-        .ok_or_else(|| UpdateError::Job("the baseline fit produced no refined optimum".into()))?;
+    let refined = out.refined.ok_or(UpdateError::NoRefinedOptimum)?;
     let mut evaluations: u64 = out
         .result
         .methods
@@ -131,7 +129,7 @@ fn baseline(
     refine_together(evaluator, &mut runs)?;
     let run = runs.remove(0);
     if let Some(f) = run.failure() {
-        return Err(UpdateError::Job(format!("the baseline's refinement: {f}")));
+        return Err(UpdateError::Refinement(f.to_string()));
     }
     let lm = run.finish();
     evaluations += lm.evaluations;
@@ -169,5 +167,5 @@ fn store(options: &UpdateOptions, job: &Job, selected: &Selected) -> Result<Stor
             names.join(", ")
         )
     };
-    updated_store(&options.scenario, &kept, &description).map_err(UpdateError::Store)
+    updated_store(&options.scenario, &kept, &description)
 }

@@ -21,6 +21,8 @@ use sepval_common::table::{
 };
 use sepval_common::table_form::interference_distances;
 
+use crate::UpdateError;
+
 /// The updated store: its scenario (tables as file references) and its table files.
 #[derive(Debug, Clone)]
 pub struct Store {
@@ -188,7 +190,7 @@ pub fn updated_store(
     base: &Scenario,
     corrections: &[(Correction, Vec<f64>)],
     description: &str,
-) -> Result<Store, String> {
+) -> Result<Store, UpdateError> {
     let mut s = base.clone();
     s.correction.clear();
     s.description = description.to_string();
@@ -201,10 +203,14 @@ pub fn updated_store(
         if on.is_empty() {
             continue;
         }
-        let c = merged(base, target, &on).map_err(|e| format!("`{}` {e}", target.field()))?;
+        let c = merged(base, target, &on).map_err(|message| UpdateError::Merge {
+            field: target.field(),
+            message,
+        })?;
         set(&mut s, target, c);
     }
-    s.validate("the updated store").map_err(|e| e.to_string())?;
+    s.validate("the updated store")
+        .map_err(UpdateError::Store)?;
     let (file_form, files) = file_form(&s);
     Ok(Store {
         scenario: s,

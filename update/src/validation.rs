@@ -54,7 +54,7 @@ pub fn validate(
         });
     }
     if out.is_empty() {
-        return Err(UpdateError::Job("--validate gave no release".into()));
+        return Err(UpdateError::NoValidation);
     }
     Ok((out, 3 * n as u64))
 }
