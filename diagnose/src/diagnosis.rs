@@ -164,6 +164,69 @@ fn yes() -> bool {
     true
 }
 
+/// Whether a diagnosis's converged baseline fit reached near the noise: one decision, so that
+/// a diagnosis cannot say both (docs/discovery.md section 11.5, step 2).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(from = "BaselineFields", into = "BaselineFields")]
+pub enum BaselineVerdict {
+    /// It did: the tests of its extensions mean something.
+    Converged,
+    /// It did not (why: its goals against the limit): the answer is unreliable.
+    Unreliable(String),
+}
+
+impl BaselineVerdict {
+    /// The verdict of a baseline that failed for `why`, or converged (`None`).
+    pub fn of(why: Option<String>) -> BaselineVerdict {
+        why.map_or(BaselineVerdict::Converged, BaselineVerdict::Unreliable)
+    }
+
+    /// Whether the baseline converged near the noise.
+    pub fn converged(&self) -> bool {
+        matches!(self, BaselineVerdict::Converged)
+    }
+
+    /// Why it counts as not converged.
+    pub fn why(&self) -> Option<&str> {
+        match self {
+            BaselineVerdict::Converged => None,
+            BaselineVerdict::Unreliable(why) => Some(why),
+        }
+    }
+}
+
+/// The verdict as diagnosis.json records it, in two fields (as before it was one decision).
+#[derive(Serialize, Deserialize)]
+struct BaselineFields {
+    #[serde(default = "yes")]
+    baseline_converged: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    baseline_unreliable: Option<String>,
+}
+
+impl From<BaselineFields> for BaselineVerdict {
+    fn from(f: BaselineFields) -> Self {
+        match (f.baseline_converged, f.baseline_unreliable) {
+            (true, None) => BaselineVerdict::Converged,
+            // A record that says both, or not converged without a reason: unreliable, the
+            // cautious reading.
+            (_, Some(why)) => BaselineVerdict::Unreliable(why),
+            (false, None) => BaselineVerdict::Unreliable(
+                "the baseline fit did not reach near the noise (the record gives no reason)".into(),
+            ),
+        }
+    }
+}
+
+impl From<BaselineVerdict> for BaselineFields {
+    fn from(v: BaselineVerdict) -> Self {
+        BaselineFields {
+            baseline_converged: v.converged(),
+            baseline_unreliable: v.why().map(str::to_string),
+        }
+    }
+}
+
 /// DIR/diagnosis.json.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
@@ -184,12 +247,10 @@ pub struct Diagnosis {
     /// Whether the converged baseline reached near the noise (both goals within
     /// [`BASELINE_LIMIT_SIGMA`](super::BASELINE_LIMIT_SIGMA) sigma). When it did not, the
     /// answer below is unreliable (a refit may have found another optimum of the factors, not
-    /// a cause) and nothing is `explained`.
-    #[serde(default = "yes")]
-    pub baseline_converged: bool,
-    /// Why the baseline counts as not converged (its goals against the limit).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub baseline_unreliable: Option<String>,
+    /// a cause) and nothing is `explained`. Recorded as `baseline_converged` and, when not,
+    /// `baseline_unreliable` (why).
+    #[serde(flatten)]
+    pub baseline_verdict: BaselineVerdict,
     /// Why the first baseline fit was replaced: the catalogue's refits showed it in a local
     /// optimum of the factors, and the baseline refined again from theirs fits better
     /// (`docs/discovery.md` section 11.5, step 2a).
@@ -258,4 +319,42 @@ pub struct Diagnosis {
     pub evaluations: u64,
     /// Wall time \[s\].
     pub wall_s: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, PartialEq, Serialize, Deserialize)]
+    struct Holder {
+        #[serde(flatten)]
+        v: BaselineVerdict,
+    }
+
+    fn read(text: &str) -> BaselineVerdict {
+        serde_json::from_str::<Holder>(text).unwrap().v
+    }
+
+    #[test]
+    fn the_baseline_verdict_is_one_decision_in_the_records_two_fields() {
+        let why = BaselineVerdict::Unreliable("J_pos 18 sigma".into());
+        for (v, text) in [
+            (BaselineVerdict::Converged, r#"{"baseline_converged":true}"#),
+            (
+                why.clone(),
+                r#"{"baseline_converged":false,"baseline_unreliable":"J_pos 18 sigma"}"#,
+            ),
+        ] {
+            assert_eq!(
+                serde_json::to_string(&Holder { v: v.clone() }).unwrap(),
+                text
+            );
+            assert_eq!(read(text), v);
+        }
+        // Records from before the field: converged. A record that says both is unreliable.
+        assert_eq!(read("{}"), BaselineVerdict::Converged);
+        let both = r#"{"baseline_converged":true,"baseline_unreliable":"J_pos 18 sigma"}"#;
+        assert_eq!(read(both), why);
+        assert!(!read(r#"{"baseline_converged":false}"#).converged());
+    }
 }

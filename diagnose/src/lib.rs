@@ -143,8 +143,8 @@ mod validation;
 mod verdict;
 
 pub use diagnosis::{
-    Alternative, CandidateReport, Diagnosis, ExtensionReport, ModelSummary, ParamValue,
-    RivalReport, SkippedRefit,
+    Alternative, BaselineVerdict, CandidateReport, Diagnosis, ExtensionReport, ModelSummary,
+    ParamValue, RivalReport, SkippedRefit,
 };
 pub use found::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
 pub use library::Sample;

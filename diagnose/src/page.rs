@@ -190,7 +190,7 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> Result<String, H
     };
     let page = Page {
         verdict: &d.verdict,
-        unreliable: d.baseline_unreliable.as_deref(),
+        unreliable: d.baseline_verdict.why(),
         baseline_restart: d.baseline_restart.as_deref(),
         skipped: d
             .skipped

@@ -119,7 +119,7 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
 /// The terminal summary: a few short lines.
 fn summary_lines(d: &Diagnosis, out: &std::path::Path) -> String {
     let mut s = String::new();
-    if !d.baseline_converged {
+    if !d.baseline_verdict.converged() {
         s.push_str(&format!(
             "UNRELIABLE: the baseline fit failed (J_pos {:.0}, J_att {:.0} sigma): no cause below is reliable\n",
             d.baseline.j_pos_m / d.sigma_pos_m,
