@@ -231,7 +231,7 @@ fn page(c: &View<'_>, current: &[Assessed]) -> String {
         let share = |part: f64| 100.0 * (part / a.spread_mm).min(1.0);
         let rivals = if a.rival_spread_mm > 0.0 {
             format!(
-                ", {:.0} % the rivals' disagreement",
+                " (within which {:.0} % the rivals' disagreement)",
                 share(a.rival_spread_mm)
             )
         } else {
