@@ -11,10 +11,11 @@ pub use campaign::{
     CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignRehearseArgs,
     CampaignStatusArgs,
 };
+use sepval_plan::conditions::{Quantity, Range};
 use sepval_transport::RunId;
 pub use shared::{
-    EvalArgs, GeometryArgs, GridArgs, InputArgs, ModelArgs, NoiseArgs, OutlierArg, OutlierArgs,
-    OverwriteArgs, TablesArgs,
+    AxisArg, EvalArgs, GeometryArgs, GridArgs, InputArgs, ModelArgs, NoiseArgs, OutlierArg,
+    OutlierArgs, OverwriteArgs, TablesArgs,
 };
 
 #[derive(Parser)]
@@ -197,20 +198,20 @@ pub struct PlanArgs {
     #[arg(long, value_name = "DIR")]
     pub from: PathBuf,
     /// Range of the candidate conditions' Mach number [default: the first release's].
-    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
-    pub mach: Option<String>,
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true, value_parser = shared::range_of(Quantity::Mach))]
+    pub mach: Option<Range>,
     /// Range of the candidate conditions' altitude [m] [default: the first release's].
-    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
-    pub altitude_m: Option<String>,
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true, value_parser = shared::range_of(Quantity::AltitudeM))]
+    pub altitude_m: Option<Range>,
     /// Range of the candidate conditions' aircraft angle of attack [deg] [default: the first release's].
-    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
-    pub alpha_deg: Option<String>,
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true, value_parser = shared::range_of(Quantity::AlphaDeg))]
+    pub alpha_deg: Option<Range>,
     /// Range of the candidate conditions' aircraft sideslip [deg] [default: the first release's].
-    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
-    pub beta_deg: Option<String>,
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true, value_parser = shared::range_of(Quantity::BetaDeg))]
+    pub beta_deg: Option<Range>,
     /// Range of the candidate conditions' flight-path angle [deg] [default: the first release's].
-    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
-    pub gamma_deg: Option<String>,
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true, value_parser = shared::range_of(Quantity::GammaDeg))]
+    pub gamma_deg: Option<Range>,
     /// Points per axis given with LO < HI (the grid has points^axes conditions).
     #[arg(long, default_value_t = sepval_plan::DEFAULT_POINTS, value_name = "N")]
     pub points: usize,

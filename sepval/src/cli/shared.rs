@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 
 use sepval_common::telemetry::outliers::Policy;
-use sepval_plan::conditions::Quantity;
+use sepval_envelope::grid::{Axis, GridError};
+use sepval_plan::conditions::{Quantity, Range};
 use sepval_transport::RunId;
 
 use super::EvaluatorKind;
@@ -101,30 +102,75 @@ pub struct GeometryArgs {
     pub clearance_mm: f64,
 }
 
+/// One axis of a grid as given: its text (recorded and digested as typed) and its values,
+/// parsed and checked by clap ([`Axis::parse`]) before the command runs.
+#[derive(Debug, Clone)]
+pub struct AxisArg {
+    /// `LO:HI:N` as typed.
+    pub text: String,
+    /// Its values.
+    pub axis: Axis,
+}
+
+/// The parser of the `LO:HI:N` flag of `quantity`.
+fn axis_of(quantity: Quantity) -> impl Fn(&str) -> Result<AxisArg, String> + Clone {
+    move |text| {
+        Axis::parse(quantity, text)
+            .map(|axis| AxisArg {
+                text: text.to_string(),
+                axis,
+            })
+            .map_err(|e| match e {
+                // The flag and its value are said by the parse error already.
+                GridError::Syntax { message, .. } => message,
+                other => other.to_string(),
+            })
+    }
+}
+
+/// The parser of the `LO:HI` range flag of `quantity` (`sepval plan`).
+pub(super) fn range_of(quantity: Quantity) -> impl Fn(&str) -> Result<Range, String> + Clone {
+    move |text| {
+        let number = |s: &str| {
+            s.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("`{s}` is not a number (expected LO:HI)"))
+        };
+        let Some((lo, hi)) = text.split_once(':') else {
+            return Err("expected LO:HI (two numbers, e.g. 0.6:0.9)".into());
+        };
+        Ok(Range {
+            quantity,
+            lo: number(lo)?,
+            hi: number(hi)?,
+        })
+    }
+}
+
 /// The axes of a grid of flight conditions (`sepval envelope`, `sepval campaign`), each
 /// `LO:HI:N`.
 #[derive(clap::Args)]
 pub struct GridArgs {
     /// Mach values: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub mach: Option<String>,
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true, value_parser = axis_of(Quantity::Mach))]
+    pub mach: Option<AxisArg>,
     /// Altitudes [m]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub altitude_m: Option<String>,
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true, value_parser = axis_of(Quantity::AltitudeM))]
+    pub altitude_m: Option<AxisArg>,
     /// Aircraft angles of attack [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub alpha_deg: Option<String>,
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true, value_parser = axis_of(Quantity::AlphaDeg))]
+    pub alpha_deg: Option<AxisArg>,
     /// Aircraft sideslip angles [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub beta_deg: Option<String>,
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true, value_parser = axis_of(Quantity::BetaDeg))]
+    pub beta_deg: Option<AxisArg>,
     /// Flight-path angles [deg]: LO:HI:N.
-    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true)]
-    pub gamma_deg: Option<String>,
+    #[arg(long, value_name = "LO:HI:N", allow_hyphen_values = true, value_parser = axis_of(Quantity::GammaDeg))]
+    pub gamma_deg: Option<AxisArg>,
 }
 
 impl GridArgs {
     /// The axes given, in the order of `[flight]`.
-    pub fn given(&self) -> Vec<(Quantity, String)> {
+    pub fn given(&self) -> Vec<(Quantity, &AxisArg)> {
         [
             (Quantity::Mach, &self.mach),
             (Quantity::AltitudeM, &self.altitude_m),
@@ -133,7 +179,7 @@ impl GridArgs {
             (Quantity::GammaDeg, &self.gamma_deg),
         ]
         .into_iter()
-        .filter_map(|(q, v)| v.clone().map(|v| (q, v)))
+        .filter_map(|(q, v)| v.as_ref().map(|v| (q, v)))
         .collect()
     }
 }

@@ -67,7 +67,7 @@ fn begin(
         .grid
         .given()
         .into_iter()
-        .map(|(q, text)| (q.flag().to_string(), text))
+        .map(|(q, a)| (q.flag().to_string(), a.text.clone()))
         .collect();
     if axes.is_empty() {
         bail!(

@@ -17,6 +17,7 @@ use sepval_predict::{Settings, Source};
 
 use super::inputs::source_inputs;
 use super::{clearance, count, evaluator_spec, starter};
+use crate::cli::AxisArg;
 use crate::cli::EnvelopeArgs;
 
 /// Runs `sepval envelope`. Every input (the flags, the source, the geometry, the grid) is
@@ -43,10 +44,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
             "give at least one axis to sweep: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N"
         );
     }
-    let axes: Vec<Axis> = given
-        .iter()
-        .map(|(q, text)| Axis::parse(*q, text))
-        .collect::<Result<_, _>>()?;
+    let axes: Vec<Axis> = given.iter().map(|(_, a)| a.axis).collect();
     let (source, fitted, held_out) = source_inputs(
         &args.from,
         args.extension.as_deref(),
@@ -179,7 +177,7 @@ fn digest(
     args: &EnvelopeArgs,
     from: &Path,
     aircraft: &Path,
-    axes: &[(Quantity, String)],
+    axes: &[(Quantity, &AxisArg)],
 ) -> Result<(String, BTreeMap<String, String>)> {
     let read = |p: &Path| -> Result<Vec<u8>> {
         std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))
@@ -210,7 +208,7 @@ fn digest(
         .collect();
     let axes: Vec<String> = axes
         .iter()
-        .map(|(q, t)| format!("{}={t}", q.flag()))
+        .map(|(q, a)| format!("{}={}", q.flag(), a.text))
         .collect();
     let mut settings = format!(
         "samples={} seed={} clearance_mm={} validate={} axes={}",

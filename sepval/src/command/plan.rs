@@ -4,11 +4,9 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use sepval_fit::out_dir::Request;
-use sepval_plan::{
-    PlanFile, Quantity, Range, plan, plan_file, prepare, read_diagnosis, write_outputs,
-};
+use sepval_plan::{PlanFile, Range, plan, plan_file, prepare, read_diagnosis, write_outputs};
 
 use super::{evaluator_spec, inputs, notices};
 use crate::cli::PlanArgs;
@@ -18,7 +16,7 @@ use crate::cli::PlanArgs;
 /// refusal writes nothing; the directory is cleared (`--overwrite`) only once the plan is made.
 pub fn run(args: PlanArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
-    let ranges = ranges(&args)?;
+    let ranges = ranges(&args);
     let diagnosis = read_diagnosis(&args.from)?;
     let record = diagnosis.inputs.clone();
     let (flown, _) = inputs::job(
@@ -61,31 +59,19 @@ pub fn run(args: PlanArgs) -> Result<()> {
     Ok(())
 }
 
-/// The ranges of the five condition flags.
-fn ranges(args: &PlanArgs) -> Result<Vec<Range>> {
-    let given = [
-        (Quantity::Mach, &args.mach),
-        (Quantity::AltitudeM, &args.altitude_m),
-        (Quantity::AlphaDeg, &args.alpha_deg),
-        (Quantity::BetaDeg, &args.beta_deg),
-        (Quantity::GammaDeg, &args.gamma_deg),
-    ];
-    let mut out = Vec::new();
-    for (quantity, text) in given {
-        let Some(text) = text else { continue };
-        let flag = quantity.flag();
-        let number = |s: &str| -> Result<f64> {
-            s.trim()
-                .parse::<f64>()
-                .with_context(|| format!("{flag} {text}: `{s}` is not a number (expected LO:HI)"))
-        };
-        let (lo, hi) = match text.split_once(':') {
-            Some((lo, hi)) => (number(lo)?, number(hi)?),
-            None => bail!("{flag} {text}: expected LO:HI (two numbers, e.g. 0.6:0.9)"),
-        };
-        out.push(Range { quantity, lo, hi });
-    }
-    Ok(out)
+/// The ranges of the five condition flags given (parsed by clap), in the order of `[flight]`.
+fn ranges(args: &PlanArgs) -> Vec<Range> {
+    [
+        &args.mach,
+        &args.altitude_m,
+        &args.alpha_deg,
+        &args.beta_deg,
+        &args.gamma_deg,
+    ]
+    .into_iter()
+    .flatten()
+    .cloned()
+    .collect()
 }
 
 /// The terminal summary: a few short lines.
