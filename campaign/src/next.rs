@@ -378,7 +378,7 @@ mod tests {
     use sepval_common::scenario::Scenario;
     use sepval_envelope::Row;
     use sepval_envelope::grid::Axis;
-    use sepval_plan::conditions::Quantity;
+    use sepval_fit::conditions::Quantity;
     use sepval_predict::record::ConditionRecord;
 
     /// A grid of five Mach numbers whose conditions fail with `p_fail`, median clearance `p50`.

@@ -1,7 +1,7 @@
 //! The envelope's grid: each axis given as `LO:HI:N` (N values from LO to HI, evenly spaced;
 //! N = 1 holds the axis at LO), the conditions their product around the condition of the
 //! source's first release (an axis not given stays there), each range checked as a plan's is
-//! (`sepval_plan::conditions`: finite, ordered, a condition the scenario can fly, within the
+//! (`sepval_fit::conditions`: finite, ordered, a condition the scenario can fly, within the
 //! model's domain and its tables' breakpoints, `sepval_fit::domain`). At most [`MAX_CONDITIONS`] conditions and [`MAX_POINTS`]
 //! per axis.
 //!
@@ -10,7 +10,7 @@
 //! highest probability of failing to clear).
 
 use sepval_common::scenario::{Flight, Scenario};
-use sepval_plan::conditions::{ConditionError, Conditions, Quantity, Range};
+use sepval_fit::conditions::{ConditionError, Conditions, Quantity, Range};
 
 /// The most conditions of one envelope.
 pub const MAX_CONDITIONS: usize = 2500;

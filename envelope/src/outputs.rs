@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use sepval_common::atomic_file::write_atomically;
-use sepval_plan::conditions::Quantity;
+use sepval_fit::conditions::Quantity;
 use sepval_report::figures::{EnvelopeMap, MapAxis, Safety, envelope_map};
 
 use crate::grid::Grid;

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use sepval_plan::conditions::Quantity;
+use sepval_fit::conditions::Quantity;
 use sepval_predict::clearance::ALLOWED_PROBABILITY;
 
 use crate::grid::Grid;

@@ -27,6 +27,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod checkpoint;
+pub mod conditions;
 pub mod domain;
 pub mod method;
 pub mod model_spec;

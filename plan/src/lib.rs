@@ -21,7 +21,7 @@
 
 #![deny(clippy::float_cmp)]
 
-pub mod conditions;
+pub use sepval_fit::conditions;
 pub mod information;
 pub mod models;
 pub mod outputs;

@@ -4,7 +4,7 @@
 //! release. A range is checked before anything runs: LO <= HI, finite, within what the scenario
 //! accepts (section 1: Mach > 0, the ISA troposphere, angles within +-90 deg) and within the
 //! model's domain and the breakpoints of the scenario's tables in Mach, alpha and beta
-//! ([`sepval_fit::domain`]: a table is held at its edge beyond them, so a planned release
+//! ([`crate::domain`]: a table is held at its edge beyond them, so a planned release
 //! there would fly on made-up aerodynamics).
 
 use sepval_common::number_text::Shown;
@@ -77,9 +77,9 @@ impl Quantity {
         }
     }
 
-    /// The quantity the model's domain bounds ([`sepval_fit::domain`]), if it is one.
-    pub fn bounded(self) -> Option<sepval_fit::domain::Bounded> {
-        use sepval_fit::domain::Bounded;
+    /// The quantity the model's domain bounds ([`crate::domain`]), if it is one.
+    pub fn bounded(self) -> Option<crate::domain::Bounded> {
+        use crate::domain::Bounded;
         match self {
             Quantity::Mach => Some(Bounded::Mach),
             Quantity::AlphaDeg => Some(Bounded::AlphaDeg),
@@ -263,7 +263,7 @@ impl Conditions {
 
 /// Checks one range: finite, ordered, accepted by the scenario at both ends (the other
 /// quantities at the base condition) and within the model's domain and its tables'
-/// breakpoints ([`sepval_fit::domain`]).
+/// breakpoints ([`crate::domain`]).
 fn check_range(base: &Scenario, r: &Range) -> Result<(), ConditionError> {
     let bad = |message: String| ConditionError::Range {
         flag: r.quantity.flag(),
@@ -289,7 +289,7 @@ fn check_range(base: &Scenario, r: &Range) -> Result<(), ConditionError> {
     }
     if let Some(q) = r.quantity.bounded() {
         for v in [r.lo, r.hi] {
-            sepval_fit::domain::check_value(base, q, v).map_err(|e| bad(e.to_string()))?;
+            crate::domain::check_value(base, q, v).map_err(|e| bad(e.to_string()))?;
         }
     }
     Ok(())
