@@ -99,16 +99,16 @@ pub fn render(file: &EnvelopeFile, figure: &str) -> Result<String, HtmlError> {
              condition is cleared when at most {} of its samples come within {} mm of the \
              aircraft (MIL-STD-1289D) or diverge. The same samples serve every condition, so \
              the map changes where the physics does, not where the draws do.",
-            file.samples,
-            file.seed,
+            file.provenance.samples,
+            file.provenance.seed,
             pct(file.allowed_probability),
             file.criterion_mm
         ),
         provenance: format!(
             "From {}; aircraft {}; store {}. {} simulations in {:.1} s{}.",
-            file.from,
-            file.aircraft,
-            file.store_shape,
+            file.provenance.from,
+            file.provenance.aircraft,
+            file.provenance.store_shape,
             file.evaluations,
             file.wall_s,
             if file.resumed > 0 {

@@ -43,18 +43,10 @@ pub struct EnvelopeFile {
     pub axes: Vec<AxisRecord>,
     /// One row per condition, in grid order.
     pub rows: Vec<Row>,
-    /// Samples per condition.
-    pub samples: usize,
-    /// The seed.
-    pub seed: u64,
-    /// The SHA-256 of the sweep's inputs ([`crate::progress::inputs_digest`]).
-    pub inputs_sha256: String,
-    /// The fit or diagnosis predicted from.
-    pub from: String,
-    /// The aircraft's geometry.
-    pub aircraft: String,
-    /// The store's shape (`default` for the scenario's store of revolution).
-    pub store_shape: String,
+    /// Where it came from (recorded as its fields: `samples`, `seed`, `inputs_sha256`, `from`,
+    /// `aircraft`, `store_shape`).
+    #[serde(flatten)]
+    pub provenance: Provenance,
     /// The releases flown (their conditions), marked on the map.
     pub flown: Vec<(f64, f64)>,
     /// Simulations run by this process (conditions resumed from not counted).
@@ -67,7 +59,7 @@ pub struct EnvelopeFile {
 
 /// Where an envelope came from, as its record says: the files and settings the caller read
 /// (the binary's flags, or a campaign's record).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
     /// Samples per condition.
     pub samples: usize,
@@ -96,22 +88,7 @@ impl EnvelopeFile {
     ) -> (Self, Summary) {
         let summary = summarise(&sweep.grid, &swept.rows, criterion_mm);
         let mut file = EnvelopeFile::new(&sweep.grid, swept.rows, &summary, criterion_mm);
-        let Provenance {
-            samples,
-            seed,
-            inputs_sha256,
-            from,
-            aircraft,
-            store_shape,
-        } = provenance;
-        (
-            file.samples,
-            file.seed,
-            file.inputs_sha256,
-            file.from,
-            file.aircraft,
-            file.store_shape,
-        ) = (samples, seed, inputs_sha256, from, aircraft, store_shape);
+        file.provenance = provenance;
         file.flown = flown(sweep);
         file.evaluations = swept.evaluations;
         file.resumed = swept.resumed;
@@ -139,12 +116,7 @@ impl EnvelopeFile {
                 })
                 .collect(),
             rows,
-            samples: 0,
-            seed: 0,
-            inputs_sha256: String::new(),
-            from: String::new(),
-            aircraft: String::new(),
-            store_shape: String::new(),
+            provenance: Provenance::default(),
             flown: Vec::new(),
             evaluations: 0,
             resumed: 0,

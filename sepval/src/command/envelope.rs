@@ -103,7 +103,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         "conditions: {} ({} resumed), {} samples each, {} simulations, {:.1} s",
         file.conditions,
         file.resumed,
-        file.samples,
+        file.provenance.samples,
         file.evaluations,
         file.wall_s
     );
