@@ -2,11 +2,11 @@
 //! recommendation first, the private module `page`) and two figures,
 //! DIR/figures/separation.png (the ranking's score over the two axes that vary it most) and
 //! DIR/figures/rivals.png (every model's predicted trajectory at the recommended condition).
-//! Each file is written atomically: a failed or interrupted plan leaves no partial file.
+//! Each file is written atomically, the cancellation flag asked before each
+//! ([`sepval_report::Written`]): a failed or interrupted plan leaves no partial file.
 
 use std::path::{Path, PathBuf};
 
-use sepval_common::atomic_file::write_atomically;
 use sepval_report::figures::{MapAxis, channel_figure, condition_map};
 
 use crate::conditions::Quantity;
@@ -15,33 +15,24 @@ use crate::record::PlanFile;
 use crate::{Plan, Prepared};
 
 pub use sepval_report::OutputError;
+use sepval_report::Written;
 
-/// Writes the figures, the page and plan.json into `out` (plan.json last); returns the files
-/// written.
+/// Writes the figures, the page and plan.json into `out` (plan.json last), the cancellation
+/// flag asked before each ([`Written`]); returns the files written.
 pub fn write_outputs(
     prepared: &Prepared,
     plan: &Plan,
     file: &PlanFile,
     out: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
-    let figures = OutputError::figures_dir(out)?;
-    let mut written = vec![separation_map(
-        prepared,
-        plan,
-        &figures.join("separation.png"),
-    )?];
-    if let Some(path) = rivals_figure(prepared, plan, &figures.join("rivals.png"))? {
-        written.push(path);
-    }
-    let html = crate::page::render(file, &written, out)?;
-    let page = out.join("plan.html");
-    write_atomically(&page, html.as_bytes()).map_err(OutputError::Write)?;
-    written.push(page);
-    let json = serde_json::to_string_pretty(file).expect("a plan serialises") + "\n";
-    let path = out.join("plan.json");
-    write_atomically(&path, json.as_bytes()).map_err(OutputError::Write)?;
-    written.push(path);
-    Ok(written)
+    let mut w = Written::into(out);
+    let figures = w.figures()?;
+    w.maybe(|| separation_map(prepared, plan, &figures.join("separation.png")).map(Some))?;
+    w.maybe(|| rivals_figure(prepared, plan, &figures.join("rivals.png")))?;
+    let html = crate::page::render(file, w.files(), out)?;
+    w.file("plan.html", html.as_bytes())?;
+    w.json("plan.json", file)?;
+    Ok(w.done())
 }
 
 /// The score that ranks a condition: its separation with rivals, its information gain

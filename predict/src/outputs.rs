@@ -6,13 +6,13 @@
 
 use std::path::{Path, PathBuf};
 
-use sepval_common::atomic_file::write_atomically;
 use sepval_report::figures::{Band, band_figure};
 
 use crate::Prediction;
 use crate::record::{PredictionFile, bands_csv};
 
 pub use sepval_report::OutputError;
+use sepval_report::Written;
 
 /// Writes the figure, the page, bands.csv and prediction.json into `out`; returns the files
 /// written.
@@ -21,9 +21,8 @@ pub fn write_outputs(
     file: &PredictionFile,
     out: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
-    let figures = OutputError::figures_dir(out)?;
-    OutputError::check_cancel()?;
-    let figure = figures.join("prediction.png");
+    let mut w = Written::into(out);
+    let figures = w.figures()?;
     let ch = file.channels();
     let bands: [Band; 6] = std::array::from_fn(|c| Band {
         lo: &ch[c].lo,
@@ -44,28 +43,13 @@ pub fn write_outputs(
         crate::page::number(c.beta_deg),
         100.0 * file.level
     );
-    band_figure(
-        &figure,
-        &file.t_s,
-        &bands,
-        data,
-        &format!("{:.0} % band", 100.0 * file.level),
-        &title,
-    )?;
-    let mut written = vec![figure];
-    OutputError::check_cancel()?;
+    let band = format!("{:.0} % band", 100.0 * file.level);
+    w.figure(figures.join("prediction.png"), |path| {
+        band_figure(path, &file.t_s, &bands, data, &band, &title)
+    })?;
     let html = crate::page::render(file, "figures/prediction.png")?;
-    let page = out.join("report.html");
-    write_atomically(&page, html.as_bytes()).map_err(OutputError::Write)?;
-    written.push(page);
-    OutputError::check_cancel()?;
-    let csv = out.join("bands.csv");
-    write_atomically(&csv, bands_csv(file).as_bytes()).map_err(OutputError::Write)?;
-    written.push(csv);
-    OutputError::check_cancel()?;
-    let json = serde_json::to_string_pretty(file).expect("a prediction serialises") + "\n";
-    let path = out.join("prediction.json");
-    write_atomically(&path, json.as_bytes()).map_err(OutputError::Write)?;
-    written.push(path);
-    Ok(written)
+    w.file("report.html", html.as_bytes())?;
+    w.file("bands.csv", bands_csv(file).as_bytes())?;
+    w.json("prediction.json", file)?;
+    Ok(w.done())
 }

@@ -9,5 +9,7 @@ pub mod figures;
 pub mod html;
 mod output_error;
 pub mod words;
+mod written;
 
 pub use output_error::OutputError;
+pub use written::Written;

@@ -1,0 +1,115 @@
+//! The one way a command writes its directory's files: the cancellation flag asked before each
+//! file (an interrupted command stops between files, never inside one), each file written
+//! atomically (a temporary file renamed into place: never a partial file), and the files
+//! recorded in the order written, for the command to report.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use sepval_common::atomic_file::write_atomically;
+
+use crate::OutputError;
+
+/// The files written into a command's directory so far.
+#[derive(Debug)]
+pub struct Written {
+    out: PathBuf,
+    files: Vec<PathBuf>,
+}
+
+impl Written {
+    /// Nothing written yet into `out`.
+    pub fn into(out: &Path) -> Written {
+        Written {
+            out: out.to_path_buf(),
+            files: Vec::new(),
+        }
+    }
+
+    /// `out/figures`, created (the cancellation flag asked first).
+    pub fn figures(&self) -> Result<PathBuf, OutputError> {
+        OutputError::figures_dir(&self.out)
+    }
+
+    /// Draws a figure with `draw` at `path` (the figure writes its own file atomically), once
+    /// the cancellation flag is asked, and records it.
+    pub fn figure<E>(
+        &mut self,
+        path: PathBuf,
+        draw: impl FnOnce(&Path) -> Result<(), E>,
+    ) -> Result<(), OutputError>
+    where
+        OutputError: From<E>,
+    {
+        OutputError::check_cancel()?;
+        draw(&path)?;
+        self.files.push(path);
+        Ok(())
+    }
+
+    /// Records a file that `make` wrote (a figure that may decline to draw: `None`), once the
+    /// cancellation flag is asked.
+    pub fn maybe<E>(
+        &mut self,
+        make: impl FnOnce() -> Result<Option<PathBuf>, E>,
+    ) -> Result<(), OutputError>
+    where
+        OutputError: From<E>,
+    {
+        OutputError::check_cancel()?;
+        if let Some(path) = make()? {
+            self.files.push(path);
+        }
+        Ok(())
+    }
+
+    /// `out/name` with `bytes`, written atomically once the cancellation flag is asked.
+    pub fn file(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf, OutputError> {
+        OutputError::check_cancel()?;
+        let path = self.out.join(name);
+        write_atomically(&path, bytes).map_err(OutputError::Write)?;
+        self.files.push(path.clone());
+        Ok(path)
+    }
+
+    /// `out/name`: `value` as pretty JSON with a final newline ([`Written::file`]).
+    pub fn json<T: Serialize>(&mut self, name: &str, value: &T) -> Result<PathBuf, OutputError> {
+        let json = serde_json::to_string_pretty(value).expect("a record serialises") + "\n";
+        self.file(name, json.as_bytes())
+    }
+
+    /// The files written so far, in order.
+    pub fn files(&self) -> &[PathBuf] {
+        &self.files
+    }
+
+    /// The files written, in order.
+    pub fn done(self) -> Vec<PathBuf> {
+        self.files
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn files_are_written_whole_and_recorded_in_order() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut w = Written::into(dir.path());
+        let figures = w.figures().unwrap();
+        assert!(figures.is_dir());
+        w.maybe(|| Ok::<_, OutputError>(None)).unwrap();
+        w.file("a.csv", b"x\n1\n").unwrap();
+        w.json("b.json", &[1, 2]).unwrap();
+        let names: Vec<String> = w
+            .done()
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, ["a.csv", "b.json"]);
+        let json = std::fs::read_to_string(dir.path().join("b.json")).unwrap();
+        assert_eq!(json, "[\n  1,\n  2\n]\n");
+    }
+}
