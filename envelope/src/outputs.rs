@@ -3,11 +3,11 @@
 //! DIR/report.html (the answer first, the private module `page`), DIR/envelope.csv (one row
 //! per condition, [`crate::row`]) and DIR/envelope.json (the record), in that order,
 //! envelope.json last. Each file is written atomically and the cancellation flag is checked
-//! before each: a failed or interrupted envelope leaves no partial file.
+//! before each ([`sepval_report::Written`]): a failed or interrupted envelope leaves no
+//! partial file.
 
 use std::path::{Path, PathBuf};
 
-use sepval_common::atomic_file::write_atomically;
 use sepval_fit::conditions::Quantity;
 use sepval_report::figures::{EnvelopeMap, MapAxis, Safety, envelope_map};
 
@@ -16,6 +16,7 @@ use crate::record::EnvelopeFile;
 use crate::row::csv;
 
 pub use sepval_report::OutputError;
+use sepval_report::Written;
 
 /// Writes the figure, the page, envelope.csv and envelope.json into `out`; returns the files
 /// written.
@@ -24,26 +25,14 @@ pub fn write_outputs(
     file: &EnvelopeFile,
     out: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
-    let figures = OutputError::figures_dir(out)?;
-    OutputError::check_cancel()?;
-    let figure = figures.join("envelope.png");
-    map(grid, file, &figure)?;
-    let mut written = vec![figure];
-    OutputError::check_cancel()?;
+    let mut w = Written::into(out);
+    let figures = w.figures()?;
+    w.figure(figures.join("envelope.png"), |path| map(grid, file, path))?;
     let html = crate::page::render(file, "figures/envelope.png")?;
-    let page = out.join("report.html");
-    write_atomically(&page, html.as_bytes()).map_err(OutputError::Write)?;
-    written.push(page);
-    OutputError::check_cancel()?;
-    let path = out.join("envelope.csv");
-    write_atomically(&path, csv(&file.rows).as_bytes()).map_err(OutputError::Write)?;
-    written.push(path);
-    OutputError::check_cancel()?;
-    let json = serde_json::to_string_pretty(file).expect("an envelope serialises") + "\n";
-    let path = out.join("envelope.json");
-    write_atomically(&path, json.as_bytes()).map_err(OutputError::Write)?;
-    written.push(path);
-    Ok(written)
+    w.file("report.html", html.as_bytes())?;
+    w.file("envelope.csv", csv(&file.rows).as_bytes())?;
+    w.json("envelope.json", file)?;
+    Ok(w.done())
 }
 
 /// DIR/figures/envelope.png: the worst probability of failing to clear in each cell.

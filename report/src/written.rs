@@ -64,8 +64,9 @@ impl Written {
         Ok(())
     }
 
-    /// `out/name` with `bytes`, written atomically once the cancellation flag is asked.
-    pub fn file(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf, OutputError> {
+    /// `out/name` (`name` relative to `out`, its directory there already) with `bytes`,
+    /// written atomically once the cancellation flag is asked.
+    pub fn file(&mut self, name: impl AsRef<Path>, bytes: &[u8]) -> Result<PathBuf, OutputError> {
         OutputError::check_cancel()?;
         let path = self.out.join(name);
         write_atomically(&path, bytes).map_err(OutputError::Write)?;

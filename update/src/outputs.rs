@@ -1,16 +1,16 @@
 //! The update's outputs, in this order: DIR/figures/corrections.png (when a correction is
 //! kept), the updated store (DIR/tables/*.csv, then DIR/scenario.toml, read back and compared
 //! with the store fitted), DIR/factors.json, DIR/report.html and DIR/update.json last. Each
-//! file is written atomically and the cancellation flag is checked before each: a failed or
-//! interrupted update leaves no partial file.
+//! file is written atomically and the cancellation flag is checked before each
+//! ([`sepval_report::Written`]): a failed or interrupted update leaves no partial file.
 
 use std::path::{Path, PathBuf};
 
-use sepval_common::atomic_file::write_atomically;
 use sepval_common::scenario::Scenario;
 use sepval_report::figures::{CorrectionPanel, correction_figure};
 
 pub use sepval_report::OutputError;
+use sepval_report::Written;
 
 use crate::outcome::Update;
 
@@ -31,19 +31,12 @@ pub enum OutputsError {
     },
 }
 
-fn write(path: &Path, bytes: &[u8]) -> Result<(), OutputsError> {
-    OutputError::check_cancel()?;
-    write_atomically(path, bytes)
-        .map_err(OutputError::Write)
-        .map_err(OutputsError::from)
-}
-
-/// Writes every output into `out`; returns the files written.
+/// Writes every output into `out` ([`Written`]: the cancellation flag asked before each file,
+/// each written atomically); returns the files written.
 pub fn write_outputs(update: &Update, out: &Path) -> Result<Vec<PathBuf>, OutputsError> {
-    let figures = OutputError::figures_dir(out)?;
-    let mut written = Vec::new();
+    let mut w = Written::into(out);
+    let figures = w.figures()?;
     if !update.panels.is_empty() {
-        OutputError::check_cancel()?;
         let panels: Vec<CorrectionPanel> = update
             .panels
             .iter()
@@ -58,39 +51,28 @@ pub fn write_outputs(update: &Update, out: &Path) -> Result<Vec<PathBuf>, Output
                 evidence: p.evidence.clone(),
             })
             .collect();
-        let path = figures.join("corrections.png");
-        correction_figure(
-            &path,
-            &panels,
-            "The store's data updated: each correction with its ±2σ band",
-        )
-        .map_err(OutputError::from)?;
-        written.push(path);
+        w.figure(figures.join("corrections.png"), |path| {
+            correction_figure(
+                path,
+                &panels,
+                "The store's data updated: each correction with its ±2σ band",
+            )
+        })?;
     }
-    written.extend(write_store(update, out)?);
-    let factors = serde_json::to_string_pretty(&update.factors).expect("factors serialise") + "\n";
-    let path = out.join("factors.json");
-    write(&path, factors.as_bytes())?;
-    written.push(path);
-    OutputError::check_cancel()?;
+    write_store(update, out, &mut w)?;
+    w.json("factors.json", &update.factors)?;
     let figure = (!update.panels.is_empty()).then_some("figures/corrections.png");
     let html = crate::page::render(&update.file, figure).map_err(OutputError::from)?;
-    let path = out.join("report.html");
-    write(&path, html.as_bytes())?;
-    written.push(path);
-    let json = serde_json::to_string_pretty(&update.file).expect("an update serialises") + "\n";
-    let path = out.join("update.json");
-    write(&path, json.as_bytes())?;
-    written.push(path);
-    Ok(written)
+    w.file("report.html", html.as_bytes())?;
+    w.json("update.json", &update.file)?;
+    Ok(w.done())
 }
 
 /// The header of the scenario written.
 const HEADER: &str = "# sepval scenario written by `sepval update` (SI units, angles in degrees; docs/model.md section 1).\n# Its tables are the CSV files under tables/, relative to this file; update.json says what was corrected and how sure it is.\n";
 
 /// DIR/tables/*.csv, then DIR/scenario.toml, then the check that it reads back as fitted.
-fn write_store(update: &Update, out: &Path) -> Result<Vec<PathBuf>, OutputsError> {
-    let mut written = Vec::new();
+fn write_store(update: &Update, out: &Path, w: &mut Written) -> Result<(), OutputsError> {
     let store = &update.store;
     if !store.files.is_empty() {
         let tables = out.join("tables");
@@ -100,14 +82,10 @@ fn write_store(update: &Update, out: &Path) -> Result<Vec<PathBuf>, OutputsError
         })?;
     }
     for (rel, text) in &store.files {
-        let path = out.join(rel);
-        write(&path, text.as_bytes())?;
-        written.push(path);
+        w.file(rel, text.as_bytes())?;
     }
-    let path = out.join("scenario.toml");
     let text = format!("{HEADER}{}", store.file_form.to_toml_string());
-    write(&path, text.as_bytes())?;
-    written.push(path.clone());
+    let path = w.file("scenario.toml", text.as_bytes())?;
     let back = Scenario::load(&path).map_err(|e| OutputsError::ReadBack {
         path: path.clone(),
         reason: format!("{e:#}"),
@@ -118,5 +96,5 @@ fn write_store(update: &Update, out: &Path) -> Result<Vec<PathBuf>, OutputsError
             reason: "its content differs from the store fitted".into(),
         });
     }
-    Ok(written)
+    Ok(())
 }
