@@ -72,17 +72,14 @@ fn add_all(
     refuse_known(c, flown.as_ref(), &releases)?;
     let model = c.model_of(flown)?;
     let settings = c.assess_settings();
+    // One band for every release checked: its held-out evidence (a refit per release flown)
+    // is computed once.
+    let mut form = FormBand::of(&model);
     let mut checks = Vec::new();
     for r in &releases {
         let name = r.given.display().to_string();
-        checks.push(check_release(
-            &model,
-            &r.scenario,
-            &r.data,
-            &name,
-            &settings,
-            start,
-        )?);
+        let flown = (&r.scenario, &r.data, name.as_str());
+        checks.push(check_release(&model, &mut form, flown, &settings, start)?);
     }
     let round = c.file.rounds.len();
     std::fs::create_dir_all(c.dir.join("releases")).map_err(|e| record_error(&c.dir, e))?;
@@ -212,14 +209,14 @@ fn diagnose(
     Ok(())
 }
 
-/// The post-flight check of `data` (flown at `scenario`) against the bands `model` predicts
-/// there at the 95 % level, with the measurement noise: the same model-form band as the
-/// round's envelope (the discrepancy at the releases, the reach beyond them).
-pub fn check_release(
+/// The post-flight check of release `name` (its `data`, flown at `scenario`) against the
+/// bands `model` predicts there at the 95 % level, with the measurement noise: the same
+/// model-form band as the round's envelope (`form`: the discrepancy at the releases, the reach
+/// beyond them).
+pub(crate) fn check_release(
     model: &Model,
-    scenario: &Scenario,
-    data: &Trajectory,
-    name: &str,
+    form: &mut FormBand<'_>,
+    (scenario, data, name): (&Scenario, &Trajectory, &str),
     settings: &AssessSettings,
     start: &mut StartEvaluator<'_>,
 ) -> Result<Check, CampaignError> {
@@ -227,7 +224,7 @@ pub fn check_release(
     let (candidates, _) = crate::assess::draws(model, settings)?;
     let (job, runs) = crate::assess::fly(scenario, &data.times_s, &points, &candidates, start)?;
     let ran: Vec<&GridTrajectory> = runs.trajectories.iter().flatten().collect();
-    let (sd, _) = FormBand::of(model).at(&job, &points, &ran, settings)?;
+    let (sd, _) = form.at(&job, &points, &ran, settings)?;
     let noise = model
         .fitted
         .as_ref()

@@ -18,8 +18,9 @@ use sepval_common::factors::Factors;
 use sepval_common::scenario::{Scenario, hex_sha256};
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
-use sepval_geometry::Pose;
+
 use sepval_predict::record::ConditionRecord;
+use sepval_predict::releases;
 use sepval_solve::run::ProgressObserver;
 
 use crate::CampaignError;
@@ -115,27 +116,8 @@ pub fn truth_envelope(c: &Campaign, truth: &Truth) -> Result<Vec<TruthCondition>
                 None,
             )
             .ok()
-            .and_then(|t| {
-                let poses: Vec<Pose> = t
-                    .pos_m
-                    .iter()
-                    .zip(&t.att_deg)
-                    .map(|(p, a)| Pose {
-                        position_m: *p,
-                        euler_deg: *a,
-                    })
-                    .collect();
-                c.clearance
-                    .geometry
-                    .trace_until(
-                        &t.times_s,
-                        &poses,
-                        c.clearance.free_after_m,
-                        &cancel::requested,
-                    )
-                    .ok()
-                    .map(|tr| tr.min.distance_m)
-            })
+            .and_then(|t| releases::trace(&c.clearance, &t).ok())
+            .map(|tr| tr.min.distance_m)
             .unwrap_or(f64::NAN);
             Ok(TruthCondition {
                 condition: ConditionRecord::of(&s.flight),
