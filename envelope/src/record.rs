@@ -5,7 +5,6 @@ use serde::{Deserialize, Serialize};
 use sepval_fit::conditions::Quantity;
 use sepval_predict::clearance::ALLOWED_PROBABILITY;
 
-use crate::grid::Grid;
 use crate::row::Row;
 use crate::summary::{Summary, summarise};
 use crate::sweep::{Sweep, Swept};
@@ -59,7 +58,7 @@ pub struct EnvelopeFile {
 
 /// Where an envelope came from, as its record says: the files and settings the caller read
 /// (the binary's flags, or a campaign's record).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
     /// Samples per condition.
     pub samples: usize,
@@ -87,18 +86,7 @@ impl EnvelopeFile {
         wall_s: f64,
     ) -> (Self, Summary) {
         let summary = summarise(&sweep.grid, &swept.rows, criterion_mm);
-        let mut file = EnvelopeFile::new(&sweep.grid, swept.rows, &summary, criterion_mm);
-        file.provenance = provenance;
-        file.flown = flown(sweep);
-        file.evaluations = swept.evaluations;
-        file.resumed = swept.resumed;
-        file.wall_s = wall_s;
-        (file, summary)
-    }
-
-    /// The record of a sweep, its provenance left empty (filled by [`EnvelopeFile::of`]).
-    pub fn new(grid: &Grid, rows: Vec<Row>, summary: &Summary, criterion_mm: f64) -> Self {
-        EnvelopeFile {
+        let file = EnvelopeFile {
             format: ENVELOPE_FORMAT.into(),
             headline: summary.headline.clone(),
             summary: summary.lines.clone(),
@@ -106,7 +94,8 @@ impl EnvelopeFile {
             conditions: summary.total,
             criterion_mm,
             allowed_probability: ALLOWED_PROBABILITY,
-            axes: grid
+            axes: sweep
+                .grid
                 .conditions
                 .axes
                 .iter()
@@ -115,13 +104,14 @@ impl EnvelopeFile {
                     values: v.clone(),
                 })
                 .collect(),
-            rows,
-            provenance: Provenance::default(),
-            flown: Vec::new(),
-            evaluations: 0,
-            resumed: 0,
-            wall_s: f64::NAN,
-        }
+            rows: swept.rows,
+            provenance,
+            flown: flown(sweep),
+            evaluations: swept.evaluations,
+            resumed: swept.resumed,
+            wall_s,
+        };
+        (file, summary)
     }
 }
 
