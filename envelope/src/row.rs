@@ -94,13 +94,7 @@ impl Row {
             }
         };
         let c = &self.condition;
-        let text = |s: &str| {
-            if s.contains([',', '"']) {
-                format!("\"{}\"", s.replace('"', "\"\""))
-            } else {
-                s.to_string()
-            }
-        };
+        let text = sepval_report::words::csv_text;
         [
             n(c.mach),
             n(c.altitude_m),

@@ -9,15 +9,15 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use sepval_common::atomic_file::write_atomically;
 use sepval_common::cancel;
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, InProcess, Job};
 use sepval_common::telemetry::Trajectory;
 use sepval_diagnose::Diagnosis;
 use sepval_fit::results::ReleaseClearance;
 use sepval_geometry::{GeometryError, Pose, Trace};
-use sepval_report::OutputError;
 use sepval_report::figures::{ClearanceSeries, clearance_figure};
+use sepval_report::words::csv_text;
+use sepval_report::{OutputError, Written};
 
 use crate::clearance::ClearanceSettings;
 use crate::ensemble::{Ensemble, EnsembleError};
@@ -191,18 +191,14 @@ pub fn write(
 ) -> Result<(), ReleasesError> {
     let mut csv = String::from("release,t_s,clearance_m\n");
     for ((name, traj), (_, t)) in releases.iter().zip(of) {
-        let quoted = if name.contains([',', '"']) {
-            format!("\"{}\"", name.replace('"', "\"\""))
-        } else {
-            name.clone()
-        };
+        let quoted = csv_text(name);
         for (ts, d) in traj.times_s.iter().zip(&t.distance_m) {
             csv.push_str(&format!("{quoted},{ts},{d}\n"));
         }
     }
-    OutputError::check_cancel()?;
-    write_atomically(&out.join("clearance.csv"), csv.as_bytes()).map_err(OutputError::Write)?;
-    let figures = OutputError::figures_dir(out)?;
+    let mut w = Written::into(out);
+    w.file("clearance.csv", csv.as_bytes())?;
+    let figures = w.figures()?;
     let series: Vec<ClearanceSeries> = releases
         .iter()
         .zip(of)
@@ -215,12 +211,13 @@ pub fn write(
             min_m: t.min.distance_m,
         })
         .collect();
-    clearance_figure(
-        &figures.join("clearance.png"),
-        "Clearance to the aircraft along each release",
-        &series,
-        c.criterion_m,
-    )
-    .map_err(OutputError::from)?;
+    w.figure(figures.join("clearance.png"), |path| {
+        clearance_figure(
+            path,
+            "Clearance to the aircraft along each release",
+            &series,
+            c.criterion_m,
+        )
+    })?;
     Ok(())
 }

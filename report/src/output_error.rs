@@ -34,17 +34,18 @@ pub enum OutputError {
 }
 
 impl OutputError {
-    /// Creates `out/figures` (and `out`) and returns it: the first step of every command that
-    /// writes figures. The cancellation flag is asked first, so an interrupted command leaves
-    /// no empty `figures/` behind (a run directory that received nothing is removed).
-    pub fn figures_dir(out: &std::path::Path) -> Result<PathBuf, OutputError> {
+    /// Creates `out/name` (and `out`) and returns it (`figures/` is the first step of every
+    /// command that writes figures). The cancellation flag is asked first, so an interrupted
+    /// command leaves no empty directory behind (a run directory that received nothing is
+    /// removed).
+    pub fn subdir(out: &std::path::Path, name: &str) -> Result<PathBuf, OutputError> {
         OutputError::check_cancel()?;
-        let figures = out.join("figures");
-        std::fs::create_dir_all(&figures).map_err(|source| OutputError::Dir {
-            path: figures.clone(),
+        let dir = out.join(name);
+        std::fs::create_dir_all(&dir).map_err(|source| OutputError::Dir {
+            path: dir.clone(),
             source,
         })?;
-        Ok(figures)
+        Ok(dir)
     }
 
     /// [`OutputError::Interrupted`] once a signal asked the process to stop (checked before

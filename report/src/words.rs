@@ -1,4 +1,5 @@
-//! Numbers and flight conditions in words, as every page and reading of sepval writes them:
+//! Numbers, flight conditions and CSV text fields, as every page, reading and table of sepval
+//! writes them:
 //! short (trailing zeros dropped, no "-0"), "-" for a value that is not a number, and the
 //! same condition in the same words on every page.
 
@@ -41,6 +42,16 @@ pub fn condition(
     )
 }
 
+/// A text field of a CSV file (RFC 4180): as it is, or quoted with its quotes doubled when it
+/// holds a comma or a quote.
+pub fn csv_text(s: &str) -> String {
+    if s.contains([',', '"']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
 /// A number written with decimals, its trailing zeros (and a bare point) dropped, "-0" as "0".
 fn trimmed(t: String) -> String {
     let t = if t.contains('.') {
@@ -68,6 +79,8 @@ mod tests {
         assert_eq!(significant(0.0125, 6), "0.0125");
         assert_eq!(significant(0.0, 6), "0");
         assert_eq!(significant(f64::INFINITY, 6), "-");
+        assert_eq!(csv_text("r1.csv"), "r1.csv");
+        assert_eq!(csv_text("a,\"b\""), "\"a,\"\"b\"\"\"");
         assert_eq!(
             condition(0.8, 3000.0, 2.0, 0.0, -1.5),
             "Mach 0.8, altitude 3000 m, aircraft alpha 2 deg, beta 0 deg, flight-path angle -1.5 deg"

@@ -29,7 +29,12 @@ impl Written {
 
     /// `out/figures`, created (the cancellation flag asked first).
     pub fn figures(&self) -> Result<PathBuf, OutputError> {
-        OutputError::figures_dir(&self.out)
+        self.dir("figures")
+    }
+
+    /// `out/name`, created (the cancellation flag asked first).
+    pub fn dir(&self, name: &str) -> Result<PathBuf, OutputError> {
+        OutputError::subdir(&self.out, name)
     }
 
     /// Draws a figure with `draw` at `path` (the figure writes its own file atomically), once

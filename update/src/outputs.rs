@@ -59,7 +59,7 @@ pub fn write_outputs(update: &Update, out: &Path) -> Result<Vec<PathBuf>, Output
             )
         })?;
     }
-    write_store(update, out, &mut w)?;
+    write_store(update, &mut w)?;
     w.json("factors.json", &update.factors)?;
     let figure = (!update.panels.is_empty()).then_some("figures/corrections.png");
     let html = crate::page::render(&update.file, figure).map_err(OutputError::from)?;
@@ -72,14 +72,10 @@ pub fn write_outputs(update: &Update, out: &Path) -> Result<Vec<PathBuf>, Output
 const HEADER: &str = "# sepval scenario written by `sepval update` (SI units, angles in degrees; docs/model.md section 1).\n# Its tables are the CSV files under tables/, relative to this file; update.json says what was corrected and how sure it is.\n";
 
 /// DIR/tables/*.csv, then DIR/scenario.toml, then the check that it reads back as fitted.
-fn write_store(update: &Update, out: &Path, w: &mut Written) -> Result<(), OutputsError> {
+fn write_store(update: &Update, w: &mut Written) -> Result<(), OutputsError> {
     let store = &update.store;
     if !store.files.is_empty() {
-        let tables = out.join("tables");
-        std::fs::create_dir_all(&tables).map_err(|source| OutputError::Dir {
-            path: tables.clone(),
-            source,
-        })?;
+        w.dir("tables")?;
     }
     for (rel, text) in &store.files {
         w.file(rel, text.as_bytes())?;
