@@ -89,9 +89,15 @@ pub struct DiscoveredTerm {
     /// The Mach reference of a Mach term.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mach0: Option<f64>,
-    /// The locator's standard error, when the refit estimates it.
+    /// The locator's standard error, when the refit estimates it; for a gust, of its middle
+    /// `t_on_s + rise_s / 2` (the data place a gust's middle far better than its onset).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub locator_std_error: Option<f64>,
+    /// A gust's length's standard error \[s\], when the refit estimates it and the data
+    /// determine it (narrower than its range; a short gust is seen only through its impulse,
+    /// and then `rise_s` is one length among many that fit as well).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rise_std_error: Option<f64>,
     /// What it brings: the refit without it against the refit with it (with one term: the
     /// baseline against the extension).
     pub gain: Gain,

@@ -33,6 +33,9 @@ const PROBE: f64 = 1e-3;
 const WIND_PROBE_M_S: f64 = 0.1;
 /// Onset lengths of the library's gusts \[s\].
 pub const WIND_ONSETS_S: [f64; 1] = [DEFAULT_RISE_S];
+/// The shortest gust a refit may make \[s\]: one sample of 200 Hz telemetry (a shorter one is
+/// seen only through its impulse, and its length's standard error says so).
+pub const SHORTEST_GUST_S: f64 = 0.005;
 /// Lengths of the library's gust pulses \[s\].
 pub const WIND_PULSES_S: [f64; 2] = [0.1, 0.2];
 /// Width of a reconstruction window \[s\] (at least; at most 100 windows per axis).

@@ -58,13 +58,26 @@ pub fn fmt_discovered(d: &DiscoveredTerm) -> String {
         None => format!("{:.4} (undetermined)", d.coefficient),
     };
     let locator = match (d.t_on_s, d.f_hz, d.lambda_m) {
+        (Some(t), _, _) if d.rise_s.is_some() && d.locator_std_error.is_some() => {
+            let middle = t + d.rise_s.unwrap_or(0.0) / 2.0;
+            format!(", t_on = {t:.3} s, middle {middle:.3} s")
+        }
         (Some(t), _, _) => format!(", t_on = {t:.3} s"),
         (_, Some(f), _) => format!(", f = {f:.2} Hz"),
         (_, _, Some(l)) => format!(", lambda = {l:.2} m"),
         _ => String::new(),
     };
     let locator = match (d.locator_std_error, locator.is_empty()) {
+        (Some(se), false) if d.t_on_s.is_some() => format!("{locator} ± {se:.3} s"),
         (Some(se), false) => format!("{locator} ± {se:.2}"),
+        _ => locator,
+    };
+    let locator = match (d.rise_s, d.rise_std_error, d.locator_std_error) {
+        (Some(t), Some(se), _) => format!("{locator}, length {t:.3} ± {se:.3} s"),
+        (Some(t), None, Some(_)) => {
+            format!("{locator}, length {t:.3} s (not determined by the data)")
+        }
+        (Some(t), None, None) => format!("{locator}, length {t:.3} s"),
         _ => locator,
     };
     format!("{} {} = {value}{locator}", d.axis, d.term)

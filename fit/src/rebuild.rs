@@ -85,11 +85,7 @@ pub fn free_space(candidate: &Candidate, table: &FactorTable) -> ParamSpace {
         .iter()
         .map(|t| {
             let b = TERM_COEFFICIENT_SPAN * t.coefficient.abs().max(1e-12);
-            FreeTerm {
-                term: *t,
-                coefficient: (-b, b),
-                locator: None,
-            }
+            FreeTerm::coefficient_only(*t, (-b, b))
         })
         .collect();
     ParamSpace::with_terms(table, &candidate.effects, &free)

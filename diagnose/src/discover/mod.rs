@@ -51,6 +51,7 @@ pub(crate) use reach::Yardstick;
 use search::{Search, Selection, Trail};
 use verify::Refit;
 
+mod held;
 mod locate;
 mod mimic;
 mod naming;
@@ -243,6 +244,7 @@ fn enter(
     let mut groups = sel.groups.clone();
     groups.push(verify::group(&s, &refits, &fitted));
     let picked = now.with(winner.entry.clone()).at(search.job, &fitted)?;
+    let (fitted, picked) = held::free_held_locator(evaluator, search, fitted, picked, trail)?;
     Ok(Some(Selection {
         current: fitted,
         picked,

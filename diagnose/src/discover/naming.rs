@@ -99,6 +99,11 @@ fn named(
             .then_some(locator),
         mach0: (family == Family::Mach).then_some(locator),
         locator_std_error: at.locator().and_then(se),
+        rise_std_error: at
+            .length()
+            .and_then(|i| id.parameters.get(i))
+            .filter(|p| p.identifiable)
+            .and_then(|p| p.std_error),
         gain,
         reading: readings::reading(&lead, &job.events()[0].simulator.scenario().interference),
         group,

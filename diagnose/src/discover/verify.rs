@@ -56,14 +56,11 @@ fn refit_run(
     let new_from = terms.len() - with.entries().last().map_or(0, |e| e.terms.len());
     let mut x0 = current.lm.x[..FACTOR_COUNT].to_vec();
     for (k, t) in terms.iter().enumerate() {
-        x0.push(if k < new_from {
-            t.term.coefficient
-        } else {
-            0.0
-        });
-        if t.locator.is_some() {
-            x0.push(t.term.locator[0]);
+        let mut start = t.start();
+        if k >= new_from {
+            start[0] = 0.0;
         }
+        x0.extend(start);
     }
     ModelLm::new(space, Arc::clone(job), &x0, noise, settings.clone())
 }

@@ -19,6 +19,12 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
  "cloff": -0.05, "caintfac": 1.1, "cyintfac": 1.4, "czintfac": 0.9, "cmintfac": 1.3,
  "cnintfac": 0.8, "clintfac": 1.6}"#;
 
+/// Another base (not the tests' default factors, nor the default truth).
+const OTHER_BASE: &str = r#"{"fwdfac": 0.55, "aftfac": 0.6, "xinerfac": 1.02, "yinerfac": 0.97,
+ "zinerfac": 1.01, "caoff": 0.01, "cyoff": -0.03, "czoff": 0.04, "cmoff": -0.05, "cnoff": 0.06,
+ "cloff": 0.03, "caintfac": 0.9, "cyintfac": 1.2, "czintfac": 1.1, "cmintfac": 0.8,
+ "cnintfac": 1.2, "clintfac": 0.7}"#;
+
 /// The hidden gust: the air moves 3 m/s to starboard from t = 0.3 s over the default 0.1 s.
 const GUST: &str = "format = \"sepval-extension/1\"\n\n[[term]]\naxis = \"wind_y\"\n\
                     family = \"wind\"\nregressor = \"step\"\nt_on_s = 0.3\ncoefficient = 3.0\n";
@@ -101,6 +107,62 @@ fn a_short_gust_and_a_side_force_step_are_rivals_on_one_release() {
     assert!(verdict.contains("cannot tell it from"), "{verdict}");
 }
 
+/// A short gust (issue 36, item 3): the air moves 10 m/s to starboard from t = 0.45 s over
+/// 20 ms, a fifth of the library's shortest, on another base and seed. Its middle is placed
+/// within 25 ms, with a standard error that covers the truth (measured: 0.441 ± 0.012 s for
+/// the truth's 0.46 s; the issue asked for 10 ms, finer than this release's own standard
+/// error); its length is either determined (the truth within three standard errors) or said
+/// not to be (measured: estimating it lowers the chi-square by 0.6, so it is held).
+#[test]
+fn a_short_gust_is_placed_by_its_middle_and_its_length_is_honest() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let short = GUST
+        .replace("t_on_s = 0.3", "t_on_s = 0.45\nrise_s = 0.02")
+        .replace("coefficient = 3.0", "coefficient = 10.0");
+    std::fs::write(dir.join("gust.toml"), &short).unwrap();
+    std::fs::write(dir.join("base.json"), OTHER_BASE).unwrap();
+    ok(&sepval(
+        &[
+            "simulate",
+            "--factors",
+            "base.json",
+            "--extension",
+            "gust.toml",
+            "--noise-seed",
+            "11",
+            "--out",
+            "gust.csv",
+        ],
+        dir,
+    ));
+    let d = diagnose(dir, &["gust.csv"], "diag");
+    let first = &d["discovered"][0];
+    assert_eq!(first["axis"], "wind_y", "{}", d["verdict"]);
+    let (t_on, rise_s) = (
+        first["t_on_s"].as_f64().unwrap(),
+        first["rise_s"].as_f64().unwrap(),
+    );
+    let middle = t_on + rise_s / 2.0;
+    let se = first["locator_std_error"].as_f64().unwrap();
+    assert!((middle - 0.46).abs() < 0.025, "middle {middle} s: {first}");
+    assert!(
+        (middle - 0.46).abs() < 3.0 * se,
+        "middle {middle} ± {se} s: {first}"
+    );
+    let verdict = d["verdict"].as_str().unwrap();
+    match first["rise_std_error"].as_f64() {
+        Some(se) => assert!(
+            (rise_s - 0.02).abs() < 3.0 * se,
+            "length {rise_s} ± {se}: {first}"
+        ),
+        None => assert!(verdict.contains("not determined by the data"), "{verdict}"),
+    }
+}
+
 #[test]
 fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
     if sepval_tests::skip_slow_tests() {
@@ -150,11 +212,22 @@ fn a_lateral_gust_is_discovered_as_wind_at_its_time() {
         d["verdict"],
         serde_json::to_string_pretty(&d["discovered"]).unwrap()
     );
-    let t_on = first["t_on_s"].as_f64().unwrap();
-    assert!((t_on - T_ON_S).abs() < 0.025, "t_on {t_on} s");
+    // The refit estimates the gust's middle, with its standard error (issue 36, item 3): the
+    // truth's within 25 ms and within three standard errors.
+    let (t_on, rise_s) = (
+        first["t_on_s"].as_f64().unwrap(),
+        first["rise_s"].as_f64().unwrap(),
+    );
+    let (middle, truth) = (t_on + rise_s / 2.0, T_ON_S + 0.05);
+    let se = first["locator_std_error"].as_f64().unwrap();
+    assert!((middle - truth).abs() < 0.025, "middle {middle} s: {first}");
+    assert!(
+        (middle - truth).abs() < 3.0 * se,
+        "middle {middle} ± {se} s: {first}"
+    );
     let w = first["coefficient"].as_f64().unwrap();
     assert!((1.5..4.5).contains(&w), "{w} m/s");
-    assert!(first["rise_s"].as_f64().unwrap() > 0.0, "{first}");
+    assert!(rise_s > 0.0, "{first}");
     let reading = first["reading"].as_str().unwrap();
     assert!(reading.starts_with("A lateral gust of"), "{reading}");
     // The extension written reads back and simulates, with its gust's two locators.
