@@ -264,7 +264,6 @@ fn calibration<'a>(f: &'a Fitted, job: &'a Job, s: &AssessSettings) -> Calibrati
         held_out: &[],
         target: &job.events()[0],
         noise: f.source.noise,
-        fitted_rms: f.source.fitted_rms,
         threads: s.threads,
         seed: s.seed,
     }

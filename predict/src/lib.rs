@@ -33,6 +33,7 @@ pub mod clearance;
 pub mod condition;
 pub mod discrepancy;
 pub mod ensemble;
+mod excess;
 pub mod outputs;
 mod page;
 pub mod reach;
@@ -158,7 +159,6 @@ impl Prepared {
             held_out: &self.held_out,
             target: &self.job.events()[0],
             noise: self.source.noise,
-            fitted_rms: self.source.fitted_rms,
             threads: self.settings.threads,
             seed: self.settings.seed,
         }

@@ -101,9 +101,6 @@ pub struct Source {
     pub identifiability: Identifiability,
     /// The measurement noise of the source.
     pub noise: Noise,
-    /// The answer's RMS residual per channel on the releases fitted (x, y, z \[m\], roll,
-    /// pitch, yaw \[deg\]).
-    pub fitted_rms: [f64; 6],
     /// Where the releases fitted came from.
     pub inputs: InputsRecord,
     /// Releases the source held out of its fits (a diagnosis's `--validate`) whose files still
@@ -197,7 +194,6 @@ impl Source {
                 pos_m: d.sigma_pos_m,
                 att_deg: d.sigma_att_deg,
             },
-            fitted_rms: d.extended.channel_rms.as_array(),
             inputs: d.inputs,
             held_out,
         })
@@ -244,7 +240,6 @@ fn fit_source(dir: &Path) -> Result<Source, SourceError> {
             pos_m: r.sigma_pos_m,
             att_deg: r.sigma_att_deg,
         },
-        fitted_rms: best.best.channel_rms.as_array(),
         inputs,
         held_out: Vec::new(),
     })

@@ -26,7 +26,6 @@ use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::problem::Evaluate;
 use sepval_fit::refine::ModelLm;
-use sepval_fit::results::residual_rms;
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_predict::source::{Source, SourceKind, SourceModel};
 use sepval_predict::{Flown, Prediction, Prepared, Settings, predict, prepare};
@@ -222,10 +221,6 @@ pub fn fitted_source(case: &Case, job: &Arc<Job>) -> Source {
     let samples: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
     let id = identifiability(&space.params, &r.x, &r.residuals, &r.jacobian, &samples);
     let candidate: Candidate = space.candidate(&r.x).unwrap();
-    let sims: Vec<Vec<Observation>> = job
-        .evaluate_with_samples(&candidate)
-        .samples
-        .expect("the fitted model simulates its releases");
     Source {
         kind: SourceKind::Fit,
         dir: "calibration".into(),
@@ -235,7 +230,6 @@ pub fn fitted_source(case: &Case, job: &Arc<Job>) -> Source {
         }],
         identifiability: id,
         noise,
-        fitted_rms: residual_rms(job, &sims).as_array(),
         inputs: InputsRecord {
             data: Vec::new(),
             scenario: None,

@@ -171,3 +171,30 @@ fn the_same_seed_gives_the_same_bands_whatever_the_thread_count() {
         }
     }
 }
+
+/// At release the state is known (carriage): the band is empty there, whatever the model gets
+/// wrong later (issue 36: a floor constant in time gave the Eglin case +-25 mm in x and +-3 deg
+/// in roll at t = 0), and it grows from there. A cause the model lacks, one release fitted: the
+/// only evidence is the answer's own misfit on it.
+#[test]
+fn the_band_is_empty_at_carriage_and_grows_after_it() {
+    let mut c = case(causes()[1], 2, 17);
+    c.fitted.truncate(1);
+    let prepared = cases::prepared_at(&c, 200, 0.9, None);
+    assert!(
+        prepared.grid.t_s[0].abs() < 1e-12,
+        "the grid starts at release"
+    );
+    let p = predicted(&prepared, 2);
+    for (k, b) in p.bands.channels.iter().enumerate() {
+        assert!(
+            b.hi[0] - b.lo[0] < 1e-9,
+            "channel {k} at t = 0: [{}, {}]",
+            b.lo[0],
+            b.hi[0]
+        );
+        let n = b.lo.len();
+        let late = b.hi[n - 1] - b.lo[n - 1];
+        assert!(late > 0.0, "channel {k} has no band at the end");
+    }
+}

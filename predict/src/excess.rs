@@ -1,0 +1,116 @@
+//! The excess of one release over time (docs/prediction.md section 13.4, steps 2 to 5 of
+//! [`crate::discrepancy`]'s rule): squared errors beyond the factor band and the noise,
+//! smoothed by a moving window that is empty at carriage and symmetric after release, with what
+//! noise alone would give each window's mean, and read at any time after release.
+
+use sepval_fit::space::Noise;
+
+/// How many standard deviations of noise alone the smoothed excess must exceed to count.
+pub const SIGNIFICANCE: f64 = 2.0;
+
+/// The noise of channel `c`.
+pub fn sigma(noise: Noise, c: usize) -> f64 {
+    if c < 3 { noise.pos_m } else { noise.att_deg }
+}
+
+/// The excess of one release, smoothed, on its own times, with what noise alone would give it.
+pub(crate) struct Excess {
+    /// Its times \[s\].
+    pub t_s: Vec<f64>,
+    /// The smoothed excess at each time.
+    pub value: Vec<[f64; 6]>,
+    /// At each point, [`SIGNIFICANCE`] standard deviations of its window's mean of e^2 -
+    /// sigma^2 under noise alone: SIGNIFICANCE sigma^2 sqrt(2 / W), W the window's samples
+    /// (0 where nothing is subtracted for noise).
+    pub threshold: Vec<[f64; 6]>,
+}
+
+impl Excess {
+    /// `raw` on times `t_s` smoothed ([`smooth`]), with the thresholds of noise `noise` (none
+    /// when `None`).
+    pub(crate) fn smoothed(t_s: &[f64], raw: &[[f64; 6]], noise: Option<Noise>) -> Excess {
+        let (value, widths) = smooth(t_s, raw);
+        let threshold = widths
+            .iter()
+            .map(|&w| {
+                std::array::from_fn(|c| match noise {
+                    Some(noise) if w > 0.0 => {
+                        SIGNIFICANCE * sigma(noise, c).powi(2) * (2.0 / w).sqrt()
+                    }
+                    _ => 0.0,
+                })
+            })
+            .collect();
+        Excess {
+            t_s: t_s.to_vec(),
+            value,
+            threshold,
+        }
+    }
+}
+
+/// The mean of `excesses` at time `t` on channel `c` less what noise alone gives it (their
+/// mean threshold over the square root of their number), at least 0; 0 without any.
+pub(crate) fn beyond_noise(excesses: &[Excess], t: f64, c: usize) -> f64 {
+    if excesses.is_empty() {
+        return 0.0;
+    }
+    let j = excesses.len() as f64;
+    let mean = excesses
+        .iter()
+        .map(|e| at_time(&e.t_s, &e.value, t, c))
+        .sum::<f64>()
+        / j;
+    let tau = excesses
+        .iter()
+        .map(|e| at_time(&e.t_s, &e.threshold, t, c))
+        .sum::<f64>()
+        / j;
+    (mean - tau / j.sqrt()).max(0.0)
+}
+
+/// The moving average of each channel of `raw` (on times `t_s`) over +-10 % of the points (at
+/// least one), and each point's window width in points. At and before release (t <= 0) the
+/// state is known (carriage): 0 there, width 0. After it the window stays symmetric, narrowing
+/// towards the first point after release, so that what the model gets wrong later does not
+/// leak back to the release; near the end it is cut off one-sided.
+fn smooth(t_s: &[f64], raw: &[[f64; 6]]) -> (Vec<[f64; 6]>, Vec<f64>) {
+    let n = raw.len();
+    let h = (n / 10).max(1);
+    let first = t_s.partition_point(|&t| t <= 0.0);
+    let mut prefix = vec![[0.0; 6]; n + 1];
+    for k in 0..n {
+        for c in 0..6 {
+            prefix[k + 1][c] = prefix[k][c] + raw[k][c];
+        }
+    }
+    (0..n)
+        .map(|k| {
+            if k < first {
+                return ([0.0; 6], 0.0);
+            }
+            let half = h.min(k - first);
+            let (a, b) = (k - half, (k + half + 1).min(n));
+            let mean = std::array::from_fn(|c| (prefix[b][c] - prefix[a][c]) / (b - a) as f64);
+            (mean, (b - a) as f64)
+        })
+        .unzip()
+}
+
+/// The excess of channel `c` at time `t` (linear between points, held beyond the ends).
+pub(crate) fn at_time(t_s: &[f64], series: &[[f64; 6]], t: f64, c: usize) -> f64 {
+    let n = t_s.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let k = t_s.partition_point(|&s| s < t);
+    if k == 0 {
+        return series[0][c];
+    }
+    if k >= n {
+        return series[n - 1][c];
+    }
+    let (t0, t1) = (t_s[k - 1], t_s[k]);
+    let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+    series[k - 1][c] * (1.0 - w) + series[k][c] * w
+}
