@@ -56,8 +56,9 @@ pub mod units;
 /// The version of the simulation's arithmetic, raised whenever a change moves any bit of a
 /// result (recorded in checkpoints, so that one that no longer reproduces can say why):
 /// 1, the host's C library for the elementary functions (wire protocol 3 and earlier); 2,
-/// sepval's own (`elementary`, docs/model.md section 9; protocol 4).
-pub const ARITHMETIC_VERSION: u32 = 2;
+/// sepval's own (`elementary`, docs/model.md section 9; protocol 4); 3, stroke ends located to
+/// the last bit rather than to a bracket of 1e-12 s (docs/model.md section 3a; protocol 8).
+pub const ARITHMETIC_VERSION: u32 = 3;
 
 pub use effects::EffectSet;
 pub use factors::{Factor, FactorTable, Factors};

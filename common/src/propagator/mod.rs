@@ -16,9 +16,10 @@
 //!
 //! Choices made here (docs/model.md leaves them open):
 //! - Stroke-end times are located by the Illinois variant of regula falsi on the length of the
-//!   trial step, safeguarded by bisection, until the bracket is at most 1e-12 s wide; the step
-//!   is taken to the bracket's upper end, where the foot's displacement has just exceeded the
-//!   stroke (the foot "turns off the first time s_i exceeds the stroke").
+//!   trial step, safeguarded by bisection, until no double lies inside the bracket (to the last
+//!   bit, so that the switch time, and the trajectory, move continuously with the parameters);
+//!   the step is taken to the bracket's upper end, where the foot's displacement has just
+//!   exceeded the stroke (the foot "turns off the first time s_i exceeds the stroke").
 //! - A foot already past the stroke at the start of a (part-)step turns off at once (this
 //!   happens only when two feet end their stroke within 1e-12 s of each other).
 //! - The ejector start time is matched to within 1e-12 s: a step that would end within that
@@ -39,7 +40,8 @@ use crate::lanes::{F64x4, Real};
 use crate::model::{EquationsOfMotion, LaneEquations, Model, RunSetup, STATE_LEN, StateVector};
 use crate::table::TableState;
 
-/// Tolerance to which switch times are located \[s\] (docs/model.md section 3a).
+/// Tolerance to which the ejector start time is matched and two feet's stroke ends count as
+/// one \[s\] (docs/model.md section 3a). Stroke ends themselves are located to the last bit.
 pub const SWITCH_TOLERANCE_S: f64 = 1e-12;
 /// A sample time this close to a grid time takes the grid state \[s\] (docs/model.md section 3a).
 pub const GRID_MATCH_TOLERANCE_S: f64 = 1e-9;
@@ -464,7 +466,11 @@ impl<'a> Engine<'a> {
         // when the same end is kept twice).
         let mut side = 0i8;
         let mut iterations = 0;
-        while hi - lo > SWITCH_TOLERANCE_S {
+        // To the last bit: until no double lies inside the bracket. A bracket left 1e-12 s wide
+        // (before issue 36) made the switch time, and with it the trajectory, a staircase of the
+        // parameters: a step of ~1e-9 deg in attitude after 1 s, larger than the change a probe
+        // of 1e-6 of a weak parameter's range makes, which broke finite differences.
+        while hi > lo {
             iterations += 1;
             let secant = hi - g_hi * (hi - lo) / (g_hi - g_lo);
             // Safeguard: bisect every fourth iteration or when the secant point is unusable.
@@ -473,6 +479,9 @@ impl<'a> Engine<'a> {
             } else {
                 secant
             };
+            if !(mid > lo && mid < hi) {
+                break;
+            }
             let x_mid = self.rk4(&c.x, c.t_s, mid, c.modes);
             let g_mid = g(&x_mid);
             if g_mid > 0.0 {

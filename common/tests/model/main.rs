@@ -5,6 +5,7 @@
 //! `cargo test --release -p sepval-common`.
 
 mod conformance;
+mod continuity;
 mod effects;
 mod elementary;
 mod fuzz;

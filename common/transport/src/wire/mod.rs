@@ -38,8 +38,11 @@ use sepval_common::propagator::Observation;
 /// 7: the same messages, but a zenoh coordinator sends a worker that joined the setup of the
 /// run's next job (an envelope's next condition, an update's next round), which the worker
 /// accepts and serves, saying `Ready` again; a version-6 worker would take that setup for a
-/// protocol error and leave the run after its first job, so the handshake refuses it.
-pub const PROTOCOL_VERSION: u32 = 7;
+/// protocol error and leave the run after its first job, so the handshake refuses it. Version
+/// 8: the same messages, but the simulation locates stroke ends to the last bit (arithmetic
+/// version 3, docs/model.md section 3a), so a version-7 worker's results differ in their last
+/// bits from a version-8 coordinator's, and the handshake refuses it.
+pub const PROTOCOL_VERSION: u32 = 8;
 
 /// "SEPVAL01" as a little-endian integer: the first field of [`Hello`], [`SetupHeader`] and
 /// every byte-stream frame.
