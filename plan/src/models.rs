@@ -5,6 +5,7 @@
 //! held) and the forward-difference steps of its sensitivities.
 
 use sepval_common::evaluation::Candidate;
+use sepval_common::extension::Family;
 use sepval_common::factors::FactorTable;
 use sepval_diagnose::Diagnosis;
 use sepval_fit::model_spec::ModelSpec;
@@ -68,6 +69,22 @@ impl PlanModel {
             space,
             x,
             steps,
+        })
+    }
+
+    /// Whether it has a located term whose locator the diagnosis refits (a step's or gust's
+    /// time, a gust's length, a frequency, a decay length) and the plan holds at its value
+    /// (its linearised refit moves coefficients and factors only).
+    pub fn located(&self) -> bool {
+        self.candidate.terms.iter().any(|t| {
+            matches!(
+                t.regressor.family(),
+                Family::Step
+                    | Family::Wind
+                    | Family::Oscillation
+                    | Family::Interference
+                    | Family::InterferenceFlowAngle
+            )
         })
     }
 

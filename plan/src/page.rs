@@ -106,6 +106,21 @@ fn row(c: &ConditionRecord, total_pairs: usize) -> Row {
 
 /// The recommendation and why, in words.
 fn headline(file: &PlanFile) -> (String, String) {
+    let (headline, why) = headline_alone(file);
+    let held = file
+        .conditions
+        .first()
+        .is_some_and(|c| c.pairs.iter().any(|p| p.locators_held));
+    if held {
+        let caution = " A model here has a located term (a step's or gust's time, a frequency, a decay length) whose locator the diagnosis refits but this plan holds at its value: its separations may be optimistic, and the diagnosis of the release decides.";
+        (headline, format!("{why}{caution}"))
+    } else {
+        (headline, why)
+    }
+}
+
+/// [`headline`] without the caution on held locators.
+fn headline_alone(file: &PlanFile) -> (String, String) {
     let answer = &file.models[0].name;
     let best = file
         .conditions

@@ -43,6 +43,12 @@ pub struct PairRecord {
     pub separation: f64,
     /// Whether it is above the threshold.
     pub separated: bool,
+    /// Whether a model of the pair has a located term (a step's or gust's time, a gust's length,
+    /// a frequency, a decay length) whose locator the diagnosis refits but this separation,
+    /// linearised at the models' fits, holds: the separation may then be optimistic (a refitted
+    /// frequency and phase can absorb more than the coefficients alone). Absent when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub locators_held: bool,
 }
 
 /// One condition of the ranking.
@@ -114,6 +120,7 @@ pub fn plan_file(prepared: &Prepared, plan: &Plan, from: &Path, wall_s: f64) -> 
         margins: p.margins,
         separation: p.separation,
         separated: p.separated(),
+        locators_held: p.models.iter().any(|&i| models[i].located()),
     };
     let condition = |rank: usize, c: &RankedCondition| {
         let f = &prepared.conditions.list[c.index].flight;

@@ -303,3 +303,36 @@ fn with_rivals_the_pairs_separated_rank_first_then_the_hardest_pair_then_informa
     let order: Vec<usize> = r.conditions.iter().map(|c| c.index).collect();
     assert_eq!(order, [2, 1, 0]);
 }
+
+/// A model with a located term (a step's time, a frequency, a gust's time, a decay length) is
+/// marked, so that plan.json and the page say its separations hold the locator the diagnosis
+/// refits; a flow-angle term has no locator and is not.
+#[test]
+fn models_with_located_terms_are_marked() {
+    use sepval_common::extension::{Axis, Regressor, Term, TermRecord};
+    let with = |regressor: Regressor, locator: [f64; 2]| {
+        let mut s = spec(Factors::TRUTH, &[]);
+        s.terms = vec![TermRecord::of(&Term {
+            axis: if regressor == Regressor::WindPulse {
+                Axis::WindY
+            } else {
+                Axis::Cn
+            },
+            regressor,
+            locator,
+            coefficient: 0.01,
+        })];
+        (s, 1.0)
+    };
+    let specs = [
+        (spec(Factors::TRUTH, &[]), 0.0),
+        with(Regressor::Beta, [0.0; 2]),
+        with(Regressor::Step, [0.5, 0.0]),
+        with(Regressor::Sin, [30.5, 0.0]),
+        with(Regressor::WindPulse, [0.3, 0.1]),
+        with(Regressor::F, [0.9, 0.0]),
+    ];
+    let models = Models::new(&specs, flown().factor_table()).unwrap();
+    let located: Vec<bool> = models.list.iter().map(PlanModel::located).collect();
+    assert_eq!(located, [false, false, true, true, true, true]);
+}
