@@ -1,5 +1,5 @@
 //! The shared parts of the property-based tests that feed arbitrary and mutated input to every
-//! reader of outside input (`common/tests/model/fuzz.rs`, `common/transport/src/fuzz_tests.rs`,
+//! reader of outside input (`common/tests/model/fuzz.rs`, `transport/src/fuzz_tests.rs`,
 //! `coordinator/tests/cli/fuzz.rs`): their configuration, an allocator that records the largest
 //! allocation a call makes, structured mutations of a valid input, and the kinds of path a
 //! reader may be given instead of a regular file ([`PathKind`], awaited with
