@@ -57,7 +57,7 @@ use sepval_solve::run::{NoProgress, RunError, run};
 use serde::{Deserialize, Serialize};
 
 use crate::ensemble::Member;
-use crate::excess::{Excess, at_time, beyond_noise};
+use crate::excess::{Excess, beyond_noise};
 pub use crate::excess::{SIGNIFICANCE, sigma};
 use crate::sampling::{ParameterDistribution, sample_rng};
 use crate::simulate::{Grid, GridTrajectory, SimulateError, data_on_grid, run_candidates};
@@ -121,8 +121,6 @@ pub struct Discrepancy {
     pub sd: Vec<[f64; 6]>,
     /// The releases held out.
     pub held_out: Vec<HeldOutRecord>,
-    /// The floor from the releases fitted (step 5 of the rule), its RMS over the grid.
-    pub fitted_floor: [f64; 6],
     /// Simulations run.
     pub evaluations: u64,
     /// The reach of the condition predicted, by which [`crate::reach`] widened `sd` (0 until
@@ -257,9 +255,6 @@ pub fn carry(
         .iter()
         .map(|&t| std::array::from_fn(|c| beyond_noise(&ev.misfits, t, c)))
         .collect();
-    let m = floor2.len().max(1) as f64;
-    let fitted_floor: [f64; 6] =
-        std::array::from_fn(|c| (floor2.iter().map(|f| f[c]).sum::<f64>() / m).sqrt());
     let sd = grid
         .t_s
         .iter()
@@ -267,17 +262,8 @@ pub fn carry(
         .map(|(&t, floor2)| {
             std::array::from_fn(|c| {
                 let beyond = beyond_noise(excesses, t, c);
-                let departed = if departures.is_empty() {
-                    0.0
-                } else {
-                    let j = departures.len() as f64;
-                    (departures
-                        .iter()
-                        .map(|e| at_time(&e.t_s, &e.value, t, c))
-                        .sum::<f64>()
-                        / j)
-                        .max(0.0)
-                };
+                // Departures carry no noise threshold: their mean, at least 0.
+                let departed = beyond_noise(&departures, t, c);
                 let beyond = beyond.max(departed);
                 (KAPPA * beyond).max(floor2[c]).sqrt()
             })
@@ -286,7 +272,6 @@ pub fn carry(
     Ok(Discrepancy {
         sd,
         held_out,
-        fitted_floor,
         evaluations,
         reach: 0.0,
     })

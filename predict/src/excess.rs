@@ -98,7 +98,7 @@ fn smooth(t_s: &[f64], raw: &[[f64; 6]]) -> (Vec<[f64; 6]>, Vec<f64>) {
 }
 
 /// The excess of channel `c` at time `t` (linear between points, held beyond the ends).
-pub(crate) fn at_time(t_s: &[f64], series: &[[f64; 6]], t: f64, c: usize) -> f64 {
+fn at_time(t_s: &[f64], series: &[[f64; 6]], t: f64, c: usize) -> f64 {
     let n = t_s.len();
     if n == 0 {
         return 0.0;

@@ -5,22 +5,20 @@
 //! freed locator kept only when the BIC falls. Otherwise the library's value stays and the
 //! report says the data do not determine it.
 
-use std::sync::Arc;
-
 use sepval_common::effects::EffectSet;
-use sepval_common::factors::FACTOR_COUNT;
-use sepval_fit::refine::{ModelLm, refine_together};
-use sepval_fit::space::ParamSpace;
+use sepval_common::evaluation::Evaluator;
+use sepval_common::extension::Family;
+use sepval_fit::refine::refine_together;
 
 use super::picked::{Picked, has_held_locator};
 use super::search::{Search, Trail};
-use super::verify::gain_over;
+use super::verify::{LastEntry, gain_over, refit_run};
 use crate::{Fitted, Result};
 
 /// `fitted` (made of `picked`, at its values) with the last entry's held locator estimated
 /// too, when that earns its parameter; `fitted` and `picked` unchanged otherwise.
 pub(super) fn free_held_locator(
-    evaluator: &mut dyn sepval_common::evaluation::Evaluator,
+    evaluator: &mut dyn Evaluator,
     search: &Search,
     fitted: Fitted,
     picked: Picked,
@@ -34,27 +32,23 @@ pub(super) fn free_held_locator(
         return Ok((fitted, picked));
     }
     let freed = picked.with_held_free(k);
-    let terms = freed.free_terms();
     let job = search.job;
-    let space = ParamSpace::with_terms(job.factor_table(), &EffectSet::NONE, &terms);
-    let mut x0 = fitted.lm.x[..FACTOR_COUNT].to_vec();
-    for t in &terms {
-        x0.extend(t.start());
-    }
-    let mut runs = [ModelLm::new(
-        space,
-        Arc::clone(job),
-        &x0,
+    let mut runs = [refit_run(
+        job,
+        &fitted,
+        &freed,
+        LastEntry::AsPicked,
         search.noise,
-        search.settings.clone(),
+        search.settings,
     )];
     refine_together(evaluator, &mut runs)?;
     let [run] = runs;
+    let terms = run.space().terms.clone();
     let failure = run.failure().map(str::to_string);
     let lm = run.finish();
     trail.evaluations += lm.evaluations;
     let what = match entry.family() {
-        sepval_common::extension::Family::Wind => "its length",
+        Family::Wind => "its length",
         _ => "its frequency",
     };
     if let Some(reason) = failure {

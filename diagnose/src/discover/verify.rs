@@ -41,13 +41,24 @@ impl Refit {
     }
 }
 
+/// Where a refit of the factors and the terms of a [`Picked`] starts its last entry's
+/// coefficients.
+#[derive(Clone, Copy, PartialEq)]
+pub(super) enum LastEntry {
+    /// At zero (an entry just tried: its linear estimate can overshoot).
+    AtZero,
+    /// At their values in the [`Picked`] (an entry already in).
+    AsPicked,
+}
+
 /// The refinement of the factors of `current` and the terms of `with` together, by output
-/// error, from `current`'s factors, the values of the terms already in and the last entry's
-/// coefficients at zero.
-fn refit_run(
+/// error, from `current`'s factors and the values of the terms in `with`, the last entry's
+/// coefficients as `last` says.
+pub(super) fn refit_run(
     job: &Arc<Job>,
     current: &Fitted,
     with: &Picked,
+    last: LastEntry,
     noise: Noise,
     settings: &LmSettings,
 ) -> ModelLm {
@@ -57,7 +68,7 @@ fn refit_run(
     let mut x0 = current.lm.x[..FACTOR_COUNT].to_vec();
     for (k, t) in terms.iter().enumerate() {
         let mut start = t.start();
-        if k >= new_from {
+        if k >= new_from && last == LastEntry::AtZero {
             start[0] = 0.0;
         }
         x0.extend(start);
@@ -82,7 +93,14 @@ pub(super) fn refit_candidates(
         .iter()
         .map(|l| {
             let with = now.with(l.entry.clone());
-            refit_run(search.job, current, &with, search.noise, &search.screening)
+            refit_run(
+                search.job,
+                current,
+                &with,
+                LastEntry::AtZero,
+                search.noise,
+                &search.screening,
+            )
         })
         .collect();
     refine_together(evaluator, &mut runs)?;
