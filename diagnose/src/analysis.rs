@@ -24,7 +24,7 @@ use crate::verdict::{VerdictInput, ambiguity, verdict};
 use crate::{
     Alternative, BASELINE_LIMIT_SIGMA, BIC_MARGIN, CandidateReport, DIAGNOSIS_FORMAT,
     DiagnoseError, DiagnoseOptions, Diagnosis, ExtensionReport, Fitted, ModelSummary, ParamValue,
-    Result, RivalReport, SkippedRefit, ValidationReport, catalogue, readings, tables,
+    Result, RivalClass, RivalReport, SkippedRefit, ValidationReport, catalogue, readings, tables,
 };
 use sepval_fit::space::Noise;
 use sepval_solve::identifiability::{Identifiability, identifiability};
@@ -37,6 +37,8 @@ pub(super) struct Decided {
     pub answer: Answer,
     /// The explanations the data cannot tell from the answer, best first.
     pub rivals: Vec<(Contender, RivalReport)>,
+    /// The rival classes of discovery's first step.
+    pub rival_classes: Vec<RivalClass>,
     /// Every catalogue candidate tried, every round.
     pub candidates: Vec<CandidateReport>,
     /// Discovery's reconstruction of the baseline's misfit, per event.
@@ -164,6 +166,9 @@ pub(super) fn analyse(
     if let Some(a) = ambiguity(&rivals, job.events().len()) {
         verdict.push_str(&format!("; {a}"));
     }
+    if let Some(c) = crate::verdict::open_classes(&d.rival_classes) {
+        verdict.push_str(&format!("; {c}"));
+    }
     if let Some(why) = &unreliable {
         verdict = format!("unreliable: {why}; as found: {verdict}");
     }
@@ -184,6 +189,7 @@ pub(super) fn analyse(
         discovered,
         ambiguous: !rivals.is_empty(),
         rivals,
+        rival_classes: d.rival_classes,
         clearance: None,
         alternatives,
         extension,

@@ -13,6 +13,8 @@ pub(crate) struct Contender {
     pub pool_size: usize,
     /// How it came to be tried.
     pub origin: String,
+    /// The rival class (`crate::classes`) of discovery's first step it represents.
+    pub class: Option<usize>,
 }
 
 impl Contender {
@@ -26,6 +28,12 @@ impl Contender {
             fitted,
             pool_size,
             origin,
+            class: None,
         }
+    }
+
+    /// The contender as the representative of rival class `class`.
+    pub fn in_class(self, class: Option<usize>) -> Contender {
+        Contender { class, ..self }
     }
 }

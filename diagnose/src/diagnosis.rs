@@ -122,6 +122,22 @@ pub struct Alternative {
     pub note: String,
 }
 
+/// A class of library terms that discovery's first screening cannot tell from its best entry
+/// (`docs/discovery.md` section 11.6), decided by a refit of one representative.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RivalClass {
+    /// In words: "any of 14 rolling-moment terms: roll rate, sideslip, Mach, ...".
+    pub words: String,
+    /// Its members (`axis formula`), the best by the screening first.
+    pub members: Vec<String>,
+    /// `answer` (a member is a term of the answer), `rival` (its representative is a rival),
+    /// `told apart` (its representatives' refits are beyond the margin or not significant) or
+    /// `not refitted` (beyond the budget of refits: the data were not asked).
+    pub status: String,
+    /// Its best representative's BIC less the answer's, when one was refitted.
+    pub delta_bic: Option<f64>,
+}
+
 /// An explanation the data cannot tell from the answer: its evidence is within
 /// [`RIVAL_MARGIN`](super::RIVAL_MARGIN) of the answer's in BIC.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -266,6 +282,10 @@ pub struct Diagnosis {
     pub ambiguous: bool,
     /// Explanations the data cannot tell from the answer, best first.
     pub rivals: Vec<RivalReport>,
+    /// The classes of library terms the first screening could not tell apart, and what the
+    /// refits of their representatives said.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rival_classes: Vec<RivalClass>,
     /// The clearance to the aircraft of the answer's trajectory of each release, when the
     /// diagnosis was given `--aircraft` (docs/envelope.md section 14.2).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -135,6 +135,8 @@ pub(super) struct Discovery {
     pub contenders: Vec<crate::contender::Contender>,
     /// Refits that did not simulate and were left out.
     pub skipped: Vec<crate::SkippedRefit>,
+    /// The first step's rival classes.
+    pub classes: Vec<crate::classes::ClassInfo>,
     /// Why discovery could not run at all (the term budget full), if it could not.
     pub blocked: Option<String>,
 }

@@ -120,6 +120,7 @@ type Result<T> = std::result::Result<T, DiagnoseError>;
 mod analysis;
 mod answer;
 mod catalogue;
+mod classes;
 mod contender;
 mod diagnosis;
 mod discover;
@@ -144,7 +145,7 @@ mod verdict;
 
 pub use diagnosis::{
     Alternative, BaselineVerdict, CandidateReport, Diagnosis, ExtensionReport, ModelSummary,
-    ParamValue, RivalReport, SkippedRefit,
+    ParamValue, RivalClass, RivalReport, SkippedRefit,
 };
 pub use found::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
 pub use library::Sample;
@@ -307,20 +308,21 @@ pub fn diagnose(
     let mut contenders = cat.contenders;
     contenders.extend(disc.contenders);
     contenders.extend(answer.rival().map(|r| r.contender()));
-    let rivals = rivals::rivals(
+    let (rivals, rival_classes) = rival_search(
         evaluator,
         &setting,
         &baseline,
         &answer,
         contenders,
-        &candidate_lm,
-        &mut evaluations,
+        &disc.classes,
+        (&candidate_lm, &mut evaluations),
     )?;
     stage_clock::lap("rivals");
     let decided = Decided {
         baseline,
         answer,
         rivals,
+        rival_classes,
         candidates: cat.candidates,
         reconstruction: disc.reconstruction,
         notes: disc.notes,
@@ -337,6 +339,36 @@ pub fn diagnose(
     write_outputs(&options.out, &setting, &analysis, progress)?;
     stage_clock::lap("outputs");
     Ok(analysis.diagnosis)
+}
+
+/// The rivals, best first, each with the contender it came from.
+type Rivals = Vec<(contender::Contender, RivalReport)>;
+
+/// The rival search (`rivals`) and the rival classes' reports.
+fn rival_search(
+    evaluator: &mut dyn Evaluator,
+    setting: &Setting,
+    baseline: &Fitted,
+    answer: &Answer,
+    contenders: Vec<contender::Contender>,
+    classes: &[classes::ClassInfo],
+    (settings, evaluations): (&LmSettings, &mut u64),
+) -> Result<(Rivals, Vec<RivalClass>)> {
+    let searched = rivals::rivals(
+        evaluator,
+        setting,
+        baseline,
+        answer,
+        contenders,
+        settings,
+        evaluations,
+    )?;
+    let reports = if matches!(answer, Answer::Baseline) {
+        Vec::new()
+    } else {
+        rivals::class_reports(setting, answer.model(baseline), classes, &searched.classes)
+    };
+    Ok((searched.rivals, reports))
 }
 
 /// What discovery takes from the catalogue: what the catalogue's answer changes in the

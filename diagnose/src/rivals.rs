@@ -26,15 +26,17 @@ use std::sync::Arc;
 
 use sepval_common::effects::{CATALOGUE, EffectSet};
 use sepval_common::evaluation::Job;
-use sepval_common::extension::{Axis, TermRecord};
+use sepval_common::extension::{Axis, Regressor, TermRecord};
 use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_solve::lm::LmSettings;
 
 use crate::answer::{Answer, Setting};
+use crate::classes::ClassInfo;
 use crate::contender::Contender;
 use crate::found::Gain;
-use crate::{ALPHA, Fitted, RIVAL_MARGIN, Result, RivalReport};
+use crate::library::Entry;
+use crate::{ALPHA, Fitted, RIVAL_MARGIN, Result, RivalClass, RivalReport};
 use sepval_common::evaluation::Evaluator;
 
 /// Contenders within this BIC distance of the answer are refitted to convergence before the
@@ -94,8 +96,17 @@ fn names(c: &Contender, job: &Job) -> (Vec<String>, Vec<TermRecord>) {
     (effects, terms)
 }
 
+/// What the rival search gives: the rivals, and what became of each rival class's contenders.
+pub(crate) struct RivalSearch {
+    /// The rivals, best (lowest BIC) first.
+    pub rivals: Vec<(Contender, RivalReport)>,
+    /// Per contender of a rival class: its class, its BIC less the answer's, whether it is a
+    /// rival.
+    pub classes: Vec<(usize, f64, bool)>,
+}
+
 /// The rivals of `answer` among `contenders`, best (lowest BIC) first, each refitted to
-/// convergence; `notes` receives what the search saw beyond them.
+/// convergence.
 pub(crate) fn rivals(
     evaluator: &mut dyn Evaluator,
     setting: &Setting,
@@ -104,38 +115,99 @@ pub(crate) fn rivals(
     contenders: Vec<Contender>,
     settings: &LmSettings,
     evaluations: &mut u64,
-) -> Result<Vec<(Contender, RivalReport)>> {
+) -> Result<RivalSearch> {
     let job = &setting.job;
+    let mut classes: Vec<(usize, f64, bool)> = Vec::new();
     if matches!(answer, Answer::Baseline) {
-        return Ok(Vec::new());
+        return Ok(RivalSearch {
+            rivals: Vec::new(),
+            classes,
+        });
     }
     let model = answer.model(baseline);
     let answer_bic = setting.bic(model);
     let mut near: Vec<Contender> = Vec::new();
     for c in contenders {
+        let delta_bic = setting.bic(&c.fitted) - answer_bic;
         if same_model(&c.fitted, model, job)
             || near.iter().any(|n| same_model(&n.fitted, &c.fitted, job))
         {
             continue;
         }
-        if (setting.bic(&c.fitted) - answer_bic).abs() < CONVERGE_WITHIN {
+        if delta_bic.abs() < CONVERGE_WITHIN {
             near.push(c);
+        } else if let Some(k) = c.class {
+            classes.push((k, delta_bic, false));
         }
     }
     converge_all(evaluator, job, &mut near, setting, settings, evaluations)?;
-    let mut out: Vec<(Contender, RivalReport)> = near
-        .into_iter()
-        .filter(|c| significant(setting, baseline, c))
-        .filter_map(|c| {
-            let delta_bic = setting.bic(&c.fitted) - answer_bic;
-            (delta_bic.abs() < RIVAL_MARGIN).then(|| {
-                let report = report(setting, &c, delta_bic);
-                report.map(|r| (c, r))
-            })
-        })
-        .collect::<Result<_>>()?;
+    let mut out: Vec<(Contender, RivalReport)> = Vec::new();
+    for c in near {
+        let delta_bic = setting.bic(&c.fitted) - answer_bic;
+        let rival = significant(setting, baseline, &c) && delta_bic.abs() < RIVAL_MARGIN;
+        if let Some(k) = c.class {
+            classes.push((k, delta_bic, rival));
+        }
+        if rival {
+            let r = report(setting, &c, delta_bic)?;
+            out.push((c, r));
+        }
+    }
     out.sort_by(|a, b| a.1.delta_bic.total_cmp(&b.1.delta_bic));
-    Ok(out)
+    Ok(RivalSearch {
+        rivals: out,
+        classes,
+    })
+}
+
+/// The rival classes as diagnosis.json reports them: each class of the answer (one of its
+/// members is a term of the answer's model, or of an effect that is one term), a rival (its
+/// representative is), told apart (its representatives' refits are not) or not refitted
+/// (beyond the budget of refits).
+pub(crate) fn class_reports(
+    setting: &Setting,
+    answer_model: &Fitted,
+    classes: &[ClassInfo],
+    searched: &[(usize, f64, bool)],
+) -> Vec<RivalClass> {
+    let job = &setting.job;
+    let mut kinds: Vec<(Axis, Regressor)> = answer_model
+        .space(job)
+        .terms_at(&answer_model.lm.x)
+        .unwrap_or_default()
+        .iter()
+        .map(|t| (t.axis, t.regressor))
+        .collect();
+    kinds.extend(
+        answer_model
+            .effects
+            .iter()
+            .filter_map(|a| a.effect().as_term()),
+    );
+    classes
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let mine: Vec<&(usize, f64, bool)> =
+                searched.iter().filter(|(j, ..)| *j == k).collect();
+            let best = mine.iter().map(|m| m.1).min_by(f64::total_cmp);
+            let (status, delta_bic) = if kinds.iter().any(|&(a, r)| c.holds(a, r)) {
+                ("answer", Some(0.0))
+            } else if mine.iter().any(|m| m.2) {
+                ("rival", best)
+            } else if best.is_some() {
+                ("told apart", best)
+            } else {
+                ("not refitted", None)
+            };
+            RivalClass {
+                words: c.words.clone(),
+                members: c.members.iter().map(Entry::label).collect(),
+                status: status.to_string(),
+                delta_bic,
+            }
+        })
+        .collect()
 }
 
 /// Whether a contender is significant against the baseline by its pool's rule.

@@ -124,7 +124,7 @@ pub fn screen(
 }
 
 /// The orthonormal directions entry `columns` adds beyond `basis`.
-fn new_directions(
+pub fn new_directions(
     cols: &DMatrix<f64>,
     columns: &[usize],
     basis: &[DVector<f64>],

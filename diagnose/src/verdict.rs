@@ -170,6 +170,57 @@ pub(super) fn verdict(v: &VerdictInput) -> String {
     }
 }
 
+/// Rival classes the verdict names one by one; the rest are counted (diagnosis.json lists
+/// them all).
+const CLASSES_NAMED: usize = 3;
+
+/// The clause that names the rival classes left open beyond the answer's own single term:
+/// "the first screening cannot tell the answer from any of 14 rolling-moment terms: roll rate,
+/// sideslip, ... (the answer's class) or from ... (BIC +1.2), and 5 more classes of 40 terms
+/// not told apart (rival_classes)"; none when every class is told apart.
+pub(super) fn open_classes(classes: &[crate::RivalClass]) -> Option<String> {
+    let open: Vec<&crate::RivalClass> = classes
+        .iter()
+        .filter(|c| c.status != "told apart" && !(c.status == "answer" && c.members.len() == 1))
+        .collect();
+    if open.is_empty() {
+        return None;
+    }
+    let named: Vec<String> = open
+        .iter()
+        .filter(|c| c.status != "not refitted")
+        .take(CLASSES_NAMED)
+        .map(|c| match (c.status.as_str(), c.delta_bic) {
+            ("answer", _) => format!("{} (the answer's class)", c.words),
+            (_, Some(d)) => format!("{} (BIC {d:+.1})", c.words),
+            _ => c.words.clone(),
+        })
+        .collect();
+    let rest = open.len() - named.len();
+    let rest_terms: usize = open
+        .iter()
+        .filter(|c| c.status == "not refitted")
+        .chain(
+            open.iter()
+                .filter(|c| c.status != "not refitted")
+                .skip(CLASSES_NAMED),
+        )
+        .map(|c| c.members.len())
+        .sum();
+    let more = (rest > 0).then(|| {
+        format!("{rest} more classes of {rest_terms} terms not told apart (rival_classes)")
+    });
+    let text = match (named.is_empty(), more) {
+        (false, Some(m)) => format!("{}, and {m}", named.join(" or from ")),
+        (false, None) => named.join(" or from "),
+        (true, Some(m)) => m,
+        (true, None) => return None,
+    };
+    Some(format!(
+        "the first screening cannot tell the answer from {text}"
+    ))
+}
+
 /// The clause that says what the data cannot tell apart, when the answer has rivals: "this
 /// release cannot tell it from A (BIC -1.2) or from B (BIC +3.4)".
 pub(super) fn ambiguity(rivals: &[crate::RivalReport], events: usize) -> Option<String> {

@@ -13,6 +13,7 @@ use super::picked::Picked;
 use super::screen::Screening;
 use super::search::{Search, Trail};
 use super::verify::{Refit, refit_candidates};
+use crate::classes::{ClassInfo, class_of};
 use crate::contender::Contender;
 use crate::{Fitted, Result, stepwise};
 
@@ -20,22 +21,23 @@ use crate::{Fitted, Result, stepwise};
 pub const MIMICS: usize = 3;
 
 /// A step's refit as a contender of the rival search.
-fn contender(r: &Refit, pool_size: usize, origin: &str) -> Contender {
+fn contender(r: &Refit, pool_size: usize, origin: &str, classes: &[ClassInfo]) -> Contender {
     Contender::new(
         &r.fitted,
         pool_size,
         format!("{origin}: {}", r.entry.label()),
     )
+    .in_class(class_of(classes, &r.entry))
 }
 
 /// The first step's verification refits as contenders.
 pub(super) fn from_refits(s: &Screening, refits: &[Refit], trail: &mut Trail) {
     let n = s.entries.len();
-    trail.contenders.extend(
-        refits
-            .iter()
-            .map(|r| contender(r, n, "discovery's first-step refit")),
-    );
+    let tagged: Vec<Contender> = refits
+        .iter()
+        .map(|r| contender(r, n, "discovery's first-step refit", &trail.classes))
+        .collect();
+    trail.contenders.extend(tagged);
 }
 
 /// The entries of `s` that best reproduce `signature` (full residual vector), one per family,
@@ -91,10 +93,17 @@ pub(super) fn mimics(
         trail,
     )?;
     let n = s.entries.len();
-    trail.contenders.extend(
-        refits
-            .iter()
-            .map(|r| contender(r, n, "library mimic of the catalogue's answer")),
-    );
+    let tagged: Vec<Contender> = refits
+        .iter()
+        .map(|r| {
+            contender(
+                r,
+                n,
+                "library mimic of the catalogue's answer",
+                &trail.classes,
+            )
+        })
+        .collect();
+    trail.contenders.extend(tagged);
     Ok(())
 }

@@ -51,6 +51,7 @@ pub(crate) use reach::Yardstick;
 use search::{Search, Selection, Trail};
 use verify::Refit;
 
+mod classes;
 mod held;
 mod locate;
 mod mimic;
@@ -89,6 +90,7 @@ pub(super) fn discover(
             evaluations: 0,
             contenders: Vec::new(),
             skipped: Vec::new(),
+            classes: Vec::new(),
             blocked: Some(why),
         });
     }
@@ -147,6 +149,7 @@ pub(super) fn discover(
         evaluations: trail.evaluations,
         contenders: trail.contenders,
         skipped: trail.skipped,
+        classes: trail.classes,
         blocked: None,
     })
 }
@@ -177,6 +180,9 @@ fn enter(
         return Ok(None);
     };
     crate::stage_clock::lap("  screening");
+    if step == 0 {
+        classes::gather(&s, trail);
+    }
     if let Some(signature) = at.signature {
         let exclude = s.to_verify();
         mimic::mimics(
@@ -215,6 +221,8 @@ fn enter(
     record.verified = refits.iter().map(Refit::verified).collect();
     if step == 0 {
         mimic::from_refits(&s, &refits, trail);
+        classes::refit_leads(evaluator, search, &s, &sel.current, trail)?;
+        crate::stage_clock::lap("  rival classes");
     }
     let Some(winner) = refits.first() else {
         trail.steps.push(record);

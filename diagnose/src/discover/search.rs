@@ -104,6 +104,8 @@ pub(super) struct Trail {
     pub contenders: Vec<crate::contender::Contender>,
     /// Refits that did not simulate and were left out.
     pub skipped: Vec<crate::SkippedRefit>,
+    /// The first step's rival classes (`crate::classes`).
+    pub classes: Vec<crate::classes::ClassInfo>,
 }
 
 impl Trail {

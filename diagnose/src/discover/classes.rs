@@ -1,0 +1,78 @@
+//! Discovery's part of the rival classes (`crate::classes`): at the first step, the classes of
+//! the entries the screening cannot tell from the best, and a refit of the lead of each class
+//! that no verification refit or mimic represents (at most [`CLASS_REFITS`]), as contenders of
+//! the rival search.
+
+use sepval_common::evaluation::Evaluator;
+
+use super::locate;
+use super::picked::Picked;
+use super::screen::Screening;
+use super::search::{Search, Trail};
+use super::verify::refit_candidates;
+use crate::classes::{self, CLASS_REFITS, ClassInfo};
+use crate::contender::Contender;
+use crate::{Fitted, Result};
+
+/// The first step's classes, from its screening, into `trail`.
+pub(super) fn gather(s: &Screening, trail: &mut Trail) {
+    let candidates = classes::candidates(&s.scores, &s.entry_cols, s.threshold);
+    trail.classes = classes::classes(
+        &s.linear.r0,
+        &s.linear.fixed,
+        &s.lib_cols,
+        &s.entry_cols,
+        &candidates,
+    )
+    .iter()
+    .map(|c| ClassInfo::new(c, &s.entries))
+    .collect();
+}
+
+/// Refits the lead of each class without a contender yet (the best classes first, at most
+/// [`CLASS_REFITS`]) about the baseline `current`, as contenders.
+pub(super) fn refit_leads(
+    evaluator: &mut dyn Evaluator,
+    search: &Search,
+    s: &Screening,
+    current: &Fitted,
+    trail: &mut Trail,
+) -> Result<()> {
+    let leads: Vec<usize> = (0..trail.classes.len())
+        .filter(|&k| !trail.contenders.iter().any(|c| c.class == Some(k)))
+        .filter_map(|k| {
+            let lead = &trail.classes[k].members[0];
+            s.entries.iter().position(|e| e.label() == lead.label())
+        })
+        .take(CLASS_REFITS)
+        .collect();
+    if leads.is_empty() {
+        return Ok(());
+    }
+    let located = locate::locate(
+        evaluator,
+        search,
+        s,
+        current,
+        &leads,
+        &mut trail.evaluations,
+    )?;
+    let refits = refit_candidates(
+        evaluator,
+        search,
+        current,
+        &Picked::default(),
+        located,
+        trail,
+    )?;
+    let n = s.entries.len();
+    let tagged: Vec<Contender> = refits
+        .iter()
+        .map(|r| {
+            Contender::new(&r.fitted, n, format!("rival class: {}", r.entry.label()))
+                .in_class(classes::class_of(&trail.classes, &r.entry))
+        })
+        .collect();
+    trail.contenders.extend(tagged);
+    Ok(())
+}
