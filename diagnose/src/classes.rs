@@ -1,5 +1,6 @@
 //! Rival classes: every library entry the screening cannot tell from the best, grouped by what
-//! it changes in the residuals (issue 36, item 1; `docs/discovery.md` section 11.6).
+//! it changes in the residuals (issue 36, item 1; `docs/discovery.md` section 11.5,
+//! step 4b).
 //!
 //! Verification refits only the few best entries by F-to-enter, so on one release the true
 //! cause can be missing from the rivals while a dozen terms explain the misfit about equally

@@ -130,8 +130,9 @@ pub struct RivalClass {
     pub words: String,
     /// Its members (`axis formula`), the best by the screening first.
     pub members: Vec<String>,
-    /// `answer` (a member is a term of the answer), `rival` (its representative is a rival),
-    /// `told apart` (its representatives' refits are beyond the margin or not significant) or
+    /// `answer` (a member is a term of the answer), `better` (a significant representative's
+    /// BIC is below the answer's by the margin or more), `rival` (a significant representative
+    /// within the margin), `told apart` (its representatives' refits are neither) or
     /// `not refitted` (beyond the budget of refits: the data were not asked).
     pub status: String,
     /// Its best representative's BIC less the answer's, when one was refitted.

@@ -37,6 +37,7 @@ struct Page<'a> {
     figures: &'a [String],
     alternatives: Vec<AlternativeRow<'a>>,
     rivals: Vec<RivalRow<'a>>,
+    classes: Vec<ClassRow<'a>>,
     discovery: Option<DiscoveryTable<'a>>,
     channels: Vec<ChannelRow>,
     candidates: Vec<CandidateRow<'a>>,
@@ -225,6 +226,17 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> Result<String, H
         figures,
         alternatives: alternative_rows(d),
         rivals: rival_rows(d),
+        classes: d
+            .rival_classes
+            .iter()
+            .map(|c| ClassRow {
+                words: &c.words,
+                members: c.members.join("; "),
+                status: &c.status,
+                delta_bic: c.delta_bic.map_or("-".into(), |v| format!("{v:+.1}")),
+                open: c.status != "told apart",
+            })
+            .collect(),
         discovery: (!d.discovery_steps.is_empty() || !d.discovery_notes.is_empty()).then(|| {
             DiscoveryTable {
                 steps: step_rows(d),
@@ -333,6 +345,17 @@ struct RivalRow<'a> {
     j_att_deg: String,
     delta_bic: String,
     origin: &'a str,
+}
+
+/// A rival class (`docs/discovery.md` section 11.5, step 4b).
+#[derive(Serialize)]
+struct ClassRow<'a> {
+    words: &'a str,
+    members: String,
+    status: &'a str,
+    delta_bic: String,
+    /// Not told apart by the data.
+    open: bool,
 }
 
 fn rival_rows(d: &Diagnosis) -> Vec<RivalRow<'_>> {

@@ -100,8 +100,8 @@ fn names(c: &Contender, job: &Job) -> (Vec<String>, Vec<TermRecord>) {
 pub(crate) struct RivalSearch {
     /// The rivals, best (lowest BIC) first.
     pub rivals: Vec<(Contender, RivalReport)>,
-    /// Per contender of a rival class: its class, its BIC less the answer's, whether it is a
-    /// rival.
+    /// Per contender of a rival class: its class, its BIC less the answer's, whether it is
+    /// significant against the baseline.
     pub classes: Vec<(usize, f64, bool)>,
 }
 
@@ -137,16 +137,17 @@ pub(crate) fn rivals(
         if delta_bic.abs() < CONVERGE_WITHIN {
             near.push(c);
         } else if let Some(k) = c.class {
-            classes.push((k, delta_bic, false));
+            classes.push((k, delta_bic, significant(setting, baseline, &c)));
         }
     }
     converge_all(evaluator, job, &mut near, setting, settings, evaluations)?;
     let mut out: Vec<(Contender, RivalReport)> = Vec::new();
     for c in near {
         let delta_bic = setting.bic(&c.fitted) - answer_bic;
-        let rival = significant(setting, baseline, &c) && delta_bic.abs() < RIVAL_MARGIN;
+        let significant = significant(setting, baseline, &c);
+        let rival = significant && delta_bic.abs() < RIVAL_MARGIN;
         if let Some(k) = c.class {
-            classes.push((k, delta_bic, rival));
+            classes.push((k, delta_bic, significant));
         }
         if rival {
             let r = report(setting, &c, delta_bic)?;
@@ -161,9 +162,10 @@ pub(crate) fn rivals(
 }
 
 /// The rival classes as diagnosis.json reports them: each class of the answer (one of its
-/// members is a term of the answer's model, or of an effect that is one term), a rival (its
-/// representative is), told apart (its representatives' refits are not) or not refitted
-/// (beyond the budget of refits).
+/// members is a term of the answer's model, or of an effect that is one term), better (a
+/// significant representative's BIC is below the answer's by the margin or more: the data
+/// favour it), a rival (a significant representative within the margin), told apart (its
+/// representatives' refits are neither) or not refitted (beyond the budget of refits).
 pub(crate) fn class_reports(
     setting: &Setting,
     answer_model: &Fitted,
@@ -191,10 +193,17 @@ pub(crate) fn class_reports(
             let mine: Vec<&(usize, f64, bool)> =
                 searched.iter().filter(|(j, ..)| *j == k).collect();
             let best = mine.iter().map(|m| m.1).min_by(f64::total_cmp);
+            let significant_best = mine
+                .iter()
+                .filter(|m| m.2)
+                .map(|m| m.1)
+                .min_by(f64::total_cmp);
             let (status, delta_bic) = if kinds.iter().any(|&(a, r)| c.holds(a, r)) {
                 ("answer", Some(0.0))
-            } else if mine.iter().any(|m| m.2) {
-                ("rival", best)
+            } else if significant_best.is_some_and(|d| d <= -RIVAL_MARGIN) {
+                ("better", significant_best)
+            } else if significant_best.is_some_and(|d| d.abs() < RIVAL_MARGIN) {
+                ("rival", significant_best)
             } else if best.is_some() {
                 ("told apart", best)
             } else {

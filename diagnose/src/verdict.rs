@@ -186,12 +186,15 @@ pub(super) fn open_classes(classes: &[crate::RivalClass]) -> Option<String> {
     if open.is_empty() {
         return None;
     }
+    let mut open = open;
+    open.sort_by_key(|c| c.status != "better");
     let named: Vec<String> = open
         .iter()
         .filter(|c| c.status != "not refitted")
         .take(CLASSES_NAMED)
         .map(|c| match (c.status.as_str(), c.delta_bic) {
             ("answer", _) => format!("{} (the answer's class)", c.words),
+            ("better", Some(d)) => format!("{} (BIC {d:+.1}: it fits better)", c.words),
             (_, Some(d)) => format!("{} (BIC {d:+.1})", c.words),
             _ => c.words.clone(),
         })
@@ -207,8 +210,14 @@ pub(super) fn open_classes(classes: &[crate::RivalClass]) -> Option<String> {
         )
         .map(|c| c.members.len())
         .sum();
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     let more = (rest > 0).then(|| {
-        format!("{rest} more classes of {rest_terms} terms not told apart (rival_classes)")
+        format!(
+            "{} of {} not told apart (rival_classes)",
+            plural(rest, "more class", "more classes"),
+            plural(rest_terms, "term", "terms")
+        )
     });
     let text = match (named.is_empty(), more) {
         (false, Some(m)) => format!("{}, and {m}", named.join(" or from ")),
