@@ -1,0 +1,111 @@
+//! A DAVE-ML file as another tool writes it (radians, feet, a breakpoint set shared by three
+//! tables, inputs out of sepval's order, a derivative per degree, a uniformPDF, checkData) read
+//! into a scenario.
+
+use sepval_common::correction::Target;
+use sepval_common::scenario::Scenario;
+use sepval_common::table::{Coefficient, Variable};
+use sepval_daveml::{Map, import_model, load_map, read_model};
+
+use super::{fixture, fixture_text};
+
+fn table(s: &Scenario, field: &str) -> sepval_common::table::Table {
+    let t = Target::of_field(field).unwrap();
+    match sepval_daveml::assemble::field(s, t) {
+        Some(Coefficient::Table(t)) => t.clone(),
+        other => panic!("{field}: {other:?}"),
+    }
+}
+
+#[test]
+fn another_tools_file_reads_with_units_converted_and_checks_passing() {
+    let map = load_map(Some(&fixture("other_tool.toml"))).unwrap();
+    let base = Scenario::embedded_default();
+    let m = read_model(&fixture("other_tool.dml"), &map, &base).unwrap();
+    assert_eq!(
+        m.fields,
+        [
+            "aero.cz",
+            "aero.cm",
+            "aero.cl_p_per_rad",
+            "interference.dcz0",
+            "aero.ca0"
+        ]
+    );
+    // Two cases: 5 + 4 outputs compared (CL is ignored by the map).
+    assert_eq!(m.checked, 9);
+    assert!(
+        m.notes.iter().any(|n| n.contains("uniformPDF")),
+        "{:?}",
+        m.notes
+    );
+    assert!(m.notes.iter().any(|n| n.contains("CL")), "{:?}", m.notes);
+
+    // CN = -CZ; alpha breakpoints from radians to degrees (to_degrees), Mach shared.
+    let cz = table(&m.scenario, "aero.cz");
+    assert_eq!(cz.axes()[0].variable, Variable::Mach);
+    assert_eq!(cz.axes()[0].breakpoints, [0.6, 0.9, 1.2]);
+    assert_eq!(cz.axes()[1].variable, Variable::Alpha);
+    assert_eq!(cz.axes()[1].breakpoints[2], 0.2f64.to_degrees());
+    assert_eq!(cz.values()[..3], [1.0, -0.0, -1.0]);
+    // Cm was given over (alpha, Mach): put in sepval's order (Mach, alpha), values transposed.
+    let cm = table(&m.scenario, "aero.cm");
+    assert_eq!(cm.axes()[0].variable, Variable::Mach);
+    assert_eq!(
+        cm.values(),
+        [0.10, 0.0, -0.10, 0.12, 0.0, -0.12, 0.14, 0.0, -0.14]
+    );
+    // Per degree to per radian; feet to metres, exactly.
+    let clp = table(&m.scenario, "aero.cl_p_per_rad");
+    assert_eq!(clp.values()[0], (-0.5f64).to_degrees());
+    let dcz = table(&m.scenario, "interference.dcz0");
+    assert_eq!(dcz.axes()[0].breakpoints, [0.0, 1.524, 3.048, 9.144]);
+    // The static tables replace their slopes' linear terms; CA is a constant.
+    assert!(m.scenario.aero.cz_alpha_per_rad.is_none());
+    assert!(m.scenario.aero.cm_alpha_per_rad.is_none());
+    assert_eq!(m.scenario.aero.ca0.as_constant(), Some(0.35));
+    // The rest is the base's.
+    assert_eq!(m.scenario.store, base.store);
+    assert_eq!(m.scenario.aero.cy_beta_per_rad, base.aero.cy_beta_per_rad);
+}
+
+#[test]
+fn without_its_map_the_files_own_names_are_refused_naming_them() {
+    let e = import_model(
+        &fixture_text("other_tool.dml"),
+        "other_tool.dml",
+        &Map::default(),
+        &Scenario::embedded_default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("other_tool.dml line 82, <independentVarRef>: the function's input `dist_ft` is not in the map"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_map_file_names_fields_and_inputs_and_its_errors_name_the_entry() {
+    let text =
+        "[inputs]\naoa_r = \"alpha\"\n[outputs]\nCNtot = { field = \"aero.cz\", negate = true }\n";
+    let map = Map::with_file(text, "m.toml").unwrap();
+    assert!(matches!(
+        map.role("aoa_r", ""),
+        Some(sepval_daveml::map::Role::Input(Variable::Alpha))
+    ));
+    let e = Map::with_file("[outputs]\nX = { field = \"aero.cq\" }\n", "m.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("map m.toml: [outputs] X: field `aero.cq` is not a field"),
+        "{e}"
+    );
+    let e = Map::with_file("[inputs]\nq = \"altitude\"\n", "m.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("expected mach, alpha, beta, distance or lateral"),
+        "{e}"
+    );
+}
