@@ -25,6 +25,7 @@
 #![deny(clippy::float_cmp)]
 
 pub mod assemble;
+pub mod bands;
 pub mod check;
 pub mod error;
 pub mod export;
@@ -43,6 +44,7 @@ use sepval_common::atomic_file::write_atomically;
 use sepval_common::input_file::read_string;
 use sepval_common::scenario::Scenario;
 
+pub use bands::{CorrectionSpread, bands};
 pub use error::{DavemlError, Mismatch, Place};
 pub use export::{Band, Provenance, to_daveml};
 pub use map::Map;
