@@ -107,7 +107,7 @@ mod tests {
         };
         let b = bands(&s, &[c.clone(), c]).unwrap();
         assert_eq!(b.len(), 1);
-        let one = [0.02, 0.03, 0.035, 0.04];
+        let one: [f64; 4] = [0.02, 0.03, 0.035, 0.04];
         for (i, got) in b[0].sigma.iter().enumerate() {
             let want = one[i % 4].hypot(one[i % 4]);
             assert!((got - want).abs() <= 1e-15, "{i}: {got} {want}");

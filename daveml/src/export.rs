@@ -155,11 +155,20 @@ fn header(x: &mut Xml, s: &Scenario, prov: &Provenance) {
     } else {
         format!("the releases {}", prov.releases.join(", "))
     };
+    let beyond = if s.extension.is_empty() && s.correction.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " Not in this file: the scenario's {} model-extension term(s) and {} correction(s) (docs/model.md), which sepval adds to these tables.",
+            s.extension.len(),
+            s.correction.len()
+        )
+    };
     x.leaf(
         "description",
         &[],
         &format!(
-            "{} written by sepval {} on {} from {}, using {}. Axes: body axes of docs/model.md section 2 (CA axial, positive aft; CZ positive down); moments about the CG, reference diameter {} m. Tables hold their edge values outside their breakpoints.",
+            "{} written by sepval {} on {} from {}, using {}. Axes: body axes of docs/model.md section 2 (CA axial, positive aft; CZ positive down); moments about the CG, reference diameter {} m. Tables hold their edge values outside their breakpoints.{beyond}",
             s.name,
             prov.sepval_version,
             prov.date,

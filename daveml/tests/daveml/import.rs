@@ -17,6 +17,11 @@ fn table(s: &Scenario, field: &str) -> sepval_common::table::Table {
     }
 }
 
+/// The fixture's check cases, worked out: at Mach 0.75 (half-way from 0.6 to 0.9) and alpha
+/// 0.1 rad (half-way from 0 to 0.2), CN is the mean of 0.5 (Mach 0.6) and 0.55 (Mach 0.9),
+/// 0.525; Cm the mean of 0 and -0.11, -0.055; Clp -0.55 per deg; dCZ at 2.5 ft (half-way from 0
+/// to 5 ft) -0.45. Beyond every table (Mach 1.5, alpha -0.3 rad, 40 ft) each is held at its
+/// corner: CN -1.2, Cm 0.14, Clp -0.7, dCZ 0.
 #[test]
 fn another_tools_file_reads_with_units_converted_and_checks_passing() {
     let map = load_map(Some(&fixture("other_tool.toml"))).unwrap();
@@ -108,4 +113,60 @@ fn a_map_file_names_fields_and_inputs_and_its_errors_name_the_entry() {
         e.contains("expected mach, alpha, beta, distance or lateral"),
         "{e}"
     );
+}
+
+/// A table of three inputs listed as (beta, Mach, alpha): read in sepval's order (Mach, alpha,
+/// beta), every grid point the same value.
+#[test]
+fn three_inputs_in_another_order_are_nested_with_their_values() {
+    let (mach, alpha, beta) = ([0.5, 1.0], [-4.0, 0.0, 4.0], [-2.0, 0.0, 2.0, 6.0]);
+    let f = |m: f64, a: f64, b: f64| 100.0 * m + 10.0 * a + b;
+    let mut data = Vec::new();
+    for b in beta {
+        for m in mach {
+            for a in alpha {
+                data.push(f(m, a, b).to_string());
+            }
+        }
+    }
+    let list = |v: &[f64]| v.iter().map(f64::to_string).collect::<Vec<_>>().join(",");
+    let text = format!(
+        r#"<DAVEfunc>
+  <fileHeader><author name="x" org="y"/><creationDate date="2020-01-01"/></fileHeader>
+  <variableDef varID="mach" units="nd"/><variableDef varID="alpha" units="deg"/>
+  <variableDef varID="beta" units="deg"/><variableDef varID="Cl" units="nd"/>
+  <breakpointDef bpID="m"><bpVals>{}</bpVals></breakpointDef>
+  <breakpointDef bpID="a"><bpVals>{}</bpVals></breakpointDef>
+  <breakpointDef bpID="b"><bpVals>{}</bpVals></breakpointDef>
+  <function name="Cl">
+    <independentVarRef varID="beta"/><independentVarRef varID="mach"/><independentVarRef varID="alpha"/>
+    <dependentVarRef varID="Cl"/>
+    <functionDefn><griddedTableDef><breakpointRefs><bpRef bpID="b"/><bpRef bpID="m"/><bpRef bpID="a"/></breakpointRefs>
+      <dataTable>{}</dataTable></griddedTableDef></functionDefn>
+  </function>
+</DAVEfunc>"#,
+        list(&mach),
+        list(&alpha),
+        list(&beta),
+        data.join(",")
+    );
+    let m = import_model(
+        &text,
+        "t.dml",
+        &Map::default(),
+        &Scenario::embedded_default(),
+    )
+    .unwrap();
+    let t = table(&m.scenario, "aero.cl");
+    let vars: Vec<Variable> = t.axes().iter().map(|a| a.variable).collect();
+    assert_eq!(vars, [Variable::Mach, Variable::Alpha, Variable::Beta]);
+    let mut k = 0;
+    for mm in mach {
+        for a in alpha {
+            for b in beta {
+                assert_eq!(t.values()[k], f(mm, a, b), "at {mm}, {a}, {b}");
+                k += 1;
+            }
+        }
+    }
 }
