@@ -226,7 +226,7 @@ fn output_description(t: Target, c: &Coefficient, s: &Scenario) -> String {
     let base = format!("sepval field {}", t.field());
     match (t, c) {
         (Target::Interference(_), Coefficient::Constant(_)) => format!(
-            "{base}: the increment at carriage, decaying as f(s) = exp(-s / lambda) to 0 at s_end (docs/model.md section 3), lambda = {} m, s_end = {} m",
+            "{base}: the increment at carriage, times f(s) = (exp(-s/lambda) - exp(-s_end/lambda)) / (1 - exp(-s_end/lambda)) below s_end and 0 from s_end (docs/model.md section 3), lambda = {} m, s_end = {} m",
             number(s.interference.lambda_m),
             number(s.interference.s_end_m)
         ),

@@ -2,8 +2,8 @@
 //! points of the tables' ranges, each giving every input and every field's value there as
 //! sepval's tables compute it, with a tolerance, so the receiving tool can verify its import.
 //!
-//! Choices (docs/daveml.md): three shots, at 0.25, 0.5 and 0.8 of each input's range over all
-//! tables (between breakpoints, so interpolation is exercised, and inside every table's edges
+//! Choices (docs/daveml.md): three shots (one when no table spans an input), at 0.25, 0.5 and
+//! 0.8 of each input's range over all tables (between breakpoints, so interpolation is exercised, and inside every table's edges
 //! where the ranges agree); Mach alone, when no table spans it, at the flight's Mach. Each
 //! output's tolerance is 1e-9 of max(1, the largest magnitude of its table): other tools'
 //! interpolation differs from sepval's by rounding only.
@@ -86,7 +86,8 @@ pub fn check_data(
     s: &Scenario,
 ) {
     x.open("checkData", &[]);
-    for (k, f) in FRACTIONS.iter().enumerate() {
+    let mut shots: Vec<Vec<(Variable, f64)>> = Vec::new();
+    for f in FRACTIONS {
         let at: Vec<(Variable, f64)> = inputs
             .iter()
             .map(|&v| {
@@ -94,15 +95,22 @@ pub fn check_data(
                 (v, p)
             })
             .collect();
+        // No table spans an input: every shot would be the same one.
+        if !shots.contains(&at) {
+            shots.push(at);
+        }
+    }
+    for (k, at) in shots.iter().enumerate() {
+        let at = at.as_slice();
         x.open("staticShot", &[("name", &format!("sepval case {}", k + 1))]);
         x.open("checkInputs", &[]);
-        for (v, p) in &at {
+        for (v, p) in at {
             signal(x, input_id(*v), written_input(*v), *p, None);
         }
         x.close("checkInputs");
         x.open("checkOutputs", &[]);
         for (t, c) in fields {
-            if let Some(y) = value(c, &at) {
+            if let Some(y) = value(c, at) {
                 let units = written_output(kind_of(*t));
                 signal(x, output_id(*t), units, y, Some(tol(c)));
             }

@@ -150,7 +150,20 @@ fn daveml_bad_files_are_refused_and_nothing_is_written() {
         &sepval(&["scenario", "--from-daveml", "wrong.dml", "--out", "x"], d),
         "line 82, <independentVarRef>: the function's input `dist_ft` is not in the map",
     );
-    assert_eq!(entries(d), ["not.dml", "wrong.dml"], "nothing written");
+    // A gigabyte (sparse: no disk used) is refused by its size before it is read.
+    std::fs::File::create(d.join("big.dml"))
+        .unwrap()
+        .set_len(1 << 30)
+        .unwrap();
+    refused(
+        &sepval(&["scenario", "--from-daveml", "big.dml", "--out", "x"], d),
+        "big.dml: the DAVE-ML file is 1073741824 bytes, more than the limit of 268435456 bytes",
+    );
+    assert_eq!(
+        entries(d),
+        ["big.dml", "not.dml", "wrong.dml"],
+        "nothing written"
+    );
     // An output directory that exists is never written into.
     std::fs::create_dir(d.join("x")).unwrap();
     ok(&sepval(&["scenario", "--to-daveml", "--out", "t.dml"], d));
@@ -162,5 +175,8 @@ fn daveml_bad_files_are_refused_and_nothing_is_written() {
     // --map belongs to --from-daveml.
     let out = sepval(&["scenario", "--map", "m.toml", "--out", "y"], d);
     assert_eq!(out.status.code(), Some(2));
-    assert_eq!(entries(d), ["not.dml", "t.dml", "wrong.dml", "x"]);
+    assert_eq!(
+        entries(d),
+        ["big.dml", "not.dml", "t.dml", "wrong.dml", "x"]
+    );
 }
