@@ -255,6 +255,48 @@ struct AxisIn {
     breakpoints: Vec<f64>,
 }
 
+/// The gridded table of a function, and where it is defined.
+fn table_of<'a>(idx: &'a Index, f: &'a Function) -> Result<(&'a GriddedTable, Place), DavemlError> {
+    match &f.table.item {
+        TableDefn::Inline(t) => Ok((t, f.table.place.clone())),
+        TableDefn::Ref(id) => idx
+            .tables
+            .get(id.as_str())
+            .map(|t| (&t.item, t.place.clone()))
+            .ok_or_else(|| {
+                DavemlError::at(
+                    &f.table.place,
+                    format!("unknown table `{id}`: no <griddedTableDef> has this gtID"),
+                )
+            }),
+        TableDefn::Unsupported(what) => Err(DavemlError::at(
+            &f.table.place,
+            format!(
+                "function `{}` is {what}: sepval imports gridded tables (griddedTableDef) only",
+                f.name
+            ),
+        )),
+    }
+}
+
+/// Refuses an output whose `minValue`/`maxValue` would saturate its table's `data`.
+fn unsaturated(var: &Located<VariableDef>, data: &[f64]) -> Result<(), DavemlError> {
+    let (min, max) = var.item.limits;
+    if let Some(x) = data
+        .iter()
+        .find(|&&x| min.is_some_and(|m| x < m) || max.is_some_and(|m| x > m))
+    {
+        return Err(DavemlError::at(
+            &var.place,
+            format!(
+                "minValue/maxValue of `{}` limit its table (a value {x:?} lies beyond them): sepval's tables are not saturated",
+                var.item.var_id
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The table of a function whose output is the field `o`.
 fn function_table(
     idx: &Index,
@@ -263,33 +305,7 @@ fn function_table(
     var: &Located<VariableDef>,
     o: Output,
 ) -> Result<Table, DavemlError> {
-    let table = match &f.table.item {
-        TableDefn::Inline(t) => t,
-        TableDefn::Ref(id) => {
-            &idx.tables
-                .get(id.as_str())
-                .ok_or_else(|| {
-                    DavemlError::at(
-                        &f.table.place,
-                        format!("unknown table `{id}`: no <griddedTableDef> has this gtID"),
-                    )
-                })?
-                .item
-        }
-        TableDefn::Unsupported(what) => {
-            return Err(DavemlError::at(
-                &f.table.place,
-                format!(
-                    "function `{}` is {what}: sepval imports gridded tables (griddedTableDef) only",
-                    f.name
-                ),
-            ));
-        }
-    };
-    let table_place = match &f.table.item {
-        TableDefn::Ref(id) => idx.tables[id.as_str()].place.clone(),
-        _ => f.table.place.clone(),
-    };
+    let (table, table_place) = table_of(idx, f)?;
     if f.inputs.len() != table.breakpoints.len() {
         return Err(DavemlError::at(
             &table_place,
@@ -339,6 +355,7 @@ fn function_table(
     }
     let c =
         units::output(kind, &var.item.units).map_err(|e| units_error(&var.place, &var.item, e))?;
+    unsaturated(var, &table.data)?;
     let values: Vec<f64> = table.data.iter().map(|&x| signed(o, c.apply(x))).collect();
     let (axes, values) =
         nest(axes, values, kind).map_err(|m| DavemlError::at(&f.inputs[0].place, m))?;
@@ -413,15 +430,23 @@ fn axis(
         ));
     }
     let (lo, hi) = (b.first().copied(), b.last().copied());
-    let inside = |x: Option<f64>, edge: Option<f64>, below: bool| match (x, edge) {
-        (Some(x), Some(e)) => (below && x > e) || (!below && x < e),
-        _ => false,
+    let inside = |(min, max): (Option<f64>, Option<f64>)| {
+        min.zip(lo).is_some_and(|(x, e)| x > e) || max.zip(hi).is_some_and(|(x, e)| x < e)
     };
-    if inside(i.min, lo, true) || inside(i.max, hi, false) {
+    if inside((i.min, i.max)) {
         return Err(DavemlError::at(
             &input.place,
             format!(
                 "min/max of `{}` lie inside its breakpoints {bp_id}: sepval holds a table at its breakpoints' edges only",
+                i.var_id
+            ),
+        ));
+    }
+    if inside(var.item.limits) {
+        return Err(DavemlError::at(
+            &var.place,
+            format!(
+                "minValue/maxValue of `{}` lie inside the breakpoints {bp_id}: sepval limits a table's input at its breakpoints' edges only",
                 i.var_id
             ),
         ));

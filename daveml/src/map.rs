@@ -3,7 +3,10 @@
 //! for a name the default has replaces it). docs/daveml.md lists the default map.
 //!
 //! A variable is looked up by its `varID`, then by its `name` (case matters: `Cl` is the
-//! rolling moment, `CL` the lift, `Cn` the yawing moment, `CN` the normal force).
+//! rolling moment, `CL` the lift, `Cn` the yawing moment, `CN` the normal force). The default
+//! map knows the usual short names and the AIAA standard variable names S-119 recommends
+//! (`angleOfAttack`, `aeroBodyForceCoefficient_X`, ...: body axes, X forward, Z down, the
+//! moments positive right wing down, nose up and nose right, as sepval's).
 //!
 //! The map file (TOML):
 //!
@@ -54,11 +57,27 @@ pub struct Map {
 const DEFAULT_INPUTS: [(&[&str], Variable); 5] = [
     (&["mach", "Mach", "MACH", "M"], Variable::Mach),
     (
-        &["alpha", "alpdeg", "alpha_deg", "alprad", "ALPHA", "AOA"],
+        &[
+            "alpha",
+            "alpdeg",
+            "alpha_deg",
+            "alprad",
+            "ALPHA",
+            "AOA",
+            "angleOfAttack",
+        ],
         Variable::Alpha,
     ),
     (
-        &["beta", "betdeg", "beta_deg", "betrad", "BETA", "AOS"],
+        &[
+            "beta",
+            "betdeg",
+            "beta_deg",
+            "betrad",
+            "BETA",
+            "AOS",
+            "angleOfSideslip",
+        ],
         Variable::Beta,
     ),
     (&["distance", "distance_m", "s"], Variable::Distance),
@@ -68,13 +87,13 @@ const DEFAULT_INPUTS: [(&[&str], Variable); 5] = [
 /// The default map's outputs: (DAVE-ML names, sepval field, negate).
 const DEFAULT_OUTPUTS: [(&[&str], &str, bool); 21] = [
     (&["CA"], "aero.ca0", false),
-    (&["CX"], "aero.ca0", true),
-    (&["CY"], "aero.cy", false),
-    (&["CZ"], "aero.cz", false),
+    (&["CX", "aeroBodyForceCoefficient_X"], "aero.ca0", true),
+    (&["CY", "aeroBodyForceCoefficient_Y"], "aero.cy", false),
+    (&["CZ", "aeroBodyForceCoefficient_Z"], "aero.cz", false),
     (&["CN"], "aero.cz", true),
-    (&["Cl"], "aero.cl", false),
-    (&["Cm"], "aero.cm", false),
-    (&["Cn"], "aero.cn", false),
+    (&["Cl", "aeroBodyMomentCoefficient_Roll"], "aero.cl", false),
+    (&["Cm", "aeroBodyMomentCoefficient_Pitch"], "aero.cm", false),
+    (&["Cn", "aeroBodyMomentCoefficient_Yaw"], "aero.cn", false),
     (&["CZalpha", "CZa"], "aero.cz_alpha_per_rad", false),
     (&["CYbeta", "CYb"], "aero.cy_beta_per_rad", false),
     (&["Cmalpha", "Cma"], "aero.cm_alpha_per_rad", false),

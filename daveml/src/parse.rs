@@ -3,8 +3,8 @@
 //!
 //! Source: DAVE-ML 2.0 (the reference manual of the DAVE-ML 2.0 release, and ANSI/AIAA
 //! S-119-2011, sections 5.1 to 5.6 and 5.8): `DAVEfunc` holds `fileHeader`, `variableDef`s
-//! (`varID`, `name`, `units`, optional `initialValue`, `calculation` and `uncertainty`),
-//! `breakpointDef`s (`bpID`, `units`, `bpVals`: comma or white-space separated),
+//! (`varID`, `name`, `units`, optional `initialValue`, `calculation` and `uncertainty`,
+//! `minValue`, `maxValue`), `breakpointDef`s (`bpID`, `units`, `bpVals`: comma or white-space separated),
 //! `griddedTableDef`s (`gtID`, `breakpointRefs`/`bpRef`, optional `uncertainty`, `dataTable`
 //! with the last breakpoint set changing fastest), `function`s (`independentVarRef`s with
 //! `varID`, `min`, `max`, `extrapolate` and `interpolate`, a `dependentVarRef`, a
@@ -47,6 +47,8 @@ pub struct VariableDef {
     pub units: String,
     /// `initialValue`.
     pub initial_value: Option<f64>,
+    /// `minValue` and `maxValue`: limits (saturations) on the variable's value.
+    pub limits: (Option<f64>, Option<f64>),
     /// The line of its `calculation`, if it has one.
     pub calculation: Option<Place>,
     /// Its `uncertainty`'s PDF, if it has one.
@@ -297,6 +299,10 @@ impl<'a, 'input> Reader<'a, 'input> {
             name: n.attribute("name").unwrap_or("").to_string(),
             units: self.attr(n, "units")?,
             initial_value: self.optional_number(n, "initialValue")?,
+            limits: (
+                self.optional_number(n, "minValue")?,
+                self.optional_number(n, "maxValue")?,
+            ),
             calculation: self.child(n, "calculation").map(|c| self.place(c)),
             uncertainty: self.pdf(n),
         })

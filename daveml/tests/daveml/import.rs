@@ -170,3 +170,39 @@ fn three_inputs_in_another_order_are_nested_with_their_values() {
         }
     }
 }
+
+/// The AIAA standard names (as NASA's F-16 model writes them: short varIDs, standard names)
+/// read with the default map; X is negated (CX = -CA), the moments are sepval's.
+#[test]
+fn aiaa_standard_names_read_with_the_default_map() {
+    let text = r#"<?xml version="1.0"?>
+<DAVEfunc xmlns="http://daveml.org/2010/DAVEML">
+  <fileHeader><author name="x" org="y"/><creationDate date="2013-10-21"/></fileHeader>
+  <variableDef name="angleOfAttack" varID="alpha" units="deg"><isStdAIAA/></variableDef>
+  <variableDef name="aeroBodyForceCoefficient_X" varID="cx" units="nd"><isStdAIAA/></variableDef>
+  <variableDef name="aeroBodyMomentCoefficient_Pitch" varID="cm" units="nd"><isStdAIAA/></variableDef>
+  <breakpointDef bpID="ALPHA1" units="deg"><bpVals>-10 0 10</bpVals></breakpointDef>
+  <function name="cx_fn">
+    <independentVarRef varID="alpha" min="-10" max="10" extrapolate="neither"/>
+    <dependentVarRef varID="cx"/>
+    <functionDefn><griddedTableDef><breakpointRefs><bpRef bpID="ALPHA1"/></breakpointRefs>
+      <dataTable>-0.05 -0.02 -0.05</dataTable></griddedTableDef></functionDefn>
+  </function>
+  <function name="cm_fn">
+    <independentVarRef varID="alpha" min="-10" max="10" extrapolate="neither"/>
+    <dependentVarRef varID="cm"/>
+    <functionDefn><griddedTableDef><breakpointRefs><bpRef bpID="ALPHA1"/></breakpointRefs>
+      <dataTable>0.1 0 -0.1</dataTable></griddedTableDef></functionDefn>
+  </function>
+</DAVEfunc>"#;
+    let m = import_model(
+        text,
+        "f.dml",
+        &Map::default(),
+        &Scenario::embedded_default(),
+    )
+    .unwrap();
+    assert_eq!(m.fields, ["aero.ca0", "aero.cm"]);
+    assert_eq!(table(&m.scenario, "aero.ca0").values(), [0.05, 0.02, 0.05]);
+    assert_eq!(table(&m.scenario, "aero.cm").values(), [0.1, 0.0, -0.1]);
+}

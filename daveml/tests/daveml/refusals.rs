@@ -151,3 +151,33 @@ fn a_gigabyte_file_is_refused_before_it_is_read() {
         "{e}"
     );
 }
+
+#[test]
+fn limits_sepval_cannot_honour_are_refused_at_their_variable() {
+    // An output saturated below its table's values.
+    let e = refused(
+        "<variableDef name=\"Cm\" varID=\"Cm\" units=\"nd\">",
+        "<variableDef name=\"Cm\" varID=\"Cm\" units=\"nd\" maxValue=\"0.12\">",
+    );
+    assert_eq!(
+        e,
+        "t.dml line 20, <variableDef>: minValue/maxValue of `Cm` limit its table (a value 0.14 lies beyond them): sepval's tables are not saturated"
+    );
+    // An input limited inside its breakpoints.
+    let e = refused(
+        "<variableDef name=\"MACH\" varID=\"MACH\" units=\"nd\"/>",
+        "<variableDef name=\"MACH\" varID=\"MACH\" units=\"nd\" minValue=\"0.7\"/>",
+    );
+    assert!(
+        e.starts_with("t.dml line 15, <variableDef>: minValue/maxValue of `MACH` lie inside the breakpoints MACH_bp"),
+        "{e}"
+    );
+    // Limits at or beyond the table change nothing.
+    let text = fixture_text("other_tool.dml").replacen(
+        "<variableDef name=\"MACH\" varID=\"MACH\" units=\"nd\"/>",
+        "<variableDef name=\"MACH\" varID=\"MACH\" units=\"nd\" minValue=\"0.0\" maxValue=\"1.2\"/>",
+        1,
+    );
+    let map = load_map(Some(&fixture("other_tool.toml"))).unwrap();
+    import_model(&text, "t.dml", &map, &Scenario::embedded_default()).unwrap();
+}
