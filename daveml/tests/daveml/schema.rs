@@ -1,9 +1,13 @@
 //! What sepval writes, checked against the DAVE-ML 2.0 document structure: the content models
-//! of the elements sepval writes, encoded from the DAVE-ML 2.0 DTD (`DAVEfunc.dtd` of the
-//! DAVE-ML 2.0 release, daveml.org; the same order as ANSI/AIAA S-119-2011 section 5), each an
-//! ordered list of (allowed names, least, most) that an element's children must follow in order.
-//! Elements sepval never writes (provenance, reference, calculation, ...) appear only where
-//! they fix the order of those it does.
+//! of the elements sepval writes, after the DAVE-ML 2.0 DTD (`DAVEfunc.dtd`, public identifier
+//! `-//AIAA//DTD for Flight Dynamic Models - Functions 2.0//EN`; the element order of ANSI/AIAA
+//! S-119-2011 section 5), each an ordered list of (allowed names, least, most) that an
+//! element's children must follow in order. The DTD itself could not be fetched where this was
+//! written: the models are encoded from the standard's structure as documented, and agree with
+//! DAVE-ML 2.0 files other tools write (NASA's F-16 model: the namespace, `creationDate`,
+//! `internalValues` between `checkInputs` and `checkOutputs`). Elements sepval never writes
+//! (provenance, reference, calculation, ...) appear only where they fix the order of those it
+//! does. Check against the published DTD when it is at hand.
 
 use roxmltree::{Document, Node};
 use sepval_common::scenario::Scenario;
