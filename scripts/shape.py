@@ -49,7 +49,9 @@ MAY_USE = {
                         "sepval-predict", "sepval-envelope", "sepval-report"},
     "sepval": {"sepval-common", "sepval-transport", "sepval-solve", "sepval-fit",
                "sepval-diagnose", "sepval-plan", "sepval-predict", "sepval-envelope",
-               "sepval-update", "sepval-campaign", "sepval-geometry", "sepval-report"},
+               "sepval-update", "sepval-campaign", "sepval-geometry", "sepval-report",
+               "sepval-daveml"},
+    "sepval-daveml": {"sepval-common"},
     "sepval-worker": {"sepval-common", "sepval-transport"},
     # The Python package's extension module: the commands of the binary's library, the model
     # library's readers, the solvers' progress and the output directories' bookkeeping names.

@@ -401,6 +401,11 @@ pub struct UpdateArgs {
     pub eval: EvalArgs,
     #[command(flatten)]
     pub noise: NoiseArgs,
+    /// Also write the updated store as a DAVE-ML 2.0 model, DIR/store.dml: its tables, each
+    /// correction's standard deviation as an uncertainty (normalPDF), and checkData
+    /// (docs/daveml.md).
+    #[arg(long)]
+    pub daveml: bool,
     /// Output directory (update.json, scenario.toml, tables/, factors.json, report.html,
     /// figures/, baseline/).
     #[arg(long, value_name = "DIR")]
@@ -465,8 +470,22 @@ pub struct ScenarioArgs {
     /// the exponential form's trajectory, not to rounding).
     #[arg(long, requires = "tables")]
     pub interference_tables: bool,
-    /// Output TOML file (written atomically); with --tables, an output directory.
-    #[arg(long, value_name = "FILE.toml|DIR")]
+    /// Read the store's aerodynamics from a DAVE-ML model (docs/daveml.md) into the scenario
+    /// (the embedded default unless --scenario is given): --out is then a new directory that
+    /// receives scenario.toml and tables/*.csv; the file's checkData must pass first.
+    #[arg(long, value_name = "FILE.dml", conflicts_with_all = ["tables", "to_daveml"])]
+    pub from_daveml: Option<PathBuf>,
+    /// With --from-daveml, which DAVE-ML variable is which sepval input or field, added to the
+    /// default map (docs/daveml.md).
+    #[arg(long, value_name = "MAP.toml", requires = "from_daveml")]
+    pub map: Option<PathBuf>,
+    /// Write the scenario's aerodynamic and interference fields as a DAVE-ML 2.0 model to
+    /// --out FILE.dml, with checkData computed by sepval (docs/daveml.md).
+    #[arg(long, conflicts_with = "tables")]
+    pub to_daveml: bool,
+    /// Output TOML file (written atomically); with --tables or --from-daveml, an output
+    /// directory; with --to-daveml, the DAVE-ML file.
+    #[arg(long, value_name = "FILE.toml|DIR|FILE.dml")]
     pub out: PathBuf,
 }
 

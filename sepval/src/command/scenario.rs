@@ -1,5 +1,7 @@
 //! `sepval scenario`: a scenario written as TOML (the embedded default to start your own), or
-//! with `--tables` as a directory of TOML and CSV tables (docs/model.md section 1, "Tables").
+//! with `--tables` as a directory of TOML and CSV tables (docs/model.md section 1, "Tables");
+//! `--from-daveml` and `--to-daveml` read and write the store's aerodynamics as DAVE-ML
+//! (docs/daveml.md, the crate `sepval_daveml`).
 
 use anyhow::{Context, Result, bail};
 use sepval_common::atomic_file::write_atomically;
@@ -17,7 +19,21 @@ pub fn toml_text(scenario: &Scenario) -> String {
 
 /// Runs `sepval scenario`.
 pub fn run(args: ScenarioArgs) -> Result<()> {
+    if let Some(model) = &args.from_daveml {
+        return from_daveml(&args, model);
+    }
     let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
+    if args.to_daveml {
+        let prov = sepval_daveml::Provenance {
+            sepval_version: env!("CARGO_PKG_VERSION").to_string(),
+            date: sepval_daveml::today(),
+            releases: Vec::new(),
+            source: inputs::scenario_name(args.scenario.as_deref()),
+        };
+        sepval_daveml::write_model(&args.out, &scenario, &[], &prov)?;
+        note!("wrote {} (DAVE-ML 2.0)", args.out.display());
+        return Ok(());
+    }
     if !args.tables {
         let text = toml_text(&scenario);
         write_atomically(&args.out, text.as_bytes())?;
@@ -64,6 +80,35 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
         toml_path.display(),
         form.files.len(),
         dir.join("tables").display()
+    );
+    Ok(())
+}
+
+/// `--from-daveml`: the model read into the scenario, its checkData passed, written in table
+/// form into a new directory (nothing written when it is refused).
+fn from_daveml(args: &ScenarioArgs, model: &std::path::Path) -> Result<()> {
+    let base = inputs::scenario(args.scenario.as_deref(), None)?;
+    let map = sepval_daveml::load_map(args.map.as_deref())?;
+    let imported = sepval_daveml::read_model(model, &map, &base)?;
+    let form = sepval_daveml::output::write_table_dir(
+        &imported.scenario,
+        &args.out,
+        &model.display().to_string(),
+    )?;
+    for n in &imported.notes {
+        note!("note: {n}");
+    }
+    say!(
+        "read {}: {} ({} check outputs matched)",
+        model.display(),
+        imported.fields.join(", "),
+        imported.checked
+    );
+    note!(
+        "wrote {} and {} table files in {}",
+        args.out.join("scenario.toml").display(),
+        form.files.len(),
+        args.out.join("tables").display()
     );
     Ok(())
 }

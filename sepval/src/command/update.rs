@@ -42,6 +42,9 @@ pub fn run(args: UpdateArgs) -> Result<()> {
         &mut *crate::front::progress(),
     )?;
     write_outputs(&u, &args.out)?;
+    if args.daveml {
+        write_daveml(&u, &args)?;
+    }
     drop(run_dir);
     say!("update:    {}", u.file.verdict);
     for c in &u.file.cannot_tell {
@@ -59,6 +62,39 @@ pub fn run(args: UpdateArgs) -> Result<()> {
         u.file.evaluations,
         u.file.wall_s
     );
+    Ok(())
+}
+
+/// `--daveml`: the updated store as DIR/store.dml, each correction's standard deviation as
+/// its table's uncertainty.
+fn write_daveml(u: &sepval_update::Update, args: &UpdateArgs) -> Result<()> {
+    let store = sepval_common::scenario::Scenario::load(&args.out.join("scenario.toml"))?;
+    let spreads: Vec<sepval_daveml::CorrectionSpread> = u
+        .file
+        .corrections
+        .iter()
+        .map(|c| sepval_daveml::CorrectionSpread {
+            field: c.field.clone(),
+            variable: c.variable.clone(),
+            breakpoints: c.breakpoints.clone(),
+            std: c.std.clone(),
+        })
+        .collect();
+    let bands = sepval_daveml::bands(&store, &spreads).map_err(anyhow::Error::msg)?;
+    let prov = sepval_daveml::Provenance {
+        sepval_version: env!("CARGO_PKG_VERSION").to_string(),
+        date: sepval_daveml::today(),
+        releases: args
+            .inputs
+            .data
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect(),
+        source: format!("sepval update --out {}", args.out.display()),
+    };
+    let path = args.out.join("store.dml");
+    sepval_daveml::write_model(&path, &store, &bands, &prov)?;
+    say!("daveml:    {}", path.display());
     Ok(())
 }
 

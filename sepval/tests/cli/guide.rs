@@ -13,8 +13,10 @@ use sepval_tests::{ok, sepval};
 /// The commands cheap enough to run here (a second or less each).
 const CHEAP: [&str; 4] = ["effects", "scenario", "simulate", "goals"];
 /// The flags whose value is a file the command reads.
-const INPUT_FLAGS: [&str; 7] = [
+const INPUT_FLAGS: [&str; 9] = [
     "--scenario",
+    "--from-daveml",
+    "--map",
     "--factors",
     "--extension",
     "--data",

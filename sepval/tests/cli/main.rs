@@ -9,6 +9,7 @@ mod campaign;
 mod checkpoint;
 mod cli;
 mod closing;
+mod daveml;
 mod diagnose;
 mod discover;
 mod envelope;

@@ -72,7 +72,11 @@ fn fixture() -> &'static Path {
                 p,
             ));
         }
-        update(p, "up", &["--evaluator", "inproc", "--threads", "2"]);
+        update(
+            p,
+            "up",
+            &["--evaluator", "inproc", "--threads", "2", "--daveml"],
+        );
         dir
     })
     .path()
@@ -172,6 +176,30 @@ fn the_updated_store_is_written_and_predicts_as_its_record_says() {
     assert!(jp < fo["j_pos_m"].as_f64().unwrap() || ja < fo["j_att_deg"].as_f64().unwrap());
     let page = std::fs::read_to_string(up.join("report.html")).unwrap();
     assert!(page.contains("Updated:"), "{page}");
+    // --daveml: the updated store as DAVE-ML, the corrected table with its standard deviation,
+    // the releases named; read back, it is the same store (docs/daveml.md).
+    let dml = std::fs::read_to_string(up.join("store.dml")).unwrap();
+    assert!(
+        dml.contains("<griddedTableDef name=\"dCZ_table\"")
+            && dml.contains("<normalPDF numSigmas=\"1\">")
+            && dml.contains("the releases a.csv, b.csv"),
+        "{dml}"
+    );
+    ok(&sepval(
+        &[
+            "scenario",
+            "--scenario",
+            "up/scenario.toml",
+            "--from-daveml",
+            "up/store.dml",
+            "--out",
+            "up_back",
+        ],
+        p,
+    ));
+    let back = Scenario::load(&p.join("up_back/scenario.toml")).unwrap();
+    let store = Scenario::load(&up.join("scenario.toml")).unwrap();
+    assert_eq!(back, store);
 }
 
 #[test]

@@ -1,0 +1,110 @@
+//! Stage 5, **write**: the imported scenario as a directory in table form (`scenario.toml` and
+//! `tables/*.csv`, docs/model.md section 1 "Tables"), staged in a temporary directory beside
+//! the target, read back and compared, then renamed into place: a refusal or a failure leaves
+//! nothing (no partial file, no partial directory).
+
+use std::path::{Path, PathBuf};
+
+use sepval_common::atomic_file::write_atomically;
+use sepval_common::correction::Target;
+use sepval_common::scenario::Scenario;
+use sepval_common::table::{Coefficient, Kind, TableFile, write_csv};
+
+use crate::assemble::{field, set_field};
+use crate::error::DavemlError;
+use crate::import::kind_of;
+
+/// A scenario in table form: its TOML (tables as file references) and its files.
+#[derive(Debug, Clone)]
+pub struct TableDir {
+    /// The scenario, each table a reference to its file.
+    pub scenario: Scenario,
+    /// (path relative to the scenario file, CSV text) of each table.
+    pub files: Vec<(PathBuf, String)>,
+}
+
+/// The field's key within its section, e.g. `cz` or `dcz0`.
+fn key(t: Target) -> String {
+    let f = t.field();
+    f.split_once('.').map_or(f.clone(), |(_, k)| k.to_string())
+}
+
+/// Every table of `s` as a file of its own, `tables/<field>.csv`.
+pub fn table_dir(s: &Scenario) -> TableDir {
+    let mut scenario = s.clone();
+    let mut files = Vec::new();
+    for t in Target::all() {
+        let Some(Coefficient::Table(table)) = field(s, t) else {
+            continue;
+        };
+        let k = key(t);
+        let path = PathBuf::from(format!("tables/{k}.csv"));
+        let unit = match kind_of(t) {
+            Kind::Derivative => "1/rad",
+            _ => "-",
+        };
+        files.push((
+            path.clone(),
+            write_csv(table.axes(), &[(&k, unit, table.values())]),
+        ));
+        let reference = Coefficient::File(TableFile {
+            csv: path,
+            column: Some(k),
+        });
+        set_field(&mut scenario, t, Some(reference));
+    }
+    TableDir { scenario, files }
+}
+
+/// Writes `s` in table form into the new directory `dir` (refused if it exists), with a header
+/// naming `source`; the directory appears only once complete and read back equal to `s`.
+pub fn write_table_dir(s: &Scenario, dir: &Path, source: &str) -> Result<TableDir, DavemlError> {
+    let form = table_dir(s);
+    if dir.exists() {
+        return Err(DavemlError::Output {
+            path: dir.to_path_buf(),
+            message: "exists; choose a new directory (nothing was written)".to_string(),
+        });
+    }
+    let parent = match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| DavemlError::Io { path, source }
+    };
+    let stage = tempfile::Builder::new()
+        .prefix(".sepval-tmp-")
+        .tempdir_in(parent)
+        .map_err(io(dir))?;
+    std::fs::create_dir(stage.path().join("tables")).map_err(io(dir))?;
+    for (p, text) in &form.files {
+        write_atomically(&stage.path().join(p), text.as_bytes())?;
+    }
+    let toml = format!(
+        "# sepval scenario (SI units, angles in degrees) imported from the DAVE-ML model {source}\n# (docs/daveml.md); docs/model.md section 1 describes each field, CSV files are relative to this file.\n{}",
+        form.scenario.to_toml_string()
+    );
+    let staged_toml = stage.path().join("scenario.toml");
+    write_atomically(&staged_toml, toml.as_bytes())?;
+    let back = Scenario::load(&staged_toml).map_err(|source| DavemlError::Scenario {
+        file: staged_toml.display().to_string(),
+        source,
+    })?;
+    if &back != s {
+        return Err(DavemlError::Output {
+            path: dir.to_path_buf(),
+            message: "the scenario written does not read back as imported (a defect; nothing was written)".to_string(),
+        });
+    }
+    let staged = stage.keep();
+    std::fs::rename(&staged, dir).map_err(|e| {
+        let _ = std::fs::remove_dir_all(&staged);
+        DavemlError::Io {
+            path: dir.to_path_buf(),
+            source: e,
+        }
+    })?;
+    Ok(form)
+}
