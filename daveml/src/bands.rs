@@ -14,6 +14,7 @@ use sepval_common::scenario::Scenario;
 use sepval_common::table::{Coefficient, Variable};
 
 use crate::assemble::field;
+use crate::error::DavemlError;
 use crate::export::Band;
 
 /// A correction's standard deviation as an update records it (`update.json`).
@@ -30,31 +31,33 @@ pub struct CorrectionSpread {
 }
 
 /// The bands of the fields of `s` the `corrections` changed.
-pub fn bands(s: &Scenario, corrections: &[CorrectionSpread]) -> Result<Vec<Band>, String> {
+pub fn bands(s: &Scenario, corrections: &[CorrectionSpread]) -> Result<Vec<Band>, DavemlError> {
     let mut out: Vec<Band> = Vec::new();
     for c in corrections {
-        let target = Target::of_field(&c.field)
-            .ok_or_else(|| format!("the correction of `{}`: not a field", c.field))?;
+        let refuse = |message: String| DavemlError::Band {
+            field: c.field.clone(),
+            message,
+        };
+        let target = Target::of_field(&c.field).ok_or_else(|| refuse("not a field".into()))?;
         let variable = Variable::ALL
             .into_iter()
             .find(|v| v.key() == c.variable)
-            .ok_or_else(|| format!("the correction of {}: variable `{}`", c.field, c.variable))?;
+            .ok_or_else(|| refuse(format!("variable `{}` is not one of sepval's", c.variable)))?;
         if c.breakpoints.is_empty() || c.breakpoints.len() != c.std.len() {
-            return Err(format!(
-                "the correction of {}: {} breakpoints and {} standard deviations",
-                c.field,
+            return Err(refuse(format!(
+                "{} breakpoints and {} standard deviations",
                 c.breakpoints.len(),
                 c.std.len()
-            ));
+            )));
         }
         let Some(Coefficient::Table(t)) = field(s, target) else {
-            return Err(format!("{} is not a table in the updated store", c.field));
+            return Err(refuse("not a table in the updated store".into()));
         };
         let k = t
             .axes()
             .iter()
             .position(|a| a.variable == variable)
-            .ok_or_else(|| format!("{} has no {} axis", c.field, variable.csv_name()))?;
+            .ok_or_else(|| refuse(format!("its table has no {} axis", variable.csv_name())))?;
         let sizes: Vec<usize> = t.axes().iter().map(|a| a.breakpoints.len()).collect();
         let stride: usize = sizes[k + 1..].iter().product();
         let sigma: Vec<f64> = (0..t.values().len())

@@ -76,6 +76,14 @@ pub enum DavemlError {
         /// What is wrong.
         message: String,
     },
+    /// An update's correction whose band cannot be laid on the updated store's table.
+    #[error("the correction of {field}: {message}")]
+    Band {
+        /// The correction's field (TOML path).
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
     /// The scenario made from the file is not valid.
     #[error("{file}: the scenario made from it is refused")]
     Scenario {

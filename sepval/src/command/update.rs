@@ -80,7 +80,7 @@ fn write_daveml(u: &sepval_update::Update, args: &UpdateArgs) -> Result<()> {
             std: c.std.clone(),
         })
         .collect();
-    let bands = sepval_daveml::bands(&store, &spreads).map_err(anyhow::Error::msg)?;
+    let bands = sepval_daveml::bands(&store, &spreads)?;
     let prov = sepval_daveml::Provenance {
         sepval_version: env!("CARGO_PKG_VERSION").to_string(),
         date: sepval_daveml::today(),
