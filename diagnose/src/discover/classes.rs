@@ -5,13 +5,10 @@
 
 use sepval_common::evaluation::Evaluator;
 
-use super::locate;
-use super::picked::Picked;
+use super::mimic;
 use super::screen::Screening;
 use super::search::{Search, Trail};
-use super::verify::refit_candidates;
 use crate::classes::{self, CLASS_REFITS, ClassInfo};
-use crate::contender::Contender;
 use crate::{Fitted, Result};
 
 /// The first step's classes, from its screening, into `trail`.
@@ -46,33 +43,11 @@ pub(super) fn refit_leads(
         })
         .take(CLASS_REFITS)
         .collect();
-    if leads.is_empty() {
-        return Ok(());
-    }
-    let located = locate::locate(
+    mimic::as_contenders(
         evaluator,
-        search,
-        s,
-        current,
+        (search, s, current),
         &leads,
-        &mut trail.evaluations,
-    )?;
-    let refits = refit_candidates(
-        evaluator,
-        search,
-        current,
-        &Picked::default(),
-        located,
+        "rival class",
         trail,
-    )?;
-    let n = s.entries.len();
-    let tagged: Vec<Contender> = refits
-        .iter()
-        .map(|r| {
-            Contender::new(&r.fitted, n, format!("rival class: {}", r.entry.label()))
-                .in_class(classes::class_of(&trail.classes, &r.entry))
-        })
-        .collect();
-    trail.contenders.extend(tagged);
-    Ok(())
+    )
 }

@@ -73,6 +73,25 @@ pub(super) fn mimics(
     trail: &mut Trail,
 ) -> Result<()> {
     let picked = rank(s, search, signature, exclude);
+    as_contenders(
+        evaluator,
+        (search, s, current),
+        &picked,
+        "library mimic of the catalogue's answer",
+        trail,
+    )
+}
+
+/// The entries `picked` of the screening `s`, located and refitted alone about the model
+/// `current` (the baseline at the first step), as contenders of the rival search whose origin
+/// says `origin`; each tagged with its rival class.
+pub(super) fn as_contenders(
+    evaluator: &mut dyn Evaluator,
+    (search, s, current): (&Search, &Screening, &Fitted),
+    picked: &[usize],
+    origin: &str,
+    trail: &mut Trail,
+) -> Result<()> {
     if picked.is_empty() {
         return Ok(());
     }
@@ -81,7 +100,7 @@ pub(super) fn mimics(
         search,
         s,
         current,
-        &picked,
+        picked,
         &mut trail.evaluations,
     )?;
     let refits = refit_candidates(
@@ -95,14 +114,7 @@ pub(super) fn mimics(
     let n = s.entries.len();
     let tagged: Vec<Contender> = refits
         .iter()
-        .map(|r| {
-            contender(
-                r,
-                n,
-                "library mimic of the catalogue's answer",
-                &trail.classes,
-            )
-        })
+        .map(|r| contender(r, n, origin, &trail.classes))
         .collect();
     trail.contenders.extend(tagged);
     Ok(())
