@@ -13,7 +13,9 @@ use sepval_tests::{ok, refused, sepval};
 /// `a.csv` and `b.csv` (two releases of the default store, noise seeds 6 and 7) in a fresh
 /// directory.
 fn releases() -> tempfile::TempDir {
-    let dir = tempfile::tempdir().unwrap();
+    // Under target/ (CARGO_TARGET_TMPDIR), not /tmp: the shared fixture below is a static,
+    // never dropped, so its directory is never removed.
+    let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
     for (seed, name) in [("6", "a.csv"), ("7", "b.csv")] {
         ok(&sepval(
             &["simulate", "--noise-seed", seed, "--out", name],

@@ -23,7 +23,9 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
 pub(crate) fn fixture() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
+        // Under target/ (CARGO_TARGET_TMPDIR), not /tmp: a static is never dropped, so the
+        // fixture's directory is never removed.
+        let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
         let p = dir.path();
         std::fs::write(p.join("base.json"), BASE).unwrap();
         ok(&sepval(

@@ -48,7 +48,9 @@ fn truth(dir: &Path, name: &str, mach: f64, alpha: f64) {
 fn fixture() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
+        // Under target/ (CARGO_TARGET_TMPDIR), not /tmp: a static is never dropped, so the
+        // fixture's directory is never removed.
+        let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
         let p = dir.path();
         for (name, mach, alpha, seed) in [
             ("a", 0.8, 0.0, "1"),

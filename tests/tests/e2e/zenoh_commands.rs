@@ -28,7 +28,9 @@ fn condition(dir: &Path, name: &str, mach: f64, alpha: f64) {
 fn fixture() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
+        // Under target/ (CARGO_TARGET_TMPDIR), not /tmp: a static is never dropped, so the
+        // fixture's directory is never removed.
+        let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
         let p = dir.path();
         condition(p, "a.toml", 0.8, 0.0);
         condition(p, "b.toml", 0.9, 3.0);
