@@ -28,7 +28,7 @@ use nalgebra::{DMatrix, DVector};
 use sepval_common::extension::{Axis, Family, Regressor};
 
 use crate::library::Entry;
-use crate::stepwise::{Score, new_directions, orthonormal, project_out};
+use crate::stepwise::{Score, column_basis, new_directions, project_out};
 
 /// The one-sided 95 % normal quantile of the candidates' rule.
 pub const CLASS_Z: f64 = 1.645;
@@ -49,6 +49,8 @@ pub struct Class {
 /// A class as the diagnosis carries it from discovery's first step to the rival search.
 #[derive(Debug, Clone)]
 pub(crate) struct ClassInfo {
+    /// Its lead's index among the first step's screened entries.
+    pub lead: usize,
     /// Its members, the lead first.
     pub members: Vec<Entry>,
     /// In words.
@@ -59,6 +61,7 @@ impl ClassInfo {
     /// The class of `class` over `entries`.
     pub fn new(class: &Class, entries: &[Entry]) -> ClassInfo {
         ClassInfo {
+            lead: class.members[0],
             members: class.members.iter().map(|&e| entries[e].clone()).collect(),
             words: words(class, entries),
         }
@@ -120,11 +123,7 @@ pub fn classes(
     entry_cols: &[Vec<usize>],
     candidates: &[usize],
 ) -> Vec<Class> {
-    let basis = orthonormal(
-        &(0..fixed.ncols())
-            .map(|j| fixed.column(j).into_owned())
-            .collect::<Vec<_>>(),
-    );
+    let basis = column_basis(fixed);
     let mut r = r0.clone();
     project_out(&mut r, &basis);
     let signature = |e: usize| {
@@ -155,6 +154,9 @@ pub fn classes(
 /// 0.6 s, ..." (each kind once, in the members' order).
 pub fn words(class: &Class, entries: &[Entry]) -> String {
     let members: Vec<&Entry> = class.members.iter().map(|&e| &entries[e]).collect();
+    if let [one] = members.as_slice() {
+        return one.label();
+    }
     let mut kinds: Vec<String> = Vec::new();
     for e in &members {
         let w = kind_words(e);
@@ -162,19 +164,12 @@ pub fn words(class: &Class, entries: &[Entry]) -> String {
             kinds.push(w);
         }
     }
-    let axes: Vec<Axis> = members.iter().fold(Vec::new(), |mut a, e| {
-        if !a.contains(&e.axis()) {
-            a.push(e.axis());
-        }
-        a
-    });
-    let what = match axes.as_slice() {
-        [one] => axis_words(*one).to_string(),
-        _ => "terms on several axes".to_string(),
+    let axis = members[0].axis();
+    let what = if members.iter().all(|e| e.axis() == axis) {
+        axis_words(axis)
+    } else {
+        "terms on several axes"
     };
-    if members.len() == 1 {
-        return format!("{} {}", axes[0].name(), members[0].formula());
-    }
     let shown = kinds.len().min(KINDS_NAMED);
     let etc = if kinds.len() > shown { ", ..." } else { "" };
     format!(

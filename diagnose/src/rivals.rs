@@ -96,13 +96,22 @@ fn names(c: &Contender, job: &Job) -> (Vec<String>, Vec<TermRecord>) {
     (effects, terms)
 }
 
+/// What became of a contender that represents a rival class.
+pub(crate) struct ClassTrial {
+    /// Its class.
+    class: usize,
+    /// Its BIC less the answer's.
+    delta_bic: f64,
+    /// Whether it is significant against the baseline by its pool's rule.
+    significant: bool,
+}
+
 /// What the rival search gives: the rivals, and what became of each rival class's contenders.
 pub(crate) struct RivalSearch {
     /// The rivals, best (lowest BIC) first.
     pub rivals: Vec<(Contender, RivalReport)>,
-    /// Per contender of a rival class: its class, its BIC less the answer's, whether it is
-    /// significant against the baseline.
-    pub classes: Vec<(usize, f64, bool)>,
+    /// The trials of the rival classes' contenders.
+    pub classes: Vec<ClassTrial>,
 }
 
 /// The rivals of `answer` among `contenders`, best (lowest BIC) first, each refitted to
@@ -117,7 +126,7 @@ pub(crate) fn rivals(
     evaluations: &mut u64,
 ) -> Result<RivalSearch> {
     let job = &setting.job;
-    let mut classes: Vec<(usize, f64, bool)> = Vec::new();
+    let mut classes: Vec<ClassTrial> = Vec::new();
     if matches!(answer, Answer::Baseline) {
         return Ok(RivalSearch {
             rivals: Vec::new(),
@@ -136,8 +145,12 @@ pub(crate) fn rivals(
         }
         if delta_bic.abs() < CONVERGE_WITHIN {
             near.push(c);
-        } else if let Some(k) = c.class {
-            classes.push((k, delta_bic, significant(setting, baseline, &c)));
+        } else if let Some(class) = c.class {
+            classes.push(ClassTrial {
+                class,
+                delta_bic,
+                significant: significant(setting, baseline, &c),
+            });
         }
     }
     converge_all(evaluator, job, &mut near, setting, settings, evaluations)?;
@@ -146,8 +159,12 @@ pub(crate) fn rivals(
         let delta_bic = setting.bic(&c.fitted) - answer_bic;
         let significant = significant(setting, baseline, &c);
         let rival = significant && delta_bic.abs() < RIVAL_MARGIN;
-        if let Some(k) = c.class {
-            classes.push((k, delta_bic, significant));
+        if let Some(class) = c.class {
+            classes.push(ClassTrial {
+                class,
+                delta_bic,
+                significant,
+            });
         }
         if rival {
             let r = report(setting, &c, delta_bic)?;
@@ -170,7 +187,7 @@ pub(crate) fn class_reports(
     setting: &Setting,
     answer_model: &Fitted,
     classes: &[ClassInfo],
-    searched: &[(usize, f64, bool)],
+    searched: &[ClassTrial],
 ) -> Vec<RivalClass> {
     let job = &setting.job;
     let mut kinds: Vec<(Axis, Regressor)> = answer_model
@@ -190,13 +207,12 @@ pub(crate) fn class_reports(
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            let mine: Vec<&(usize, f64, bool)> =
-                searched.iter().filter(|(j, ..)| *j == k).collect();
-            let best = mine.iter().map(|m| m.1).min_by(f64::total_cmp);
+            let mine: Vec<&ClassTrial> = searched.iter().filter(|t| t.class == k).collect();
+            let best = mine.iter().map(|t| t.delta_bic).min_by(f64::total_cmp);
             let significant_best = mine
                 .iter()
-                .filter(|m| m.2)
-                .map(|m| m.1)
+                .filter(|t| t.significant)
+                .map(|t| t.delta_bic)
                 .min_by(f64::total_cmp);
             let (status, delta_bic) = if kinds.iter().any(|&(a, r)| c.holds(a, r)) {
                 ("answer", Some(0.0))

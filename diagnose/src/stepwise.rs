@@ -51,6 +51,15 @@ pub fn orthonormal(cols: &[DVector<f64>]) -> Vec<DVector<f64>> {
     q
 }
 
+/// Orthonormal basis of the span of the columns of `fixed` (the model's own sensitivities).
+pub fn column_basis(fixed: &DMatrix<f64>) -> Vec<DVector<f64>> {
+    orthonormal(
+        &(0..fixed.ncols())
+            .map(|j| fixed.column(j).into_owned())
+            .collect::<Vec<_>>(),
+    )
+}
+
 /// Removes from `v` its components along the orthonormal `basis`.
 pub fn project_out(v: &mut DVector<f64>, basis: &[DVector<f64>]) {
     for b in basis {
@@ -84,11 +93,7 @@ pub fn screen(
     entries: &[Vec<usize>],
 ) -> Vec<Score> {
     let m = r0.len() as f64;
-    let basis = orthonormal(
-        &(0..fixed.ncols())
-            .map(|j| fixed.column(j).into_owned())
-            .collect::<Vec<_>>(),
-    );
+    let basis = column_basis(fixed);
     let p = basis.len() as f64;
     let mut r = r0.clone();
     project_out(&mut r, &basis);
@@ -148,11 +153,7 @@ pub fn group(
     entries: &[Vec<usize>],
     lead: usize,
 ) -> Vec<(usize, f64)> {
-    let basis = orthonormal(
-        &(0..fixed.ncols())
-            .map(|j| fixed.column(j).into_owned())
-            .collect::<Vec<_>>(),
-    );
+    let basis = column_basis(fixed);
     let first = |e: usize| {
         let mut v = cols.column(entries[e][0]).into_owned();
         project_out(&mut v, &basis);

@@ -179,19 +179,15 @@ const CLASSES_NAMED: usize = 3;
 /// sideslip, ... (the answer's class) or from ... (BIC +1.2), and 5 more classes of 40 terms
 /// not told apart (rival_classes)"; none when every class is told apart.
 pub(super) fn open_classes(classes: &[crate::RivalClass]) -> Option<String> {
-    let open: Vec<&crate::RivalClass> = classes
+    let open = classes
         .iter()
-        .filter(|c| c.status != "told apart" && !(c.status == "answer" && c.members.len() == 1))
-        .collect();
-    if open.is_empty() {
-        return None;
-    }
-    let mut open = open;
-    open.sort_by_key(|c| c.status != "better");
-    let named: Vec<String> = open
+        .filter(|c| c.status != "told apart" && !(c.status == "answer" && c.members.len() == 1));
+    let (mut refitted, unrefitted): (Vec<_>, Vec<_>) =
+        open.partition(|c| c.status != "not refitted");
+    refitted.sort_by_key(|c| c.status != "better");
+    let named_count = refitted.len().min(CLASSES_NAMED);
+    let named: Vec<String> = refitted[..named_count]
         .iter()
-        .filter(|c| c.status != "not refitted")
-        .take(CLASSES_NAMED)
         .map(|c| match (c.status.as_str(), c.delta_bic) {
             ("answer", _) => format!("{} (the answer's class)", c.words),
             ("better", Some(d)) => format!("{} (BIC {d:+.1}: it fits better)", c.words),
@@ -199,23 +195,18 @@ pub(super) fn open_classes(classes: &[crate::RivalClass]) -> Option<String> {
             _ => c.words.clone(),
         })
         .collect();
-    let rest = open.len() - named.len();
-    let rest_terms: usize = open
+    let rest: Vec<&crate::RivalClass> = refitted[named_count..]
         .iter()
-        .filter(|c| c.status == "not refitted")
-        .chain(
-            open.iter()
-                .filter(|c| c.status != "not refitted")
-                .skip(CLASSES_NAMED),
-        )
-        .map(|c| c.members.len())
-        .sum();
+        .chain(&unrefitted)
+        .copied()
+        .collect();
+    let rest_terms: usize = rest.iter().map(|c| c.members.len()).sum();
     let plural =
         |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
-    let more = (rest > 0).then(|| {
+    let more = (!rest.is_empty()).then(|| {
         format!(
             "{} of {} not told apart (rival_classes)",
-            plural(rest, "more class", "more classes"),
+            plural(rest.len(), "more class", "more classes"),
             plural(rest_terms, "term", "terms")
         )
     });

@@ -37,10 +37,7 @@ pub(super) fn refit_leads(
 ) -> Result<()> {
     let leads: Vec<usize> = (0..trail.classes.len())
         .filter(|&k| !trail.contenders.iter().any(|c| c.class == Some(k)))
-        .filter_map(|k| {
-            let lead = &trail.classes[k].members[0];
-            s.entries.iter().position(|e| e.label() == lead.label())
-        })
+        .map(|k| trail.classes[k].lead)
         .take(CLASS_REFITS)
         .collect();
     mimic::as_contenders(
