@@ -41,6 +41,18 @@ pub struct Provenance {
     pub source: String,
 }
 
+impl Provenance {
+    /// This sepval's provenance, dated today, of a model made by `source` from `releases`.
+    pub fn now(source: String, releases: Vec<String>) -> Provenance {
+        Provenance {
+            sepval_version: env!("CARGO_PKG_VERSION").to_string(),
+            date: crate::today(),
+            releases,
+            source,
+        }
+    }
+}
+
 /// A field's standard deviation at each value of its table (an update's correction).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Band {

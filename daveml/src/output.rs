@@ -9,19 +9,11 @@ use sepval_common::atomic_file::write_atomically;
 use sepval_common::correction::Target;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{Coefficient, Kind, TableFile, write_csv};
+use sepval_common::table_form::TableForm;
 
 use crate::assemble::{field, set_field};
 use crate::error::DavemlError;
 use crate::import::kind_of;
-
-/// A scenario in table form: its TOML (tables as file references) and its files.
-#[derive(Debug, Clone)]
-pub struct TableDir {
-    /// The scenario, each table a reference to its file.
-    pub scenario: Scenario,
-    /// (path relative to the scenario file, CSV text) of each table.
-    pub files: Vec<(PathBuf, String)>,
-}
 
 /// The field's key within its section, e.g. `cz` or `dcz0`.
 fn key(t: Target) -> String {
@@ -30,7 +22,7 @@ fn key(t: Target) -> String {
 }
 
 /// Every table of `s` as a file of its own, `tables/<field>.csv`.
-pub fn table_dir(s: &Scenario) -> TableDir {
+pub fn table_dir(s: &Scenario) -> TableForm {
     let mut scenario = s.clone();
     let mut files = Vec::new();
     for t in Target::all() {
@@ -53,12 +45,12 @@ pub fn table_dir(s: &Scenario) -> TableDir {
         });
         set_field(&mut scenario, t, Some(reference));
     }
-    TableDir { scenario, files }
+    TableForm { scenario, files }
 }
 
 /// Writes `s` in table form into the new directory `dir` (refused if it exists), with a header
 /// naming `source`; the directory appears only once complete and read back equal to `s`.
-pub fn write_table_dir(s: &Scenario, dir: &Path, source: &str) -> Result<TableDir, DavemlError> {
+pub fn write_table_dir(s: &Scenario, dir: &Path, source: &str) -> Result<TableForm, DavemlError> {
     let form = table_dir(s);
     if dir.exists() {
         return Err(DavemlError::Output {

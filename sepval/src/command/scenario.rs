@@ -24,12 +24,10 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
     }
     let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
     if args.to_daveml {
-        let prov = sepval_daveml::Provenance {
-            sepval_version: env!("CARGO_PKG_VERSION").to_string(),
-            date: sepval_daveml::today(),
-            releases: Vec::new(),
-            source: inputs::scenario_name(args.scenario.as_deref()),
-        };
+        let prov = sepval_daveml::Provenance::now(
+            inputs::scenario_name(args.scenario.as_deref()),
+            Vec::new(),
+        );
         sepval_daveml::write_model(&args.out, &scenario, &[], &prov)?;
         note!("wrote {} (DAVE-ML 2.0)", args.out.display());
         return Ok(());

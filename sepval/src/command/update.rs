@@ -81,17 +81,14 @@ fn write_daveml(u: &sepval_update::Update, args: &UpdateArgs) -> Result<()> {
         })
         .collect();
     let bands = sepval_daveml::bands(&store, &spreads)?;
-    let prov = sepval_daveml::Provenance {
-        sepval_version: env!("CARGO_PKG_VERSION").to_string(),
-        date: sepval_daveml::today(),
-        releases: args
-            .inputs
+    let prov = sepval_daveml::Provenance::now(
+        format!("sepval update --out {}", args.out.display()),
+        args.inputs
             .data
             .iter()
             .map(|p| p.display().to_string())
             .collect(),
-        source: format!("sepval update --out {}", args.out.display()),
-    };
+    );
     let path = args.out.join("store.dml");
     sepval_daveml::write_model(&path, &store, &bands, &prov)?;
     say!("daveml:    {}", path.display());
