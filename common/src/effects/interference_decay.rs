@@ -1,5 +1,6 @@
 //! `interference_decay` (docs/model.md section 7): lambda becomes k_lambda * 0.6 m (generally:
-//! k_lambda times the scenario's lambda); s_end is unchanged.
+//! k_lambda times the scenario's lambda); s_end is unchanged. With a flowfield (section 3b), its
+//! depth L_z scales by k_lambda.
 
 use super::{Effect, EffectError, ParamSpec, require};
 use crate::model::{InterferenceDecay, RunSetup};
@@ -27,6 +28,10 @@ impl Effect for InterferenceDecayFactor {
     fn apply(&self, p: &[f64], run: &mut RunSetup) -> Result<(), EffectError> {
         require(self, 0, p[0], p[0] > 0.0, "must be > 0")?;
         run.decay = InterferenceDecay::new(p[0] * run.decay.lambda_m, run.decay.s_end_m);
+        // With an aircraft flowfield (docs/model.md section 3b), its depth L_z scales instead.
+        if let Some(field) = run.flowfield.as_mut() {
+            field.half_depth_m *= p[0];
+        }
         Ok(())
     }
 }

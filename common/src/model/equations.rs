@@ -22,73 +22,13 @@
 
 use crate::elementary::atan2_asin;
 use crate::lanes::{F64x4, Real, gather, lane, mask};
-use crate::table::{Inputs, PreparedTables, TableState};
+use crate::table::TableState;
 
-use super::aero::{AeroConstants, Coefficients, Flow};
+use super::aero::{AeroConstants, Flow};
+use super::by_lane::{Parts, alike_fields, flowfield_lanes, lane_by_lane_terms, wind_lanes};
+use super::flowfield::{FieldLanes, FieldSums};
 use super::interference::DecayLanes;
 use super::{Dcm, EjectorCurve, Model, RunSetup, STATE_LEN, StateVector};
-
-/// What one run's force evaluation needs beyond its constants: the run, its ejector force curve,
-/// and the scenario's tables with this propagation's table scratch (none without tables).
-#[derive(Clone, Copy)]
-pub(crate) struct Parts<'a> {
-    run: &'a RunSetup,
-    curve: &'a EjectorCurve,
-    tables: Option<(&'a PreparedTables, &'a TableState)>,
-}
-
-impl Parts<'_> {
-    /// Whether the run has terms beyond the linear coefficients (tables, catalogue terms,
-    /// extension terms).
-    fn has_extra_terms(&self) -> bool {
-        self.tables.is_some()
-            || self.run.coefficient_term_count > 0
-            || !self.run.terms.is_empty()
-            || !self.run.corrections.is_empty()
-    }
-
-    /// The tables' terms (section 3), then the catalogue's extra terms (section 7) and the
-    /// extension's (section 11), at the flow `flow` and lateral offset `lateral_m`.
-    #[inline(always)]
-    fn extra_terms(&self, flow: &Flow, lateral_m: f64, mut k: Coefficients) -> Coefficients {
-        let run = self.run;
-        if let Some((tables, state)) = self.tables {
-            state.count_evaluation();
-            if tables.runtime() {
-                k = add_table_terms(run, tables, state, flow, lateral_m, k);
-            }
-        }
-        if !run.corrections.is_empty() {
-            k = add_corrections(run, flow, k);
-        }
-        if run.coefficient_term_count > 0 {
-            k = run.add_coefficient_terms(*flow, k);
-        }
-        if !run.terms.is_empty() {
-            k = run.add_extension_terms(flow, k);
-        }
-        k
-    }
-
-    /// The pushing feet's total force \[N\] and its moment arm sum x_i F_i \[N m\] (section 3):
-    /// F_i = fac_i F_ej(clamp(s_i, 0, stroke)), s_i = r_z + C_LB(2, 0) x_i, times the
-    /// extension's factor.
-    #[inline(always)]
-    fn ejector(&self, c20: f64, rz: f64, t_s: f64, on: [bool; 2]) -> (f64, f64) {
-        let run = self.run;
-        let (mut force_n, mut arm_force_n_m) = (0.0, 0.0);
-        for (foot, _) in run.feet.iter().zip(on).filter(|(_, on)| *on) {
-            let s_i = c20.mul_add(foot.x_m, rz);
-            let mut f_i = foot.fac * self.curve.force_n(s_i.clamp(0.0, run.stroke_m));
-            if !run.terms.is_empty() {
-                f_i *= run.ejector_factor(t_s, s_i);
-            }
-            force_n += f_i;
-            arm_force_n_m = foot.x_m.mul_add(f_i, arm_force_n_m);
-        }
-        (force_n, arm_force_n_m)
-    }
-}
 
 /// The constants of the force evaluation, one run per lane of `R`, with the products of the
 /// run's constants formed once, when a propagation starts.
@@ -121,6 +61,11 @@ pub(crate) struct Constants<R: Real> {
     extra_terms: bool,
     /// Whether any lane has a wind (section 11.2: the air's velocity in L).
     wind: bool,
+    /// The lanes' aircraft flowfields (section 3b), when every lane has one with the same
+    /// number of stations (every run of one scenario).
+    field: Option<FieldLanes<R>>,
+    /// Whether some lanes have a field but not all alike (each is then evaluated alone).
+    field_by_lane: bool,
 }
 
 impl<R: Real> Constants<R> {
@@ -156,6 +101,13 @@ impl<R: Real> Constants<R> {
             any_diagonal: parts.iter().any(|p| p.run.inertia_diagonal),
             extra_terms: parts.iter().any(Parts::has_extra_terms),
             wind: parts.iter().any(|p| p.run.terms.has_wind()),
+            field: alike_fields(parts).then(|| {
+                FieldLanes::gather(
+                    |i| runs(i).flowfield.as_ref().expect("every lane has a field"),
+                    g(&|r| r.aero_reference_x_m),
+                )
+            }),
+            field_by_lane: !alike_fields(parts) && parts.iter().any(|p| p.run.flowfield.is_some()),
         }
     }
 }
@@ -268,7 +220,7 @@ fn flow_frame<R: Real>(
     parts: &[Parts],
     x: &[R; STATE_LEN],
     t_s: R,
-) -> (Flow<R>, Dcm<R>, R) {
+) -> (Flow<R>, Dcm<R>, R, Option<FieldSums<R>>) {
     let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
     // Section 1: interference decay with s = |r|. First: its input is ready long before
     // the stage's velocity and attitude, so the exponential overlaps the rest.
@@ -278,6 +230,20 @@ fn flow_frame<R: Real>(
     // |q|^2 C_LB and 1 / |q|^2 (the scale is applied where it is needed, off the chain
     // from the stage's state to the flow angles).
     let dcm = Dcm::from_quaternion(q0, q1, q2, q3);
+    // Section 3b: the flowfield's sums over the stations need only the position and the
+    // attitude; formed here, they run beside the flow angles' chain below.
+    // (An `if let`, not `Option::map`: a closure left out of line would compile its fused
+    // multiply-adds without the propagator's target features.)
+    let field = if let Some(f) = &c.field {
+        let axis_l = [
+            dcm.m[0][0] * dcm.inv_n2,
+            dcm.m[1][0] * dcm.inv_n2,
+            dcm.m[2][0] * dcm.inv_n2,
+        ];
+        Some(f.sums([rx, ry, rz], axis_l))
+    } else {
+        None
+    };
 
     // Section 2: v_air = v + V_inf (cos a cos b, sin b, sin a cos b) in L;
     // (u, v, w) = C_BL v_air, here |q|^2 (u, v, w).
@@ -316,7 +282,7 @@ fn flow_frame<R: Real>(
         distance_m,
         mach: (speed2 * inv_speed) * c.inv_speed_of_sound_s_m,
     };
-    (flow, dcm, speed2)
+    (flow, dcm, speed2, field)
 }
 
 /// The state derivative (docs/model.md sections 2 and 3) of one run per lane of `R` (`parts`
@@ -329,13 +295,24 @@ fn derivative<R: Real>(
     t_s: R,
     on: &[[bool; 2]],
 ) -> [R; STATE_LEN] {
-    let (flow, dcm, speed2) = flow_frame(c, parts, x, t_s);
-    let [_, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
+    let (flow, dcm, speed2, field) = flow_frame(c, parts, x, t_s);
+    let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
     // Section 3: the six coefficients, then the tables' terms, the catalogue's extra terms
     // (section 7) and the extension's (section 11), lane by lane.
     let mut k = c.aero.coefficients(&flow, &c.interference_increments);
     if c.extra_terms {
         k = lane_by_lane_terms(parts, &flow, ry, k);
+    }
+    // Section 3b: the aircraft's flowfield, station by station, after every other term.
+    if let (Some(f), Some(sums)) = (&c.field, field) {
+        k = sums.add_loads(f, flow.alpha_rad, flow.beta_rad, k);
+    } else if c.field_by_lane {
+        let axis_l = [
+            dcm.m[0][0] * dcm.inv_n2,
+            dcm.m[1][0] * dcm.inv_n2,
+            dcm.m[2][0] * dcm.inv_n2,
+        ];
+        k = flowfield_lanes(parts, [rx, ry, rz], axis_l, &flow, k);
     }
     // Section 3: M_aero_B = qbar S d (Cl, Cm, Cn), moved from the moment reference point
     // (x_ref, 0, 0) to the CG: M += (x_ref, 0, 0) x F_aero_B.
@@ -390,95 +367,6 @@ fn derivative<R: Real>(
     [vx, vy, vz, ax, ay, az, dq0, dq1, dq2, dq3, dp, dq, dr]
 }
 
-/// Each lane's wind in L at its time (section 11.2; +0.0 in lanes without one), from the
-/// scalar code of its run, as the extra terms below. Out of line: only runs with a wind call
-/// it.
-#[inline(never)]
-fn wind_lanes<R: Real>(parts: &[Parts], t_s: R) -> [R; 3] {
-    let mut w = [R::splat(0.0).to_array(); 3];
-    for (i, part) in parts.iter().enumerate() {
-        if part.run.terms.has_wind() {
-            let w_i = super::wind_l_m_s(&part.run.terms, lane(t_s, i));
-            for (j, v) in w_i.into_iter().enumerate() {
-                w[j].as_mut()[i] = v;
-            }
-        }
-    }
-    w.map(R::from_array)
-}
-
-/// The extra terms of each lane's run ([`Parts::extra_terms`]) at that lane's flow, put back into
-/// the lanes (inlined, so that the tables' arithmetic is compiled with the propagator's target
-/// features; the catalogue's and the extension's terms are out of line).
-#[inline(always)]
-fn lane_by_lane_terms<R: Real>(
-    parts: &[Parts],
-    flow: &Flow<R>,
-    lateral_m: R,
-    k: Coefficients<R>,
-) -> Coefficients<R> {
-    // Through arrays, each lane read and written once (a lane written into a register's
-    // memory and read back whole stalls the load).
-    let f = [
-        flow.alpha_rad,
-        flow.beta_rad,
-        flow.p_hat,
-        flow.q_hat,
-        flow.r_hat,
-        flow.speed_m_s,
-        flow.interference_factor,
-        flow.t_s,
-        flow.distance_m,
-        flow.mach,
-        lateral_m,
-    ]
-    .map(R::to_array);
-    let mut c = [k.cx, k.cy, k.cz, k.cl, k.cm, k.cn].map(R::to_array);
-    for (i, part) in parts.iter().enumerate() {
-        if !part.has_extra_terms() {
-            continue;
-        }
-        let l = |j: usize| f[j].as_ref()[i];
-        let flow_i = Flow {
-            alpha_rad: l(0),
-            beta_rad: l(1),
-            p_hat: l(2),
-            q_hat: l(3),
-            r_hat: l(4),
-            speed_m_s: l(5),
-            interference_factor: l(6),
-            t_s: l(7),
-            distance_m: l(8),
-            mach: l(9),
-        };
-        let at = |j: usize| c[j].as_ref()[i];
-        let k_i = Coefficients {
-            cx: at(0),
-            cy: at(1),
-            cz: at(2),
-            cl: at(3),
-            cm: at(4),
-            cn: at(5),
-        };
-        let k_i = part.extra_terms(&flow_i, l(10), k_i);
-        for (j, v) in [k_i.cx, k_i.cy, k_i.cz, k_i.cl, k_i.cm, k_i.cn]
-            .into_iter()
-            .enumerate()
-        {
-            c[j].as_mut()[i] = v;
-        }
-    }
-    let [cx, cy, cz, cl, cm, cn] = c.map(R::from_array);
-    Coefficients {
-        cx,
-        cy,
-        cz,
-        cl,
-        cm,
-        cn,
-    }
-}
-
 /// I^-1 (M - omega x (I omega)) (docs/model.md section 2), with a short path for the diagonal
 /// tensor of the contract.
 #[inline(always)]
@@ -519,58 +407,6 @@ fn diagonal_angular_acceleration<R: Real>(c: &Constants<R>, m: [R; 3], w: [R; 3]
         (-dzx * r).mul_add(p, m[1]) * jy,
         (-dxy * p).mul_add(q, m[2]) * jz,
     ]
-}
-
-/// Adds the tables' terms (docs/model.md section 3, "Tabulated coefficients"): the static
-/// coefficients (CX = -CA) and the tabulated interference increments times their multipliers,
-/// at the stage's local alpha and beta, distance from carriage and lateral offset `lateral_m`.
-#[inline(always)]
-fn add_table_terms(
-    run: &RunSetup,
-    tables: &PreparedTables,
-    state: &TableState,
-    flow: &Flow,
-    lateral_m: f64,
-    mut k: Coefficients,
-) -> Coefficients {
-    let (s, d) = tables.evaluate(
-        state,
-        &Inputs {
-            alpha_rad: flow.alpha_rad,
-            beta_rad: flow.beta_rad,
-            distance_m: flow.distance_m,
-            lateral_m,
-        },
-    );
-    let m = &run.interference_multipliers;
-    let c = tables.constants();
-    // The static tables' values (late: they wait for alpha and beta) are added last.
-    k.cx = m[0].mul_add(d[0], k.cx) - s[0];
-    k.cy = m[1].mul_add(d[1], k.cy + c[1]) + s[1];
-    k.cz = m[2].mul_add(d[2], k.cz + c[2]) + s[2];
-    k.cl = m[3].mul_add(d[3], k.cl + c[3]) + s[3];
-    k.cm = m[4].mul_add(d[4], k.cm + c[4]) + s[4];
-    k.cn = m[5].mul_add(d[5], k.cn + c[5]) + s[5];
-    k
-}
-
-/// Adds the corrections evaluated at each force evaluation (docs/update.md): a static
-/// coefficient's as its table's (CX = -CA), an interference increment's times its multiplier,
-/// at the stage's local alpha and beta and distance from carriage. Out of line: only runs of
-/// an update have them.
-#[inline(never)]
-fn add_corrections(run: &RunSetup, flow: &Flow, mut k: Coefficients) -> Coefficients {
-    let d = run
-        .corrections
-        .evaluate(flow.alpha_rad, flow.beta_rad, flow.distance_m);
-    let m = &run.interference_multipliers;
-    k.cx = m[0].mul_add(d[6], k.cx) - d[0];
-    k.cy = m[1].mul_add(d[7], k.cy) + d[1];
-    k.cz = m[2].mul_add(d[8], k.cz) + d[2];
-    k.cl = m[3].mul_add(d[9], k.cl) + d[3];
-    k.cm = m[4].mul_add(d[10], k.cm) + d[4];
-    k.cn = m[5].mul_add(d[11], k.cn) + d[5];
-    k
 }
 
 /// a . b with fused multiply-adds.

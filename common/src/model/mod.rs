@@ -27,10 +27,12 @@
 //! exactly the contract's operations.
 
 pub mod aero;
+mod by_lane;
 mod corrected;
 mod dcm;
 pub mod ejector;
 mod equations;
+pub mod flowfield;
 pub mod interference;
 pub mod tables;
 
@@ -52,6 +54,7 @@ use tables::AeroAtMach;
 
 pub use aero::{Coefficients, Flow};
 pub use ejector::EjectorCurve;
+pub use flowfield::FlowfieldRun;
 pub use interference::InterferenceDecay;
 
 /// Standard gravity [m/s^2] (docs/model.md section 1).
@@ -231,6 +234,8 @@ pub struct RunSetup {
     pub interference_multipliers: [f64; 6],
     /// Interference decay f(s).
     pub decay: InterferenceDecay,
+    /// The aircraft's flowfield (docs/model.md section 3b), when the scenario has one.
+    pub flowfield: Option<FlowfieldRun>,
     /// Forward and aft feet.
     pub feet: [Foot; 2],
     /// Ejector stroke \[m\].
@@ -344,6 +349,16 @@ impl RunSetup {
                 fx(Factor::Cnintfac),
             ],
             decay: InterferenceDecay::new(sc.interference.lambda_m, sc.interference.s_end_m),
+            flowfield: sc.flowfield.as_ref().map(|f| {
+                FlowfieldRun::new(
+                    f,
+                    &model.aero_at_mach,
+                    model.diameter_m,
+                    sc.flight.mach,
+                    sc.flight.alpha_deg,
+                    factors,
+                )
+            }),
             feet: [
                 Foot {
                     x_m: model.feet_x_m[0],

@@ -288,6 +288,9 @@ pub struct Scenario {
     pub aero: Aero,
     /// Interference model.
     pub interference: Interference,
+    /// The aircraft's flowfield (docs/model.md section 3b), in place of the decay increments.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flowfield: Option<FlowfieldSpec>,
     /// Flight condition.
     pub flight: Flight,
     /// Integrator settings.
@@ -494,8 +497,11 @@ pub fn hex_sha256(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+mod flowfield;
 mod same_store;
 mod validate;
+
+pub use flowfield::{FlowfieldSpec, MAX_STATIONS, MachScaling};
 
 pub use same_store::StoreDifference;
 

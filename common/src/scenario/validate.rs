@@ -17,6 +17,10 @@ impl Scenario {
         c.coefficients(&self.aero, &self.interference)?;
         c.slopes(&self.aero)?;
         c.interference(&self.interference)?;
+        if let Some(f) = &self.flowfield {
+            f.check(&self.aero, &self.interference)
+                .map_err(|(field, reason)| c.bad(&field, reason))?;
+        }
         c.flight(&self.flight)?;
         c.integrator(&self.integrator)?;
         c.initial(&self.initial)?;

@@ -84,7 +84,7 @@ fn mixed_runs(sim: &Simulator) -> Vec<RunSetup> {
     (0..n).map(|j| runs[(j * stride) % n]).collect()
 }
 
-fn check_lanes_against_scalar(sim: &Simulator, times: &[f64]) {
+pub(crate) fn check_lanes_against_scalar(sim: &Simulator, times: &[f64]) {
     let model = sim.model();
     let runs = mixed_runs(sim);
     let mut diverged = 0;

@@ -8,6 +8,7 @@ mod conformance;
 mod continuity;
 mod effects;
 mod elementary;
+mod flowfield;
 mod fuzz;
 mod input_files;
 mod lanes;

@@ -1,0 +1,405 @@
+//! The aircraft's flowfield acting on the store station by station (docs/model.md section 3b).
+//!
+//! Sources: the flow-angularity method (F. D. Fernandes, *Theoretical prediction of
+//! interference loading on aircraft stores*, NASA CR-112065, 1972): the store's loads from the
+//! local flow angles at stations along its length; the field's scaling with the aircraft's lift
+//! and the Prandtl-Glauert factor, its inverse-distance decay as a vortex line's induced
+//! velocity (J. Katz and A. Plotkin, *Low-Speed Aerodynamics*, 2nd ed.,
+//! 2001). The equations, from docs/model.md section 3b:
+//!
+//! ```text
+//! g(z)       = (1 - z+ / z_r) / (1 + z+ / L_z),   z+ = max(z, 0)
+//! alpha_i(P) = (A + A_x p_x) g(p_z),   beta_i(P) = (B + B_x p_x) g(p_z),   eta(P) = 1 + E g(p_z)
+//! P_k        = r + C_LB (x_k + x_ref, 0, 0)
+//! n_k = eta_k (alpha + alpha_k) - alpha,       m_k = eta_k (beta + beta_k) - beta
+//! dCZ = CZ_alpha sum w_k n_k,    dCm = -(CZ_alpha / d) sum w_k x_k n_k
+//! dCY = CY_beta  sum v_k m_k,    dCn =  (CY_beta / d)  sum v_k x_k m_k
+//! dCX = (eta_bar - 1) CX,        dCl = Lr g(r_z)
+//! ```
+//!
+//! The loads are written once over [`Real`] (`FieldLanes`): for one run, and for four runs
+//! in the lanes of an `F64x4` with the same operations, so that a lane has its run's bits. A
+//! run without a field takes none of these operations.
+
+use super::aero::Coefficients;
+use super::tables::AeroAtMach;
+use crate::factors::{Factor, Factors};
+use crate::lanes::Real;
+use crate::scenario::{FlowfieldSpec, MAX_STATIONS, MachScaling};
+
+/// Pg(M) of docs/model.md section 3b: 1 / sqrt(max(|1 - M^2|, 0.1)), or 1 without scaling.
+pub fn mach_factor(scaling: MachScaling, mach: f64) -> f64 {
+    match scaling {
+        MachScaling::PrandtlGlauert => 1.0 / (1.0 - mach * mach).abs().max(0.1).sqrt(),
+        MachScaling::None => 1.0,
+    }
+}
+
+/// One run's field and stations, with the factors and the flight condition applied.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlowfieldRun {
+    /// Number of stations in use.
+    pub stations: usize,
+    /// Body x of each station from the moment reference point \[m\].
+    pub station_x_m: [f64; MAX_STATIONS],
+    /// Weights of the normal force (w_k) and of the side force (v_k).
+    pub weights: [[f64; MAX_STATIONS]; 2],
+    /// A: upwash at the carriage point \[rad\], and A_x, its gradient along L's x \[rad/m\].
+    pub upwash: [f64; 2],
+    /// B and B_x: the sidewash's \[rad, rad/m\].
+    pub sidewash: [f64; 2],
+    /// E: eta - 1 at carriage.
+    pub dynamic_pressure: f64,
+    /// Lr: the rolling-moment coefficient at carriage.
+    pub roll_cl: f64,
+    /// L_z: the depth below carriage at which the field has halved \[m\] (the effect
+    /// `interference_decay` scales it).
+    pub half_depth_m: f64,
+    /// 1 / z_r \[1/m\] (0: the field never changes sign).
+    pub inv_reversal_per_m: f64,
+    /// CZ_alpha and CY_beta \[1/rad\], the slopes the field acts through.
+    pub slopes_per_rad: [f64; 2],
+    /// 1 / d \[1/m\].
+    pub inv_diameter_per_m: f64,
+}
+
+impl FlowfieldRun {
+    /// The run of `spec` for a store of diameter `diameter_m` with the derivatives `aero` at
+    /// the flight condition (`mach`, aircraft angle of attack `alpha_deg`), with `factors`.
+    pub fn new(
+        spec: &FlowfieldSpec,
+        aero: &AeroAtMach,
+        diameter_m: f64,
+        mach: f64,
+        alpha_deg: f64,
+        factors: &Factors,
+    ) -> Self {
+        let fx = |f: Factor| factors.get(f);
+        let s_m = mach_factor(spec.mach_scaling, mach)
+            / mach_factor(spec.mach_scaling, spec.reference_mach);
+        let d_alpha = alpha_deg - spec.reference_alpha_deg;
+        let n = spec.stations;
+        let length_m = spec.nose_x_m - spec.tail_x_m;
+        let mut station_x_m = [0.0; MAX_STATIONS];
+        for (k, x) in station_x_m.iter_mut().take(n).enumerate() {
+            *x = spec.tail_x_m + (k as f64 + 0.5) * length_m / n as f64;
+        }
+        let x_bar = 0.5 * (spec.nose_x_m + spec.tail_x_m);
+        let spread: f64 = station_x_m[..n].iter().map(|x| (x - x_bar).powi(2)).sum();
+        let centres_of_pressure = [
+            -diameter_m * aero.cm_alpha_per_rad / aero.cz_alpha_per_rad,
+            diameter_m * aero.cn_beta_per_rad / aero.cy_beta_per_rad,
+        ];
+        let weights = centres_of_pressure.map(|x_cp| {
+            let mut w = [0.0; MAX_STATIONS];
+            for (w_k, x_k) in w.iter_mut().zip(&station_x_m).take(n) {
+                *w_k = 1.0 / n as f64 + (x_cp - x_bar) * (x_k - x_bar) / spread;
+            }
+            w
+        });
+        FlowfieldRun {
+            stations: n,
+            station_x_m,
+            weights,
+            upwash: [
+                fx(Factor::Czintfac)
+                    * s_m
+                    * (spec.upwash_deg + spec.upwash_per_alpha * d_alpha).to_radians(),
+                fx(Factor::Cmintfac) * s_m * spec.upwash_gradient_deg_per_m.to_radians(),
+            ],
+            sidewash: [
+                fx(Factor::Cyintfac)
+                    * s_m
+                    * (spec.sidewash_deg + spec.sidewash_per_alpha * d_alpha).to_radians(),
+                fx(Factor::Cnintfac) * s_m * spec.sidewash_gradient_deg_per_m.to_radians(),
+            ],
+            dynamic_pressure: fx(Factor::Caintfac) * s_m * (spec.dynamic_pressure_ratio - 1.0),
+            roll_cl: fx(Factor::Clintfac) * s_m * spec.roll_cl,
+            half_depth_m: spec.half_depth_m,
+            inv_reversal_per_m: spec.reversal_m.map_or(0.0, |z_r| 1.0 / z_r),
+            slopes_per_rad: [aero.cz_alpha_per_rad, aero.cy_beta_per_rad],
+            inv_diameter_per_m: 1.0 / diameter_m,
+        }
+    }
+
+    /// g(z): the field's shape with depth `z_m` below carriage.
+    pub fn shape(&self, z_m: f64) -> f64 {
+        FieldLanes::<f64>::gather(|_| self, 0.0).shape(z_m)
+    }
+
+    /// The field at the point `p_m` of L: (alpha_i \[rad\], beta_i \[rad\], eta).
+    pub fn at(&self, p_m: [f64; 3]) -> [f64; 3] {
+        FieldLanes::<f64>::gather(|_| self, 0.0).at(p_m)
+    }
+
+    /// The coefficients `k` with the field's loads added (docs/model.md section 3b), for the
+    /// CG at `r_m` (L), the store's axis `axis_l` (C_LB's first column), the moment reference
+    /// point `x_ref_m` ahead of the CG, and the stage's flow angles.
+    pub fn add_loads(
+        &self,
+        r_m: [f64; 3],
+        axis_l: [f64; 3],
+        x_ref_m: f64,
+        alpha_rad: f64,
+        beta_rad: f64,
+        k: Coefficients,
+    ) -> Coefficients {
+        FieldLanes::<f64>::gather(|_| self, x_ref_m).add_loads(r_m, axis_l, alpha_rad, beta_rad, k)
+    }
+}
+
+/// The fields of one run per lane (see [`crate::lanes`]), all with the same number of stations:
+/// the loads of section 3b as one sequence of operations on every lane, so that a lane has the
+/// bits of its run's scalar evaluation.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FieldLanes<R> {
+    stations: usize,
+    /// Each station's arm from the CG, x_k + x_ref \[m\].
+    arm_m: [R; MAX_STATIONS],
+    weights: [[R; MAX_STATIONS]; 2],
+    /// w_k x_k and v_k x_k \[m\].
+    weighted_x_m: [[R; MAX_STATIONS]; 2],
+    upwash: [R; 2],
+    sidewash: [R; 2],
+    dynamic_pressure: R,
+    roll_cl: R,
+    inv_half_depth_per_m: R,
+    inv_reversal_per_m: R,
+    /// CZ_alpha / d and CY_beta / d \[1/(rad m)\], and the slopes themselves \[1/rad\].
+    slopes_per_rad: [R; 2],
+    slopes_per_rad_m: [R; 2],
+    inv_stations: R,
+    /// Whether any lane's field has a rolling moment (its shape at the CG is otherwise not
+    /// formed).
+    any_roll: bool,
+}
+
+impl<R: Real> FieldLanes<R> {
+    /// The fields of one run per lane (`runs(i)`: lane `i`'s), each lane's moment reference
+    /// point `x_ref_m`; every run has [`FieldLanes::stations`] of lane 0.
+    #[inline(always)]
+    pub(crate) fn gather<'a>(runs: impl Fn(usize) -> &'a FlowfieldRun, x_ref_m: R) -> Self {
+        let g = |f: &dyn Fn(&FlowfieldRun) -> f64| crate::lanes::gather::<R>(|i| f(runs(i)));
+        let per_station = |f: &dyn Fn(&FlowfieldRun, usize) -> f64| {
+            std::array::from_fn(|k| crate::lanes::gather::<R>(|i| f(runs(i), k)))
+        };
+        let station_x_m: [R; MAX_STATIONS] = per_station(&|r, k| r.station_x_m[k]);
+        FieldLanes {
+            stations: runs(0).stations,
+            arm_m: station_x_m.map(|x| x + x_ref_m),
+            weights: [
+                per_station(&|r, k| r.weights[0][k]),
+                per_station(&|r, k| r.weights[1][k]),
+            ],
+            weighted_x_m: [
+                per_station(&|r, k| r.weights[0][k] * r.station_x_m[k]),
+                per_station(&|r, k| r.weights[1][k] * r.station_x_m[k]),
+            ],
+            upwash: [g(&|r| r.upwash[0]), g(&|r| r.upwash[1])],
+            sidewash: [g(&|r| r.sidewash[0]), g(&|r| r.sidewash[1])],
+            dynamic_pressure: g(&|r| r.dynamic_pressure),
+            roll_cl: g(&|r| r.roll_cl),
+            inv_half_depth_per_m: g(&|r| 1.0 / r.half_depth_m),
+            inv_reversal_per_m: g(&|r| r.inv_reversal_per_m),
+            slopes_per_rad: [g(&|r| r.slopes_per_rad[0]), g(&|r| r.slopes_per_rad[1])],
+            slopes_per_rad_m: [
+                g(&|r| r.slopes_per_rad[0] * r.inv_diameter_per_m),
+                g(&|r| r.slopes_per_rad[1] * r.inv_diameter_per_m),
+            ],
+            inv_stations: g(&|r| 1.0 / r.stations as f64),
+            any_roll: (0..R::LANES).any(|i| runs(i).roll_cl != 0.0),
+        }
+    }
+
+    /// g(z) = (1 - z+ / z_r) / (1 + z+ / L_z), z+ = max(z, 0).
+    #[inline(always)]
+    fn shape(&self, z_m: R) -> R {
+        let zero = R::splat(0.0);
+        let z = R::select(z_m.lt(zero), zero, z_m);
+        (-z).mul_add(self.inv_reversal_per_m, R::splat(1.0))
+            / z.mul_add(self.inv_half_depth_per_m, R::splat(1.0))
+    }
+
+    /// (alpha_i, beta_i, eta) at the point `p_m` of L (the field does not vary with y).
+    #[inline(always)]
+    fn at(&self, p_m: [R; 3]) -> [R; 3] {
+        let g = self.shape(p_m[2]);
+        [
+            self.upwash[1].mul_add(p_m[0], self.upwash[0]) * g,
+            self.sidewash[1].mul_add(p_m[0], self.sidewash[0]) * g,
+            self.dynamic_pressure.mul_add(g, R::splat(1.0)),
+        ]
+    }
+
+    /// The loads of docs/model.md section 3b added to `k`.
+    #[inline(always)]
+    pub(crate) fn add_loads(
+        &self,
+        r_m: [R; 3],
+        axis_l: [R; 3],
+        alpha_rad: R,
+        beta_rad: R,
+        k: Coefficients<R>,
+    ) -> Coefficients<R> {
+        self.sums(r_m, axis_l)
+            .add_loads(self, alpha_rad, beta_rad, k)
+    }
+
+    /// The sums over the stations that need the field alone, for the CG at `r_m` and the
+    /// store's axis `axis_l`.
+    ///
+    /// With e_k = E g_k (so eta_k = 1 + e_k), n_k = e_k alpha + eta_k alpha_k: the sums of the
+    /// weights times e_k and times eta_k alpha_k (or eta_k beta_k) need only the position and
+    /// attitude, so they are formed beside the flow angles (the slowest chain of a force
+    /// evaluation), which then enter by one multiply-add each ([`FieldSums::add_loads`]).
+    #[inline(always)]
+    pub(crate) fn sums(&self, r_m: [R; 3], axis_l: [R; 3]) -> FieldSums<R> {
+        let zero = R::splat(0.0);
+        // alpha_i / g = A + A_x p_x with p_x = r_x + C_LB[0][0] arm: at each station
+        // (A + A_x r_x) + (A_x C_LB[0][0]) arm, one multiply-add (likewise beta_i).
+        let upwash = [
+            self.upwash[1].mul_add(r_m[0], self.upwash[0]),
+            self.upwash[1] * axis_l[0],
+        ];
+        let sidewash = [
+            self.sidewash[1].mul_add(r_m[0], self.sidewash[0]),
+            self.sidewash[1] * axis_l[0],
+        ];
+        // Each sum its own variable (an array indexed in a loop may be kept in memory).
+        let [mut e_n, mut e_m, mut e_y, mut e_r] = [zero; 4];
+        let [mut f_n, mut f_m, mut f_y, mut f_r] = [zero; 4];
+        let mut e_sum = zero;
+        for i in 0..self.stations {
+            let arm = self.arm_m[i];
+            let g = self.shape(axis_l[2].mul_add(arm, r_m[2]));
+            let e_k = self.dynamic_pressure * g;
+            let eta_g = e_k.mul_add(g, g);
+            let alpha_k = upwash[1].mul_add(arm, upwash[0]) * eta_g;
+            let beta_k = sidewash[1].mul_add(arm, sidewash[0]) * eta_g;
+            let (w, wx) = (self.weights[0][i], self.weighted_x_m[0][i]);
+            let (v, vx) = (self.weights[1][i], self.weighted_x_m[1][i]);
+            e_n = w.mul_add(e_k, e_n);
+            e_m = wx.mul_add(e_k, e_m);
+            e_y = v.mul_add(e_k, e_y);
+            e_r = vx.mul_add(e_k, e_r);
+            f_n = w.mul_add(alpha_k, f_n);
+            f_m = wx.mul_add(alpha_k, f_m);
+            f_y = v.mul_add(beta_k, f_y);
+            f_r = vx.mul_add(beta_k, f_r);
+            e_sum = e_sum + e_k;
+        }
+        let (by_angle, field) = ([e_n, e_m, e_y, e_r], [f_n, f_m, f_y, f_r]);
+        FieldSums {
+            by_angle,
+            field,
+            e_sum,
+            roll_cl: if self.any_roll {
+                self.roll_cl * self.shape(r_m[2])
+            } else {
+                zero
+            },
+        }
+    }
+}
+
+/// The sums over a field's stations that need the field alone ([`FieldLanes::sums`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FieldSums<R> {
+    /// Normal, pitch, side and yaw: sum w_k e_k, sum w_k x_k e_k, sum v_k e_k, sum v_k x_k e_k.
+    by_angle: [R; 4],
+    /// The same with eta_k alpha_k (normal, pitch) and eta_k beta_k (side, yaw) for e_k.
+    field: [R; 4],
+    /// sum e_k.
+    e_sum: R,
+    /// dCl = Lr g(r_z).
+    roll_cl: R,
+}
+
+impl<R: Real> FieldSums<R> {
+    /// The loads of docs/model.md section 3b added to `k`, at the stage's flow angles.
+    #[inline(always)]
+    pub(crate) fn add_loads(
+        &self,
+        f: &FieldLanes<R>,
+        alpha_rad: R,
+        beta_rad: R,
+        mut k: Coefficients<R>,
+    ) -> Coefficients<R> {
+        let sum = |j: usize, angle: R| self.by_angle[j].mul_add(angle, self.field[j]);
+        k.cx = (self.e_sum * f.inv_stations).mul_add(k.cx, k.cx);
+        k.cz = f.slopes_per_rad[0].mul_add(sum(0, alpha_rad), k.cz);
+        k.cm = (-f.slopes_per_rad_m[0]).mul_add(sum(1, alpha_rad), k.cm);
+        k.cy = f.slopes_per_rad[1].mul_add(sum(2, beta_rad), k.cy);
+        k.cn = f.slopes_per_rad_m[1].mul_add(sum(3, beta_rad), k.cn);
+        k.cl = k.cl + self.roll_cl;
+        k
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::float_cmp)] // the field above carriage is exactly that of carriage
+mod tests {
+    use super::*;
+
+    fn spec() -> FlowfieldSpec {
+        FlowfieldSpec {
+            stations: 5,
+            nose_x_m: 1.5,
+            tail_x_m: -1.5,
+            upwash_deg: 3.0,
+            upwash_per_alpha: 0.5,
+            upwash_gradient_deg_per_m: 0.0,
+            sidewash_deg: -1.5,
+            sidewash_per_alpha: 0.0,
+            sidewash_gradient_deg_per_m: 0.0,
+            dynamic_pressure_ratio: 1.0,
+            roll_cl: 0.0,
+            half_depth_m: 0.8,
+            reversal_m: Some(2.0),
+            reference_mach: 0.85,
+            reference_alpha_deg: 2.0,
+            mach_scaling: MachScaling::PrandtlGlauert,
+        }
+    }
+
+    fn aero() -> AeroAtMach {
+        AeroAtMach {
+            ca0: 1.1,
+            cz_alpha_per_rad: -6.0,
+            cy_beta_per_rad: -6.0,
+            cm_alpha_per_rad: 0.3,
+            cn_beta_per_rad: -0.3,
+            cl_p_per_rad: -40.0,
+            cm_q_per_rad: -80.0,
+            cn_r_per_rad: -80.0,
+        }
+    }
+
+    #[test]
+    fn weights_sum_to_one_and_put_the_force_at_the_centre_of_pressure() {
+        let run = FlowfieldRun::new(&spec(), &aero(), 0.508, 0.95, 0.0, &Factors::NOMINAL);
+        for (plane, x_cp) in [(0, -0.508 * 0.3 / -6.0), (1, 0.508 * -0.3 / -6.0)] {
+            let w = &run.weights[plane][..run.stations];
+            let sum: f64 = w.iter().sum();
+            let moment: f64 = w.iter().zip(&run.station_x_m).map(|(w, x)| w * x).sum();
+            assert!((sum - 1.0).abs() < 1e-15, "plane {plane}: sum {sum}");
+            assert!(
+                (moment - x_cp).abs() < 1e-15,
+                "plane {plane}: {moment} vs {x_cp}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_field_scales_with_lift_and_mach_and_changes_sign_at_the_reversal() {
+        let run = FlowfieldRun::new(&spec(), &aero(), 0.508, 0.95, 0.0, &Factors::NOMINAL);
+        let s_m = (1.0 / 0.1f64.sqrt()) / (1.0 / (1.0 - 0.85f64 * 0.85).sqrt());
+        let a = s_m * (3.0f64 + 0.5 * (0.0 - 2.0)).to_radians();
+        assert!((run.upwash[0] - a).abs() < 1e-15);
+        assert!(run.at([0.0, 0.0, 1.0])[0] > 0.0);
+        assert!(run.at([0.0, 0.0, 2.0])[0].abs() < 1e-18);
+        assert!(run.at([0.0, 0.0, 3.0])[0] < 0.0);
+        // Above carriage the field is that of carriage.
+        assert_eq!(run.at([0.0, 0.0, -0.5]), run.at([0.0, 0.0, 0.0]));
+    }
+}

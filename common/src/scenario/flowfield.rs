@@ -1,0 +1,189 @@
+//! The `[flowfield]` table of a scenario: the aircraft's flowfield interference model
+//! (docs/model.md section 3b) and the checks of its values. The field itself, its stations and
+//! its loads are in [`crate::model::flowfield`].
+
+use serde::{Deserialize, Serialize};
+
+use super::{Aero, Interference};
+use crate::table::Coefficient;
+
+/// The most stations along the store (docs/model.md section 3b).
+pub const MAX_STATIONS: usize = 16;
+
+/// How the field's strength scales with the flight Mach number (docs/model.md section 3b).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MachScaling {
+    /// Pg(M) = 1 / sqrt(max(|1 - M^2|, 0.1)).
+    #[default]
+    PrandtlGlauert,
+    /// Pg(M) = 1: the field does not change with Mach.
+    None,
+}
+
+fn default_stations() -> usize {
+    5
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// The analytic flowfield of docs/model.md section 3b, as the scenario file gives it (angles
+/// in degrees).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowfieldSpec {
+    /// Number N of stations along the store (2 to [`MAX_STATIONS`]).
+    #[serde(default = "default_stations")]
+    pub stations: usize,
+    /// Body x of the store's nose from the CG (the moment reference point) \[m\].
+    pub nose_x_m: f64,
+    /// Body x of the store's tail from the CG \[m\].
+    pub tail_x_m: f64,
+    /// a0: induced angle of attack at carriage at the reference condition \[deg\].
+    pub upwash_deg: f64,
+    /// a_alpha: its change per degree of aircraft angle of attack \[deg/deg\].
+    #[serde(default)]
+    pub upwash_per_alpha: f64,
+    /// a_x: its change per metre along L's x \[deg/m\].
+    #[serde(default)]
+    pub upwash_gradient_deg_per_m: f64,
+    /// b0: induced sideslip at carriage \[deg\].
+    #[serde(default)]
+    pub sidewash_deg: f64,
+    /// b_alpha: its change per degree of aircraft angle of attack \[deg/deg\].
+    #[serde(default)]
+    pub sidewash_per_alpha: f64,
+    /// b_x: its change per metre along L's x \[deg/m\].
+    #[serde(default)]
+    pub sidewash_gradient_deg_per_m: f64,
+    /// eta0: local over free-stream dynamic pressure at carriage.
+    #[serde(default = "one")]
+    pub dynamic_pressure_ratio: f64,
+    /// l0: rolling-moment coefficient the field induces at carriage.
+    #[serde(default)]
+    pub roll_cl: f64,
+    /// L_z: the depth below carriage at which the field has halved \[m\].
+    pub half_depth_m: f64,
+    /// z_r: depth below carriage where the field changes sign \[m\] (none: it never does).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reversal_m: Option<f64>,
+    /// M_ref: the Mach number at which a0, b0, eta0 and l0 hold.
+    pub reference_mach: f64,
+    /// alpha_ref: the aircraft angle of attack at which they hold \[deg\].
+    #[serde(default)]
+    pub reference_alpha_deg: f64,
+    /// How the field scales with Mach.
+    #[serde(default)]
+    pub mach_scaling: MachScaling,
+}
+
+/// A field of `[flowfield]` (its TOML path) and why its value is refused.
+pub(super) type Refusal = (String, String);
+
+fn refuse(field: &str, reason: String) -> Refusal {
+    (format!("flowfield.{field}"), reason)
+}
+
+impl FlowfieldSpec {
+    /// Checks the values for their range, and the rest of the scenario for what the field
+    /// needs (docs/model.md section 3b): the six decay increments 0, the store's slopes
+    /// CZ_alpha and CY_beta given and non-zero.
+    pub(super) fn check(&self, aero: &Aero, interference: &Interference) -> Result<(), Refusal> {
+        if !(2..=MAX_STATIONS).contains(&self.stations) {
+            return Err(refuse(
+                "stations",
+                format!("= {}: expected 2 to {MAX_STATIONS}", self.stations),
+            ));
+        }
+        self.check_values()?;
+        for (field, c) in interference.increments() {
+            if !matches!(c.value, Coefficient::Constant(v) if v == 0.0) {
+                return Err((
+                    field.to_string(),
+                    "must be the constant 0 in a scenario with a [flowfield]: the field replaces \
+                     the distance-decay increments (leave out [flowfield] to use them)"
+                        .to_string(),
+                ));
+            }
+        }
+        for (field, slope) in [
+            ("aero.cz_alpha_per_rad", aero.cz_alpha_per_rad.as_ref()),
+            ("aero.cy_beta_per_rad", aero.cy_beta_per_rad.as_ref()),
+        ] {
+            let nonzero = match slope.map(|s| &s.value) {
+                Some(Coefficient::Constant(v)) => *v != 0.0,
+                // A Mach table whose values share a sign is non-zero wherever it is read.
+                Some(Coefficient::Table(t)) => {
+                    t.values().iter().all(|v| *v > 0.0) || t.values().iter().all(|v| *v < 0.0)
+                }
+                _ => false,
+            };
+            if !nonzero {
+                return Err((
+                    field.to_string(),
+                    "must be given and non-zero (a Mach table of one sign) in a scenario with a \
+                     [flowfield]: the field acts on the store through its slopes"
+                        .to_string(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn check_values(&self) -> Result<(), Refusal> {
+        let finite = |field: &str, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(refuse(field, format!("= {v}: expected a finite value")))
+            }
+        };
+        let positive = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(refuse(field, format!("= {v}: expected a finite value > 0")))
+            }
+        };
+        finite("nose_x_m", self.nose_x_m)?;
+        finite("tail_x_m", self.tail_x_m)?;
+        if self.nose_x_m <= self.tail_x_m {
+            return Err(refuse(
+                "nose_x_m",
+                format!(
+                    "= {}: expected the nose ahead of the tail (tail_x_m = {})",
+                    self.nose_x_m, self.tail_x_m
+                ),
+            ));
+        }
+        for (field, v) in [
+            ("upwash_deg", self.upwash_deg),
+            ("sidewash_deg", self.sidewash_deg),
+        ] {
+            if !(v.is_finite() && v.abs() < 45.0) {
+                return Err(refuse(
+                    field,
+                    format!("= {v}: expected a finite angle within +-45 deg"),
+                ));
+            }
+        }
+        finite("upwash_per_alpha", self.upwash_per_alpha)?;
+        finite("upwash_gradient_deg_per_m", self.upwash_gradient_deg_per_m)?;
+        finite("sidewash_per_alpha", self.sidewash_per_alpha)?;
+        finite(
+            "sidewash_gradient_deg_per_m",
+            self.sidewash_gradient_deg_per_m,
+        )?;
+        finite("roll_cl", self.roll_cl)?;
+        finite("reference_alpha_deg", self.reference_alpha_deg)?;
+        positive("dynamic_pressure_ratio", self.dynamic_pressure_ratio)?;
+        positive("half_depth_m", self.half_depth_m)?;
+        positive("reference_mach", self.reference_mach)?;
+        if let Some(z_r) = self.reversal_m {
+            positive("reversal_m", z_r)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,286 @@
+//! The flowfield interference model (docs/model.md section 3b): a uniform field is a change of
+//! the store's flow angle, the loads agree with the independent reference implementation
+//! (`scripts/reference_model.py`) at a state off carriage and along a whole release, the lanes
+//! keep the scalar runs' bits, and a scenario that asks for what the field cannot do is refused
+//! naming the field.
+
+use sepval_common::model::{Coefficients, EquationsOfMotion, FlowfieldRun};
+use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
+use sepval_common::{EffectSet, Factors, Simulator};
+
+/// The conformance case's `[flowfield]` (docs/model.md section 3b).
+pub(crate) const FIELD: &str = "
+[flowfield]
+stations = 5
+nose_x_m = 1.5
+tail_x_m = -1.5
+upwash_deg = 3.0
+upwash_per_alpha = 0.5
+upwash_gradient_deg_per_m = -1.0
+sidewash_deg = -1.5
+sidewash_gradient_deg_per_m = 0.5
+dynamic_pressure_ratio = 0.9
+roll_cl = -0.02
+half_depth_m = 0.8
+reversal_m = 2.0
+reference_mach = 0.85
+reference_alpha_deg = 2.0
+";
+
+/// The default scenario's text with its six decay increments set to 0.
+fn without_increments() -> String {
+    let mut text = DEFAULT_SCENARIO_TOML.to_string();
+    for (from, to) in [
+        ("dcx0 = -0.10", "dcx0 = 0.0"),
+        ("dcy0 = 0.60", "dcy0 = 0.0"),
+        ("dcz0 = -0.60", "dcz0 = 0.0"),
+        ("dcl0 = -0.03", "dcl0 = 0.0"),
+        ("dcm0 = -1.50", "dcm0 = 0.0"),
+        ("dcn0 = -0.60", "dcn0 = 0.0"),
+    ] {
+        assert!(text.contains(from), "the default scenario has `{from}`");
+        text = text.replace(from, to);
+    }
+    text
+}
+
+/// The conformance scenario: the default, its increments 0, with [`FIELD`].
+pub(crate) fn conformance_scenario() -> Scenario {
+    Scenario::from_toml_str(&(without_increments() + FIELD), "flowfield").unwrap()
+}
+
+fn refusal(text: &str) -> String {
+    Scenario::from_toml_str(text, "f.toml")
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn a_uniform_field_is_a_change_of_flow_angle() {
+    // No gradient, no change of dynamic pressure, the store level at carriage: every station
+    // sees the same upwash and sidewash, and the loads are the store's own derivatives times
+    // them (docs/model.md section 3b).
+    let field = FIELD
+        .replace("upwash_gradient_deg_per_m = -1.0", "")
+        .replace("sidewash_gradient_deg_per_m = 0.5", "")
+        .replace("dynamic_pressure_ratio = 0.9", "");
+    let scenario = Scenario::from_toml_str(&(without_increments() + &field), "uniform").unwrap();
+    let sim = Simulator::new(&scenario);
+    let run = sim.run_setup(&Factors::TRUTH, &EffectSet::NONE).unwrap();
+    let f: FlowfieldRun = run.flowfield.expect("the scenario has a field");
+    let [alpha_i, beta_i, eta] = f.at([0.0, 0.0, 0.0]);
+    assert!(eta == 1.0 && alpha_i > 0.01 && beta_i < -0.005);
+    let a = &sim.model().aero_at_mach;
+    for (alpha, beta) in [(0.0, 0.0), (0.05, -0.02)] {
+        let k = f.add_loads(
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            0.0,
+            alpha,
+            beta,
+            Coefficients::default(),
+        );
+        let close = |got: f64, want: f64| (got - want).abs() < 1e-15 * want.abs().max(1.0);
+        assert!(close(k.cz, a.cz_alpha_per_rad * alpha_i), "{k:?}");
+        assert!(close(k.cm, a.cm_alpha_per_rad * alpha_i), "{k:?}");
+        assert!(close(k.cy, a.cy_beta_per_rad * beta_i), "{k:?}");
+        assert!(close(k.cn, a.cn_beta_per_rad * beta_i), "{k:?}");
+        assert!(k.cx == 0.0);
+    }
+}
+
+#[test]
+fn a_scenario_without_a_field_is_unchanged_and_one_with_a_field_moves_the_store() {
+    let default = Scenario::embedded_default();
+    assert!(default.flowfield.is_none());
+    let text = toml::to_string(&default).unwrap();
+    assert!(!text.contains("flowfield"), "no [flowfield] is written");
+    let sim = Simulator::new(&conformance_scenario());
+    let run = sim.run_setup(&Factors::TRUTH, &EffectSet::NONE).unwrap();
+    let x0 = run.initial_state();
+    let with = EquationsOfMotion::new(&run, &sim.model().curve).derivative(&x0, 0.0, [true; 2]);
+    let mut still = run;
+    still.flowfield = None;
+    let without =
+        EquationsOfMotion::new(&still, &sim.model().curve).derivative(&x0, 0.0, [true; 2]);
+    // At carriage the field pushes the store (upwash: up, CZ_alpha < 0) and pitches it.
+    assert!(with[5] < without[5], "dw/dt {} vs {}", with[5], without[5]);
+    assert!(with[11] != without[11]);
+}
+
+#[test]
+fn lanes_equal_scalar_runs_bit_for_bit_with_a_field() {
+    // Every catalogue effect (interference_decay scales the field's depth, cg_offset moves its
+    // stations) on three bases, with diverging runs, through the lanes.
+    let sim = Simulator::new(&conformance_scenario());
+    crate::lanes::check_lanes_against_scalar(&sim, &sim.default_times());
+}
+
+#[test]
+fn what_the_field_cannot_do_is_refused_naming_the_field() {
+    let with = |field: &str| without_increments() + field;
+    let cases = [
+        (
+            DEFAULT_SCENARIO_TOML.to_string() + FIELD,
+            "interference.dcx0",
+            "must be the constant 0",
+        ),
+        (
+            with(&FIELD.replace("stations = 5", "stations = 1")),
+            "flowfield.stations",
+            "expected 2 to 16",
+        ),
+        (
+            with(&FIELD.replace("tail_x_m = -1.5", "tail_x_m = 2.0")),
+            "flowfield.nose_x_m",
+            "nose ahead of the tail",
+        ),
+        (
+            with(&FIELD.replace("half_depth_m = 0.8", "half_depth_m = 0.0")),
+            "flowfield.half_depth_m",
+            "> 0",
+        ),
+        (
+            with(&FIELD.replace("reversal_m = 2.0", "reversal_m = -1.0")),
+            "flowfield.reversal_m",
+            "> 0",
+        ),
+        (
+            with(&FIELD.replace("upwash_deg = 3.0", "upwash_deg = 60.0")),
+            "flowfield.upwash_deg",
+            "within +-45 deg",
+        ),
+        (
+            with(&FIELD.replace("reference_mach = 0.85\n", "")),
+            "reference_mach",
+            "missing field",
+        ),
+        (
+            with(&(FIELD.to_string() + "upwash_rad = 1.0\n")),
+            "upwash_rad",
+            "unknown field",
+        ),
+        (
+            with(FIELD).replace("cz_alpha_per_rad = -6.0", "cz_alpha_per_rad = 0.0"),
+            "aero.cz_alpha_per_rad",
+            "non-zero",
+        ),
+    ];
+    for (text, field, reason) in cases {
+        let message = refusal(&text);
+        assert!(
+            message.contains(field) && message.contains(reason),
+            "expected `{field}` ... `{reason}`, got: {message}"
+        );
+    }
+}
+
+/// docs/model.md section 3b's conformance values, from `scripts/reference_model.py`: t, x, y,
+/// z [m], roll, pitch, yaw [deg], truth factors, noise-free.
+const CONFORMANCE: [[f64; 7]; 5] = [
+    [
+        0.05,
+        -0.005668503,
+        0.000689392,
+        0.087214708,
+        0.0595522,
+        1.6834109,
+        -0.0015095,
+    ],
+    [
+        0.10,
+        -0.023216448,
+        0.002549419,
+        0.276410306,
+        0.2548666,
+        4.9496899,
+        0.0055412,
+    ],
+    [
+        0.25,
+        -0.159723987,
+        0.011851506,
+        0.934190771,
+        1.9096580,
+        13.7934004,
+        0.2582104,
+    ],
+    [
+        0.50,
+        -0.766511492,
+        0.033976789,
+        2.191378463,
+        8.6287325,
+        26.4977215,
+        2.1234767,
+    ],
+    [
+        1.00,
+        -4.443177434,
+        0.215661244,
+        4.590611029,
+        37.6955178,
+        48.3406935,
+        16.0366532,
+    ],
+];
+
+#[test]
+fn the_conformance_case_agrees_with_the_independent_implementation() {
+    let sim = Simulator::new(&conformance_scenario());
+    let times: Vec<f64> = CONFORMANCE.iter().map(|row| row[0]).collect();
+    let traj = sim
+        .simulate(&Factors::TRUTH, &EffectSet::NONE, &times)
+        .unwrap();
+    for (k, row) in CONFORMANCE.iter().enumerate() {
+        for j in 0..3 {
+            let d = (traj.pos_m[k][j] - row[1 + j]).abs();
+            assert!(d < 2e-9, "t = {} s, position {j}: off by {d} m", row[0]);
+            let d = (traj.att_deg[k][j] - row[4 + j]).abs();
+            assert!(d < 2e-7, "t = {} s, angle {j}: off by {d} deg", row[0]);
+        }
+    }
+}
+
+#[test]
+fn the_loads_off_carriage_agree_with_the_independent_implementation() {
+    // The reference's test state (`scripts/reference_model.py --json`): the store below and
+    // beside carriage, pitched, yawed and rolled, moving and turning.
+    let n = [0.99_f64, 0.02, 0.08, -0.03];
+    let norm = n.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let q = n.map(|v| v / norm);
+    let x = [
+        0.3, -0.1, 0.6, 1.0, 0.5, 8.0, q[0], q[1], q[2], q[3], 0.2, 0.5, -0.3,
+    ];
+    let expected = [
+        0.09979289137980427,
+        0.09475866791346009,
+        -0.07356666360226327,
+        -0.007995998999499687,
+        -0.039486893089889764,
+        -0.019190245628808625,
+    ];
+    let sim = Simulator::new(&conformance_scenario());
+    let run = sim.run_setup(&Factors::TRUTH, &EffectSet::NONE).unwrap();
+    let flow = EquationsOfMotion::new(&run, &sim.model().curve).flow(&x, 0.0);
+    let c = sepval_common::frames::dcm_from_quaternion(q);
+    let base = Coefficients {
+        cx: run.aero.cx0,
+        ..Coefficients::default()
+    };
+    let k = run.flowfield.unwrap().add_loads(
+        [x[0], x[1], x[2]],
+        [c[(0, 0)], c[(1, 0)], c[(2, 0)]],
+        0.0,
+        flow.alpha_rad,
+        flow.beta_rad,
+        base,
+    );
+    let got = [k.cx - base.cx, k.cy, k.cz, k.cl, k.cm, k.cn];
+    for (name, (g, e)) in ["dCX", "dCY", "dCZ", "dCl", "dCm", "dCn"]
+        .iter()
+        .zip(got.iter().zip(expected))
+    {
+        assert!((g - e).abs() < 1e-13, "{name}: {g} vs the reference's {e}");
+    }
+}
