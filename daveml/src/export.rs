@@ -80,6 +80,16 @@ struct BreakpointSet {
 
 /// The scenario's fields as a DAVE-ML 2.0 document (text).
 pub fn to_daveml(s: &Scenario, bands: &[Band], prov: &Provenance) -> Result<String, String> {
+    if s.flowfield.is_some() {
+        // Its increments would be written as zeros and the field itself not at all: a file
+        // that flies another store (docs/daveml.md).
+        return Err(
+            "the scenario's interference is an aircraft flowfield ([flowfield], \
+                    docs/model.md section 3b), which sepval does not write as DAVE-ML: \
+                    only its aerodynamic tables would be exported and the field lost"
+                .to_string(),
+        );
+    }
     let fields: Vec<Written> = Target::all()
         .into_iter()
         .filter_map(|t| {

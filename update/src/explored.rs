@@ -43,6 +43,10 @@ pub struct Explored {
     pub machs: Vec<f64>,
     /// The scenario's interference cut-off \[m\].
     pub s_end_m: f64,
+    /// Whether the scenario's interference is the aircraft's flowfield (docs/model.md section
+    /// 3b), whose increments over distance are 0 by definition: no correction over distance
+    /// is proposed then (it would bring back the model the field replaces).
+    pub flowfield: bool,
 }
 
 impl Explored {
@@ -74,6 +78,7 @@ impl Explored {
             beta_deg: beta,
             machs,
             s_end_m: job.events()[0].simulator.scenario().interference.s_end_m,
+            flowfield: job.events()[0].simulator.scenario().flowfield.is_some(),
         }
     }
 
@@ -176,7 +181,7 @@ pub fn proposals(axis: usize, explored: &Explored) -> Vec<Proposal> {
         (b, vec![false; n])
     };
     let s_max = explored.distance_m;
-    if s_max > 0.0 {
+    if s_max > 0.0 && !explored.flowfield {
         let mut b: Vec<f64> = (0..DISTANCE_KNOTS)
             .map(|j| s_max * (j as f64 / (DISTANCE_KNOTS - 1) as f64).powi(2))
             .collect();

@@ -284,3 +284,54 @@ fn the_loads_off_carriage_agree_with_the_independent_implementation() {
         assert!((g - e).abs() < 1e-13, "{name}: {g} vs the reference's {e}");
     }
 }
+
+#[test]
+fn small_changes_of_the_field_give_small_trajectory_changes() {
+    // continuity.rs's test for the field (issue 36's property): each interference factor
+    // (the field's upwash, gradient, sidewash, its gradient, dynamic pressure, rolling moment)
+    // at several values, the second difference of the trajectory small beside its change.
+    use sepval_common::Factor;
+    use sepval_common::propagator::{Observation, propagate};
+    let sim = Simulator::new(&conformance_scenario());
+    let times = sim.default_times();
+    let fly = |factor: Factor, u: f64| {
+        let mut f = Factors::TRUTH;
+        f.0[factor as usize] *= 1.0 + u;
+        let run = sim.run_setup(&f, &EffectSet::NONE).unwrap();
+        let mut samples: Vec<Observation> = Vec::new();
+        propagate(sim.model(), &run, &times, &mut samples).unwrap();
+        samples
+    };
+    let mut failures = Vec::new();
+    for factor in [
+        Factor::Czintfac,
+        Factor::Cmintfac,
+        Factor::Cyintfac,
+        Factor::Cnintfac,
+        Factor::Caintfac,
+        Factor::Clintfac,
+    ] {
+        for start in [-0.2, 0.0, 0.1] {
+            let step = 1e-6;
+            let [a, b, c] = [0.0, 1.0, 2.0].map(|k| fly(factor, start + k * step));
+            let (mut second, mut change) = (0.0f64, 0.0f64);
+            for k in 0..a.len() {
+                for j in 0..3 {
+                    let d2 = |v: fn(&Observation) -> [f64; 3]| {
+                        (v(&c[k])[j] - 2.0 * v(&b[k])[j] + v(&a[k])[j]).abs()
+                    };
+                    second = second.max(d2(|o| o.pos_m)).max(d2(|o| o.att_deg));
+                    change = change
+                        .max((c[k].pos_m[j] - a[k].pos_m[j]).abs())
+                        .max((c[k].att_deg[j] - a[k].att_deg[j]).abs());
+                }
+            }
+            if second > 1e-3 * change + 1e-12 {
+                failures.push(format!(
+                    "{factor:?} at 1 + {start}: second difference {second:.3e}, change {change:.3e}"
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

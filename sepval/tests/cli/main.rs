@@ -14,6 +14,7 @@ mod diagnose;
 mod discover;
 mod envelope;
 mod fit;
+mod flowfield;
 mod fuzz;
 mod guide;
 mod gust;

@@ -1,0 +1,141 @@
+#!/usr/bin/env bash
+# What a flowfield fitted at two or three flight conditions predicts at a new one, against
+# today's distance-decay model fitted and updated on the same releases (issue 37, "done when").
+#
+#   scripts/flowfield-study.sh [OUT_DIR]       (default bench-out/flowfield-study)
+#
+# For each of three truths (a field and a store, docs/model.md section 3b), releases are made
+# by `sepval simulate` from the truth scenario at the truth factors, with the default flight
+# test's noise (3 mm, 0.1 deg; seeds 11, 12, 13) at the fitted conditions
+#   C1 Mach 0.80 alpha 0,  C2 Mach 0.95 alpha 3,  C3 Mach 0.90 alpha -2
+# and noise-free at the condition predicted, C4 Mach 0.85 alpha 1.5. Each model is then fitted
+# to C1 and C2 (and to C1, C2 and C3) and its prediction at C4 compared with the truth there
+# (`sepval goals`: the RMS position and attitude errors over 1 s):
+#   decay      the default model (distance-decay increments), its 17 factors fitted (ga+lm);
+#   decay+upd  the same, then `sepval update` (corrections kept as far as they cross-validate);
+#   flowfield  the truth's field form with its strengths unknown: the 17 factors fitted (the
+#              interference factors scale the field's upwash, gradient, sidewash, dynamic
+#              pressure and roll).
+# Writes OUT_DIR/study.csv and prints it. About 15 minutes on 2 cores.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT=${1:-bench-out/flowfield-study}
+SEPVAL=target/release/sepval
+[ -x "$SEPVAL" ] || { echo "build first: cargo build --release --workspace" >&2; exit 2; }
+rm -rf "$OUT"
+mkdir -p "$OUT"
+BASE=common/scenarios/eglin_default.toml
+
+# A scenario from the default: $1 the store's changes (sed expressions), $2 the [flowfield]
+# table (empty: the decay model), $3 Mach, $4 alpha.
+scenario() {
+    local text
+    text=$(sed -e "$1" -e "s/^mach = .*/mach = $3/" -e "s/^alpha_deg = .*/alpha_deg = $4/" "$BASE")
+    if [ -n "$2" ]; then
+        text=$(printf '%s\n' "$text" | sed -E 's/^(dc[xyzlmn]0) = .*/\1 = 0.0/')
+        printf '%s\n%s\n' "$text" "$2"
+    else
+        printf '%s\n' "$text"
+    fi
+}
+
+STORE_DEFAULT='s/^name = .*/name = "study"/'
+STORE_STABLE='s/^cm_alpha_per_rad = .*/cm_alpha_per_rad = -0.5/;s/^cn_beta_per_rad = .*/cn_beta_per_rad = 0.5/;s/^cm_q_per_rad = .*/cm_q_per_rad = -120.0/'
+STORE_LIGHT='s/^mass_kg = .*/mass_kg = 600.0/;s/^iyy_kg_m2 = .*/iyy_kg_m2 = 300.0/;s/^izz_kg_m2 = .*/izz_kg_m2 = 300.0/;s/^ixx_kg_m2 = .*/ixx_kg_m2 = 20.0/'
+
+FIELD_1='[flowfield]
+stations = 5
+nose_x_m = 1.5
+tail_x_m = -1.5
+upwash_deg = 3.0
+upwash_per_alpha = 0.5
+upwash_gradient_deg_per_m = -1.0
+sidewash_deg = -1.5
+sidewash_gradient_deg_per_m = 0.5
+dynamic_pressure_ratio = 0.9
+roll_cl = -0.02
+half_depth_m = 0.8
+reversal_m = 2.0
+reference_mach = 0.85
+reference_alpha_deg = 2.0'
+FIELD_2='[flowfield]
+stations = 5
+nose_x_m = 1.4
+tail_x_m = -1.6
+upwash_deg = 2.0
+upwash_per_alpha = 0.8
+upwash_gradient_deg_per_m = 0.5
+sidewash_deg = 1.0
+sidewash_per_alpha = 0.2
+dynamic_pressure_ratio = 1.05
+roll_cl = 0.01
+half_depth_m = 1.2
+reference_mach = 0.9'
+FIELD_3='[flowfield]
+stations = 7
+nose_x_m = 1.2
+tail_x_m = -1.3
+upwash_deg = -1.0
+upwash_per_alpha = 1.2
+upwash_gradient_deg_per_m = -2.0
+sidewash_deg = 0.5
+dynamic_pressure_ratio = 0.95
+half_depth_m = 0.5
+reversal_m = 1.2
+reference_mach = 0.95
+reference_alpha_deg = 2.0'
+
+CONDITIONS=("0.80 0.0" "0.95 3.0" "0.90 -2.0")
+PREDICTED="0.85 1.5"
+
+echo "truth,model,releases,rms_position_mm,rms_attitude_deg" > "$OUT/study.csv"
+for k in 1 2 3; do
+    case $k in
+        1) store=$STORE_DEFAULT field=$FIELD_1 ;;
+        2) store=$STORE_STABLE field=$FIELD_2 ;;
+        3) store=$STORE_LIGHT field=$FIELD_3 ;;
+    esac
+    dir="$OUT/truth-$k"
+    mkdir -p "$dir"
+    for i in 0 1 2; do
+        read -r mach alpha <<< "${CONDITIONS[$i]}"
+        scenario "$store" "$field" "$mach" "$alpha" > "$dir/truth-c$((i + 1)).toml"
+        "$SEPVAL" simulate --scenario "$dir/truth-c$((i + 1)).toml" --factors truth \
+            --noise-seed $((11 + i)) --out "$dir/c$((i + 1)).csv" > /dev/null
+    done
+    read -r mach alpha <<< "$PREDICTED"
+    scenario "$store" "$field" "$mach" "$alpha" > "$dir/truth-c4.toml"
+    "$SEPVAL" simulate --scenario "$dir/truth-c4.toml" --factors truth --out "$dir/c4.csv" > /dev/null
+    # The models at C1 (the releases' metadata set each one's condition) and at C4.
+    scenario "$store" "" 0.80 0.0 > "$dir/decay.toml"
+    scenario "$store" "" "$mach" "$alpha" > "$dir/decay-c4.toml"
+    cp "$dir/truth-c1.toml" "$dir/flowfield.toml"
+    cp "$dir/truth-c4.toml" "$dir/flowfield-c4.toml"
+    for n in 2 3; do
+        data=(--data "$dir/c1.csv" --data "$dir/c2.csv")
+        [ "$n" = 3 ] && data+=(--data "$dir/c3.csv")
+        for model in decay flowfield; do
+            fit="$dir/$model-fit-$n"
+            "$SEPVAL" fit --scenario "$dir/$model.toml" "${data[@]}" --method ga+lm --seed 1 \
+                --no-figures --out "$fit" > /dev/null
+            # The refined optimum's factors, as `simulate --factors` reads them.
+            python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print(json.dumps(r["methods"]["ga+lm"]["best"]["factors"]))' \
+                "$fit/result.json" > "$fit/factors.json"
+            "$SEPVAL" simulate --scenario "$dir/$model-c4.toml" --factors "$fit/factors.json" \
+                --out "$fit/c4.csv" > /dev/null
+            read -r pos att < <("$SEPVAL" goals --data "$dir/c4.csv" --sim "$fit/c4.csv" \
+                | awk '/J_pos/ {p = $3} /J_att/ {a = $3} END {print p, a}')
+            echo "$k,$model,$n,$(awk "BEGIN {print $pos * 1000}"),$att" >> "$OUT/study.csv"
+        done
+        up="$dir/decay-update-$n"
+        "$SEPVAL" update --scenario "$dir/decay.toml" "${data[@]}" --seed 1 --out "$up" > /dev/null
+        sed -e "s/^mach = .*/mach = $mach/" -e "s/^alpha_deg = .*/alpha_deg = $alpha/" \
+            "$up/scenario.toml" > "$up/scenario-c4.toml"
+        "$SEPVAL" simulate --scenario "$up/scenario-c4.toml" --factors "$up/factors.json" \
+            --out "$up/c4.csv" > /dev/null
+        read -r pos att < <("$SEPVAL" goals --data "$dir/c4.csv" --sim "$up/c4.csv" \
+            | awk '/J_pos/ {p = $3} /J_att/ {a = $3} END {print p, a}')
+        echo "$k,decay+update,$n,$(awk "BEGIN {print $pos * 1000}"),$att" >> "$OUT/study.csv"
+    done
+done
+column -s, -t < "$OUT/study.csv"
