@@ -43,21 +43,8 @@ STORE_DEFAULT='s/^name = .*/name = "study"/'
 STORE_STABLE='s/^cm_alpha_per_rad = .*/cm_alpha_per_rad = -0.5/;s/^cn_beta_per_rad = .*/cn_beta_per_rad = 0.5/;s/^cm_q_per_rad = .*/cm_q_per_rad = -120.0/'
 STORE_LIGHT='s/^mass_kg = .*/mass_kg = 600.0/;s/^iyy_kg_m2 = .*/iyy_kg_m2 = 300.0/;s/^izz_kg_m2 = .*/izz_kg_m2 = 300.0/;s/^ixx_kg_m2 = .*/ixx_kg_m2 = 20.0/'
 
-FIELD_1='[flowfield]
-stations = 5
-nose_x_m = 1.5
-tail_x_m = -1.5
-upwash_deg = 3.0
-upwash_per_alpha = 0.5
-upwash_gradient_deg_per_m = -1.0
-sidewash_deg = -1.5
-sidewash_gradient_deg_per_m = 0.5
-dynamic_pressure_ratio = 0.9
-roll_cl = -0.02
-half_depth_m = 0.8
-reversal_m = 2.0
-reference_mach = 0.85
-reference_alpha_deg = 2.0'
+# Truth 1: the guide's example field (docs/model.md section 3b's conformance case).
+FIELD_1=$(sed -n '/^\[flowfield\]/,$p' examples/flowfield-store/scenario.toml)
 FIELD_2='[flowfield]
 stations = 5
 nose_x_m = 1.4

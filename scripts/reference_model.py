@@ -59,24 +59,10 @@ SECTION8 = {
 }
 TIMES = [0.05, 0.10, 0.25, 0.50, 1.00]
 
-# Section 3b: the flowfield conformance case's table, verbatim.
-FLOWFIELD_CASE = tomllib.loads("""
-[flowfield]
-stations = 5
-nose_x_m = 1.5
-tail_x_m = -1.5
-upwash_deg = 3.0
-upwash_per_alpha = 0.5
-upwash_gradient_deg_per_m = -1.0
-sidewash_deg = -1.5
-sidewash_gradient_deg_per_m = 0.5
-dynamic_pressure_ratio = 0.9
-roll_cl = -0.02
-half_depth_m = 0.8
-reversal_m = 2.0
-reference_mach = 0.85
-reference_alpha_deg = 2.0
-""")["flowfield"]
+# Section 3b: the flowfield conformance case's table, as the guide's example store gives it
+# (examples/flowfield-store/scenario.toml, whose [flowfield] is the section's, verbatim).
+EXAMPLE = SCENARIO.parent.parent.parent / "examples" / "flowfield-store" / "scenario.toml"
+FLOWFIELD_CASE = tomllib.loads(EXAMPLE.read_text())["flowfield"]
 
 # Task item 5: the documented state at which the flowfield's increments are printed.
 _q = (0.99, 0.02, 0.08, -0.03)

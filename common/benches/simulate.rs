@@ -174,27 +174,11 @@ fn simulate_lanes_corrections(c: &mut Criterion) {
     });
 }
 
-/// The default with the flowfield of docs/model.md section 3b's conformance case (5 stations).
+/// The guide's example store under a field: the default with docs/model.md section 3b's
+/// conformance field (5 stations) in place of its decay increments.
 fn flowfield_simulator() -> Simulator {
-    let mut text = sepval_common::scenario::DEFAULT_SCENARIO_TOML.to_string();
-    for c in [
-        "dcx0 = -0.10",
-        "dcy0 = 0.60",
-        "dcz0 = -0.60",
-        "dcl0 = -0.03",
-        "dcm0 = -1.50",
-        "dcn0 = -0.60",
-    ] {
-        let name = &c[..4];
-        text = text.replace(c, &format!("{name} = 0.0"));
-    }
-    text.push_str(
-        "[flowfield]\nstations = 5\nnose_x_m = 1.5\ntail_x_m = -1.5\nupwash_deg = 3.0\n\
-         upwash_per_alpha = 0.5\nupwash_gradient_deg_per_m = -1.0\nsidewash_deg = -1.5\n\
-         sidewash_gradient_deg_per_m = 0.5\ndynamic_pressure_ratio = 0.9\nroll_cl = -0.02\n\
-         half_depth_m = 0.8\nreversal_m = 2.0\nreference_mach = 0.85\nreference_alpha_deg = 2.0\n",
-    );
-    Simulator::new(&sepval_common::Scenario::from_toml_str(&text, "bench").expect("a valid field"))
+    let text = include_str!("../../examples/flowfield-store/scenario.toml");
+    Simulator::new(&sepval_common::Scenario::from_toml_str(text, "bench").expect("a valid field"))
 }
 
 fn simulate_default_event_flowfield(c: &mut Criterion) {

@@ -18,40 +18,13 @@ use std::time::Instant;
 use sepval_common::goals::GoalAccumulator;
 use sepval_common::model::RunSetup;
 use sepval_common::propagator::{LANES, propagate_lanes};
-use sepval_common::scenario::DEFAULT_SCENARIO_TOML;
 use sepval_common::{EffectSet, Factors, Scenario, Simulator};
 
-const FIELD: &str = "
-[flowfield]
-stations = 5
-nose_x_m = 1.5
-tail_x_m = -1.5
-upwash_deg = 3.0
-upwash_per_alpha = 0.5
-upwash_gradient_deg_per_m = -1.0
-sidewash_deg = -1.5
-sidewash_gradient_deg_per_m = 0.5
-dynamic_pressure_ratio = 0.9
-roll_cl = -0.02
-half_depth_m = 0.8
-reversal_m = 2.0
-reference_mach = 0.85
-reference_alpha_deg = 2.0
-";
-
+/// The guide's example store under a field: the default with docs/model.md section 3b's
+/// conformance field (5 stations) in place of its decay increments.
 fn flowfield() -> Scenario {
-    let mut text = DEFAULT_SCENARIO_TOML.to_string();
-    for c in [
-        "dcx0 = -0.10",
-        "dcy0 = 0.60",
-        "dcz0 = -0.60",
-        "dcl0 = -0.03",
-        "dcm0 = -1.50",
-        "dcn0 = -0.60",
-    ] {
-        text = text.replace(c, &format!("{} = 0.0", &c[..4]));
-    }
-    Scenario::from_toml_str(&(text + FIELD), "flowfield").expect("a valid field")
+    let text = include_str!("../../examples/flowfield-store/scenario.toml");
+    Scenario::from_toml_str(text, "flowfield").expect("a valid field")
 }
 
 /// 100 runs around the truth (the criterion bench's spread).

@@ -48,20 +48,12 @@ pub(super) fn flowfield_lanes<R: Real>(
     flow: &Flow<R>,
     k: Coefficients<R>,
 ) -> Coefficients<R> {
-    let mut c = [k.cx, k.cy, k.cz, k.cl, k.cm, k.cn].map(R::to_array);
+    let mut c = lanes_of(k);
     for (i, part) in parts.iter().enumerate() {
         let Some(field) = &part.run.flowfield else {
             continue;
         };
-        let at = |j: usize| c[j].as_ref()[i];
-        let k_i = Coefficients {
-            cx: at(0),
-            cy: at(1),
-            cz: at(2),
-            cl: at(3),
-            cm: at(4),
-            cn: at(5),
-        };
+        let k_i = lane_of::<R>(&c, i);
         let k_i = FieldLanes::<f64>::gather(|_| field, part.run.aero_reference_x_m).add_loads(
             r_m.map(|v| lane(v, i)),
             axis_l.map(|v| lane(v, i)),
@@ -69,22 +61,9 @@ pub(super) fn flowfield_lanes<R: Real>(
             lane(flow.beta_rad, i),
             k_i,
         );
-        for (j, v) in [k_i.cx, k_i.cy, k_i.cz, k_i.cl, k_i.cm, k_i.cn]
-            .into_iter()
-            .enumerate()
-        {
-            c[j].as_mut()[i] = v;
-        }
+        set_lane::<R>(&mut c, i, k_i);
     }
-    let [cx, cy, cz, cl, cm, cn] = c.map(R::from_array);
-    Coefficients {
-        cx,
-        cy,
-        cz,
-        cl,
-        cm,
-        cn,
-    }
+    from_lanes::<R>(c)
 }
 
 /// The extra terms of each lane's run ([`Parts::extra_terms`]) at that lane's flow, put back into
@@ -113,7 +92,7 @@ pub(super) fn lane_by_lane_terms<R: Real>(
         lateral_m,
     ]
     .map(R::to_array);
-    let mut c = [k.cx, k.cy, k.cz, k.cl, k.cm, k.cn].map(R::to_array);
+    let mut c = lanes_of(k);
     for (i, part) in parts.iter().enumerate() {
         if !part.has_extra_terms() {
             continue;
@@ -131,32 +110,11 @@ pub(super) fn lane_by_lane_terms<R: Real>(
             distance_m: l(8),
             mach: l(9),
         };
-        let at = |j: usize| c[j].as_ref()[i];
-        let k_i = Coefficients {
-            cx: at(0),
-            cy: at(1),
-            cz: at(2),
-            cl: at(3),
-            cm: at(4),
-            cn: at(5),
-        };
+        let k_i = lane_of::<R>(&c, i);
         let k_i = part.extra_terms(&flow_i, l(10), k_i);
-        for (j, v) in [k_i.cx, k_i.cy, k_i.cz, k_i.cl, k_i.cm, k_i.cn]
-            .into_iter()
-            .enumerate()
-        {
-            c[j].as_mut()[i] = v;
-        }
+        set_lane::<R>(&mut c, i, k_i);
     }
-    let [cx, cy, cz, cl, cm, cn] = c.map(R::from_array);
-    Coefficients {
-        cx,
-        cy,
-        cz,
-        cl,
-        cm,
-        cn,
-    }
+    from_lanes::<R>(c)
 }
 
 /// What one run's force evaluation needs beyond its constants: the run, its ejector force curve,
@@ -276,4 +234,48 @@ fn add_corrections(run: &RunSetup, flow: &Flow, mut k: Coefficients) -> Coeffici
     k.cm = m[4].mul_add(d[10], k.cm) + d[4];
     k.cn = m[5].mul_add(d[11], k.cn) + d[5];
     k
+}
+
+/// The six coefficients of every lane as arrays (CX, CY, CZ, Cl, Cm, Cn), each lane read and
+/// written once through them (a lane written into a register's memory and read back whole
+/// stalls the load).
+#[inline(always)]
+fn lanes_of<R: Real>(k: Coefficients<R>) -> [R::Array; 6] {
+    [k.cx, k.cy, k.cz, k.cl, k.cm, k.cn].map(R::to_array)
+}
+
+/// Lane `i`'s coefficients from [`lanes_of`]'s arrays.
+#[inline(always)]
+fn lane_of<R: Real>(c: &[R::Array; 6], i: usize) -> Coefficients {
+    let at = |j: usize| c[j].as_ref()[i];
+    Coefficients {
+        cx: at(0),
+        cy: at(1),
+        cz: at(2),
+        cl: at(3),
+        cm: at(4),
+        cn: at(5),
+    }
+}
+
+/// Puts lane `i`'s coefficients `k` back into [`lanes_of`]'s arrays.
+#[inline(always)]
+fn set_lane<R: Real>(c: &mut [R::Array; 6], i: usize, k: Coefficients) {
+    for (j, v) in [k.cx, k.cy, k.cz, k.cl, k.cm, k.cn].into_iter().enumerate() {
+        c[j].as_mut()[i] = v;
+    }
+}
+
+/// The coefficients of every lane from [`lanes_of`]'s arrays.
+#[inline(always)]
+fn from_lanes<R: Real>(c: [R::Array; 6]) -> Coefficients<R> {
+    let [cx, cy, cz, cl, cm, cn] = c.map(R::from_array);
+    Coefficients {
+        cx,
+        cy,
+        cz,
+        cl,
+        cm,
+        cn,
+    }
 }

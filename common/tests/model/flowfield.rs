@@ -5,48 +5,22 @@
 //! naming the field.
 
 use sepval_common::model::{Coefficients, EquationsOfMotion, FlowfieldRun};
-use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
+use sepval_common::scenario::Scenario;
 use sepval_common::{EffectSet, Factors, Simulator};
 
-/// The conformance case's `[flowfield]` (docs/model.md section 3b).
-pub(crate) const FIELD: &str = "
-[flowfield]
-stations = 5
-nose_x_m = 1.5
-tail_x_m = -1.5
-upwash_deg = 3.0
-upwash_per_alpha = 0.5
-upwash_gradient_deg_per_m = -1.0
-sidewash_deg = -1.5
-sidewash_gradient_deg_per_m = 0.5
-dynamic_pressure_ratio = 0.9
-roll_cl = -0.02
-half_depth_m = 0.8
-reversal_m = 2.0
-reference_mach = 0.85
-reference_alpha_deg = 2.0
-";
+/// The guide's example store under a field (`examples/flowfield-store/scenario.toml`): the
+/// default with its six decay increments 0 and docs/model.md section 3b's conformance field.
+pub(crate) const EXAMPLE: &str = include_str!("../../../examples/flowfield-store/scenario.toml");
 
-/// The default scenario's text with its six decay increments set to 0.
-fn without_increments() -> String {
-    let mut text = DEFAULT_SCENARIO_TOML.to_string();
-    for (from, to) in [
-        ("dcx0 = -0.10", "dcx0 = 0.0"),
-        ("dcy0 = 0.60", "dcy0 = 0.0"),
-        ("dcz0 = -0.60", "dcz0 = 0.0"),
-        ("dcl0 = -0.03", "dcl0 = 0.0"),
-        ("dcm0 = -1.50", "dcm0 = 0.0"),
-        ("dcn0 = -0.60", "dcn0 = 0.0"),
-    ] {
-        assert!(text.contains(from), "the default scenario has `{from}`");
-        text = text.replace(from, to);
-    }
-    text
+/// The conformance scenario: [`EXAMPLE`].
+pub(crate) fn conformance_scenario() -> Scenario {
+    Scenario::from_toml_str(EXAMPLE, "flowfield").unwrap()
 }
 
-/// The conformance scenario: the default, its increments 0, with [`FIELD`].
-pub(crate) fn conformance_scenario() -> Scenario {
-    Scenario::from_toml_str(&(without_increments() + FIELD), "flowfield").unwrap()
+/// [`EXAMPLE`] with `from` (which it holds) replaced by `to`.
+fn example_with(from: &str, to: &str) -> String {
+    assert!(EXAMPLE.contains(from), "the example has `{from}`");
+    EXAMPLE.replacen(from, to, 1)
 }
 
 fn refusal(text: &str) -> String {
@@ -60,11 +34,10 @@ fn a_uniform_field_is_a_change_of_flow_angle() {
     // No gradient, no change of dynamic pressure, the store level at carriage: every station
     // sees the same upwash and sidewash, and the loads are the store's own derivatives times
     // them (docs/model.md section 3b).
-    let field = FIELD
-        .replace("upwash_gradient_deg_per_m = -1.0", "")
+    let text = example_with("upwash_gradient_deg_per_m = -1.0", "")
         .replace("sidewash_gradient_deg_per_m = 0.5", "")
         .replace("dynamic_pressure_ratio = 0.9", "");
-    let scenario = Scenario::from_toml_str(&(without_increments() + &field), "uniform").unwrap();
+    let scenario = Scenario::from_toml_str(&text, "uniform").unwrap();
     let sim = Simulator::new(&scenario);
     let run = sim.run_setup(&Factors::TRUTH, &EffectSet::NONE).unwrap();
     let f: FlowfieldRun = run.flowfield.expect("the scenario has a field");
@@ -118,50 +91,49 @@ fn lanes_equal_scalar_runs_bit_for_bit_with_a_field() {
 
 #[test]
 fn what_the_field_cannot_do_is_refused_naming_the_field() {
-    let with = |field: &str| without_increments() + field;
     let cases = [
         (
-            DEFAULT_SCENARIO_TOML.to_string() + FIELD,
+            example_with("dcx0 = 0.0", "dcx0 = -0.10"),
             "interference.dcx0",
             "must be the constant 0",
         ),
         (
-            with(&FIELD.replace("stations = 5", "stations = 1")),
+            example_with("stations = 5", "stations = 1"),
             "flowfield.stations",
             "expected 2 to 16",
         ),
         (
-            with(&FIELD.replace("tail_x_m = -1.5", "tail_x_m = 2.0")),
+            example_with("tail_x_m = -1.5", "tail_x_m = 2.0"),
             "flowfield.nose_x_m",
             "nose ahead of the tail",
         ),
         (
-            with(&FIELD.replace("half_depth_m = 0.8", "half_depth_m = 0.0")),
+            example_with("half_depth_m = 0.8", "half_depth_m = 0.0"),
             "flowfield.half_depth_m",
             "> 0",
         ),
         (
-            with(&FIELD.replace("reversal_m = 2.0", "reversal_m = -1.0")),
+            example_with("reversal_m = 2.0", "reversal_m = -1.0"),
             "flowfield.reversal_m",
             "> 0",
         ),
         (
-            with(&FIELD.replace("upwash_deg = 3.0", "upwash_deg = 60.0")),
+            example_with("upwash_deg = 3.0", "upwash_deg = 60.0"),
             "flowfield.upwash_deg",
             "within +-45 deg",
         ),
         (
-            with(&FIELD.replace("reference_mach = 0.85\n", "")),
+            example_with("reference_mach = 0.85\n", ""),
             "reference_mach",
             "missing field",
         ),
         (
-            with(&(FIELD.to_string() + "upwash_rad = 1.0\n")),
+            EXAMPLE.to_string() + "upwash_rad = 1.0\n",
             "upwash_rad",
             "unknown field",
         ),
         (
-            with(FIELD).replace("cz_alpha_per_rad = -6.0", "cz_alpha_per_rad = 0.0"),
+            example_with("cz_alpha_per_rad = -6.0", "cz_alpha_per_rad = 0.0"),
             "aero.cz_alpha_per_rad",
             "non-zero",
         ),
