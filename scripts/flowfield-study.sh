@@ -72,6 +72,16 @@ reversal_m = 1.2
 reference_mach = 0.95
 reference_alpha_deg = 2.0'
 
+# The prediction at C4 of the model `$2` with the factors `$3/factors.json`, against the truth
+# `$1/c4.csv`: a row of study.csv starting with `$4`.
+predicted() {
+    "$SEPVAL" simulate --scenario "$2" --factors "$3/factors.json" --out "$3/c4.csv" > /dev/null
+    local pos att
+    read -r pos att < <("$SEPVAL" goals --data "$1/c4.csv" --sim "$3/c4.csv" \
+        | awk '/J_pos/ {p = $3} /J_att/ {a = $3} END {print p, a}')
+    echo "$4,$(awk "BEGIN {print $pos * 1000}"),$att" >> "$OUT/study.csv"
+}
+
 CONDITIONS=("0.80 0.0" "0.95 3.0" "0.90 -2.0")
 PREDICTED="0.85 1.5"
 
@@ -108,21 +118,13 @@ for k in 1 2 3; do
             # The refined optimum's factors, as `simulate --factors` reads them.
             python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print(json.dumps(r["methods"]["ga+lm"]["best"]["factors"]))' \
                 "$fit/result.json" > "$fit/factors.json"
-            "$SEPVAL" simulate --scenario "$dir/$model-c4.toml" --factors "$fit/factors.json" \
-                --out "$fit/c4.csv" > /dev/null
-            read -r pos att < <("$SEPVAL" goals --data "$dir/c4.csv" --sim "$fit/c4.csv" \
-                | awk '/J_pos/ {p = $3} /J_att/ {a = $3} END {print p, a}')
-            echo "$k,$model,$n,$(awk "BEGIN {print $pos * 1000}"),$att" >> "$OUT/study.csv"
+            predicted "$dir" "$dir/$model-c4.toml" "$fit" "$k,$model,$n"
         done
         up="$dir/decay-update-$n"
         "$SEPVAL" update --scenario "$dir/decay.toml" "${data[@]}" --seed 1 --out "$up" > /dev/null
         sed -e "s/^mach = .*/mach = $mach/" -e "s/^alpha_deg = .*/alpha_deg = $alpha/" \
             "$up/scenario.toml" > "$up/scenario-c4.toml"
-        "$SEPVAL" simulate --scenario "$up/scenario-c4.toml" --factors "$up/factors.json" \
-            --out "$up/c4.csv" > /dev/null
-        read -r pos att < <("$SEPVAL" goals --data "$dir/c4.csv" --sim "$up/c4.csv" \
-            | awk '/J_pos/ {p = $3} /J_att/ {a = $3} END {print p, a}')
-        echo "$k,decay+update,$n,$(awk "BEGIN {print $pos * 1000}"),$att" >> "$OUT/study.csv"
+        predicted "$dir" "$up/scenario-c4.toml" "$up" "$k,decay+update,$n"
     done
 done
 column -s, -t < "$OUT/study.csv"
