@@ -191,10 +191,7 @@ pub(crate) fn draws(
         .map(|s| {
             let mut rng = sample_rng(settings.seed, s as u64, STREAM_PARAMETERS);
             let x = model.distribution.draw(&mut rng);
-            model
-                .space
-                .candidate(&x)
-                .map_err(|e| CampaignError::Model(e.to_string()))
+            model.space.candidate(&x).map_err(CampaignError::Model)
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok((candidates, vec![0; settings.samples]))

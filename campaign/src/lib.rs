@@ -49,8 +49,8 @@ pub enum CampaignError {
     #[error("the prediction of a condition")]
     Condition(#[source] Box<sepval_predict::PredictError>),
     /// The model could not be made of its parameters.
-    #[error("the model: {0}")]
-    Model(String),
+    #[error("the model")]
+    Model(#[source] sepval_solve::run::RunError),
     /// An evaluator that could not be started.
     #[error("cannot start the evaluator")]
     Start(#[source] EvalError),

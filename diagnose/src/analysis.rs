@@ -504,8 +504,7 @@ fn extension_file(
     ));
     text.push_str(&extension_toml(&records));
     // What is written must read back.
-    sepval_common::extension::parse_extension(&text, "extension.toml").map_err(|e| {
-        DiagnoseError::Model(format!("the extension written does not read back: {e}"))
-    })?;
+    sepval_common::extension::parse_extension(&text, "extension.toml")
+        .map_err(DiagnoseError::ExtensionReadBack)?;
     Ok(text)
 }

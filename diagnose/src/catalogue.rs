@@ -15,7 +15,7 @@ use sepval_common::factors::FACTOR_COUNT;
 
 use super::contender::Contender;
 use super::residuals::{physical_residuals, rms_channels};
-use super::{ALPHA, CandidateReport, DiagnoseError, Fitted, ParamValue, Result, SkippedRefit, bic};
+use super::{ALPHA, CandidateReport, Fitted, ParamValue, Result, SkippedRefit, bic};
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_solve::identifiability::identifiability;
@@ -113,8 +113,7 @@ fn try_extensions(
             .iter()
             .map(|p| p.neutral)
             .collect();
-        set.push(index, &neutral)
-            .map_err(|e| DiagnoseError::Model(e.to_string()))?;
+        set.push(index, &neutral)?;
         let space = ParamSpace::new(&table, &set);
         let mut x0 = base.lm.x.clone();
         x0.extend(neutral);

@@ -97,9 +97,24 @@ pub enum DiagnoseError {
     /// The HTML report that cannot be rendered.
     #[error(transparent)]
     Html(#[from] HtmlError),
-    /// A model extension that cannot be made.
-    #[error("{0}")]
-    Model(String),
+    /// The extension written does not read back (a defect: what sepval writes it must read).
+    #[error("the extension written does not read back")]
+    ExtensionReadBack(#[source] sepval_common::extension::ExtensionError),
+    /// A catalogue effect that cannot be added to the baseline's effects.
+    #[error("a catalogue effect cannot be added")]
+    Effect(#[from] sepval_common::effects::EffectError),
+    /// A term that cannot be added to the model's extension.
+    #[error("a term cannot be added to the extension")]
+    Term(#[from] sepval_common::extension::TermError),
+    /// The baseline fit stopped without a refined optimum (a diagnosis needs one).
+    #[error("the baseline fit produced no refined optimum")]
+    NoRefinedOptimum,
+    /// The fitted trajectory could not be simulated again (for its misfit).
+    #[error("the fitted trajectory could not be simulated again")]
+    NotSimulatedAgain,
+    /// A leave-one-out refit of the discovery's selection is missing (a defect).
+    #[error("a leave-one-out refit is missing")]
+    MissingRefit,
     /// The baseline fit left a scenario table and `strict_tables` refuses that: one line per
     /// event and table, worded as `sepval fit --strict-tables` words them.
     #[error(
@@ -422,9 +437,7 @@ fn baseline_fit(
         FitError::Run(RunError::Interrupted) => DiagnoseError::Run(RunError::Interrupted),
         other => DiagnoseError::Baseline(other),
     })?;
-    let lm = out.refined.ok_or_else(|| {
-        DiagnoseError::Model("the baseline fit produced no refined optimum".into())
-    })?;
+    let lm = out.refined.ok_or(DiagnoseError::NoRefinedOptimum)?;
     let mut evaluations: u64 = out
         .result
         .methods

@@ -57,9 +57,7 @@ pub fn reconstruct_misfit(
     let job = std::sync::Arc::clone(evaluator.job());
     let history = library::flow_history(&job, base);
     if history.iter().any(Vec::is_empty) {
-        return Err(DiagnoseError::Model(
-            "the fitted trajectory could not be simulated again".into(),
-        ));
+        return Err(DiagnoseError::NotSimulatedAgain);
     }
     let rows = probe::rows(&job);
     let r0 = DVector::from_iterator(rows.len(), rows.iter().map(|&i| residuals[i]));

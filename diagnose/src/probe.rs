@@ -72,9 +72,7 @@ pub fn columns(
         .iter()
         .map(|t| {
             let mut c = *base;
-            c.terms
-                .push(*t)
-                .map_err(|e| DiagnoseError::Model(e.to_string()))?;
+            c.terms.push(*t)?;
             Ok(c)
         })
         .collect::<Result<_, DiagnoseError>>()?;

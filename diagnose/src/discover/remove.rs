@@ -107,9 +107,7 @@ pub(super) fn f_to_remove(
         ));
         sel.picked.remove(k);
         sel.groups.remove(k);
-        sel.current = without
-            .swap_remove(k)
-            .ok_or_else(|| DiagnoseError::Model("a leave-one-out refit is missing".into()))?;
+        sel.current = without.swap_remove(k).ok_or(DiagnoseError::MissingRefit)?;
         sel.without = None;
     } else {
         sel.without = Some(without);
