@@ -78,6 +78,7 @@ impl<R: Real> Constants<R> {
         let g33 = |f: &dyn Fn(&RunSetup) -> nalgebra::Matrix3<f64>| {
             [0, 1, 2].map(|r| [0, 1, 2].map(|c| gather::<R>(|i| f(runs(i))[(r, c)])))
         };
+        let alike = alike_fields(parts);
         Constants {
             accel_per_speed2: g(&|r| r.half_rho_area * r.inv_mass_per_kg),
             moment_per_speed2: g(&|r| r.half_rho_area * r.diameter_m),
@@ -101,13 +102,13 @@ impl<R: Real> Constants<R> {
             any_diagonal: parts.iter().any(|p| p.run.inertia_diagonal),
             extra_terms: parts.iter().any(Parts::has_extra_terms),
             wind: parts.iter().any(|p| p.run.terms.has_wind()),
-            field: alike_fields(parts).then(|| {
+            field: alike.then(|| {
                 FieldLanes::gather(
                     |i| runs(i).flowfield.as_ref().expect("every lane has a field"),
                     g(&|r| r.aero_reference_x_m),
                 )
             }),
-            field_by_lane: !alike_fields(parts) && parts.iter().any(|p| p.run.flowfield.is_some()),
+            field_by_lane: !alike && parts.iter().any(|p| p.run.flowfield.is_some()),
         }
     }
 }

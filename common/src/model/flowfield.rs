@@ -122,11 +122,6 @@ impl FlowfieldRun {
         }
     }
 
-    /// g(z): the field's shape with depth `z_m` below carriage.
-    pub fn shape(&self, z_m: f64) -> f64 {
-        FieldLanes::<f64>::gather(|_| self, 0.0).shape(z_m)
-    }
-
     /// The field at the point `p_m` of L: (alpha_i \[rad\], beta_i \[rad\], eta).
     pub fn at(&self, p_m: [f64; 3]) -> [f64; 3] {
         FieldLanes::<f64>::gather(|_| self, 0.0).at(p_m)
@@ -325,14 +320,21 @@ impl<R: Real> FieldSums<R> {
         beta_rad: R,
         mut k: Coefficients<R>,
     ) -> Coefficients<R> {
-        let sum = |j: usize, angle: R| self.by_angle[j].mul_add(angle, self.field[j]);
         k.cx = (self.e_sum * f.inv_stations).mul_add(k.cx, k.cx);
-        k.cz = f.slopes_per_rad[0].mul_add(sum(0, alpha_rad), k.cz);
-        k.cm = (-f.slopes_per_rad_m[0]).mul_add(sum(1, alpha_rad), k.cm);
-        k.cy = f.slopes_per_rad[1].mul_add(sum(2, beta_rad), k.cy);
-        k.cn = f.slopes_per_rad_m[1].mul_add(sum(3, beta_rad), k.cn);
+        k.cz = f.slopes_per_rad[0].mul_add(self.sum(0, alpha_rad), k.cz);
+        k.cm = (-f.slopes_per_rad_m[0]).mul_add(self.sum(1, alpha_rad), k.cm);
+        k.cy = f.slopes_per_rad[1].mul_add(self.sum(2, beta_rad), k.cy);
+        k.cn = f.slopes_per_rad_m[1].mul_add(self.sum(3, beta_rad), k.cn);
         k.cl = k.cl + self.roll_cl;
         k
+    }
+
+    /// Sum `j` (normal, pitch, side, yaw) at the flow angle `angle`: sum w_k n_k = angle
+    /// sum w_k e_k + sum w_k eta_k alpha_k (likewise the others). A method, not a closure: sure
+    /// to be inlined, so its multiply-add is compiled with the propagator's target features.
+    #[inline(always)]
+    fn sum(&self, j: usize, angle: R) -> R {
+        self.by_angle[j].mul_add(angle, self.field[j])
     }
 }
 

@@ -307,3 +307,45 @@ fn small_changes_of_the_field_give_small_trajectory_changes() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+#[test]
+fn lanes_whose_fields_differ_in_kind_keep_the_scalar_runs_bits() {
+    // One scenario gives every run the same field; a run whose field was taken away by hand
+    // (RunSetup's fields are public) sends the batch through the lane-by-lane path instead.
+    use sepval_common::propagator::{LANES, Observation, propagate, propagate_lanes};
+    let sim = Simulator::new(&conformance_scenario());
+    let times = sim.default_times();
+    let mut runs: Vec<_> = [
+        Factors::TRUTH,
+        Factors::NOMINAL,
+        Factors::TRUTH,
+        Factors::NOMINAL,
+    ]
+    .iter()
+    .map(|f| sim.run_setup(f, &EffectSet::NONE).unwrap())
+    .collect();
+    runs[1].flowfield = None;
+    runs[2].flowfield = None;
+    assert_eq!(runs.len(), LANES);
+    let bits = |s: &[Observation]| -> Vec<u64> {
+        s.iter()
+            .flat_map(|o| o.pos_m.iter().chain(&o.att_deg).map(|v| v.to_bits()))
+            .collect()
+    };
+    let mut sinks = vec![Vec::<Observation>::new(); LANES];
+    for r in propagate_lanes(sim.model(), &runs, &times, &mut sinks) {
+        r.unwrap();
+    }
+    for (i, run) in runs.iter().enumerate() {
+        let mut alone = Vec::<Observation>::new();
+        propagate(sim.model(), run, &times, &mut alone).unwrap();
+        assert!(
+            bits(&sinks[i]) == bits(&alone),
+            "lane {i} differs from its scalar run"
+        );
+    }
+    assert!(
+        bits(&sinks[0]) != bits(&sinks[2]),
+        "the field moves the store"
+    );
+}
