@@ -132,8 +132,10 @@ pub struct RivalClass {
     pub members: Vec<String>,
     /// `answer` (a member is a term of the answer), `better` (a significant representative's
     /// BIC is below the answer's by the margin or more), `rival` (a significant representative
-    /// within the margin), `told apart` (its representatives' refits are neither) or
-    /// `not refitted` (beyond the budget of refits: the data were not asked).
+    /// within the margin), `unsettled` (the class of the first screening's best entry whose
+    /// every refit stopped at its iteration limit: open), `told apart` (its representatives'
+    /// refits are neither) or `not refitted` (beyond the budget of refits: the data were not
+    /// asked).
     pub status: String,
     /// Its best representative's BIC less the answer's, when one was refitted.
     pub delta_bic: Option<f64>,

@@ -104,6 +104,8 @@ pub(crate) struct ClassTrial {
     delta_bic: f64,
     /// Whether it is significant against the baseline by its pool's rule.
     significant: bool,
+    /// Whether its refit stopped at its iteration limit (its chi-square only an upper bound).
+    cut_off: bool,
 }
 
 /// What the rival search gives: the rivals, and what became of each rival class's contenders.
@@ -150,6 +152,7 @@ pub(crate) fn rivals(
                 class,
                 delta_bic,
                 significant: significant(setting, baseline, &c),
+                cut_off: c.fitted.lm.cut_off(),
             });
         }
     }
@@ -164,6 +167,7 @@ pub(crate) fn rivals(
                 class,
                 delta_bic,
                 significant,
+                cut_off: c.fitted.lm.cut_off(),
             });
         }
         if rival {
@@ -181,8 +185,17 @@ pub(crate) fn rivals(
 /// The rival classes as diagnosis.json reports them: each class of the answer (one of its
 /// members is a term of the answer's model, or of an effect that is one term), better (a
 /// significant representative's BIC is below the answer's by the margin or more: the data
-/// favour it), a rival (a significant representative within the margin), told apart (its
+/// favour it), a rival (a significant representative within the margin), unsettled (the class
+/// of the first screening's best entry, every refit of which stopped at its iteration limit:
+/// the regression and the refit disagree, and a refit cut off is no optimum), told apart (its
 /// representatives' refits are neither) or not refitted (beyond the budget of refits).
+///
+/// Unsettled is issue 36's item 2: a pitch-damping change on two releases at very different
+/// dynamic pressures, where the screening ranked `Cm q d/2V` first but its refit from the
+/// baseline's factors (which had compensated the weaker damping) crept along a curved valley
+/// and stopped at 3.9 times the noise's chi-square, while a Mach term and two more won; from
+/// the truth's factors the same refit reaches the noise. Told apart on that refit, the answer
+/// had no rival and was wrong.
 pub(crate) fn class_reports(
     setting: &Setting,
     answer_model: &Fitted,
@@ -220,6 +233,8 @@ pub(crate) fn class_reports(
                 ("better", significant_best)
             } else if significant_best.is_some_and(|d| d.abs() < RIVAL_MARGIN) {
                 ("rival", significant_best)
+            } else if k == 0 && !mine.is_empty() && mine.iter().all(|t| t.cut_off) {
+                ("unsettled", best)
             } else if best.is_some() {
                 ("told apart", best)
             } else {

@@ -191,6 +191,10 @@ pub(super) fn open_classes(classes: &[crate::RivalClass]) -> Option<String> {
         .map(|c| match (c.status.as_str(), c.delta_bic) {
             ("answer", _) => format!("{} (the answer's class)", c.words),
             ("better", Some(d)) => format!("{} (BIC {d:+.1}: it fits better)", c.words),
+            ("unsettled", Some(d)) => format!(
+                "{} (the screening's best; its refit stopped at its iteration limit at BIC {d:+.1}: not settled)",
+                c.words
+            ),
             (_, Some(d)) => format!("{} (BIC {d:+.1})", c.words),
             _ => c.words.clone(),
         })
@@ -240,4 +244,32 @@ pub(super) fn ambiguity(rivals: &[crate::RivalReport], events: usize) -> Option<
         "{data} cannot tell it from {}: a release that separates them settles it (`sepval plan`)",
         named.join(" or from ")
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn class(words: &str, status: &str, delta_bic: Option<f64>) -> crate::RivalClass {
+        crate::RivalClass {
+            words: words.into(),
+            members: vec![words.into()],
+            status: status.into(),
+            delta_bic,
+        }
+    }
+
+    #[test]
+    fn an_unsettled_class_is_named_open_and_a_told_apart_one_is_not() {
+        let classes = [
+            class("Cm q d/2V", "unsettled", Some(3251.2)),
+            class("Cm beta", "told apart", Some(40.0)),
+        ];
+        let text = open_classes(&classes).unwrap();
+        assert!(text.contains("Cm q d/2V"), "{text}");
+        assert!(text.contains("iteration limit"), "{text}");
+        assert!(text.contains("+3251.2"), "{text}");
+        assert!(!text.contains("Cm beta"), "{text}");
+        assert_eq!(open_classes(&classes[1..]), None);
+    }
 }

@@ -42,6 +42,10 @@ fn search_error(what: impl std::fmt::Display) -> RunError {
     RunError::Search(what.to_string())
 }
 
+/// [`LmResult::stop`] of a refinement that ran out of iterations before it converged or
+/// stalled: its cost is then only an upper bound of its optimum's.
+pub const ITERATION_LIMIT: &str = "iteration limit";
+
 /// Settings of the refinement.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LmSettings {
@@ -111,6 +115,14 @@ pub struct LmResult {
     pub history: Vec<(u64, Goals)>,
     /// Why it stopped.
     pub stop: String,
+}
+
+impl LmResult {
+    /// Whether it stopped at its iteration limit ([`ITERATION_LIMIT`]), neither converged nor
+    /// stalled.
+    pub fn cut_off(&self) -> bool {
+        self.stop == ITERATION_LIMIT
+    }
 }
 
 /// Where a refinement is: its point, residuals and Jacobian, damping and counters.
@@ -354,6 +366,22 @@ mod tests {
         }
         // The parts change how the points travel, never the arithmetic.
         assert!(answers.windows(2).all(|w| w[0] == w[1]));
+    }
+
+    #[test]
+    fn a_refinement_out_of_iterations_is_cut_off_and_one_converged_is_not() {
+        let few = LmSettings {
+            max_iterations: 2,
+            ..LmSettings::default()
+        };
+        let mut lm = LmRun::new(params(), &[-1.2, 1.0], Rms, few, 100);
+        run(&mut lm, &mut Rosenbrock, &mut []).unwrap();
+        let r = lm.finish();
+        assert!(r.cut_off(), "{}", r.stop);
+        assert!(r.cost > 1e-6, "{}", r.cost);
+        let mut lm = LmRun::new(params(), &[-1.2, 1.0], Rms, LmSettings::default(), 100);
+        run(&mut lm, &mut Rosenbrock, &mut []).unwrap();
+        assert!(!lm.finish().cut_off());
     }
 
     #[test]

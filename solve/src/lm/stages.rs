@@ -8,7 +8,7 @@ use std::ops::Range;
 use nalgebra::{DMatrix, DVector};
 
 use super::linear::solve_damped;
-use super::{LmRun, Measure, Result, search_error};
+use super::{ITERATION_LIMIT, LmRun, Measure, Result, search_error};
 
 /// A stage's points asked in parts: the part that starts at `next` of `len` points.
 #[derive(Debug, Clone, Copy)]
@@ -126,7 +126,7 @@ impl<M: Measure> LmRun<M> {
         let n = self.params.len();
         let at = &mut self.at;
         if at.iterations >= self.settings.max_iterations {
-            at.stop = "iteration limit".into();
+            at.stop = ITERATION_LIMIT.into();
             return Stage::Done;
         }
         if at.evaluations + 8 + n as u64 > self.settings.budget {
