@@ -11,8 +11,9 @@
 //! 2. *Errors beyond the factor band.* At each sample of release j and channel c: e the data
 //!    minus the held-out fit's trajectory, v the variance of [`HELD_OUT_SAMPLES`] trajectories
 //!    drawn from that fit's covariance ([`crate::sampling`]), sigma_c the noise; the excess is
-//!    e^2 - v - sigma_c^2 (signed: noise alone gives it a mean of zero), averaged over a
-//!    moving window of +-10 % of the release's samples (W samples); the window stays symmetric
+//!    e^2 - v - sigma_c^2 (signed: noise and the factors alone give it a mean of zero),
+//!    averaged over a moving window of +-10 % of the release's samples (W samples); the window
+//!    stays symmetric
 //!    near the release, narrowing to the first sample after it (W then counts the samples in
 //!    it), and at and before release (t <= 0), where the state is known (carriage), the
 //!    excess is 0.
@@ -23,9 +24,15 @@
 //!    flown say that the model's form, not its factors, decides the prediction there.
 //! 4. *Carried to the release predicted.* M_c(t) is the mean over the J held-out releases of
 //!    their excess at the same time after release (linear between samples, held beyond a
-//!    release's end), less what noise alone gives a window's mean there, [`SIGNIFICANCE`]
-//!    sigma_c^2 sqrt(2 / W) / sqrt(J) (e^2 - sigma^2 has variance 2 sigma^4 for white noise); D_c(t)
-//!    the mean of the departures. delta_c(t)^2 = [`KAPPA`] max(0, M_c(t), D_c(t)).
+//!    release's end), less what noise and the held-out fit's own factor spread alone give a
+//!    window's mean there, [`SIGNIFICANCE`] sqrt(2 v^2 + (2 sigma_c^4 + 4 v sigma_c^2) / W)
+//!    / sqrt(J) (`excess::threshold`: the noise averages over the window, but the
+//!    fit's factor error is one draw, smooth in time, whose square keeps its variance 2 v^2);
+//!    D_c(t) the mean of the departures less [`SIGNIFICANCE`] sqrt(2) v_-j / sqrt(J) alike.
+//!    delta_c(t)^2 = [`KAPPA`] max(0, M_c(t), D_c(t)). Without the factor spread in these
+//!    thresholds (before 2026-11-27), one refit's parameter error at the release it left out,
+//!    a draw from its own band, counted as the model's form: the bands of a flowfield whose
+//!    form is right were 17 to 37 times its prediction's error (issue 37).
 //! 5. *The releases fitted.* Whatever the held-out releases say, delta_c(t)^2 is at least the
 //!    answer's own misfit on the releases fitted beyond the noise at the same time after
 //!    release: F_c(t) = max(0, mean over the R releases fitted of the smoothed e^2 -
@@ -262,7 +269,7 @@ pub fn carry(
         .map(|(&t, floor2)| {
             std::array::from_fn(|c| {
                 let beyond = beyond_noise(excesses, t, c);
-                // Departures carry no noise threshold: their mean, at least 0.
+                // Departures carry no noise threshold, only their factor bands' (`threshold`).
                 let departed = beyond_noise(&departures, t, c);
                 let beyond = beyond.max(departed);
                 (KAPPA * beyond).max(floor2[c]).sqrt()
@@ -294,7 +301,7 @@ fn misfit(cal: &Calibration, event: &Event) -> Result<(Option<Excess>, u64), Dis
         })
         .collect();
     Ok((
-        Some(Excess::smoothed(&b.grid.t_s, &raw, Some(cal.noise))),
+        Some(Excess::smoothed(&b.grid.t_s, &raw, Some(cal.noise), None)),
         b.evaluations,
     ))
 }
@@ -416,7 +423,12 @@ fn departure(b: &FactorBand, full: &GridTrajectory, grid: &Grid) -> Option<Exces
     let raw: Vec<[f64; 6]> = (0..grid.len())
         .map(|k| std::array::from_fn(|c| (nominal[k][c] - full[k][c]).powi(2) - b.var[k][c]))
         .collect();
-    Some(Excess::smoothed(&grid.t_s, &raw, None))
+    Some(Excess::smoothed(
+        &grid.t_s,
+        &raw,
+        None,
+        Some(b.var.as_slice()),
+    ))
 }
 
 /// Release `event` predicted by the fit at `x` with covariance `id`: its record, its smoothed
@@ -453,7 +465,7 @@ fn predict_held_out(
         });
         raw.push(point);
     }
-    let excess = Excess::smoothed(&grid.t_s, &raw, Some(cal.noise));
+    let excess = Excess::smoothed(&grid.t_s, &raw, Some(cal.noise), Some(b.var.as_slice()));
     for p in &excess.value {
         for c in 0..6 {
             exc2[c] += p[c].max(0.0);

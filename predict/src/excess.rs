@@ -13,31 +13,39 @@ pub fn sigma(noise: Noise, c: usize) -> f64 {
     if c < 3 { noise.pos_m } else { noise.att_deg }
 }
 
-/// The excess of one release, smoothed, on its own times, with what noise alone would give it.
+/// The excess of one release, smoothed, on its own times, with what noise and the factors'
+/// spread alone would give it.
 pub(crate) struct Excess {
     /// Its times \[s\].
     pub t_s: Vec<f64>,
     /// The smoothed excess at each time.
     pub value: Vec<[f64; 6]>,
-    /// At each point, [`SIGNIFICANCE`] standard deviations of its window's mean of e^2 -
-    /// sigma^2 under noise alone: SIGNIFICANCE sigma^2 sqrt(2 / W), W the window's samples
-    /// (0 where nothing is subtracted for noise).
+    /// At each point, [`SIGNIFICANCE`] standard deviations of its window's mean of
+    /// e^2 - v - sigma^2 when the model's form is right ([`threshold`]; 0 where nothing is
+    /// subtracted).
     pub threshold: Vec<[f64; 6]>,
 }
 
 impl Excess {
-    /// `raw` on times `t_s` smoothed ([`smooth`]), with the thresholds of noise `noise` (none
-    /// when `None`).
-    pub(crate) fn smoothed(t_s: &[f64], raw: &[[f64; 6]], noise: Option<Noise>) -> Excess {
+    /// `raw` on times `t_s` smoothed ([`smooth`]), with the thresholds ([`threshold`]) of noise
+    /// `noise` (none when `None`) and of the factor variance `v` at each point (none when
+    /// `None`: the answer's own misfit on the releases it was fitted to).
+    pub(crate) fn smoothed(
+        t_s: &[f64],
+        raw: &[[f64; 6]],
+        noise: Option<Noise>,
+        v: Option<&[[f64; 6]]>,
+    ) -> Excess {
         let (value, widths) = smooth(t_s, raw);
+        let v_bar = v.map(|v| smooth(t_s, v).0);
         let threshold = widths
             .iter()
-            .map(|&w| {
-                std::array::from_fn(|c| match noise {
-                    Some(noise) if w > 0.0 => {
-                        SIGNIFICANCE * sigma(noise, c).powi(2) * (2.0 / w).sqrt()
-                    }
-                    _ => 0.0,
+            .enumerate()
+            .map(|(k, &w)| {
+                std::array::from_fn(|c| {
+                    let s2 = noise.map_or(0.0, |n| sigma(n, c).powi(2));
+                    let v = v_bar.as_ref().map_or(0.0, |v| v[k][c].max(0.0));
+                    threshold(s2, v, w)
                 })
             })
             .collect();
@@ -47,6 +55,23 @@ impl Excess {
             threshold,
         }
     }
+}
+
+/// [`SIGNIFICANCE`] standard deviations of a window's mean of e^2 - v - sigma^2 (W points,
+/// `w`) when the model's form is right: e = a + n, the factors' error a ~ N(0, v) and the
+/// noise n ~ N(0, sigma^2) white. The noise averages over the window (2 sigma^4 / W), but a is
+/// one draw of the fit's parameters, smooth in time, nearly the same across the window: its
+/// a^2 - v keeps its variance 2 v^2 whatever W, and the cross term gives 4 v sigma^2 / W. So
+/// SIGNIFICANCE sqrt(2 v^2 + (2 sigma^4 + 4 v sigma^2) / W); with v = 0, the noise's
+/// SIGNIFICANCE sigma^2 sqrt(2 / W) as before; 0 for an empty window (issue 37: without the
+/// 2 v^2, one refit's parameter error at a release left out, a draw from its own band, counted
+/// as the model's form, and the bands of a model whose form is right were 17 to 65 times its
+/// error).
+pub fn threshold(sigma2: f64, v: f64, w: f64) -> f64 {
+    if w <= 0.0 {
+        return 0.0;
+    }
+    SIGNIFICANCE * (2.0 * v * v + (2.0 * sigma2 * sigma2 + 4.0 * v * sigma2) / w).sqrt()
 }
 
 /// The mean of `excesses` at time `t` on channel `c` less what noise alone gives it (their
@@ -113,4 +138,25 @@ fn at_time(t_s: &[f64], series: &[[f64; 6]], t: f64, c: usize) -> f64 {
     let (t0, t1) = (t_s[k - 1], t_s[k]);
     let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
     series[k - 1][c] * (1.0 - w) + series[k][c] * w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_threshold_is_the_noises_without_factor_spread_and_keeps_the_spread_in_long_windows() {
+        // No spread: the noise's SIGNIFICANCE sigma^2 sqrt(2 / W).
+        let (s2, w) = (0.01_f64, 40.0);
+        let noise_only = threshold(s2, 0.0, w);
+        assert!((noise_only - SIGNIFICANCE * s2 * (2.0 / w).sqrt()).abs() < 1e-15);
+        // A factor spread v: its 2 v^2 does not average away however long the window.
+        let v = 0.04;
+        for w in [10.0, 1e3, 1e9] {
+            assert!(threshold(s2, v, w) >= SIGNIFICANCE * 2f64.sqrt() * v);
+        }
+        assert!((threshold(s2, v, 1e12) - SIGNIFICANCE * 2f64.sqrt() * v).abs() < 1e-9);
+        // An empty window (at carriage) subtracts nothing.
+        assert_eq!(threshold(s2, v, 0.0).to_bits(), 0.0_f64.to_bits());
+    }
 }
