@@ -13,8 +13,8 @@ OUT=${1:-bench-out/flowfield-bands}
 SEPVAL=$PWD/target/release/sepval
 [ -x "$SEPVAL" ] || { echo "build first: cargo build --release --workspace" >&2; exit 2; }
 BASE=$PWD/common/scenarios/eglin_default.toml
-# The study's stores and fields (the lines from STORE_DEFAULT to FIELD_3's last).
-eval "$(sed -n '/^STORE_DEFAULT=/,/^reference_alpha_deg = 2.0.$/p' scripts/flowfield-study.sh)"
+# The studies' three truths: STORE_*, FIELD_* and `truth K`.
+. scripts/flowfield-truths.sh
 rm -rf "$OUT"
 mkdir -p "$OUT"
 cd "$OUT"
@@ -53,11 +53,7 @@ PY
 echo "| truth | releases | x | y | z | roll | pitch | yaw |"
 echo "|---|---|---|---|---|---|---|---|"
 for k in 1 2 3; do
-    case $k in
-        1) store=$STORE_DEFAULT field=$FIELD_1 ;;
-        2) store=$STORE_STABLE field=$FIELD_2 ;;
-        3) store=$STORE_LIGHT field=$FIELD_3 ;;
-    esac
+    truth $k
     d=truth-$k
     mkdir -p $d
     scenario "$store" "$field" 0.80 0.0 > $d/c1.toml

@@ -8,12 +8,25 @@
 
 use std::path::Path;
 
-use sepval_common::scenario::Scenario;
+use sepval_common::scenario::{Aero, Scenario};
+use sepval_common::table::DerivativeCoefficient;
 use sepval_tests::{ok, sepval};
 use serde_json::Value;
 
 use super::discover::{default_scenario, diagnose, release};
 use super::gust::{PULSE, gust_release, terms};
+
+/// `model` with the damping derivative `pick` chooses scaled by `scale` (the hidden cause).
+fn damped(
+    model: &Scenario,
+    scale: f64,
+    pick: fn(&mut Aero) -> &mut DerivativeCoefficient,
+) -> Scenario {
+    let mut truth = model.clone();
+    let d = pick(&mut truth.aero);
+    *d = DerivativeCoefficient::constant(scale * d.as_constant().unwrap());
+    truth
+}
 
 /// The three runs of a closed loop.
 struct Loop {
@@ -136,10 +149,7 @@ fn weaker_roll_damping_is_named_after_the_planned_release() {
     // Roll damping half the model's: on one release the catalogue's roll_due_to_sideslip fits
     // as well as the true cause (a Cl change with p d/2V), and so do other Cl terms.
     let model = default_scenario();
-    let mut truth = model.clone();
-    truth.aero.cl_p_per_rad = sepval_common::table::DerivativeCoefficient::constant(
-        0.5 * model.aero.cl_p_per_rad.as_constant().unwrap(),
-    );
+    let truth = damped(&model, 0.5, |a| &mut a.cl_p_per_rad);
     let l = close_loop(
         &model,
         &truth,
@@ -187,10 +197,7 @@ fn weaker_pitch_damping_is_named_or_open_after_the_planned_release() {
         return;
     }
     let model = default_scenario();
-    let mut truth = model.clone();
-    truth.aero.cm_q_per_rad = sepval_common::table::DerivativeCoefficient::constant(
-        0.4 * model.aero.cm_q_per_rad.as_constant().unwrap(),
-    );
+    let truth = damped(&model, 0.4, |a| &mut a.cm_q_per_rad);
     let l = close_loop(
         &model,
         &truth,
@@ -216,10 +223,7 @@ fn weaker_pitch_damping_stays_open_at_the_issues_second_condition() {
         return;
     }
     let model = default_scenario();
-    let mut truth = model.clone();
-    truth.aero.cm_q_per_rad = sepval_common::table::DerivativeCoefficient::constant(
-        0.4 * model.aero.cm_q_per_rad.as_constant().unwrap(),
-    );
+    let truth = damped(&model, 0.4, |a| &mut a.cm_q_per_rad);
     let mut next = truth.clone();
     (
         next.flight.mach,
