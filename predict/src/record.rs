@@ -225,7 +225,7 @@ fn dominant(s: &Shares, p: &Prediction) -> (String, String) {
         "model_form" => format!(
             "the model's form ({pct:.0} % of the variance): {}",
             if p.discrepancy.held_out.iter().any(|h| h.note.is_empty()) {
-                "the releases held out were predicted with errors beyond the factor bands, so the model lacks something the factors cannot absorb"
+                "the releases held out were predicted with errors beyond what their refits' factor bands and the noise allow, so the model lacks something the factors cannot absorb"
             } else {
                 "the answer does not fit the releases fitted to the noise"
             }
@@ -236,7 +236,7 @@ fn dominant(s: &Shares, p: &Prediction) -> (String, String) {
         _ => format!(
             "the factors ({pct:.0} % of the variance): {}",
             if p.discrepancy.held_out.iter().any(|h| h.note.is_empty()) {
-                "the releases held out were predicted within their factor bands, so the fitted model's form holds and what is left is how well the releases fitted pin its factors"
+                "the releases held out were predicted within what their refits' own factor bands and the noise allow, so nothing shows the fitted model's form to be wrong and what is left is how well the releases fitted pin its factors"
             } else {
                 "the answer fits the releases fitted to the noise and no release was held out, so nothing shows the model's form to be wrong"
             }
