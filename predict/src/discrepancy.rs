@@ -64,7 +64,7 @@ use sepval_solve::run::{NoProgress, RunError, run};
 use serde::{Deserialize, Serialize};
 
 use crate::ensemble::Member;
-use crate::excess::{Excess, beyond_noise};
+use crate::excess::{Excess, beyond_chance};
 pub use crate::excess::{SIGNIFICANCE, sigma};
 use crate::sampling::{ParameterDistribution, sample_rng};
 use crate::simulate::{Grid, GridTrajectory, SimulateError, data_on_grid, run_candidates};
@@ -260,7 +260,7 @@ pub fn carry(
     let floor2: Vec<[f64; 6]> = grid
         .t_s
         .iter()
-        .map(|&t| std::array::from_fn(|c| beyond_noise(&ev.misfits, t, c)))
+        .map(|&t| std::array::from_fn(|c| beyond_chance(&ev.misfits, t, c)))
         .collect();
     let sd = grid
         .t_s
@@ -268,9 +268,9 @@ pub fn carry(
         .zip(&floor2)
         .map(|(&t, floor2)| {
             std::array::from_fn(|c| {
-                let beyond = beyond_noise(excesses, t, c);
+                let beyond = beyond_chance(excesses, t, c);
                 // Departures carry no noise threshold, only their factor bands' (`threshold`).
-                let departed = beyond_noise(&departures, t, c);
+                let departed = beyond_chance(&departures, t, c);
                 let beyond = beyond.max(departed);
                 (KAPPA * beyond).max(floor2[c]).sqrt()
             })

@@ -1,7 +1,8 @@
 //! The excess of one release over time (docs/prediction.md section 13.4, steps 2 to 5 of
 //! [`crate::discrepancy`]'s rule): squared errors beyond the factor band and the noise,
 //! smoothed by a moving window that is empty at carriage and symmetric after release, with what
-//! noise alone would give each window's mean, and read at any time after release.
+//! the noise and the fit's own factor spread alone would give each window's mean, and read at
+//! any time after release.
 
 use sepval_fit::space::Noise;
 
@@ -74,9 +75,10 @@ pub fn threshold(sigma2: f64, v: f64, w: f64) -> f64 {
     SIGNIFICANCE * (2.0 * v * v + (2.0 * sigma2 * sigma2 + 4.0 * v * sigma2) / w).sqrt()
 }
 
-/// The mean of `excesses` at time `t` on channel `c` less what noise alone gives it (their
-/// mean threshold over the square root of their number), at least 0; 0 without any.
-pub(crate) fn beyond_noise(excesses: &[Excess], t: f64, c: usize) -> f64 {
+/// The mean of `excesses` at time `t` on channel `c` less what chance gives it, the noise and
+/// the fits' own factor spread (their mean [`threshold`] over the square root of their
+/// number), at least 0; 0 without any.
+pub(crate) fn beyond_chance(excesses: &[Excess], t: f64, c: usize) -> f64 {
     if excesses.is_empty() {
         return 0.0;
     }
