@@ -200,7 +200,7 @@ fn diagnose(
     };
     let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
     sepval_diagnose::diagnose(&options, evaluator.as_mut(), observer).map_err(|e| {
-        if sepval_common::cancel::requested() {
+        if sepval_core::cancel::requested() {
             CampaignError::Interrupted
         } else {
             CampaignError::Diagnose(Box::new(e))

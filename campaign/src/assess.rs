@@ -16,10 +16,10 @@
 
 use std::sync::Arc;
 
-use sepval_common::cancel;
 use sepval_common::evaluation::{Candidate, Job};
 use sepval_common::scenario::{Flight, Scenario};
 use sepval_common::simulation::sample_times;
+use sepval_core::cancel;
 use sepval_envelope::{Grid, Row};
 use sepval_fit::space::ParamSpace;
 use sepval_predict::discrepancy::{self, Calibration, Evidence};

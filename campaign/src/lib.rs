@@ -82,8 +82,8 @@ pub enum CampaignError {
     Interrupted,
 }
 
-impl From<sepval_common::cancel::Cancelled> for CampaignError {
-    fn from(_: sepval_common::cancel::Cancelled) -> Self {
+impl From<sepval_core::cancel::Cancelled> for CampaignError {
+    fn from(_: sepval_core::cancel::Cancelled) -> Self {
         CampaignError::Interrupted
     }
 }

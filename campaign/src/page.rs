@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use sepval_common::atomic_file::write_atomically;
+use sepval_core::atomic_file::write_atomically;
 use sepval_envelope::row::CSV_HEADER;
 use sepval_report::figures::{MapAxis, RoundCounts, state_counts_figure};
 use sepval_report::html::escape_html;

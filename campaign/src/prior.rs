@@ -26,7 +26,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use sepval_common::effects::EffectSet;
-use sepval_common::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
+use sepval_core::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
 use sepval_fit::space::ParamSpace;
 use sepval_predict::sampling::ParameterDistribution;
 
@@ -107,7 +107,7 @@ impl Prior {
             path: path.display().to_string(),
             message,
         };
-        let text = sepval_common::input_file::read_string(path, "prior file", MAX_PRIOR_BYTES)
+        let text = sepval_core::input_file::read_string(path, "prior file", MAX_PRIOR_BYTES)
             .map_err(|e| bad(e.to_string()))?;
         let file: PriorFile = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
         if file.format != PRIOR_FORMAT {

@@ -400,7 +400,7 @@ impl Campaign {
             std::fs::rename(&diagnosis, staged.join("diagnosis"))
                 .map_err(|e| record_error(&diagnosis, e))?;
         }
-        sepval_common::cancel::check()?;
+        sepval_core::cancel::check()?;
         let dir = format!("rounds/{n:02}");
         let target = self.dir.join(&dir);
         std::fs::create_dir_all(self.dir.join("rounds")).map_err(|e| record_error(&target, e))?;

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use sepval_common::atomic_file::write_atomically;
+use sepval_core::atomic_file::write_atomically;
 use sepval_predict::record::ConditionRecord;
 
 use crate::CampaignError;
@@ -185,7 +185,7 @@ pub fn read_json<T: for<'de> Deserialize<'de>>(
         path: path.display().to_string(),
         message,
     };
-    let text = sepval_common::input_file::read_string(path, "campaign record", MAX_RECORD_BYTES)
+    let text = sepval_core::input_file::read_string(path, "campaign record", MAX_RECORD_BYTES)
         .map_err(|e| bad(e.to_string()))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     let found = value.get("format").and_then(|f| f.as_str()).unwrap_or("");

@@ -12,12 +12,12 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use sepval_common::cancel;
 use sepval_common::effects::EffectSet;
-use sepval_common::factors::Factors;
 use sepval_common::scenario::{Scenario, hex_sha256};
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
+use sepval_core::cancel;
+use sepval_core::factors::Factors;
 
 use sepval_predict::record::ConditionRecord;
 use sepval_predict::releases;
@@ -50,7 +50,7 @@ pub struct TruthCondition {
     /// The condition.
     pub condition: ConditionRecord,
     /// Its smallest clearance without noise \[mm\] (null: it diverged).
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub min_clearance_mm: f64,
     /// Whether it fails to clear (below the criterion, or diverged).
     pub fails: bool,

@@ -69,14 +69,14 @@ pub struct Assessed {
     /// Its reach: how far it lies from the nearest release flown beyond what the releases
     /// held out in turn cover ([`sepval_predict::reach::uncovered`]; null when nothing was
     /// flown).
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub reach: f64,
     /// The spread of the smallest clearance over the samples \[mm\]: (p95 - p5) / 3.29, the
     /// standard deviation of a normal with those percentiles.
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub spread_mm: f64,
     /// The same spread with the factors' draws alone (no model form).
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub factor_spread_mm: f64,
     /// The part of the factors' spread that is the rivals' disagreement: the spread of their
     /// median smallest clearances \[mm\] ([`crate::rivals::clearance_spread`]; 0 with no rival).

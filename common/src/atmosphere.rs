@@ -58,7 +58,7 @@ mod tests {
     /// 26 000 ft (for orientation; the values are derived, not given).
     #[test]
     fn default_condition_matches_the_printed_orientation_values() {
-        let air = isa_troposphere(26_000.0 * crate::units::M_PER_FT);
+        let air = isa_troposphere(26_000.0 * sepval_core::units::M_PER_FT);
         assert!(
             (air.density_kg_m3 - 0.52981).abs() < 5e-6,
             "{}",

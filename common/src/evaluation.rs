@@ -13,19 +13,19 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::correction::CorrectionValues;
 use crate::effects::EffectSet;
 use crate::extension::TermSet;
-use crate::factors::{FactorTable, Factors};
-use crate::goals::{GoalAccumulator, GoalSums, Goals};
+use crate::goals::{GoalAccumulator, GoalSums};
 use crate::model::{ModelError, RunSetup};
 use crate::propagator::{LANES, Observation, propagate_lanes};
 use crate::scenario::{Scenario, hex_sha256};
 use crate::simulation::Simulator;
 use crate::telemetry::Trajectory;
+use sepval_core::factors::{FactorTable, Factors};
+pub use sepval_core::outcome::{EvalError, MAX_REASON_BYTES, Outcome};
 
 /// One release: its scenario and its measured trajectory.
 #[derive(Debug, Clone)]
@@ -45,13 +45,13 @@ pub enum JobError {
     /// No events.
     #[error("a job needs at least one event (measured trajectory)")]
     NoEvents,
-    /// An event beyond the limits of one run (`crate::limits`).
+    /// An event beyond the limits of one run (`sepval_core::limits`).
     #[error("event `{event}`: {error}")]
     Limit {
         /// The event.
         event: String,
         /// The limit.
-        error: crate::limits::LimitError,
+        error: sepval_core::limits::LimitError,
     },
     /// Events whose scenarios have different factor tables.
     #[error(
@@ -104,10 +104,10 @@ impl Job {
             // The run integrates up to the last sample (the carriage state before release).
             let span = e.data.times_s.last().copied().unwrap_or(0.0).max(0.0);
             let dt = e.simulator.scenario().integrator.dt_s;
-            crate::limits::check_steps(span, dt).map_err(limit)?;
+            sepval_core::limits::check_steps(span, dt).map_err(limit)?;
             samples += e.data.len();
-            if samples > crate::limits::MAX_SAMPLES {
-                return Err(limit(crate::limits::LimitError::Samples {
+            if samples > sepval_core::limits::MAX_SAMPLES {
+                return Err(limit(sepval_core::limits::LimitError::Samples {
                     samples: samples as f64,
                 }));
             }
@@ -326,88 +326,6 @@ impl Candidate {
     }
 }
 
-/// The typed outcome of one evaluation: never a magic penalty hidden in a number.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "status", rename_all = "snake_case")]
-pub enum Outcome {
-    /// The run finished: its goals (docs/model.md section 5), pooled over all events.
-    Goals {
-        /// RMS position error \[m\].
-        j_pos_m: f64,
-        /// RMS attitude error \[deg\].
-        j_att_deg: f64,
-    },
-    /// The run diverged (docs/model.md section 3) in event `event` at `t_s`.
-    Diverged {
-        /// Time of divergence \[s\].
-        t_s: f64,
-        /// Index of the event that diverged.
-        event: usize,
-    },
-    /// The candidate could not be run (invalid parameters, a malformed request).
-    Failed {
-        /// Why.
-        reason: String,
-    },
-}
-
-/// Longest failure reason an [`Outcome::Failed`] carries \[bytes of UTF-8\]. Reasons are cut
-/// (at a character boundary) where the outcome is made, so that every evaluator, in this process
-/// or across any transport, gives the same outcome to the last byte.
-pub const MAX_REASON_BYTES: usize = 240;
-
-impl Outcome {
-    /// Whether two outcomes are identical to the last bit (what a replay must reproduce).
-    pub fn same_bits(&self, other: &Outcome) -> bool {
-        match (self, other) {
-            (
-                Outcome::Goals {
-                    j_pos_m: p1,
-                    j_att_deg: a1,
-                },
-                Outcome::Goals {
-                    j_pos_m: p2,
-                    j_att_deg: a2,
-                },
-            ) => p1.to_bits() == p2.to_bits() && a1.to_bits() == a2.to_bits(),
-            (
-                Outcome::Diverged { t_s: t1, event: e1 },
-                Outcome::Diverged { t_s: t2, event: e2 },
-            ) => t1.to_bits() == t2.to_bits() && e1 == e2,
-            (Outcome::Failed { reason: r1 }, Outcome::Failed { reason: r2 }) => r1 == r2,
-            _ => false,
-        }
-    }
-
-    /// A failed outcome whose reason is cut to [`MAX_REASON_BYTES`] at a character boundary.
-    pub fn failed(reason: impl Into<String>) -> Outcome {
-        let mut reason = reason.into();
-        if reason.len() > MAX_REASON_BYTES {
-            let mut end = MAX_REASON_BYTES;
-            while !reason.is_char_boundary(end) {
-                end -= 1;
-            }
-            reason.truncate(end);
-        }
-        Outcome::Failed { reason }
-    }
-
-    /// The goals, if the run finished.
-    pub fn goals(&self) -> Option<Goals> {
-        match *self {
-            Outcome::Goals { j_pos_m, j_att_deg } => Some(Goals { j_pos_m, j_att_deg }),
-            _ => None,
-        }
-    }
-
-    /// The two objectives for a Pareto search: the goals, or (inf, inf) for a run that did not
-    /// finish, which every finished run dominates.
-    pub fn objectives(&self) -> [f64; 2] {
-        self.goals()
-            .map_or([f64::INFINITY; 2], |g| [g.j_pos_m, g.j_att_deg])
-    }
-}
-
 /// The result of evaluating one candidate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Evaluation {
@@ -423,25 +341,6 @@ impl From<Outcome> for Evaluation {
             outcome,
             samples: None,
         }
-    }
-}
-
-/// Errors of an evaluator (the transport, not the simulations: those are [`Outcome`]s).
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum EvalError {
-    /// The evaluator cannot go on (for example every worker is gone).
-    #[error("evaluator failed")]
-    Transport(#[source] Box<dyn std::error::Error + Send + Sync>),
-    /// A signal (SIGINT, SIGTERM) asked the process to stop.
-    #[error("interrupted by a signal")]
-    Interrupted,
-}
-
-impl EvalError {
-    /// A transport failure with its cause.
-    pub fn transport(e: impl Into<Box<dyn std::error::Error + Send + Sync>>) -> Self {
-        EvalError::Transport(e.into())
     }
 }
 
@@ -497,7 +396,7 @@ impl Evaluator for InProcess {
         if threads <= 1 {
             let mut out = Vec::with_capacity(batch.len());
             for chunk in chunks {
-                crate::cancel::check().map_err(|_| EvalError::Interrupted)?;
+                sepval_core::cancel::check().map_err(|_| EvalError::Interrupted)?;
                 out.extend(job.evaluate_batch(chunk, with_samples));
             }
             return Ok(out);
@@ -513,7 +412,7 @@ impl Evaluator for InProcess {
                         let mut mine = Vec::new();
                         loop {
                             let i = next.fetch_add(1, Ordering::Relaxed);
-                            if i >= chunks.len() || crate::cancel::requested() {
+                            if i >= chunks.len() || sepval_core::cancel::requested() {
                                 break mine;
                             }
                             mine.push((i, job.evaluate_batch(chunks[i], with_samples)));
@@ -526,7 +425,7 @@ impl Evaluator for InProcess {
                 .map(|h| h.join().expect("evaluation threads do not panic"))
                 .collect()
         });
-        crate::cancel::check().map_err(|_| EvalError::Interrupted)?;
+        sepval_core::cancel::check().map_err(|_| EvalError::Interrupted)?;
         for (i, e) in results.into_iter().flatten() {
             slots[i] = Some(e);
         }

@@ -9,33 +9,11 @@
 //!
 //! Several events pool their samples: the sums and N run over all of them.
 
-use serde::{Deserialize, Serialize};
-
 use crate::frames::wrap_deg;
 use crate::model::StateVector;
 use crate::propagator::{Observation, SampleSink};
 use crate::telemetry::Trajectory;
-
-/// The goals of one evaluation.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Goals {
-    /// RMS position error \[m\].
-    pub j_pos_m: f64,
-    /// RMS attitude error \[deg\].
-    pub j_att_deg: f64,
-}
-
-impl Goals {
-    /// The goals as an array (position first).
-    pub fn as_array(&self) -> [f64; 2] {
-        [self.j_pos_m, self.j_att_deg]
-    }
-
-    /// The weighted sum J_pos / sigma_pos + J_att / sigma_att.
-    pub fn weighted_sum(&self, sigma_pos_m: f64, sigma_att_deg: f64) -> f64 {
-        self.j_pos_m / sigma_pos_m + self.j_att_deg / sigma_att_deg
-    }
-}
+pub use sepval_core::outcome::Goals;
 
 /// Sums of squared differences, to be pooled and turned into goals.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -8,50 +8,39 @@
 //! - [`frames`]: section 2, quaternions, direction cosines, Euler angles;
 //! - [`model`]: sections 2 and 3, forces, moments and equations of motion;
 //! - [`propagator`]: section 3a, RK4 with located switching events and sampling;
-//! - [`factors`], [`encoding`]: section 4;
+//! - the factors and their encoding (section 4) are `sepval_core`'s, with the outcome of an
+//!   evaluation, cancellation, atomic output files and checked input files;
 //! - [`goals`]: section 5;
 //! - [`telemetry`]: section 6;
 //! - [`effects`]: section 7, the effect catalogue;
 //! - [`table`], [`table_form`]: sections 1 and 3, tabulated coefficients and interference;
 //! - [`correction`]: section 15, corrections of the data whose values a search estimates;
 //! - [`noise`]: the measurement noise of the synthetic flight test (section 4);
-//! - [`input_file`]: how every input file is opened and read (regular files only, within the
-//!   byte limits of [`limits`]);
 //! - [`elementary`], [`lanes`]: section 9, sepval's own elementary functions (no C library),
 //!   written once for one double and for four lanes.
 
 #![deny(clippy::float_cmp)]
 
 pub mod atmosphere;
-pub mod atomic_file;
-pub mod cancel;
 pub mod correction;
-pub mod defect;
+mod effect_error;
 pub mod effects;
 pub mod elementary;
-pub mod encoding;
 pub mod evaluation;
 pub mod extension;
-pub mod factors;
 pub mod frames;
 pub mod goals;
-pub mod input_file;
 pub mod lanes;
-pub mod limits;
 pub mod model;
 pub mod noise;
-pub mod nonfinite;
-pub mod number_text;
 pub mod propagator;
 pub mod scenario;
+mod setup;
 pub mod simulation;
-pub mod stage_clock;
 pub mod synthetic;
 pub mod table;
 pub mod table_form;
 pub mod telemetry;
-pub mod toml_error;
-pub mod units;
 
 /// The version of the simulation's arithmetic, raised whenever a change moves any bit of a
 /// result (recorded in checkpoints, so that one that no longer reproduces can say why):
@@ -61,8 +50,8 @@ pub mod units;
 pub const ARITHMETIC_VERSION: u32 = 3;
 
 pub use effects::EffectSet;
-pub use factors::{Factor, FactorTable, Factors};
 pub use goals::Goals;
 pub use scenario::Scenario;
+pub use sepval_core::factors::{Factor, FactorTable, Factors};
 pub use simulation::Simulator;
 pub use telemetry::Trajectory;

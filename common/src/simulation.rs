@@ -2,12 +2,12 @@
 //! factor and effect sets.
 
 use crate::effects::EffectSet;
-use crate::factors::Factors;
 use crate::goals::{GoalAccumulator, GoalSums, Goals};
 use crate::model::{Model, ModelError, RunSetup};
 use crate::propagator::{Diverged, Observation, RunLog, propagate};
 use crate::scenario::Scenario;
 use crate::telemetry::Trajectory;
+use sepval_core::factors::Factors;
 
 /// Errors of one simulation.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -21,7 +21,7 @@ pub enum SimError {
     Diverged(#[from] Diverged),
     /// The sample times ask for more work than one run may do.
     #[error(transparent)]
-    Limit(#[from] crate::limits::LimitError),
+    Limit(#[from] sepval_core::limits::LimitError),
 }
 
 /// A scenario set up for simulation.
@@ -86,9 +86,9 @@ impl Simulator {
         times_s: &[f64],
     ) -> Result<(Trajectory, RunLog), SimError> {
         let span = times_s.last().copied().unwrap_or(0.0).max(0.0);
-        crate::limits::check_steps(span, self.scenario().integrator.dt_s)?;
-        if times_s.len() > crate::limits::MAX_SAMPLES {
-            return Err(crate::limits::LimitError::Samples {
+        sepval_core::limits::check_steps(span, self.scenario().integrator.dt_s)?;
+        if times_s.len() > sepval_core::limits::MAX_SAMPLES {
+            return Err(sepval_core::limits::LimitError::Samples {
                 samples: times_s.len() as f64,
             }
             .into());

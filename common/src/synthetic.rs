@@ -2,11 +2,11 @@
 //! for flight data (the "flight test data" of Anderson's study; docs/model.md section 4).
 
 use crate::effects::EffectSet;
-use crate::factors::Factors;
 use crate::noise::{SIGMA_ATT_DEG, SIGMA_POS_M, add_noise};
 use crate::propagator::RunLog;
 use crate::simulation::{SimError, Simulator};
 use crate::telemetry::Trajectory;
+use sepval_core::factors::Factors;
 
 /// Noise seed of the embedded default synthetic flight test.
 pub const DEFAULT_NOISE_SEED: u64 = 20_260_101;

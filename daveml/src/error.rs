@@ -48,7 +48,7 @@ pub enum DavemlError {
     /// The file cannot be read (missing, not a regular file, larger than the limit, not
     /// UTF-8).
     #[error(transparent)]
-    Input(#[from] sepval_common::input_file::InputFileError),
+    Input(#[from] sepval_core::input_file::InputFileError),
     /// The file is not well-formed XML.
     #[error("{file}: not XML: {message}")]
     NotXml {
@@ -103,7 +103,7 @@ pub enum DavemlError {
     },
     /// Writing failed.
     #[error(transparent)]
-    Write(#[from] sepval_common::atomic_file::WriteError),
+    Write(#[from] sepval_core::atomic_file::WriteError),
     /// Writing a staged directory failed.
     #[error("cannot write {path}")]
     Io {

@@ -40,9 +40,9 @@ pub mod xml;
 
 use std::path::Path;
 
-use sepval_common::atomic_file::write_atomically;
-use sepval_common::input_file::read_string;
 use sepval_common::scenario::Scenario;
+use sepval_core::atomic_file::write_atomically;
+use sepval_core::input_file::read_string;
 
 pub use bands::{CorrectionSpread, bands};
 pub use error::{DavemlError, Mismatch, Place};
@@ -51,7 +51,7 @@ pub use map::Map;
 
 /// Largest DAVE-ML file sepval reads \[bytes\]: 256 MiB, room for tables of several million
 /// values in full precision (six static tables of the most grid points a table may hold,
-/// `sepval_common::limits::MAX_TABLE_VALUES`, take about 150 MB); checked against the file's
+/// `sepval_core::limits::MAX_TABLE_VALUES`, take about 150 MB); checked against the file's
 /// size before it is read.
 pub const MAX_DAVEML_BYTES: u64 = 256 << 20;
 /// Largest map file \[bytes\]: 1 MiB.

@@ -5,11 +5,11 @@
 
 use std::path::{Path, PathBuf};
 
-use sepval_common::atomic_file::write_atomically;
 use sepval_common::correction::Target;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{Coefficient, Kind, TableFile, write_csv};
 use sepval_common::table_form::TableForm;
+use sepval_core::atomic_file::write_atomically;
 
 use crate::assemble::{field, set_field};
 use crate::error::DavemlError;

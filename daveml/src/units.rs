@@ -4,7 +4,7 @@
 //! abbreviations of ANSI/AIAA R-004 (`deg`, `rad`, `ft`, `m`, `nd` for non-dimensional).
 
 use sepval_common::table::{Kind, Variable};
-use sepval_common::units::{M_PER_FT, M_PER_IN};
+use sepval_core::units::{M_PER_FT, M_PER_IN};
 
 /// How a value in a file's unit becomes one in the scenario's.
 #[derive(Debug, Clone, Copy, PartialEq)]

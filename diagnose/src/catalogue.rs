@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS};
 use sepval_common::evaluation::{Evaluator, Job};
-use sepval_common::factors::FACTOR_COUNT;
+use sepval_core::factors::FACTOR_COUNT;
 
 use super::contender::Contender;
 use super::residuals::{physical_residuals, rms_channels};
@@ -70,7 +70,7 @@ pub(super) fn refine_from(
     )];
     refine_together(evaluator, &mut run)?;
     let [run] = run;
-    let failure = run.failure().map(str::to_string);
+    let failure = run.failure().map(ToString::to_string);
     Ok((run.finish(), failure))
 }
 

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use sepval_common::factors::Factors;
+use sepval_core::factors::Factors;
 use serde::{Deserialize, Serialize};
 
 use super::{

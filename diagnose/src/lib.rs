@@ -53,13 +53,14 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use sepval_common::atomic_file::WriteError;
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
 use sepval_common::extension::Term;
+use sepval_core::atomic_file::WriteError;
 
 use sepval_fit::space::{FreeTerm, ParamSpace};
 use sepval_fit::{FitError, FitOptions, Method, run_fit};
+use sepval_report::OutputError;
 use sepval_report::figures::FigureError;
 use sepval_report::html::HtmlError;
 use sepval_solve::lm::{LmResult, LmSettings, Stall};
@@ -122,6 +123,19 @@ pub enum DiagnoseError {
         .0.join("; and ")
     )]
     TablesLeft(Vec<String>),
+    /// An output file that cannot be written.
+    #[error(transparent)]
+    Output(OutputError),
+}
+
+impl From<OutputError> for DiagnoseError {
+    /// A signal is the run's interruption, as everywhere else in a diagnosis.
+    fn from(e: OutputError) -> Self {
+        match e {
+            OutputError::Interrupted => DiagnoseError::Run(RunError::Interrupted),
+            other => DiagnoseError::Output(other),
+        }
+    }
 }
 
 impl From<EvalError> for DiagnoseError {
@@ -348,7 +362,7 @@ pub fn diagnose(
         baseline_restart,
         evaluations,
     };
-    sepval_common::cancel::check().map_err(RunError::from)?;
+    sepval_core::cancel::check().map_err(RunError::from)?;
     let analysis = analyse(options, &setting, decided, t0)?;
     stage_clock::lap("analysis");
     write_outputs(&options.out, &setting, &analysis, progress)?;

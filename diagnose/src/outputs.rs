@@ -3,16 +3,16 @@
 //! DIR/extension.toml and DIR/factors.json when a discovered extension is the answer,
 //! DIR/diagnosis.json and DIR/report.html.
 //!
-//! Every file is written atomically (`sepval_common::atomic_file`), and a signal is observed
-//! before each one (issue 21, item 9): a diagnosis interrupted here ends with
-//! `RunError::Interrupted` (exit status 130), the files already written stay whole and the
-//! others are not begun. The progress observer sees this stage as `outputs`, one step per file.
+//! The files are written through the output kit (`sepval_report::Written`; the figures by
+//! their own writers, which do the same): each written atomically, a signal observed before
+//! each one (issue 21, item 9). A diagnosis interrupted here ends with `RunError::Interrupted`
+//! (exit status 130), the files already written stay whole and the others are not begun. The
+//! progress observer sees this stage as `outputs`, one step per file.
 
 use std::path::Path;
 
-use sepval_common::atomic_file::write_atomically;
-use sepval_common::cancel;
-use sepval_solve::run::{Progress, ProgressObserver, RunError};
+use sepval_report::{OutputError, Written};
+use sepval_solve::run::{Progress, ProgressObserver};
 
 use crate::Result;
 use crate::analysis::Analysis;
@@ -31,10 +31,10 @@ struct Steps<'a> {
 }
 
 impl Steps<'_> {
-    /// Before a file: `Err` once a signal asked the process to stop.
+    /// Before a figure written by its own writer: `Err` once a signal asked the process to
+    /// stop.
     fn next(&self) -> Result<()> {
-        cancel::check().map_err(RunError::from)?;
-        Ok(())
+        Ok(OutputError::check_cancel()?)
     }
 
     /// After a file (or a group of figures).
@@ -86,20 +86,17 @@ pub(super) fn write_outputs(
         figures.insert(0, name.to_string());
         steps.written(1);
     }
+    let mut w = Written::into(out);
     if let Some(x) = &a.extension {
-        steps.next()?;
-        write_atomically(&out.join("extension.toml"), x.toml.as_bytes())?;
+        w.file("extension.toml", x.toml.as_bytes())?;
         steps.written(1);
-        steps.next()?;
-        write_atomically(&out.join("factors.json"), &x.factors_json)?;
+        w.file("factors.json", &x.factors_json)?;
         steps.written(1);
     }
     let html = report_html(d, &figures)?;
-    steps.next()?;
-    sepval_fit::record::write_record(&out.join("diagnosis.json"), d)?;
+    w.file("diagnosis.json", &sepval_fit::record::sealed(d))?;
     steps.written(1);
-    steps.next()?;
-    write_atomically(&out.join("report.html"), html.as_bytes())?;
+    w.file("report.html", html.as_bytes())?;
     steps.written(1);
     steps.progress.finish();
     Ok(())

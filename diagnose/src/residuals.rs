@@ -250,7 +250,7 @@ pub fn residual_figures(
     let mut names = Vec::new();
     for (k, event) in job.events().iter().enumerate() {
         // A signal is observed before each figure (each is written whole or not at all).
-        sepval_common::cancel::check().map_err(sepval_solve::run::RunError::from)?;
+        sepval_core::cancel::check().map_err(sepval_solve::run::RunError::from)?;
         let name = format!("figures/residuals_event{}.png", k + 1);
         sepval_report::figures::residual_figure(
             &dir.join(&name),

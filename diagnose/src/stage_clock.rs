@@ -1,9 +1,9 @@
 //! Where a diagnosis's wall time goes, stage by stage: when the environment variable
 //! `SEPVAL_DIAGNOSE_TIMING` is set (to anything), each stage's wall time since the previous
 //! stage ended is printed on stderr as `diagnose timing: STAGE S s` (issue 22;
-//! `sepval_common::stage_clock`).
+//! `sepval_core::stage_clock`).
 
-use sepval_common::stage_clock::StageClock;
+use sepval_core::stage_clock::StageClock;
 
 /// The environment variable that switches the stage times on.
 pub const TIMING_VAR: &str = "SEPVAL_DIAGNOSE_TIMING";

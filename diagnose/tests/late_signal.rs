@@ -32,7 +32,7 @@ impl ProgressObserver for SignalAfterFirstOutput {
 
     fn progress(&mut self, p: &Progress) {
         if self.outputs && p.step >= 1 {
-            sepval_common::cancel::request();
+            sepval_core::cancel::request();
         }
     }
 

@@ -13,9 +13,9 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use sepval_common::atomic_file::{WriteError, write_atomically};
-use sepval_common::input_file::{InputFileError, read_string};
-use sepval_common::limits::MAX_JSON_BYTES;
+use sepval_core::atomic_file::{WriteError, write_atomically};
+use sepval_core::input_file::{InputFileError, read_string};
+use sepval_core::limits::MAX_JSON_BYTES;
 
 use crate::row::Row;
 

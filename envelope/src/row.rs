@@ -15,23 +15,23 @@ pub struct Row {
     pub condition: ConditionRecord,
     /// The smallest clearance's 5th, 50th and 95th percentiles over the samples that ran \[mm\]
     /// (NaN when none ran).
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub clearance_p5_mm: f64,
     /// The median.
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub clearance_p50_mm: f64,
     /// The 95th percentile.
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub clearance_p95_mm: f64,
     /// The share of the samples that ran below the criterion.
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub p_below: f64,
     /// The share of all samples that fail to clear (below the criterion or diverged).
     pub p_fail: f64,
     /// Whether the condition is cleared.
     pub cleared: bool,
     /// The median time of closest approach \[s\].
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub t_closest_s: f64,
     /// The share of the samples that diverged or failed.
     pub diverged_share: f64,

@@ -9,8 +9,8 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use sepval_common::cancel;
 use sepval_common::evaluation::{EvalError, Event, Job};
+use sepval_core::cancel;
 use sepval_predict::discrepancy::{self, Evidence};
 use sepval_predict::{ClearanceSettings, PredictError, Settings, Source, predict_with, prepare};
 use sepval_solve::run::{NoProgress, Progress as Step, ProgressObserver};

@@ -7,7 +7,7 @@
 //! ([`crate::domain`]: a table is held at its edge beyond them, so a planned release
 //! there would fly on made-up aerodynamics).
 
-use sepval_common::number_text::Shown;
+use sepval_core::number_text::Shown;
 use serde::{Deserialize, Serialize};
 
 use sepval_common::scenario::{Flight, Scenario};

@@ -17,6 +17,8 @@
 //! - [`model_spec`]: a fitted model as files hold it, rebuilt exactly by other commands;
 //! - [`domain`]: where a fitted model may be flown (refused outside, said when far from the
 //!   releases), for every command that flies one at a new condition;
+//! - [`inputs`]: what a run reads (scenario, factors, effects, releases screened and
+//!   checked) read into a job;
 //! - [`sigma`]: the noise that weights the goals; [`method`]: which searches to run.
 //!
 //! The library returns typed errors and prints nothing: progress reaches the caller through a
@@ -29,6 +31,7 @@
 pub mod checkpoint;
 pub mod conditions;
 pub mod domain;
+pub mod inputs;
 pub mod method;
 pub mod model_spec;
 pub mod out_dir;

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use sepval_common::effects::{EffectError, EffectSet};
 use sepval_common::evaluation::Candidate;
 use sepval_common::extension::{TermError, TermRecord, TermSet};
-use sepval_common::factors::Factors;
+use sepval_core::factors::Factors;
 
 /// One catalogue effect with its parameter values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -123,7 +123,7 @@ impl ModelSpec {
 mod tests {
     use super::*;
     use sepval_common::extension::{Axis, Regressor, Term};
-    use sepval_common::factors::FACTOR_COUNT;
+    use sepval_core::factors::FACTOR_COUNT;
 
     #[test]
     fn a_candidate_survives_its_spec_and_json() {

@@ -3,7 +3,7 @@
 //! search over decoded factor values presented as a search over candidates.
 
 use sepval_common::evaluation::{Candidate, Evaluation, Evaluator, Outcome};
-use sepval_common::factors::{FACTOR_COUNT, Factors};
+use sepval_core::factors::{FACTOR_COUNT, Factors};
 use sepval_solve::run::{Ask, Problem, Progress, RunError, Solver};
 
 use crate::space::ParamSpace;

@@ -6,7 +6,7 @@
 //! rebuild the answer and the rivals of a diagnosis this way.
 
 use sepval_common::evaluation::Candidate;
-use sepval_common::factors::FactorTable;
+use sepval_core::factors::FactorTable;
 
 use crate::model_spec::{ModelSpec, ModelSpecError};
 use crate::space::{FreeTerm, ParamSpace};

@@ -31,10 +31,10 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 
-use sepval_common::atomic_file::{WriteError, write_atomically};
-use sepval_common::input_file::{InputFileError, read_string};
-use sepval_common::limits::MAX_JSON_BYTES;
 use sepval_common::scenario::hex_sha256;
+use sepval_core::atomic_file::{WriteError, write_atomically};
+use sepval_core::input_file::{InputFileError, read_string};
+use sepval_core::limits::MAX_JSON_BYTES;
 
 /// The key of the digest in a record.
 pub const DIGEST_KEY: &str = "digest";
@@ -264,7 +264,7 @@ fn number(value: f64) -> String {
 }
 
 /// The largest position noise a record may hold \[m\]: the largest position telemetry may
-/// hold (`sepval_common::limits`), beyond which no noise can have been estimated.
+/// hold (`sepval_core::limits`), beyond which no noise can have been estimated.
 pub const MAX_SIGMA_POS_M: f64 = 1e5;
 /// The largest attitude noise a record may hold \[deg\] (the largest telemetry angle).
 pub const MAX_SIGMA_ATT_DEG: f64 = 3600.0;
@@ -351,8 +351,8 @@ pub fn check_identifiability(
 }
 
 /// Checks the factors of a model at `at`: finite.
-pub fn check_factors(at: &str, f: &sepval_common::factors::Factors) -> Result<(), FieldError> {
-    for (name, v) in sepval_common::factors::Factor::ALL.iter().zip(f.0.iter()) {
+pub fn check_factors(at: &str, f: &sepval_core::factors::Factors) -> Result<(), FieldError> {
+    for (name, v) in sepval_core::factors::Factor::ALL.iter().zip(f.0.iter()) {
         field(
             format!("{at}.{}", name.name()),
             *v,

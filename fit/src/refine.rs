@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use sepval_common::evaluation::{Candidate, Evaluation, Evaluator, Job};
 use sepval_solve::lm::{LmResult, LmRun, LmSettings};
-use sepval_solve::run::{Ask, Progress, RunError, Solver, run};
+use sepval_solve::run::{Ask, Progress, RunError, SearchError, Solver, run};
 
 use crate::problem::{Evaluate, SAMPLE_BUDGET};
 use crate::space::{Noise, ParamSpace, residual_vector};
@@ -21,7 +21,7 @@ pub struct ModelLm {
     job: Arc<Job>,
     lm: LmRun<Noise>,
     /// Why it failed, when it failed on its own in [`refine_together`].
-    failure: Option<String>,
+    failure: Option<SearchError>,
 }
 
 impl ModelLm {
@@ -53,8 +53,8 @@ impl ModelLm {
     /// Why it failed on its own in [`refine_together`] (a start or a derivative probe that did
     /// not simulate), if it did: its [`ModelLm::finish`] is then not an optimum (its Jacobian
     /// may be missing) and must not be used as one.
-    pub fn failure(&self) -> Option<&str> {
-        self.failure.as_deref()
+    pub fn failure(&self) -> Option<&SearchError> {
+        self.failure.as_ref()
     }
 
     /// The result (once it asks for nothing more).
@@ -94,18 +94,18 @@ impl Solver for ModelLm {
 /// asked for candidates and told their evaluations, which can fail on its own.
 pub trait Refinement: Solver<Point = Candidate, Value = Evaluation> {
     /// Records why it failed on its own; it asks nothing more.
-    fn record_failure(&mut self, reason: String);
+    fn record_failure(&mut self, reason: SearchError);
     /// Why it failed on its own, if it did.
-    fn failure(&self) -> Option<&str>;
+    fn failure(&self) -> Option<&SearchError>;
 }
 
 impl Refinement for ModelLm {
-    fn record_failure(&mut self, reason: String) {
+    fn record_failure(&mut self, reason: SearchError) {
         self.failure = Some(reason);
     }
 
-    fn failure(&self) -> Option<&str> {
-        self.failure.as_deref()
+    fn failure(&self) -> Option<&SearchError> {
+        self.failure.as_ref()
     }
 }
 
@@ -185,9 +185,9 @@ pub fn refine_together<R: Refinement>(
 #[cfg(test)]
 mod tests {
     use sepval_common::evaluation::{EvalError, InProcess, Outcome};
-    use sepval_common::factors::{FACTOR_COUNT, Factors};
     use sepval_common::scenario::Scenario;
     use sepval_common::synthetic::default_flight_test;
+    use sepval_core::factors::{FACTOR_COUNT, Factors};
 
     use super::*;
 
@@ -270,9 +270,9 @@ mod tests {
         };
         let mut runs = runs(&job);
         refine_together(&mut evaluator, &mut runs).unwrap();
-        assert_eq!(runs[0].failure(), None);
+        assert!(runs[0].failure().is_none());
         assert_eq!(
-            runs[1].failure(),
+            runs[1].failure().map(ToString::to_string).as_deref(),
             Some("the derivative probe of fwdfac did not simulate")
         );
         let [good, _] = <[ModelLm; 2]>::try_from(runs).ok().unwrap();

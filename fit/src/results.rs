@@ -4,9 +4,9 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use sepval_common::evaluation::Job;
-use sepval_common::factors::Factors;
 use sepval_common::goals::residual;
 use sepval_common::propagator::Observation;
+use sepval_core::factors::Factors;
 use sepval_solve::best::BestSoFar;
 use serde::{Deserialize, Serialize};
 

@@ -4,17 +4,18 @@
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Candidate, Job};
 use sepval_common::extension::{Family, Term, TermSet};
-use sepval_common::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
 use sepval_common::goals::{Goals, residual};
 use sepval_common::propagator::Observation;
+use sepval_core::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
 use sepval_solve::lm::Measure;
 use sepval_solve::params::Params;
-use sepval_solve::run::RunError;
+use sepval_solve::run::{RunError, SearchError};
 
 type Result<T> = std::result::Result<T, RunError>;
 
-fn search_error(what: impl std::fmt::Display) -> RunError {
-    RunError::Search(what.to_string())
+/// A point of the space that is not a valid model: the model's own error.
+fn search_error(e: impl std::error::Error + Send + Sync + 'static) -> RunError {
+    RunError::Search(SearchError::Point(std::sync::Arc::new(e)))
 }
 
 /// An extension term whose coefficient (and, for the families that have them, locators) a fit

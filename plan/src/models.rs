@@ -6,7 +6,7 @@
 
 use sepval_common::evaluation::Candidate;
 use sepval_common::extension::Family;
-use sepval_common::factors::FactorTable;
+use sepval_core::factors::FactorTable;
 use sepval_diagnose::Diagnosis;
 use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::rebuild::{Rebuilt, rebuild};

@@ -261,7 +261,7 @@ impl Runner<'_> {
         }
         let mut out = Vec::with_capacity(self.job.events().len());
         for event in self.job.events() {
-            sepval_common::cancel::check().map_err(|_| EvalError::Interrupted)?;
+            sepval_core::cancel::check().map_err(|_| EvalError::Interrupted)?;
             let one = Job::new(vec![event.clone()])?;
             let ev = one.evaluate_with_samples(c);
             self.evaluations += 1;

@@ -8,10 +8,10 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 use sepval_common::evaluation::{Candidate, InProcess, Job};
-use sepval_common::factors::{Factor, Factors};
 use sepval_common::propagator::Observation;
 use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
+use sepval_core::factors::{Factor, Factors};
 use sepval_fit::model_spec::{EffectValues, ModelSpec};
 use sepval_fit::space::Noise;
 use sepval_solve::run::NoProgress;

@@ -20,7 +20,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use sepval_common::cancel::{self, Cancelled};
+use sepval_core::cancel::{self, Cancelled};
 use sepval_geometry::{Geometry, Pose};
 
 use crate::bands::quantile;

@@ -6,8 +6,8 @@
 //! least [`min_samples`] of the level (20 / (1 - level)), at most [`MAX_SAMPLES`], and their
 //! trajectories at the band's points fit [`MAX_VALUE_BYTES`].
 
-use sepval_common::number_text::Shown;
 use sepval_common::scenario::{Scenario, StoreDifference};
+use sepval_core::number_text::Shown;
 
 /// The most samples of one prediction.
 pub const MAX_SAMPLES: usize = 100_000;

@@ -342,7 +342,7 @@ fn refit(
     let mut evaluator = InProcess::new(Arc::clone(&job), cal.threads);
     match run(&mut lm, &mut Evaluate(&mut evaluator), &mut []) {
         Ok(()) => {}
-        Err(RunError::Search(reason)) => return Ok(Err(reason)),
+        Err(RunError::Search(reason)) => return Ok(Err(reason.to_string())),
         Err(source) => {
             return Err(DiscrepancyError::Refit {
                 release: left_out.to_string(),

@@ -12,7 +12,7 @@
 //! model) and its other parameters stay at their values.
 
 use sepval_common::evaluation::Candidate;
-use sepval_common::factors::{FACTOR_COUNT, FactorTable};
+use sepval_core::factors::{FACTOR_COUNT, FactorTable};
 use sepval_fit::rebuild::{Rebuilt, rebuild};
 use sepval_fit::space::ParamSpace;
 

@@ -57,7 +57,9 @@ pub use ensemble::Ensemble;
 pub use outputs::write_outputs;
 pub use record::{PREDICTION_FORMAT, PredictionFile, prediction_file};
 pub use sampling::Sampler;
-pub use source::{Source, SourceError, SourceKind, read_source};
+pub use source::{
+    Source, SourceError, SourceInputs, SourceInputsError, SourceKind, read_source, source_inputs,
+};
 
 use simulate::{Grid, GridTrajectory};
 
@@ -95,7 +97,7 @@ pub enum PredictError {
     Outputs(#[from] outputs::OutputError),
     /// A signal asked the process to stop.
     #[error(transparent)]
-    Cancelled(#[from] sepval_common::cancel::Cancelled),
+    Cancelled(#[from] sepval_core::cancel::Cancelled),
 }
 
 /// A release flown at the condition, to check against the bands.

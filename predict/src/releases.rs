@@ -9,9 +9,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use sepval_common::cancel;
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, InProcess, Job};
 use sepval_common::telemetry::Trajectory;
+use sepval_core::cancel;
 use sepval_diagnose::Diagnosis;
 use sepval_fit::results::ReleaseClearance;
 use sepval_geometry::{GeometryError, Pose, Trace};

@@ -9,7 +9,10 @@
 
 use std::path::{Path, PathBuf};
 
+use sepval_common::evaluation::{Event, Job};
+use sepval_common::telemetry::outliers::Policy;
 use sepval_fit::checkpoint::InputsRecord;
+use sepval_fit::inputs::{self, InputError, Tell};
 use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::record::{Record, read_record};
 use sepval_fit::results::FitResult;
@@ -242,5 +245,87 @@ fn fit_source(dir: &Path) -> Result<Source, SourceError> {
         },
         inputs,
         held_out: Vec::new(),
+    })
+}
+
+/// A `--from` source that cannot be read with its releases.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SourceInputsError {
+    /// The source itself.
+    #[error(transparent)]
+    Source(#[from] SourceError),
+    /// The releases it records as fitted no longer read as they did.
+    #[error("--from {}: the releases it was fitted to", .from.display())]
+    Fitted {
+        /// The source directory.
+        from: PathBuf,
+        /// Why.
+        #[source]
+        source: Box<InputError>,
+    },
+    /// A release held out (given, or recorded by the source) that cannot be read.
+    #[error(transparent)]
+    HeldOut(Box<InputError>),
+}
+
+/// A source with its releases: the releases it was fitted to, and those held out.
+pub struct SourceInputs {
+    /// The source read and checked.
+    pub source: Source,
+    /// The releases it was fitted to, read as its fit read them.
+    pub fitted: Job,
+    /// The releases held out: `validate` (read with its policy), then those the source records.
+    pub held_out: Vec<Event>,
+}
+
+/// The source of `--from` read and checked, the releases it was fitted to, and the releases
+/// held out (`validate`, read with `policy`, then those the source records, read as its fit
+/// read its data); `extension` replaces the one it records.
+pub fn source_inputs(
+    from: &Path,
+    extension: Option<&Path>,
+    validate: &[PathBuf],
+    policy: Policy,
+    tell: Tell,
+) -> Result<SourceInputs, SourceInputsError> {
+    let source = read_source(from)?;
+    let record = source.inputs.clone();
+    let extension = extension
+        .map(Path::to_path_buf)
+        .or(record.extension.clone());
+    let (fitted, _) = inputs::job(
+        &record.data,
+        record.scenario.as_deref(),
+        extension.as_deref(),
+        record.outliers,
+        tell,
+    )
+    .map_err(|source| SourceInputsError::Fitted {
+        from: from.to_path_buf(),
+        source: Box::new(source),
+    })?;
+    let mut held = inputs::with_policy(validate, policy);
+    let recorded = source
+        .held_out
+        .iter()
+        .filter(|p| !validate.contains(p))
+        .map(|p| (p.clone(), record.outliers));
+    held.extend(recorded.collect::<Vec<_>>());
+    let held_out = inputs::HeldOut {
+        held: &held,
+        data_paths: &record.data,
+        fitted: &fitted,
+        scenario_path: record.scenario.as_deref(),
+        extension_path: extension.as_deref(),
+    };
+    let held_out: Vec<Event> = inputs::validation_job(&held_out, tell)
+        .map_err(|e| SourceInputsError::HeldOut(Box::new(e)))?
+        .map(|j| j.events().to_vec())
+        .unwrap_or_default();
+    Ok(SourceInputs {
+        source,
+        fitted,
+        held_out,
     })
 }

@@ -19,7 +19,7 @@ use crossbeam::channel::{self, Receiver, RecvTimeoutError, Sender};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sepval_cli::front::{self, Front};
-use sepval_common::cancel;
+use sepval_core::cancel;
 use sepval_solve::run::{Progress, ProgressObserver};
 
 use crate::SepvalError;

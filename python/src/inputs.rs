@@ -9,10 +9,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
-use sepval_common::atomic_file::write_atomically;
-use sepval_common::factors::Factors;
 use sepval_common::scenario::{Scenario, hex_sha256};
 use sepval_common::telemetry::Trajectory;
+use sepval_core::atomic_file::write_atomically;
+use sepval_core::factors::Factors;
 
 /// A trajectory as the package receives it: one little-endian float64 buffer per column
 /// (`t_s`, `x_m`, `y_m`, `z_m`, `roll_deg`, `pitch_deg`, `yaw_deg`), the `# key = value`
@@ -71,7 +71,7 @@ pub fn store_telemetry(
 /// The scenario of `path` (the embedded default without one) as JSON of the TOML that `sepval
 /// scenario` writes.
 pub fn scenario_json(path: Option<&Path>) -> Result<String> {
-    let scenario = sepval_cli::command::inputs::scenario(path, None)?;
+    let scenario = sepval_fit::inputs::scenario(path, None)?;
     let text = sepval_cli::command::scenario::toml_text(&scenario);
     let value: toml::Value = toml::from_str(&text).context("the scenario's TOML reads back")?;
     Ok(serde_json::to_string(&value)?)
@@ -164,7 +164,7 @@ pub fn store_factors(
     write: bool,
 ) -> Result<PathBuf> {
     let s = match scenario {
-        ScenarioGiven::File(p) => sepval_cli::command::inputs::scenario(Some(p), None)?,
+        ScenarioGiven::File(p) => sepval_fit::inputs::scenario(Some(p), None)?,
         ScenarioGiven::Dict(j) => scenario_of_json(j, "(a dict)")?,
         ScenarioGiven::Default => Scenario::embedded_default(),
     };

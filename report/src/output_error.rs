@@ -12,7 +12,7 @@ use crate::html::HtmlError;
 pub enum OutputError {
     /// A file.
     #[error("cannot write {}", .0.path.display())]
-    Write(#[source] sepval_common::atomic_file::WriteError),
+    Write(#[source] sepval_core::atomic_file::WriteError),
     /// A directory.
     #[error("cannot create {}", path.display())]
     Dir {
@@ -51,6 +51,6 @@ impl OutputError {
     /// [`OutputError::Interrupted`] once a signal asked the process to stop (checked before
     /// each file, so an interrupted command stops between files, never inside one).
     pub fn check_cancel() -> Result<(), OutputError> {
-        sepval_common::cancel::check().map_err(|_| OutputError::Interrupted)
+        sepval_core::cancel::check().map_err(|_| OutputError::Interrupted)
     }
 }

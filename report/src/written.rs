@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use sepval_common::atomic_file::write_atomically;
+use sepval_core::atomic_file::write_atomically;
 
 use crate::OutputError;
 

@@ -21,8 +21,8 @@ use clap::error::{ContextKind, ContextValue, ErrorKind};
 pub use cli::{Cli, Command};
 
 /// Runs one command to its end. Errors carry their whole cause chain (print them with
-/// `{:#}`); after [`sepval_common::cancel::request`] a command stops within a second with an
-/// error, and `sepval_common::cancel::requested()` tells that this was why.
+/// `{:#}`); after [`sepval_core::cancel::request`] a command stops within a second with an
+/// error, and `sepval_core::cancel::requested()` tells that this was why.
 pub fn run(command: Command) -> anyhow::Result<()> {
     match command {
         Command::Simulate(args) => command::simulate::run(args),

@@ -3,13 +3,13 @@
 //! The command line only: the library (`sepval_cli`) declares the flags and runs the commands;
 //! this file parses the arguments, installs the signal handlers and reports errors: the whole
 //! cause chain, exit status 2 (130 after SIGINT/SIGTERM); a panic is reported as a defect, with
-//! its message and place, exit status 2 (`sepval_common::defect`).
+//! its message and place, exit status 2 (`sepval_core::defect`).
 
 use std::process::ExitCode;
 
 use clap::Parser;
 use sepval_cli::Cli;
-use sepval_common::defect;
+use sepval_core::defect;
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -22,7 +22,7 @@ fn main() -> ExitCode {
             e.exit()
         }
     };
-    sepval_common::cancel::install_signal_handlers();
+    sepval_core::cancel::install_signal_handlers();
     defect::install_hook();
     let outcome = defect::catch(|| {
         defect::inject("start");
@@ -37,7 +37,7 @@ fn main() -> ExitCode {
         }
         Ok(Err(e)) => {
             eprintln!("sepval: error: {e:#}");
-            if sepval_common::cancel::requested() {
+            if sepval_core::cancel::requested() {
                 ExitCode::from(130)
             } else {
                 ExitCode::from(2)

@@ -6,19 +6,19 @@
 use serde::{Deserialize, Serialize};
 
 /// The best goals so far and the simulations it took. The goals are infinite when no member
-/// finished; in JSON they are then the string `"inf"` ([`sepval_common::nonfinite`]).
+/// finished; in JSON they are then the string `"inf"` ([`sepval_core::nonfinite`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BestSoFar {
     /// Simulations run so far.
     pub evaluations: u64,
     /// Smallest first objective, J_pos \[m\].
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub best_j_pos_m: f64,
     /// Smallest second objective, J_att \[deg\].
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub best_j_att_deg: f64,
     /// Smallest weighted sum w0 J_pos + w1 J_att.
-    #[serde(with = "sepval_common::nonfinite")]
+    #[serde(with = "sepval_core::nonfinite")]
     pub best_weighted: f64,
 }
 

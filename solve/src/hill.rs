@@ -9,13 +9,13 @@
 //! When no trial step improves F, the step shrinks; below `min_step` the climber has reached a
 //! point it cannot leave (a local optimum at its resolution) and stops.
 
-use sepval_common::encoding::Chromosome;
-use sepval_common::evaluation::Outcome;
-use sepval_common::factors::FactorSpec;
+use sepval_core::encoding::Chromosome;
+use sepval_core::factors::FactorSpec;
+use sepval_core::outcome::Outcome;
 use serde::{Deserialize, Serialize};
 
 use crate::ga::Member;
-use crate::run::{Ask, Progress, RunError, Solver};
+use crate::run::{Ask, Progress, RunError, SearchError, Solver};
 
 /// Settings of the hill climber.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -212,7 +212,11 @@ impl Solver for HillSearch {
             Stage::Start => vec![self.u.clone()],
             Stage::Gradient { probes } => probes.clone(),
             Stage::Line { trials, .. } => trials.clone(),
-            Stage::Done(_) => return Err(RunError::Search("a finished climb was told".into())),
+            Stage::Done(_) => {
+                return Err(RunError::Search(SearchError::Protocol(
+                    "a finished climb was told",
+                )));
+            }
         };
         self.evaluations += outcomes.len() as u64;
         for (u, o) in points.iter().zip(&outcomes) {
@@ -271,7 +275,9 @@ impl Solver for HillSearch {
                     .map(|o| self.weighted(o))
                     .enumerate()
                     .min_by(|a, b| a.1.total_cmp(&b.1))
-                    .ok_or_else(|| RunError::Search("an empty line search".into()))?;
+                    .ok_or_else(|| {
+                        RunError::Search(SearchError::Protocol("an empty line search"))
+                    })?;
                 if fk < self.f {
                     self.u = trials[k].clone();
                     self.f = fk;

@@ -328,7 +328,7 @@ fn correlations(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sepval_common::factors::{Factor, FactorTable};
+    use sepval_core::factors::{Factor, FactorTable};
 
     /// The 17 factors of the default table.
     fn factors() -> Params {

@@ -11,8 +11,8 @@
 //! (`sepval-fit`) wraps them as solvers over model candidates, and composes them (a genetic
 //! search that tries refinements as it goes, several refinements sharing each batch).
 
-use sepval_common::cancel;
-use sepval_common::evaluation::EvalError;
+use sepval_core::cancel;
+use sepval_core::outcome::EvalError;
 
 /// Points to evaluate, as one batch.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,8 +57,8 @@ pub enum RunError {
     #[error("interrupted by a signal")]
     Interrupted,
     /// The search cannot go on (a start that does not simulate, a state that does not fit).
-    #[error("{0}")]
-    Search(String),
+    #[error(transparent)]
+    Search(SearchError),
     /// An observer failed (a checkpoint that cannot be written).
     #[error("{what}")]
     Observer {
@@ -68,6 +68,52 @@ pub enum RunError {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+}
+
+/// Why a search cannot go on, though the evaluator can: the search's own failure, which a
+/// caller running several searches together may record against that one and go on with the
+/// others.
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum SearchError {
+    /// The problem answered another number of values than the points asked.
+    #[error("{answered} evaluations for {asked} points")]
+    Answers {
+        /// The values given.
+        answered: usize,
+        /// The points asked.
+        asked: usize,
+    },
+    /// A solver told values it did not ask for, or after it finished (a defect of its
+    /// caller): what happened.
+    #[error("{0}")]
+    Protocol(&'static str),
+    /// A refinement's start that does not simulate.
+    #[error("the refinement's start does not simulate (diverged or invalid)")]
+    StartDiverged,
+    /// A finite-difference probe of one parameter that does not simulate.
+    #[error("the derivative probe of {parameter} did not simulate")]
+    ProbeDiverged {
+        /// The parameter probed.
+        parameter: String,
+    },
+    /// A search whose population has no member that finished its simulation.
+    #[error("no finished member to refine")]
+    NoFinishedMember,
+    /// The search cannot make its next step from its state (a GA's saved state that does
+    /// not fit its settings): the search's own error.
+    #[error(transparent)]
+    State(std::sync::Arc<dyn std::error::Error + Send + Sync>),
+    /// A point of the search that is not a valid model (an effect's value, an extension term
+    /// out of its range): the model's own error.
+    #[error(transparent)]
+    Point(std::sync::Arc<dyn std::error::Error + Send + Sync>),
+}
+
+impl From<SearchError> for RunError {
+    fn from(e: SearchError) -> Self {
+        RunError::Search(e)
+    }
 }
 
 impl From<EvalError> for RunError {
@@ -155,11 +201,10 @@ pub fn run<S: Solver>(
         };
         let evaluations = problem.evaluate(&ask.points, ask.with_samples)?;
         if evaluations.len() != ask.points.len() {
-            return Err(RunError::Search(format!(
-                "{} evaluations for {} points",
-                evaluations.len(),
-                ask.points.len()
-            )));
+            return Err(RunError::Search(SearchError::Answers {
+                answered: evaluations.len(),
+                asked: ask.points.len(),
+            }));
         }
         if let Some(progress) = solver.tell(evaluations)? {
             let mut stop = false;

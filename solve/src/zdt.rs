@@ -13,8 +13,8 @@
 //! rates); the final population's non-dominated set is scored by its hypervolume with reference
 //! point (1.1, 1.1).
 
-use sepval_common::evaluation::Outcome;
-use sepval_common::factors::FactorSpec;
+use sepval_core::factors::FactorSpec;
+use sepval_core::outcome::Outcome;
 
 use crate::ga::{GaError, GaSearch, GaSettings, Member};
 use crate::pareto::{hypervolume, non_dominated_fronts};

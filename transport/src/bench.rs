@@ -23,9 +23,9 @@ use crate::spec::EvaluatorSpec;
 use crate::{RunId, TransportError};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sepval_common::atomic_file::{WriteError, write_atomically};
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
-use sepval_common::factors::Factors;
+use sepval_core::atomic_file::{WriteError, write_atomically};
+use sepval_core::factors::Factors;
 
 /// A transport `sepval bench` can measure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

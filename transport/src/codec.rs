@@ -16,7 +16,7 @@ use crate::wire::{
 use sepval_common::correction::MAX_CORRECTION_VALUES;
 use sepval_common::effects::{MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::extension::MAX_TERMS;
-use sepval_common::factors::FACTOR_COUNT;
+use sepval_core::factors::FACTOR_COUNT;
 
 /// Longest text field (a host name, a reason, a run id) \[bytes\].
 pub const MAX_TEXT: usize = 64 << 10;
@@ -530,7 +530,7 @@ mod tests {
     use super::*;
     use crate::wire::{Chunk, serve_locally};
     use sepval_common::evaluation::Candidate;
-    use sepval_common::factors::Factors;
+    use sepval_core::factors::Factors;
 
     fn frames() -> Vec<Frame> {
         let job = crate::default_job();

@@ -29,10 +29,10 @@ use sepval_common::correction::MAX_CORRECTION_VALUES;
 use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::evaluation::{Candidate, Event, Job, Outcome};
 use sepval_common::extension::{Axis, MAX_TERMS, Regressor, Term, TermSet};
-use sepval_common::factors::{FACTOR_COUNT, Factors};
-use sepval_common::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
 use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
+use sepval_core::factors::{FACTOR_COUNT, Factors};
+use sepval_core::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
 use sepval_tests::fuzz::{
     At, CountingAllocator, Edit, apply, at, binary_edit, check_cost, check_typed, config, edits,
     length_value, measure, number_edits, text_edit,

@@ -176,8 +176,8 @@ impl From<TransportError> for EvalError {
     }
 }
 
-impl From<sepval_common::cancel::Cancelled> for TransportError {
-    fn from(_: sepval_common::cancel::Cancelled) -> Self {
+impl From<sepval_core::cancel::Cancelled> for TransportError {
+    fn from(_: sepval_core::cancel::Cancelled) -> Self {
         TransportError::Interrupted
     }
 }

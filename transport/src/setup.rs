@@ -11,10 +11,10 @@
 
 use sepval_common::effects::catalogue_fingerprint;
 use sepval_common::evaluation::{Event, Job, JobError};
-use sepval_common::limits::MAX_SAMPLES;
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
+use sepval_core::limits::MAX_SAMPLES;
 
 use crate::codec::{CodecError, MAX_SETUP, Reader, Writer};
 use crate::wire::{MAGIC, PROTOCOL_VERSION, SetupHeader};
@@ -86,7 +86,7 @@ pub fn hex(digest: &[u8]) -> String {
 /// Checks samples that arrived as numbers as a telemetry file's are checked: finite, within the
 /// plausible bounds, times increasing.
 fn check_samples(d: &Trajectory) -> Result<(), String> {
-    use sepval_common::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
+    use sepval_core::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
     for k in 0..d.len() {
         let t = d.times_s[k];
         let within = |v: &f64, bound: f64| v.is_finite() && v.abs() <= bound;
@@ -250,7 +250,7 @@ mod tests {
         assert_eq!(back.scenario_sha256(), j.scenario_sha256());
         let sim = &back.events()[0].simulator;
         assert_eq!(sim.scenario(), &scenario);
-        let f = sepval_common::factors::Factors::TRUTH;
+        let f = sepval_core::factors::Factors::TRUTH;
         let none = sepval_common::effects::EffectSet::NONE;
         let times = sim.default_times();
         assert_eq!(

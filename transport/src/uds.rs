@@ -12,8 +12,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use crossbeam::channel::{Receiver, RecvTimeoutError, Sender, unbounded};
-use sepval_common::cancel;
 use sepval_common::evaluation::Job;
+use sepval_core::cancel;
 
 use crate::codec::{Frame, MAX_SETUP};
 use crate::link::{Incoming, Link, LinkEvent, Stopped, WorkerId, WorkerLink};

@@ -5,9 +5,9 @@ use std::collections::BTreeMap;
 
 use sepval_common::correction::{Target, interpolate};
 use sepval_common::evaluation::Job;
-use sepval_common::factors::Factor;
 use sepval_common::goals::Goals;
 use sepval_common::table::Variable;
+use sepval_core::factors::Factor;
 use sepval_fit::space::{Noise, goals_of};
 
 use crate::explored::Proposal;

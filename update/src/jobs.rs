@@ -14,8 +14,8 @@ use crate::{Result, UpdateError};
 pub use sepval_common::evaluation::StartEvaluator;
 
 /// Each stage's wall time on stderr when `SEPVAL_UPDATE_TIMING` is set (never in the outputs).
-pub static CLOCK: sepval_common::stage_clock::StageClock =
-    sepval_common::stage_clock::StageClock::new("SEPVAL_UPDATE_TIMING", "update");
+pub static CLOCK: sepval_core::stage_clock::StageClock =
+    sepval_core::stage_clock::StageClock::new("SEPVAL_UPDATE_TIMING", "update");
 
 /// The releases of `job` with `proposals` in every scenario, so that candidates carry their
 /// values.

@@ -88,8 +88,8 @@ pub enum UpdateError {
     #[error("the baseline fit produced no refined optimum")]
     NoRefinedOptimum,
     /// The baseline's joint refinement failed.
-    #[error("the baseline's refinement: {0}")]
-    Refinement(String),
+    #[error("the baseline's refinement")]
+    Refinement(#[source] sepval_solve::run::SearchError),
     /// `--validate` named no release that could be read.
     #[error("--validate gave no release")]
     NoValidation,

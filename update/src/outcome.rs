@@ -1,7 +1,7 @@
 //! What an update produces before anything is written: its baseline, and the update itself
 //! (its record, the store, the factors and what the figure draws).
 
-use sepval_common::factors::Factors;
+use sepval_core::factors::Factors;
 use sepval_solve::lm::LmResult;
 
 use crate::record::UpdateFile;

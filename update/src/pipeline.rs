@@ -4,8 +4,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use sepval_common::evaluation::{Evaluator, Job};
-use sepval_common::factors::{Factor, Factors};
 use sepval_common::scenario::Scenario;
+use sepval_core::factors::{Factor, Factors};
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_fit::{FitError, FitOptions, Method, run_fit};
@@ -68,7 +68,7 @@ pub fn update(
     let baseline = baseline(options, &lm, evaluator.as_mut(), progress, noise)?;
     drop(evaluator);
     CLOCK.lap("baseline");
-    sepval_common::cancel::check().map_err(RunError::from)?;
+    sepval_core::cancel::check().map_err(RunError::from)?;
     let (folds, _) = folds(&job);
     let setting = Setting {
         job: Arc::clone(&job),
@@ -129,7 +129,7 @@ fn baseline(
     refine_together(evaluator, &mut runs)?;
     let run = runs.remove(0);
     if let Some(f) = run.failure() {
-        return Err(UpdateError::Refinement(f.to_string()));
+        return Err(UpdateError::Refinement(f.clone()));
     }
     let lm = run.finish();
     evaluations += lm.evaluations;

@@ -13,7 +13,7 @@ use sepval_fit::problem::SAMPLE_BUDGET;
 use sepval_fit::refine::Refinement;
 use sepval_fit::space::{Noise, goals_of};
 use sepval_solve::lm::{LmResult, LmRun, LmSettings, Measure};
-use sepval_solve::run::{Ask, Progress, RunError, Solver};
+use sepval_solve::run::{Ask, Progress, RunError, SearchError, Solver};
 
 use crate::space::UpdateSpace;
 
@@ -85,7 +85,7 @@ pub struct UpdateLm {
     job: Arc<Job>,
     mask: Mask,
     lm: LmRun<Penalised>,
-    failure: Option<String>,
+    failure: Option<SearchError>,
 }
 
 impl UpdateLm {
@@ -176,11 +176,11 @@ impl Solver for UpdateLm {
 }
 
 impl Refinement for UpdateLm {
-    fn record_failure(&mut self, reason: String) {
+    fn record_failure(&mut self, reason: SearchError) {
         self.failure = Some(reason);
     }
 
-    fn failure(&self) -> Option<&str> {
-        self.failure.as_deref()
+    fn failure(&self) -> Option<&SearchError> {
+        self.failure.as_ref()
     }
 }

@@ -25,8 +25,8 @@ use nalgebra::{DMatrix, DVector};
 use sepval_common::correction::{Derivative, Target, weights};
 use sepval_common::evaluation::Job;
 use sepval_common::extension::Axis;
-use sepval_common::factors::Factors;
 use sepval_common::table::Variable;
+use sepval_core::factors::Factors;
 use sepval_diagnose::{Linear, Misfit, Sample};
 use serde::{Deserialize, Serialize};
 

@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use sepval_common::correction::MAX_CORRECTION_VALUES;
 use sepval_common::evaluation::{Candidate, Evaluator, Job};
-use sepval_common::factors::Factors;
+use sepval_core::factors::Factors;
 use sepval_diagnose::{Misfit, reconstruct_misfit};
 use sepval_fit::space::Noise;
 use sepval_solve::lm::LmSettings;

@@ -5,8 +5,8 @@
 use nalgebra::DMatrix;
 use sepval_common::correction::{Correction, CorrectionValues, Derivative, Target};
 use sepval_common::evaluation::Candidate;
-use sepval_common::factors::{Factor, FactorTable, Factors};
 use sepval_common::model::Model;
+use sepval_core::factors::{Factor, FactorTable, Factors};
 use sepval_solve::params::Params;
 
 use crate::explored::Proposal;

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Candidate, Job};
-use sepval_common::factors::Factors;
+use sepval_core::factors::Factors;
 use sepval_fit::space::{Noise, goals_of};
 
 use crate::jobs::with_corrections;

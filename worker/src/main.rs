@@ -5,7 +5,7 @@
 //! `sepval_transport::serve` with this process's own simulations. A worker validates every
 //! request and answers a bad one with a typed failure instead of crashing; it ends cleanly when
 //! its coordinator ends the run or goes away, or on SIGINT/SIGTERM. A panic is reported as a
-//! defect with its message and place, exit status 2 (`sepval_common::defect`). Run `iox2 service
+//! defect with its message and place, exit status 2 (`sepval_core::defect`). Run `iox2 service
 //! list` with the run's configuration to see its services (see docs/guide.md, "Distributed
 //! evaluation").
 
@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use anyhow::Result;
 use clap::Parser;
-use sepval_common::defect;
+use sepval_core::defect;
 use sepval_transport::RunId;
 use sepval_transport::ipc::IpcWorker;
 use sepval_transport::link::Stopped;
@@ -69,7 +69,7 @@ fn positive_seconds(text: &str) -> Result<f64, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    sepval_common::cancel::install_signal_handlers();
+    sepval_core::cancel::install_signal_handlers();
     defect::install_hook();
     let outcome = defect::catch(|| {
         defect::inject("worker");

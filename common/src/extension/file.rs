@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::wind::DEFAULT_RISE_S;
 use super::{Axis, Family, MAX_TERMS, Regressor, Term, TermError};
-use crate::limits::MAX_EXTENSION_BYTES;
+use sepval_core::limits::MAX_EXTENSION_BYTES;
 
 /// A term as files write it: `axis`, `family`, `regressor`, the family's locator by name (a
 /// wind's two: `t_on_s` and `rise_s`, the latter [`DEFAULT_RISE_S`] when not written), and
@@ -174,7 +174,7 @@ pub enum ExtensionError {
     },
     /// The path is not a regular file, or the file is over its byte limit.
     #[error(transparent)]
-    Input(Box<crate::input_file::InputFileError>),
+    Input(Box<sepval_core::input_file::InputFileError>),
     /// Not TOML, or not the expected fields (the parser names line and column).
     #[error("extension {path}: {message}")]
     Parse {
@@ -223,7 +223,7 @@ fn field_line(text: &str, span: std::ops::Range<usize>, field: &str) -> usize {
 pub fn parse_extension(text: &str, path: &str) -> Result<Vec<Term>, ExtensionError> {
     let file: ExtensionFile = toml::from_str(text).map_err(|e| ExtensionError::Parse {
         path: path.to_string(),
-        message: crate::toml_error::one_line(text, &e),
+        message: sepval_core::toml_error::one_line(text, &e),
     })?;
     if file.format != EXTENSION_FORMAT {
         return Err(ExtensionError::Parse {
@@ -260,15 +260,14 @@ pub fn parse_extension(text: &str, path: &str) -> Result<Vec<Term>, ExtensionErr
 /// Reads an extension file.
 pub fn load_extension(path: &std::path::Path) -> Result<Vec<Term>, ExtensionError> {
     let name = path.display().to_string();
-    let text = crate::input_file::read_string(path, "extension", MAX_EXTENSION_BYTES).map_err(
-        |e| match e.into_io() {
+    let text = sepval_core::input_file::read_string(path, "extension", MAX_EXTENSION_BYTES)
+        .map_err(|e| match e.into_io() {
             Ok(source) => ExtensionError::Io {
                 path: name.clone(),
                 source,
             },
             Err(refused) => ExtensionError::Input(Box::new(refused)),
-        },
-    )?;
+        })?;
     parse_extension(&text, &name)
 }
 

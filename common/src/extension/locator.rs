@@ -26,7 +26,7 @@
 //! decay lengths about 0.1 to 3.6 m, steps and gusts within the record, gust lengths 0.05 to
 //! 0.2 s, 1 to 50.5 Hz) lie well inside.
 
-use crate::limits::MAX_SPAN_S;
+use sepval_core::limits::MAX_SPAN_S;
 
 /// The domain of one locator: `min` (excluded when `min_open`) to `max` (included).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -12,8 +12,8 @@
 //! ```
 
 use super::tables::AeroAtMach;
-use crate::factors::{Factor, Factors};
 use crate::lanes::Real;
+use sepval_core::factors::{Factor, Factors};
 
 /// The flow seen by the store at one force evaluation; effects' coefficient terms read it.
 /// (`R`: one run's doubles, or one lane per run; see [`crate::lanes`].)

@@ -23,9 +23,9 @@
 
 use super::aero::Coefficients;
 use super::tables::AeroAtMach;
-use crate::factors::{Factor, Factors};
 use crate::lanes::Real;
 use crate::scenario::{FlowfieldSpec, MAX_STATIONS, MachScaling};
+use sepval_core::factors::{Factor, Factors};
 
 /// Pg(M) of docs/model.md section 3b: 1 / sqrt(max(|1 - M^2|, 0.1)), or 1 without scaling.
 pub fn mach_factor(scaling: MachScaling, mach: f64) -> f64 {

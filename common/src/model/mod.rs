@@ -28,7 +28,6 @@
 
 pub mod aero;
 mod by_lane;
-mod corrected;
 mod dcm;
 pub mod ejector;
 mod equations;
@@ -44,12 +43,12 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::atmosphere::isa_troposphere;
 use crate::correction::{Correction, CorrectionError, CorrectionRun};
-use crate::effects::{EffectError, EffectSet, MAX_EFFECT_PARAMS};
+use crate::effect_error::{EffectError, MAX_EFFECT_PARAMS};
 use crate::elementary::{cos, sin};
 use crate::extension::{TermError, TermInput, TermSet};
-use crate::factors::{Factor, FactorError, Factors};
 use crate::scenario::Scenario;
 use crate::table::PreparedTables;
+use sepval_core::factors::{Factor, FactorError, Factors};
 use tables::AeroAtMach;
 
 pub use aero::{Coefficients, Flow};
@@ -273,37 +272,14 @@ pub struct RunSetup {
 fn no_term(_: &[f64; MAX_EFFECT_PARAMS], _: &Flow, _: &mut Coefficients) {}
 
 impl RunSetup {
-    /// The run of `model` with `factors` (checked against the scenario's factor table) and
-    /// `effects` applied.
-    pub fn new(model: &Model, factors: &Factors, effects: &EffectSet) -> Result<Self, ModelError> {
-        Self::with_terms(model, factors, effects, &TermSet::NONE)
-    }
-
-    /// The run of `model` with `factors`, `effects` and the extension `terms` (added to the
-    /// scenario's own) applied.
-    pub fn with_terms(
-        model: &Model,
-        factors: &Factors,
-        effects: &EffectSet,
-        terms: &TermSet,
-    ) -> Result<Self, ModelError> {
-        model.scenario.factors.check(factors)?;
-        let mut run = Self::new_unchecked_bounds(model, factors, effects)?;
-        run.terms = model.extension.merged(terms)?;
-        Ok(run)
-    }
-
-    /// As [`RunSetup::new`], but factors need only be finite (not within the table's bounds):
-    /// for studies that step outside the search box on purpose.
-    pub fn new_unchecked_bounds(
-        model: &Model,
-        factors: &Factors,
-        effects: &EffectSet,
-    ) -> Result<Self, ModelError> {
+    /// The run of `model` with `factors`, before any effect is applied (factors need only be
+    /// finite): what [`RunSetup::new`] and its kin (`crate::setup`) start from, then finish
+    /// with [`RunSetup::finish`].
+    pub(crate) fn base(model: &Model, factors: &Factors) -> Result<Self, ModelError> {
         for (i, &value) in factors.0.iter().enumerate() {
             if !value.is_finite() {
                 return Err(FactorError::NotFinite {
-                    name: crate::factors::Factor::NAMES[i],
+                    name: sepval_core::factors::Factor::NAMES[i],
                     value,
                 }
                 .into());
@@ -318,7 +294,7 @@ impl RunSetup {
             ia[2] * fx(Factor::Zinerfac),
         ));
         let i = &model.interference_at_carriage;
-        let mut run = RunSetup {
+        let run = RunSetup {
             inv_mass_per_kg: 1.0 / model.mass_kg,
             inertia_kg_m2: inertia,
             inertia_inv: Matrix3::identity(),
@@ -385,7 +361,13 @@ impl RunSetup {
             inv_speed_of_sound_s_m: 1.0 / model.speed_of_sound_m_s,
             corrections: CorrectionRun::NONE,
         };
-        effects.apply(&mut run)?;
+        Ok(run)
+    }
+
+    /// The run once its effects are applied: the inertia tensor's inverse and its diagonal
+    /// (the effects may have changed the tensor).
+    pub(crate) fn finish(mut self) -> Result<Self, ModelError> {
+        let run = &mut self;
         run.inertia_inv = invert_inertia(&run.inertia_kg_m2)?;
         run.inertia_diagonal = is_diagonal(&run.inertia_kg_m2);
         let i = &run.inertia_kg_m2;
@@ -393,7 +375,7 @@ impl RunSetup {
         run.inertia_principal_inv = run.inertia_principal.map(|d| 1.0 / d);
         let [ixx, iyy, izz] = run.inertia_principal;
         run.inertia_principal_differences = [izz - iyy, ixx - izz, iyy - ixx];
-        Ok(run)
+        Ok(self)
     }
 
     /// Adds a coefficient term (used by effects).

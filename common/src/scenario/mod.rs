@@ -20,12 +20,12 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::factors::{Factor, FactorSpec, FactorTable};
-use crate::input_file::read_string;
-use crate::limits::MAX_SCENARIO_BYTES;
 use crate::table::{
     Coefficient, DerivativeCoefficient, InterferenceCoefficient, StaticCoefficient, TableError,
 };
+use sepval_core::factors::{Factor, FactorSpec, FactorTable};
+use sepval_core::input_file::read_string;
+use sepval_core::limits::MAX_SCENARIO_BYTES;
 
 /// The embedded default scenario text (docs/model.md section 1).
 pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../../scenarios/eglin_default.toml");
@@ -355,7 +355,7 @@ pub enum ScenarioError {
     },
     /// The path is not a regular file, or the file is over its byte limit.
     #[error(transparent)]
-    Input(Box<crate::input_file::InputFileError>),
+    Input(Box<sepval_core::input_file::InputFileError>),
     /// The TOML does not parse or does not have the expected fields.
     #[error("scenario {origin}: {message}")]
     Parse {
@@ -409,7 +409,7 @@ impl Scenario {
     ) -> Result<Scenario, ScenarioError> {
         let mut scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             origin: origin.to_string(),
-            message: crate::toml_error::one_line(text, &e),
+            message: sepval_core::toml_error::one_line(text, &e),
         })?;
         if let Some(dir) = dir {
             scenario.resolve_tables(dir, origin)?;

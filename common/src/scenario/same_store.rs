@@ -4,7 +4,7 @@
 //! record the store fitted; issue 33, item 6).
 
 use super::{Scenario, Store};
-use crate::number_text::Shown;
+use sepval_core::number_text::Shown;
 
 /// The first field in which two scenarios' stores differ.
 #[derive(Debug, Clone, PartialEq)]

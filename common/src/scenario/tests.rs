@@ -1,5 +1,5 @@
 use super::*;
-use crate::units::*;
+use sepval_core::units::*;
 
 #[test]
 fn embedded_default_is_the_exact_conversion() {

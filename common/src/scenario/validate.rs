@@ -212,7 +212,7 @@ impl Checker<'_> {
         Ok(())
     }
 
-    /// Step, end and rate, and the work of one run (crate::limits), refused before anything is
+    /// Step, end and rate, and the work of one run (sepval_core::limits), refused before anything is
     /// allocated.
     fn integrator(&self, n: &Integrator) -> Result<(), ScenarioError> {
         self.positive("integrator.dt_s", n.dt_s)?;
@@ -227,9 +227,9 @@ impl Checker<'_> {
                 ),
             ));
         }
-        crate::limits::check_steps(n.t_end_s, n.dt_s)
+        sepval_core::limits::check_steps(n.t_end_s, n.dt_s)
             .map_err(|e| self.bad("integrator.dt_s", format!("= {}: {e}", n.dt_s)))?;
-        crate::limits::check_sampling(n.t_end_s, n.rate_hz)
+        sepval_core::limits::check_sampling(n.t_end_s, n.rate_hz)
             .map_err(|e| self.bad("integrator.rate_hz", format!("= {}: {e}", n.rate_hz)))
     }
 

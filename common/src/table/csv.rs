@@ -39,17 +39,21 @@ type Rows = Vec<(usize, Vec<f64>)>;
 /// columns first (in nesting order), then one or more value columns, then one row per grid
 /// point in row-major order (first axis slowest). `column` picks the value column (needed when
 /// there are several). Lines starting with `#` and blank lines are skipped. Only a regular file
-/// of at most [`MAX_TABLE_CSV_BYTES`](crate::limits::MAX_TABLE_CSV_BYTES) is read.
+/// of at most [`MAX_TABLE_CSV_BYTES`](sepval_core::limits::MAX_TABLE_CSV_BYTES) is read.
 pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, TableError> {
     let file = path.display().to_string();
-    let text = crate::input_file::read_string(path, "table", crate::limits::MAX_TABLE_CSV_BYTES)
-        .map_err(|e| match e.into_io() {
-            Ok(io) => TableError::Io {
-                file: file.clone(),
-                message: io.to_string(),
-            },
-            Err(refused) => TableError::Input(Box::new(refused)),
-        })?;
+    let text = sepval_core::input_file::read_string(
+        path,
+        "table",
+        sepval_core::limits::MAX_TABLE_CSV_BYTES,
+    )
+    .map_err(|e| match e.into_io() {
+        Ok(io) => TableError::Io {
+            file: file.clone(),
+            message: io.to_string(),
+        },
+        Err(refused) => TableError::Input(Box::new(refused)),
+    })?;
     let mut lines = text
         .trim_start_matches('\u{feff}')
         .lines()

@@ -15,7 +15,7 @@ pub enum TableError {
     },
     /// The path is not a regular file, or the file is over its byte limit.
     #[error(transparent)]
-    Input(Box<crate::input_file::InputFileError>),
+    Input(Box<sepval_core::input_file::InputFileError>),
     /// No header row.
     #[error("{file}: empty table: expected a header row such as `mach [-],alpha [deg],cz [-]`")]
     Empty {

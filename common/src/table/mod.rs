@@ -40,9 +40,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::units::{M_PER_FT, M_PER_IN};
+use sepval_core::units::{M_PER_FT, M_PER_IN};
 
-pub use crate::limits::MAX_TABLE_VALUES;
+pub use sepval_core::limits::MAX_TABLE_VALUES;
 
 /// A variable a table may be tabulated over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]

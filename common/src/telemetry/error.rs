@@ -1,7 +1,7 @@
 //! Errors of telemetry files: every variant names the file, those about content the line and
 //! column; and the bounds of plausible telemetry they cite.
 
-use crate::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
+use sepval_core::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
 
 /// Errors reading a telemetry file. Every variant names the file; those about content name the
 /// line and column.
@@ -18,7 +18,7 @@ pub enum TelemetryError {
     },
     /// The path is not a regular file, or the file is over its byte limit.
     #[error(transparent)]
-    Input(Box<crate::input_file::InputFileError>),
+    Input(Box<sepval_core::input_file::InputFileError>),
     /// No header row.
     #[error(
         "{file}: empty file: expected a header row `t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg`"
@@ -143,10 +143,10 @@ pub enum TelemetryError {
         /// The field.
         value: String,
     },
-    /// A line longer than [`MAX_TELEMETRY_LINE_BYTES`](crate::limits::MAX_TELEMETRY_LINE_BYTES),
+    /// A line longer than [`MAX_TELEMETRY_LINE_BYTES`](sepval_core::limits::MAX_TELEMETRY_LINE_BYTES),
     /// refused once that many bytes of it were read.
     #[error(
-        "{file}: line {line} is longer than {limit} bytes, the limit of a telemetry line (sepval_common::limits; a row is a few hundred bytes): is it a telemetry file?"
+        "{file}: line {line} is longer than {limit} bytes, the limit of a telemetry line (sepval_core::limits; a row is a few hundred bytes): is it a telemetry file?"
     )]
     LineTooLong {
         /// The file.
@@ -205,7 +205,7 @@ pub enum TelemetryError {
     },
 }
 
-/// The bounds of plausible telemetry ([`crate::limits`]).
+/// The bounds of plausible telemetry ([`sepval_core::limits`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Bound {
     /// A sample time: +-[`MAX_SPAN_S`].

@@ -134,7 +134,7 @@ mod tests {
             }
         }
         let mut counted = Counted(std::io::repeat(0).take(1 << 30), 0);
-        let bound = crate::limits::MAX_TELEMETRY_LINE_BYTES;
+        let bound = sepval_core::limits::MAX_TELEMETRY_LINE_BYTES;
         let first = BoundedLines::new(std::io::BufReader::new(&mut counted), bound).next();
         assert_eq!(too_long(&first.unwrap().unwrap_err()), Some(bound));
         assert!(

@@ -13,12 +13,12 @@
 //! - Blank lines are skipped. Fields may be surrounded by spaces, and enclosed in double quotes
 //!   as spreadsheets write them (`"t_s","x_m",...`); a quote that does not enclose a whole field
 //!   is refused. A UTF-8 byte-order mark at the start of the file is skipped.
-//! - The limits of [`crate::limits`]: at most [`MAX_SAMPLES`] samples, sample times within
-//!   +-[`MAX_SPAN_S`](crate::limits::MAX_SPAN_S), positions within +-[`MAX_POSITION_M`](crate::limits::MAX_POSITION_M) and angles within
-//!   +-[`MAX_ANGLE_DEG`](crate::limits::MAX_ANGLE_DEG); a value beyond them is refused with its line and column (it is a
+//! - The limits of [`sepval_core::limits`]: at most [`MAX_SAMPLES`] samples, sample times within
+//!   +-[`MAX_SPAN_S`](sepval_core::limits::MAX_SPAN_S), positions within +-[`MAX_POSITION_M`](sepval_core::limits::MAX_POSITION_M) and angles within
+//!   +-[`MAX_ANGLE_DEG`](sepval_core::limits::MAX_ANGLE_DEG); a value beyond them is refused with its line and column (it is a
 //!   unit or export mistake, and it would overflow the goals).
 //! - Files are read line by line: the text is never held whole in memory. Only a regular file
-//!   is read, of at most [`MAX_TELEMETRY_BYTES`] ([`crate::input_file`]), each line of at most
+//!   is read, of at most [`MAX_TELEMETRY_BYTES`] ([`sepval_core::input_file`]), each line of at most
 //!   [`MAX_TELEMETRY_LINE_BYTES`] (refused once that many bytes of it were read).
 //! - Files sepval writes print every number in the shortest form that reads back as the same
 //!   double, so writing and reading is exact.
@@ -26,10 +26,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::atomic_file::{WriteError, write_atomically};
-use crate::input_file::{InputFile, InputFileError};
-use crate::limits::{MAX_SAMPLES, MAX_TELEMETRY_BYTES, MAX_TELEMETRY_LINE_BYTES};
-use crate::units::M_PER_FT;
+use sepval_core::atomic_file::{WriteError, write_atomically};
+use sepval_core::input_file::{InputFile, InputFileError};
+use sepval_core::limits::{MAX_SAMPLES, MAX_TELEMETRY_BYTES, MAX_TELEMETRY_LINE_BYTES};
+use sepval_core::units::M_PER_FT;
 
 mod error;
 mod lines;

@@ -29,14 +29,14 @@ use sepval_common::extension::{
     Axis, EXTENSION_FORMAT, ExtensionError, Family, MAX_TERMS, Regressor, Term, TermRecord,
     extension_toml, parse_extension,
 };
-use sepval_common::factors::{FactorTable, Factors};
-use sepval_common::limits::{
-    MAX_ANGLE_DEG, MAX_EXTENSION_BYTES, MAX_POSITION_M, MAX_SCENARIO_BYTES, MAX_SPAN_S,
-    MAX_TABLE_CSV_BYTES, MAX_TELEMETRY_BYTES,
-};
 use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
 use sepval_common::synthetic::default_flight_test;
 use sepval_common::telemetry::{TelemetryError, Trajectory};
+use sepval_core::factors::{FactorTable, Factors};
+use sepval_core::limits::{
+    MAX_ANGLE_DEG, MAX_EXTENSION_BYTES, MAX_POSITION_M, MAX_SCENARIO_BYTES, MAX_SPAN_S,
+    MAX_TABLE_CSV_BYTES, MAX_TELEMETRY_BYTES,
+};
 use std::path::PathBuf;
 
 use sepval_tests::fuzz::{

@@ -1,5 +1,5 @@
 //! Every reader of outside input refuses what is not a regular file within its byte limit, at
-//! once (issue 21, items 1, 2 and 14; `sepval_common::input_file`): a FIFO with no writer, a
+//! once (issue 21, items 1, 2 and 14; `sepval_core::input_file`): a FIFO with no writer, a
 //! device that never ends (`/dev/zero`), a directory, and a sparse regular file one byte over
 //! the limit (no real allocation), each given as a table CSV (through a scenario, as a user
 //! writes it), as telemetry, as a scenario and as an extension. Each reader runs in a thread
@@ -12,11 +12,11 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use sepval_common::extension::load_extension;
-use sepval_common::limits::{
-    MAX_EXTENSION_BYTES, MAX_SCENARIO_BYTES, MAX_TABLE_CSV_BYTES, MAX_TELEMETRY_BYTES,
-};
 use sepval_common::scenario::{DEFAULT_SCENARIO_TOML, Scenario};
 use sepval_common::telemetry::Trajectory;
+use sepval_core::limits::{
+    MAX_EXTENSION_BYTES, MAX_SCENARIO_BYTES, MAX_TABLE_CSV_BYTES, MAX_TELEMETRY_BYTES,
+};
 
 /// The longest a refusal may take before the test calls the reader blocked (a refusal takes
 /// microseconds; this only bounds a failure).
@@ -144,7 +144,7 @@ fn a_sparse_file_over_its_limit_is_refused_before_it_is_read() {
         let shown = p.display().to_string();
         let expected = move |label: &str| {
             format!(
-                "{shown}: the {label} is {} bytes, more than the limit of {limit} bytes for a {label} (sepval_common::limits): check that it is the intended file, or split it",
+                "{shown}: the {label} is {} bytes, more than the limit of {limit} bytes for a {label} (sepval_core::limits): check that it is the intended file, or split it",
                 limit + 1
             )
         };

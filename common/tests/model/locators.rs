@@ -8,9 +8,9 @@ use sepval_common::extension::locator::{F_HZ, LAMBDA_M, LocatorDomain, MACH0, T_
 use sepval_common::extension::{
     Axis, Regressor, Term, TermRecord, extension_toml, parse_extension,
 };
-use sepval_common::factors::Factors;
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
+use sepval_core::factors::Factors;
 
 /// A term of `regressor` on Cm at `locator`, with a coefficient that keeps its increment of
 /// Cm small at the edge (the point is the regressor's value, not the store's response).

@@ -6,12 +6,12 @@
 use std::path::Path;
 
 use sepval_common::effects::EffectSet;
-use sepval_common::factors::Factors;
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
 use sepval_common::table::{Kind, read_csv};
 use sepval_common::table_form::table_form;
 use sepval_common::telemetry::Trajectory;
+use sepval_core::factors::Factors;
 
 /// Writes `form` into `dir` and loads it as a user would.
 pub(crate) fn write_and_load(dir: &Path, interference: bool) -> Scenario {

@@ -5,11 +5,11 @@
 use std::path::Path;
 
 use sepval_common::effects::EffectSet;
-use sepval_common::factors::Factors;
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
 use sepval_common::table::{Axis, Coefficient, Kind, Table, Tabulated, Variable};
 use sepval_common::table_form::table_form;
+use sepval_core::factors::Factors;
 use sepval_daveml::output::write_table_dir;
 use sepval_daveml::{Map, Provenance, import_model, to_daveml};
 

@@ -44,7 +44,7 @@ pub(super) fn free_held_locator(
     refine_together(evaluator, &mut runs)?;
     let [run] = runs;
     let terms = run.space().terms.clone();
-    let failure = run.failure().map(str::to_string);
+    let failure = run.failure().map(ToString::to_string);
     let lm = run.finish();
     trail.evaluations += lm.evaluations;
     let what = match entry.family() {

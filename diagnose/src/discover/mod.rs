@@ -38,7 +38,7 @@ use std::sync::Arc;
 
 use sepval_common::evaluation::{Evaluator, Job};
 use sepval_common::extension::MAX_TERMS;
-use sepval_common::factors::FACTOR_COUNT;
+use sepval_core::factors::FACTOR_COUNT;
 use sepval_fit::space::Noise;
 use sepval_solve::lm::LmSettings;
 

@@ -8,7 +8,7 @@ use std::ops::Range;
 
 use sepval_common::evaluation::Job;
 use sepval_common::extension::{Family, Term};
-use sepval_common::factors::FACTOR_COUNT;
+use sepval_core::factors::FACTOR_COUNT;
 use sepval_fit::space::FreeTerm;
 
 use crate::library::{self, Entry};

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::Evaluator;
-use sepval_common::factors::FACTOR_COUNT;
+use sepval_core::factors::FACTOR_COUNT;
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{FreeTerm, ParamSpace};
 
@@ -53,7 +53,7 @@ pub(super) fn leave_one_out(
     refine_together(evaluator, &mut runs)?;
     let mut out = Vec::with_capacity(runs.len());
     for ((run, terms), entry) in runs.into_iter().zip(kept_terms).zip(picked.entries()) {
-        let failure = run.failure().map(str::to_string);
+        let failure = run.failure().map(ToString::to_string);
         let lm = run.finish();
         trail.evaluations += lm.evaluations;
         match failure {

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Evaluator, Job};
-use sepval_common::factors::FACTOR_COUNT;
+use sepval_core::factors::FACTOR_COUNT;
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_solve::lm::LmSettings;
@@ -107,7 +107,7 @@ pub(super) fn refit_candidates(
     let mut refits: Vec<Refit> = Vec::with_capacity(runs.len());
     for (l, run) in located.into_iter().zip(runs) {
         let space = run.space().clone();
-        let failure = run.failure().map(str::to_string);
+        let failure = run.failure().map(ToString::to_string);
         let lm = run.finish();
         trail.evaluations += lm.evaluations;
         if let Some(reason) = failure {

@@ -9,7 +9,7 @@
 //! hex) of its *canonical form*, which is the compact JSON that this sepval writes for the
 //! checkpoint with the `digest` field left out (`serde_json::to_vec`: fields in declaration
 //! order, no whitespace, numbers in serde_json's shortest spelling that reads back exactly,
-//! non-finite numbers as the strings of [`nonfinite`](sepval_common::nonfinite)). [`Checkpoint::save`] writes it;
+//! non-finite numbers as the strings of [`nonfinite`](sepval_core::nonfinite)). [`Checkpoint::save`] writes it;
 //! [`Checkpoint::load`] reads the file, writes the canonical form of what it read, and refuses
 //! the file unless the two digests are equal.
 //!
@@ -49,7 +49,7 @@
 //!
 //! [`Checkpoint::check_job`] adds what needs the job: every member's chromosome has the factor
 //! table's length and decodes
-//! ([`Chromosome::decode_values`](sepval_common::encoding::Chromosome::decode_values)) to
+//! ([`Chromosome::decode_values`](sepval_core::encoding::Chromosome::decode_values)) to
 //! exactly its recorded values, and a divergence names an event of the job.
 //!
 //! # Earlier checkpoints
@@ -66,8 +66,8 @@ mod verify;
 
 use std::path::{Path, PathBuf};
 
-use sepval_common::atomic_file::{WriteError, write_atomically};
 use sepval_common::evaluation::Job;
+use sepval_core::atomic_file::{WriteError, write_atomically};
 use serde::{Deserialize, Serialize};
 
 pub use self::digest::Digest;
@@ -81,7 +81,7 @@ use sepval_solve::hill::HillSettings;
 pub enum CheckpointError {
     /// The file cannot be read (missing, not a regular file, over the size limit).
     #[error(transparent)]
-    Read(#[from] sepval_common::input_file::InputFileError),
+    Read(#[from] sepval_core::input_file::InputFileError),
     /// The file is not a checkpoint.
     #[error("checkpoint {path} is not a sepval checkpoint")]
     Parse {
@@ -214,10 +214,10 @@ impl Checkpoint {
     /// content (see the module documentation); [`Checkpoint::check_job`] checks the rest
     /// against the job.
     pub fn load(path: &Path) -> Result<Checkpoint, CheckpointError> {
-        let text = sepval_common::input_file::read_string(
+        let text = sepval_core::input_file::read_string(
             path,
             "checkpoint",
-            sepval_common::limits::MAX_JSON_BYTES,
+            sepval_core::limits::MAX_JSON_BYTES,
         )?;
         let parse = |source| CheckpointError::Parse {
             path: path.to_path_buf(),

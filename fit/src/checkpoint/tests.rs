@@ -340,7 +340,7 @@ fn content_sealed_again_after_an_edit_meets_the_consistency_checks() {
                 let mut bits = c.state.population[free].chromosome.bits().to_vec();
                 bits.pop();
                 c.state.population[free].chromosome =
-                    sepval_common::encoding::Chromosome::from_bits(bits);
+                    sepval_core::encoding::Chromosome::from_bits(bits);
             }),
         ),
         (

@@ -2,7 +2,7 @@
 //! [`crate::checkpoint`]). Each returns what disagrees, naming the member, field or count.
 
 use sepval_common::evaluation::{Job, MAX_REASON_BYTES, Outcome};
-use sepval_common::factors::{Factor, FactorSpec};
+use sepval_core::factors::{Factor, FactorSpec};
 
 use super::Checkpoint;
 use crate::method::Method;

@@ -64,7 +64,7 @@ pub(super) fn take_lock(dir: &Path, lock: &Path) -> Result<Option<String>, OutDi
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                 // Read as any input (a FIFO or a huge file planted as the lock must not hang or
                 // exhaust the run).
-                let holder = match sepval_common::input_file::read_string(lock, "lock file", 4096) {
+                let holder = match sepval_core::input_file::read_string(lock, "lock file", 4096) {
                     Ok(text) => holder(&text),
                     Err(e) => Holder::IllFormed(format!("it cannot be read ({e})")),
                 };

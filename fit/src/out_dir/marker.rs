@@ -92,7 +92,7 @@ fn write(dir: &Path, marker: &Marker) -> Result<(), OutDirError> {
     let path = dir.join(MARKER_FILE);
     let mut text = serde_json::to_string_pretty(marker).expect("a marker serialises");
     text.push('\n');
-    sepval_common::atomic_file::write_atomically(&path, text.as_bytes()).map_err(|e| {
+    sepval_core::atomic_file::write_atomically(&path, text.as_bytes()).map_err(|e| {
         OutDirError::Io {
             what: "cannot write",
             path: path.clone(),
@@ -118,10 +118,10 @@ pub(super) fn check_clearable(dir: &Path, entries: &[String]) -> Result<(), OutD
             named(entries.iter().cloned())
         )));
     }
-    let marker: Marker = sepval_common::input_file::read_string(
+    let marker: Marker = sepval_core::input_file::read_string(
         &path,
         "run marker",
-        sepval_common::limits::MAX_JSON_BYTES,
+        sepval_core::limits::MAX_JSON_BYTES,
     )
     .map_err(|e| e.to_string())
     .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
@@ -248,7 +248,7 @@ fn walk(dir: &Path, descend: &dyn Fn(&str) -> bool) -> Result<Vec<(String, Kind)
 fn sha256(path: &Path) -> std::io::Result<String> {
     // No limit on what a run wrote (the reader's limit plus one must not overflow).
     const UNLIMITED: u64 = i64::MAX as u64;
-    let mut file = sepval_common::input_file::InputFile::open(path, "run output", UNLIMITED)
+    let mut file = sepval_core::input_file::InputFile::open(path, "run output", UNLIMITED)
         .map_err(std::io::Error::other)?;
     let mut h = Sha256::new();
     let mut buf = vec![0u8; 1 << 16];

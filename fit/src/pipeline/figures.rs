@@ -5,10 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use sepval_common::evaluation::Job;
-use sepval_common::factors::Factor;
 use sepval_common::telemetry::Trajectory;
+use sepval_core::factors::Factor;
 use sepval_report::figures::{
-    Series, convergence_figure, correlation_figure, factor_figure, pareto_figure,
+    Series, Track, convergence_figure, correlation_figure, factor_figure, pareto_figure,
     trajectory_figures,
 };
 
@@ -111,9 +111,21 @@ fn write_trajectories(
         .collect();
     let series: Vec<Series> = fits
         .iter()
-        .map(|(l, t)| Series { label: l, traj: t })
+        .map(|(l, t)| Series {
+            label: l,
+            traj: track(t),
+        })
         .collect();
-    Ok(trajectory_figures(fig_dir, &data, &series)?)
+    Ok(trajectory_figures(fig_dir, track(&data), &series)?)
+}
+
+/// A trajectory as the figures draw it.
+fn track(t: &Trajectory) -> Track<'_> {
+    Track {
+        times_s: &t.times_s,
+        pos_m: &t.pos_m,
+        att_deg: &t.att_deg,
+    }
 }
 
 /// Figure 7: each method's factors beside the truth, when known.

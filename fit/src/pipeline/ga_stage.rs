@@ -10,7 +10,7 @@ use sepval_common::evaluation::{Candidate, Evaluation, Job};
 use sepval_solve::ga::{GaSearch, GaSettings, GaState};
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::{LmResult, LmSettings};
-use sepval_solve::run::{Ask, Control, Observer, Progress, RunError, Solver};
+use sepval_solve::run::{Ask, Control, Observer, Progress, RunError, SearchError, Solver};
 
 use crate::checkpoint::{CHECKPOINT_FORMAT, Checkpoint, InputsRecord};
 use crate::problem::OnModel;
@@ -144,7 +144,7 @@ impl Solver for GaStage {
                 if refinement_due(state, &self.probes) {
                     let best = state
                         .best(self.weights)
-                        .ok_or_else(|| RunError::Search("no finished member to refine".into()))?;
+                        .ok_or_else(|| RunError::Search(SearchError::NoFinishedMember))?;
                     let lm = ModelLm::new(
                         self.space.clone(),
                         Arc::clone(&self.job),

@@ -10,18 +10,18 @@ mod searches;
 
 pub use figures::write_fit_figures;
 pub use ga_stage::{Checkpointer, GaStage, Probing, refinement_due};
-pub use outputs::{resolution_advice, write_result};
+pub use outputs::{Unfinished, resolution_advice, write_result};
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use sepval_common::atomic_file::WriteError;
 use sepval_common::effects::EffectSet;
 use sepval_common::evaluation::{Candidate, EvalError, Evaluation, Evaluator, Job};
-use sepval_common::factors::Factors;
 use sepval_common::propagator::Observation;
+use sepval_core::atomic_file::WriteError;
+use sepval_core::factors::Factors;
 
 use sepval_report::figures::FigureError;
 use sepval_solve::ga::{GaError, GaSettings};
@@ -137,9 +137,27 @@ pub enum FitError {
     /// A figure that cannot be drawn.
     #[error(transparent)]
     Figure(#[from] FigureError),
-    /// The fit has no answer.
-    #[error("{0}")]
-    Failed(String),
+    /// The hill climber's start does not simulate (why: its divergence or failure).
+    #[error(
+        "the hill climber's start, the nominal factors (clamped to their bounds), does not \
+         simulate: {why}; --method ga or ga+lm start from a random population instead"
+    )]
+    HillStart {
+        /// Why it does not.
+        why: String,
+    },
+    /// The genetic search ended before its first generation.
+    #[error("the genetic search did not start")]
+    GaNotStarted,
+    /// No member of the final population finished its simulation.
+    #[error("no member of the final population finished its simulation")]
+    NoFinishedMember,
+    /// The best member's simulation did not finish when run for its deviations.
+    #[error("the best member did not finish: {0}")]
+    BestUnfinished(Unfinished),
+    /// The best member's simulation did not finish when run again for its figures.
+    #[error("the best member did not finish when re-evaluated: {0}")]
+    BestNotReproduced(Unfinished),
 }
 
 impl From<EvalError> for FitError {

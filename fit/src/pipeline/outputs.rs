@@ -6,10 +6,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Candidate, Evaluator, Job, Outcome};
-use sepval_common::factors::{FACTOR_COUNT, Factors};
 use sepval_common::goals::GoalSums;
 use sepval_common::model::StateVector;
 use sepval_common::propagator::{Observation, SampleSink, propagate};
+use sepval_core::factors::{FACTOR_COUNT, Factors};
 
 use super::FitError;
 use crate::problem::factors_of;
@@ -66,7 +66,7 @@ pub(super) fn refined_member(
 ) -> Result<Carried, FitError> {
     let values = lm.x[..FACTOR_COUNT].to_vec();
     let member = Member {
-        chromosome: sepval_common::encoding::Chromosome::encode_values(
+        chromosome: sepval_core::encoding::Chromosome::encode_values(
             &job.factor_table().0,
             &values,
         ),
@@ -92,6 +92,23 @@ pub(super) fn refined_member(
     })
 }
 
+/// Why the best member's simulation did not finish when it was run again for the outputs.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Unfinished {
+    /// Its factors do not make a model.
+    #[error(transparent)]
+    Model(#[from] sepval_common::model::ModelError),
+    /// It diverged.
+    #[error("diverged at t = {t_s} s (event {event})")]
+    Diverged {
+        /// When \[s\].
+        t_s: f64,
+        /// In which event.
+        event: usize,
+    },
+}
+
 /// Simulates `c` on every event of `job` in this process, handing each sample to
 /// `record(event, index, observation)` as it is made (no trajectory is stored unless `record`
 /// stores it); the reason when a run does not finish.
@@ -104,7 +121,7 @@ fn simulate_locally(
     job: &Job,
     c: &Candidate,
     mut record: impl FnMut(usize, usize, &Observation),
-) -> Result<(), String> {
+) -> Result<(), Unfinished> {
     struct Each<'a, F>(&'a mut F, usize);
     impl<F: FnMut(usize, usize, &Observation)> SampleSink for Each<'_, F> {
         #[inline]
@@ -113,14 +130,17 @@ fn simulate_locally(
         }
     }
     for (k, event) in job.events().iter().enumerate() {
-        let run = c.run_setup(&event.simulator).map_err(|e| e.to_string())?;
+        let run = c.run_setup(&event.simulator)?;
         propagate(
             event.simulator.model(),
             &run,
             &event.data.times_s,
             &mut Each(&mut record, k),
         )
-        .map_err(|d| format!("diverged at t = {} s (event {k})", d.t_s))?;
+        .map_err(|d| Unfinished::Diverged {
+            t_s: d.t_s,
+            event: k,
+        })?;
     }
     Ok(())
 }
@@ -135,11 +155,11 @@ fn simulate_locally(
 /// pools them).
 pub fn resolution_advice(
     evaluator: &mut dyn Evaluator,
-    table: &sepval_common::factors::FactorTable,
+    table: &sepval_core::factors::FactorTable,
     factors: &Factors,
     noise: Noise,
 ) -> Result<Vec<ResolutionRow>, FitError> {
-    use sepval_common::factors::Factor;
+    use sepval_core::factors::Factor;
     let g0 = evaluator.evaluate(&[Candidate::baseline(*factors)], false)?[0]
         .outcome
         .objectives();
@@ -152,7 +172,7 @@ pub fn resolution_advice(
     simulate_locally(&job, &Candidate::baseline(*factors), |k, _, o| {
         base[k].push(*o)
     })
-    .map_err(|e| FitError::Failed(format!("the best member did not finish: {e}")))?;
+    .map_err(FitError::BestUnfinished)?;
     let mut rows = Vec::with_capacity(table.0.len());
     for (i, spec) in table.0.iter().enumerate() {
         let mut f = *factors;
@@ -233,11 +253,7 @@ pub(super) fn best_samples_of(
             }
         },
     )
-    .map_err(|e| {
-        FitError::Failed(format!(
-            "the best member did not finish when re-evaluated: {e}"
-        ))
-    })?;
+    .map_err(FitError::BestNotReproduced)?;
     Ok((rms.rms(), plotted))
 }
 

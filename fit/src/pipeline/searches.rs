@@ -7,8 +7,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use sepval_common::evaluation::{Evaluator, Outcome};
-use sepval_common::factors::Factors;
 use sepval_common::propagator::Observation;
+use sepval_core::factors::Factors;
 use sepval_solve::best::BestSoFar;
 use sepval_solve::ga::{GaSearch, GaState, Member, update_archive};
 use sepval_solve::hill::{HillResult, HillSearch, HillStop};
@@ -115,10 +115,7 @@ fn hill_stop(cx: &Context, r: &HillResult) -> Result<&'static str, FitError> {
                 Outcome::Failed { reason } => reason.clone(),
                 Outcome::Goals { .. } => "it was not evaluated".into(),
             };
-            Err(FitError::Failed(format!(
-                "the hill climber's start, the nominal factors (clamped to their bounds), does \
-                 not simulate: {why}; --method ga or ga+lm start from a random population instead"
-            )))
+            Err(FitError::HillStart { why })
         }
     }
 }
@@ -157,7 +154,7 @@ pub(super) fn ga(
         Some(&mut checkpoints),
     )?;
     let (state, probes, reached) = stage.finish();
-    let state = state.ok_or_else(|| FitError::Failed("the genetic search did not start".into()))?;
+    let state = state.ok_or_else(|| FitError::GaNotStarted)?;
     let stop = match &reached {
         Some(_) => format!(
             "refinement after generation {} reached the noise floor",
@@ -165,9 +162,10 @@ pub(super) fn ga(
         ),
         None => format!("{} generations", state.generation),
     };
-    let best = state.best(cx.weights).cloned().ok_or_else(|| {
-        FitError::Failed("no member of the final population finished its simulation".into())
-    })?;
+    let best = state
+        .best(cx.weights)
+        .cloned()
+        .ok_or_else(|| FitError::NoFinishedMember)?;
     // The probes count for `ga+lm` only (a `ga+lm` checkpoint may be resumed as `ga`).
     let evaluations = match o.method.refines() {
         true => state.evaluations + probes.iter().map(|p| p.evaluations).sum::<u64>(),

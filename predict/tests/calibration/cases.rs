@@ -15,13 +15,13 @@ use rand_distr::{Distribution, StandardNormal};
 
 use sepval_common::effects::{EffectSet, MAX_EFFECT_PARAMS};
 use sepval_common::evaluation::{Candidate, Event, InProcess, Job};
-use sepval_common::factors::{FACTOR_COUNT, Factors};
 use sepval_common::model::{CoefficientFn, Coefficients, Flow, RunSetup};
 use sepval_common::noise::{SIGMA_ATT_DEG, SIGMA_POS_M};
 use sepval_common::propagator::{Observation, propagate};
 use sepval_common::scenario::{Flight, Scenario};
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
+use sepval_core::factors::{FACTOR_COUNT, Factors};
 use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::problem::Evaluate;

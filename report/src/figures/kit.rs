@@ -14,7 +14,7 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, register_font};
-use sepval_common::atomic_file::write_atomically;
+use sepval_core::atomic_file::write_atomically;
 
 use super::FigureError;
 

@@ -44,7 +44,7 @@
 //!   degenerate axis ranges (one value, or none) are widened. Inputs whose lengths must agree
 //!   (factor names and ranges, residual sets and times, an increment's times, values and
 //!   standard deviations, a square correlation matrix) are checked and refused with
-//!   [`FigureError::Input`]. Within a [`Trajectory`] the samples are paired up to the shortest
+//!   [`FigureError::Input`]. Within a [`Track`] the samples are paired up to the shortest
 //!   of its vectors.
 //! - Colours follow label order: the i-th fit, method, residual set, event or transport always
 //!   gets the i-th colour of one ten-colour palette (Tableau 10); measured data, the truth and
@@ -58,8 +58,6 @@
 //! whose function is re-exported here; `contour` computes contours for the maps.
 
 use std::path::{Path, PathBuf};
-
-use sepval_common::telemetry::Trajectory;
 
 mod bands;
 mod channels;
@@ -102,13 +100,25 @@ pub use state_map::state_map;
 pub use throughput::throughput_figure;
 pub use trajectory::trajectory_figures;
 
+/// A trajectory as the figures draw it, plain data borrowed from whoever computed it: the
+/// samples are paired up to the shortest of the three.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Track<'a> {
+    /// Sample times \[s\].
+    pub times_s: &'a [f64],
+    /// Launch-frame positions (x, y, z; z down) \[m\].
+    pub pos_m: &'a [[f64; 3]],
+    /// Euler angles (roll, pitch, yaw) \[deg\].
+    pub att_deg: &'a [[f64; 3]],
+}
+
 /// A labelled trajectory to draw beside the measured data.
 #[derive(Debug, Clone, Copy)]
 pub struct Series<'a> {
     /// The legend label (for example the method that found the fit).
     pub label: &'a str,
     /// The trajectory (for example the simulation with the fitted factors).
-    pub traj: &'a Trajectory,
+    pub traj: Track<'a>,
 }
 
 /// Failure to draw or write a figure. Every variant names the file.
@@ -178,7 +188,7 @@ mod tests {
     fn missing_directory_is_an_error_naming_the_file() {
         let dir = tempfile::tempdir().unwrap();
         let missing = dir.path().join("no-such-dir");
-        let err = trajectory_figures(&missing, &trajectory(1.0), &[]).unwrap_err();
+        let err = trajectory_figures(&missing, trajectory(1.0).track(), &[]).unwrap_err();
         assert!(matches!(err, FigureError::Write { .. }), "{err:?}");
         assert_eq!(err.path(), missing.join("fig1_pitch.png"));
         assert!(err.to_string().contains("no-such-dir"), "{err}");

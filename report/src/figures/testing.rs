@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use sepval_common::telemetry::Trajectory;
+use super::Track;
 
 /// Decodes a PNG: (width, height, number of distinct colours).
 pub(super) fn decode(path: &Path) -> (u32, u32, usize) {
@@ -66,8 +66,27 @@ pub(super) fn count_colour(path: &Path, colour: plotters::style::RGBColor) -> us
         .count()
 }
 
+/// A trajectory's samples, owned (what a [`Track`] borrows).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Samples {
+    pub(super) times_s: Vec<f64>,
+    pub(super) pos_m: Vec<[f64; 3]>,
+    pub(super) att_deg: Vec<[f64; 3]>,
+}
+
+impl Samples {
+    /// The samples as the figures draw them.
+    pub(super) fn track(&self) -> Track<'_> {
+        Track {
+            times_s: &self.times_s,
+            pos_m: &self.pos_m,
+            att_deg: &self.att_deg,
+        }
+    }
+}
+
 /// A trajectory over 1.2 s at 50 Hz, shaped by `k`.
-pub(super) fn trajectory(k: f64) -> Trajectory {
+pub(super) fn trajectory(k: f64) -> Samples {
     let times_s: Vec<f64> = (0..60).map(|i| f64::from(i) * 0.02).collect();
     let pos_m = times_s
         .iter()
@@ -77,10 +96,9 @@ pub(super) fn trajectory(k: f64) -> Trajectory {
         .iter()
         .map(|&t| [10.0 * (3.0 * t).sin(), -8.0 * k * t, 2.0 * t * t])
         .collect();
-    Trajectory {
+    Samples {
         times_s,
         pos_m,
         att_deg,
-        ..Trajectory::default()
     }
 }

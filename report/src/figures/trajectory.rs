@@ -4,13 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
-use sepval_common::telemetry::Trajectory;
 
 use super::kit::{
     colour, draw_legend, draw_mesh, draw_polyline, fmt_tick, legend_corner, linear_chart,
     padded_range, plottable_point, render,
 };
-use super::{FigureError, Series};
+use super::{FigureError, Series, Track};
 
 /// One channel of Figures 1-6.
 struct Channel {
@@ -62,11 +61,11 @@ const CHANNELS: [Channel; 6] = [
 
 /// The (time \[s\], value) samples of one channel of a trajectory, paired up to the shortest of
 /// its vectors.
-fn channel_samples(traj: &Trajectory, channel: &Channel) -> Vec<(f64, f64)> {
+fn channel_samples(traj: Track<'_>, channel: &Channel) -> Vec<(f64, f64)> {
     traj.times_s
         .iter()
-        .zip(&traj.pos_m)
-        .zip(&traj.att_deg)
+        .zip(traj.pos_m)
+        .zip(traj.att_deg)
         .map(|((&t, pos), att)| (t, (channel.value)(pos, att)))
         .collect()
 }
@@ -80,7 +79,7 @@ fn channel_samples(traj: &Trajectory, channel: &Channel) -> Vec<(f64, f64)> {
 /// angles in degrees. Stops at the first figure that cannot be written.
 pub fn trajectory_figures(
     dir: &Path,
-    data: &Trajectory,
+    data: Track<'_>,
     fits: &[Series<'_>],
 ) -> Result<Vec<PathBuf>, FigureError> {
     let mut written = Vec::with_capacity(CHANNELS.len());
@@ -121,7 +120,7 @@ pub fn trajectory_figures(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::figures::testing::{check_png, dark_pixels, trajectory};
+    use crate::figures::testing::{Samples, check_png, dark_pixels, trajectory};
 
     #[test]
     fn trajectory_figures_writes_six_pngs() {
@@ -131,14 +130,14 @@ mod tests {
         let fits = [
             Series {
                 label: "GA",
-                traj: &fit_a,
+                traj: fit_a.track(),
             },
             Series {
                 label: "Nelder-Mead",
-                traj: &fit_b,
+                traj: fit_b.track(),
             },
         ];
-        let paths = trajectory_figures(dir.path(), &data, &fits).unwrap();
+        let paths = trajectory_figures(dir.path(), data.track(), &fits).unwrap();
         let names: Vec<String> = paths
             .iter()
             .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -169,7 +168,7 @@ mod tests {
         data.pos_m[3][0] = f64::NAN;
         data.att_deg[7] = [f64::INFINITY, f64::NAN, f64::NEG_INFINITY];
         data.times_s[10] = f64::NAN;
-        let empty = Trajectory::default();
+        let empty = Samples::default();
         let mut constant = trajectory(1.0);
         for p in &mut constant.pos_m {
             *p = [1.0, 1.0, 1.0];
@@ -179,23 +178,23 @@ mod tests {
         let fits = [
             Series {
                 label: "empty",
-                traj: &empty,
+                traj: empty.track(),
             },
             Series {
                 label: "constant",
-                traj: &constant,
+                traj: constant.track(),
             },
             Series {
                 label: "short",
-                traj: &short,
+                traj: short.track(),
             },
         ];
-        for path in trajectory_figures(dir.path(), &data, &fits).unwrap() {
+        for path in trajectory_figures(dir.path(), data.track(), &fits).unwrap() {
             check_png(&path, (1000, 700));
         }
         // Nothing at all to draw still gives figures with axes.
         let dir2 = tempfile::tempdir().unwrap();
-        for path in trajectory_figures(dir2.path(), &empty, &[]).unwrap() {
+        for path in trajectory_figures(dir2.path(), empty.track(), &[]).unwrap() {
             check_png(&path, (1000, 700));
         }
     }

@@ -7,7 +7,7 @@ use sepval_report::figures::throughput_figure;
 use sepval_transport::bench::{BenchOptions, Transport, run_bench, series, table, write_csv};
 use sepval_transport::ipc::MAX_WORKERS;
 
-use super::{inputs, worker_executable};
+use super::{tell, worker_executable};
 use crate::cli::{BenchArgs, TransportArg};
 
 /// Runs `sepval bench`.
@@ -46,7 +46,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         worker_executable: worker_executable()?,
         repeat: args.repeat,
     };
-    let (job, _) = inputs::job(&[], None, None, Default::default())?;
+    let (job, _) = sepval_fit::inputs::job(&[], None, None, Default::default(), &mut tell())?;
     note!(
         "benchmarking {} simulations of the default event per measurement, median of {} \
          interleaved rounds, on {} core(s)",

@@ -9,10 +9,11 @@ use sepval_campaign::program::{Campaign, Init, NewRelease, input_record};
 use sepval_campaign::record::SettingsRecord;
 use sepval_campaign::{CampaignError, page};
 use sepval_common::scenario::{Scenario, hex_sha256};
+use sepval_fit::inputs;
 use sepval_predict::ClearanceSettings;
 
 use super::starter;
-use super::{clearance, count, evaluator_spec, inputs, releases};
+use super::{clearance, count, evaluator_spec, tell};
 use crate::cli::{
     CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignRehearseArgs,
     CampaignStatusArgs, GeometryArgs,
@@ -162,8 +163,8 @@ fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
 /// Loads the scenario and the geometry a campaign's settings record.
 fn load(s: &SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError> {
     let wrap = |e: anyhow::Error| CampaignError::Refused(format!("{e:#}"));
-    let scenario =
-        inputs::scenario(s.scenario.as_ref().map(|r| Path::new(&r.path)), None).map_err(wrap)?;
+    let scenario = inputs::scenario(s.scenario.as_ref().map(|r| Path::new(&r.path)), None)
+        .map_err(|e| wrap(e.into()))?;
     let geometry = GeometryArgs {
         aircraft: Some(s.aircraft.path.clone().into()),
         store_shape: s.store_shape.as_ref().map(|r| r.path.clone().into()),
@@ -200,9 +201,10 @@ fn add(a: CampaignAddArgs) -> Result<()> {
     for p in &a.data {
         let name = p.display().to_string();
         let bytes = std::fs::read(p).with_context(|| format!("--data {name}"))?;
-        let data = releases::read(p, policy).with_context(|| format!("--data {name}"))?;
+        let data =
+            inputs::read(p, policy, &mut tell()).with_context(|| format!("--data {name}"))?;
         let scenario = inputs::event_scenario(&c.scenario, &data, &name)?;
-        releases::check_store(&c.scenario, &data, &name, "the campaign's scenario")?;
+        inputs::check_store(&c.scenario, &data, &name, "the campaign's scenario")?;
         new.push(NewRelease {
             given: p.clone(),
             sha256: hex_sha256(&bytes),

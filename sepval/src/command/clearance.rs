@@ -6,9 +6,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
-use sepval_common::cancel;
 use sepval_common::evaluation::{Candidate, Job};
 use sepval_common::scenario::Scenario;
+use sepval_core::cancel;
 use sepval_fit::results::ReleaseClearance;
 use sepval_geometry::{Body, Geometry, Role};
 use sepval_predict::{ClearanceSettings, releases};

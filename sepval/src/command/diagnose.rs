@@ -5,12 +5,14 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose, fmt_discovered};
+use sepval_fit::FitOptions;
+use sepval_fit::inputs::{self, HeldOut};
 use sepval_fit::out_dir::Request;
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 
-use super::{clearance, evaluator_spec, inputs, notices};
+use super::{clearance, evaluator_spec, notices, tell};
 use crate::cli::DiagnoseArgs;
 
 /// Runs `sepval diagnose`. The output directory is claimed (locked and checked) before anything
@@ -81,26 +83,29 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
         given.model.scenario.as_deref(),
         given.model.extension.as_deref(),
         policy,
+        &mut tell(),
     )?;
     // The --extension terms, written again with the discovered ones to DIR/extension.toml.
     let given_terms = match given.model.extension.as_deref() {
         Some(path) => sepval_common::extension::load_extension(path)?,
         None => Vec::new(),
     };
-    let validation = inputs::validation_job(
-        &inputs::with_policy(&args.validate, policy),
-        &given.data,
-        &job,
-        given.model.scenario.as_deref(),
-        given.model.extension.as_deref(),
-    )?;
+    let held = inputs::with_policy(&args.validate, policy);
+    let held_out = HeldOut {
+        held: &held,
+        data_paths: &given.data,
+        fitted: &job,
+        scenario_path: given.model.scenario.as_deref(),
+        extension_path: given.model.extension.as_deref(),
+    };
+    let validation = inputs::validation_job(&held_out, &mut tell())?;
     let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
         .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
     let lm = LmSettings {
         budget: args.lm_budget,
         ..LmSettings::default()
     };
-    let fit = inputs::baseline_fit(ga, sigma, &lm, &args.out, inputs);
+    let fit = FitOptions::baseline(ga, sigma, &lm, &args.out.join("baseline"), inputs);
     let options = DiagnoseOptions {
         fit,
         out: args.out.clone(),

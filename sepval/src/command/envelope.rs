@@ -13,10 +13,9 @@ use sepval_envelope::progress::{Progress, inputs_digest, progress_path, remove_p
 use sepval_envelope::{EnvelopeFile, Provenance, Sweep, sweep, write_outputs};
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
-use sepval_predict::{Settings, Source};
+use sepval_predict::{Settings, Source, SourceInputs, source_inputs};
 
-use super::inputs::source_inputs;
-use super::{clearance, count, evaluator_spec, starter};
+use super::{clearance, count, evaluator_spec, starter, tell};
 use crate::cli::AxisArg;
 use crate::cli::EnvelopeArgs;
 
@@ -45,11 +44,16 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         );
     }
     let axes: Vec<Axis> = given.iter().map(|(_, a)| a.axis).collect();
-    let (source, fitted, held_out) = source_inputs(
+    let SourceInputs {
+        source,
+        fitted,
+        held_out,
+    } = source_inputs(
         &args.from,
         args.extension.as_deref(),
         &args.validate,
         args.outliers.policy(),
+        &mut tell(),
     )?;
     let base = fitted.events()[0].simulator.scenario().clone();
     let grid = Grid::of(&base, &axes)?;

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_fit::checkpoint::Checkpoint;
+use sepval_fit::inputs;
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_fit::pipeline::{FitOutput, write_fit_figures};
 use sepval_fit::sigma::Sigma;
@@ -14,7 +15,7 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 
-use super::{clearance, evaluator_spec, inputs, notices};
+use super::{clearance, evaluator_spec, notices, tell};
 use crate::cli::{FitArgs, MethodArg};
 
 /// The library's method of `--method`.
@@ -162,6 +163,7 @@ fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
         scenario_path.as_deref(),
         extension_path.as_deref(),
         given.outliers.or(recorded),
+        &mut tell(),
     )?;
     let method = match (args.method, &resume) {
         (Some(m), _) => method(m),
@@ -181,7 +183,7 @@ fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
             &p.display().to_string(),
             job.factor_table(),
         )?),
-        None if data_paths.is_empty() => Some(sepval_common::factors::Factors::TRUTH),
+        None if data_paths.is_empty() => Some(sepval_core::factors::Factors::TRUTH),
         None => None,
     };
     let options = FitOptions {

@@ -14,10 +14,8 @@ pub mod envelope;
 pub mod fit;
 pub mod gateway;
 pub mod goals;
-pub mod inputs;
 pub mod plan;
 pub mod predict;
-pub mod releases;
 pub mod rerun;
 pub mod scenario;
 pub mod selftest;
@@ -30,7 +28,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{EvalError, Evaluator, Job};
-use sepval_common::number_text::Shown;
+use sepval_core::number_text::Shown;
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_transport::RunId;
 use sepval_transport::dispatch::DispatchOptions;
@@ -198,6 +196,12 @@ pub fn several_jobs(args: &EvalArgs, command: &str, jobs: &str) -> Result<()> {
     Ok(())
 }
 
+/// Where the libraries' words about what they read go (what `--outliers drop` left out):
+/// stderr, through the front end.
+pub fn tell() -> impl FnMut(String) {
+    |said| note!("{said}")
+}
+
 /// Transport notices, told on stderr as `sepval: ...`.
 pub fn notices() -> Notices {
     Arc::new(|n| note!("sepval: {n}"))
@@ -213,7 +217,7 @@ pub fn claim_out(out: &Path, request: Request<'_>) -> Result<RunDir> {
     if let Some(n) = run_dir.notice() {
         note!("sepval: {n}");
     }
-    sepval_common::defect::inject("claimed");
+    sepval_core::defect::inject("claimed");
     Ok(run_dir)
 }
 

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use sepval_fit::out_dir::Request;
 use sepval_plan::{PlanFile, Range, plan, plan_file, prepare, read_diagnosis, write_outputs};
 
-use super::{evaluator_spec, inputs, notices};
+use super::{evaluator_spec, notices, tell};
 use crate::cli::PlanArgs;
 
 /// Runs `sepval plan`. Every input (the flags, the diagnosis, its releases, the ranges against
@@ -19,11 +19,12 @@ pub fn run(args: PlanArgs) -> Result<()> {
     let ranges = ranges(&args);
     let diagnosis = read_diagnosis(&args.from)?;
     let record = diagnosis.inputs.clone();
-    let (flown, _) = inputs::job(
+    let (flown, _) = sepval_fit::inputs::job(
         &record.data,
         record.scenario.as_deref(),
         record.extension.as_deref(),
         record.outliers,
+        &mut tell(),
     )
     .with_context(|| {
         format!(

@@ -6,12 +6,14 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use sepval_fit::inputs;
 use sepval_fit::out_dir::Request;
 use sepval_predict::{
-    Flown, PredictionFile, Settings, predict, prediction_file, prepare, write_outputs,
+    Flown, PredictionFile, Settings, SourceInputs, predict, prediction_file, prepare,
+    source_inputs, write_outputs,
 };
 
-use super::{clearance, count, evaluator_spec, input_files, inputs, notices, releases};
+use super::{clearance, count, evaluator_spec, input_files, notices, tell};
 use crate::cli::PredictArgs;
 
 /// Runs `sepval predict`. Every input (the flags, the source, its releases, the condition, the
@@ -29,11 +31,16 @@ pub fn run(args: PredictArgs) -> Result<()> {
     };
     settings.check()?;
     let policy = args.outliers.policy();
-    let (source, fitted, held_out) = inputs::source_inputs(
+    let SourceInputs {
+        source,
+        fitted,
+        held_out,
+    } = source_inputs(
         &args.from,
         args.extension.as_deref(),
         &args.validate,
         policy,
+        &mut tell(),
     )?;
     let mut read = super::recorded_inputs(&args.from, &source.inputs, &source.held_out);
     read.extend(input_files("--scenario", [&args.scenario]));
@@ -90,10 +97,10 @@ fn flown(
     policy: sepval_common::telemetry::outliers::Policy,
 ) -> Result<Flown> {
     let name = path.display().to_string();
-    let data = releases::read(path, policy).with_context(|| format!("--data {name}"))?;
+    let data = inputs::read(path, policy, &mut tell()).with_context(|| format!("--data {name}"))?;
     let named = inputs::event_scenario(condition, &data, &name)?;
     let scenario_name = format!("--scenario {}", scenario_path.display());
-    releases::check_store(condition, &data, &name, &scenario_name)?;
+    inputs::check_store(condition, &data, &name, &scenario_name)?;
     let (a, b) = (&named.flight, &condition.flight);
     let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + x.abs().max(y.abs()));
     if !(same(a.mach, b.mach)

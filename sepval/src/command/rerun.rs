@@ -5,8 +5,9 @@ use std::sync::Arc;
 
 use anyhow::{Result, bail};
 use sepval_fit::checkpoint::{Checkpoint, CheckpointError};
+use sepval_fit::inputs;
 
-use super::{evaluator_spec, inputs, notices};
+use super::{evaluator_spec, notices, tell};
 use crate::cli::RerunArgs;
 
 /// Runs `sepval rerun`.
@@ -33,6 +34,7 @@ pub fn run(args: RerunArgs) -> Result<()> {
         scenario_path.map(PathBuf::as_path),
         extension_path.map(PathBuf::as_path),
         policy,
+        &mut tell(),
     )?;
     if let Err(e) = checkpoint.check_job(&job, &args.checkpoint) {
         // A scenario that differs only by the extension given: say so, not "another scenario".
@@ -44,6 +46,7 @@ pub fn run(args: RerunArgs) -> Result<()> {
                     scenario_path.map(PathBuf::as_path),
                     recorded_x,
                     policy,
+                    &mut |_| {},
                 )
                 .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
             if same_but_extension {

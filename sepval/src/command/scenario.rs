@@ -4,10 +4,10 @@
 //! (docs/daveml.md, the crate `sepval_daveml`).
 
 use anyhow::{Context, Result, bail};
-use sepval_common::atomic_file::write_atomically;
 use sepval_common::scenario::Scenario;
+use sepval_core::atomic_file::write_atomically;
+use sepval_fit::inputs;
 
-use super::inputs;
 use crate::cli::ScenarioArgs;
 
 const HEADER: &str = "# sepval scenario (SI units, angles in degrees); docs/model.md section 1 describes each field.\n";

@@ -1,13 +1,14 @@
 //! `sepval simulate`: one release, written as a trajectory file.
 
 use anyhow::{Context, Result};
-use sepval_common::limits::{check_sampling, check_steps};
-use sepval_common::number_text::Shown;
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test_logged;
+use sepval_core::limits::{check_sampling, check_steps};
+use sepval_core::number_text::Shown;
+use sepval_fit::inputs;
 use sepval_predict::releases;
 
-use super::{clearance, inputs, positive};
+use super::{clearance, positive};
 use crate::cli::SimulateArgs;
 
 /// Runs `sepval simulate`.

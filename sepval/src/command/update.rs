@@ -5,7 +5,9 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::Job;
-use sepval_common::factors::Factor;
+use sepval_core::factors::Factor;
+use sepval_fit::FitOptions;
+use sepval_fit::inputs::{self, HeldOut};
 use sepval_fit::out_dir::Request;
 use sepval_fit::sigma::Sigma;
 use sepval_solve::ga::GaSettings;
@@ -13,7 +15,7 @@ use sepval_solve::lm::LmSettings;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
 use super::starter;
-use super::{evaluator_spec, inputs};
+use super::{evaluator_spec, tell};
 use crate::cli::{FactorNames, UpdateArgs};
 
 /// Runs `sepval update`. Every input is checked before the output directory is claimed or a
@@ -109,15 +111,23 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
         given.model.extension.as_deref(),
     );
     let policy = given.outliers.policy();
-    let (job, inputs) = inputs::job(&given.data, scenario_path, extension_path, policy)?;
-    let scenario = inputs::scenario(scenario_path, extension_path)?;
-    let validation = inputs::validation_job(
-        &inputs::with_policy(&args.validate, policy),
+    let (job, inputs) = inputs::job(
         &given.data,
-        &job,
         scenario_path,
         extension_path,
+        policy,
+        &mut tell(),
     )?;
+    let scenario = inputs::scenario(scenario_path, extension_path)?;
+    let held = inputs::with_policy(&args.validate, policy);
+    let held_out = HeldOut {
+        held: &held,
+        data_paths: &given.data,
+        fitted: &job,
+        scenario_path,
+        extension_path,
+    };
+    let validation = inputs::validation_job(&held_out, &mut tell())?;
     let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
         .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
     let ga = GaSettings {
@@ -132,7 +142,7 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
         ..LmSettings::default()
     };
     let options = UpdateOptions {
-        fit: inputs::baseline_fit(ga, sigma, &lm, &args.out, inputs),
+        fit: FitOptions::baseline(ga, sigma, &lm, &args.out.join("baseline"), inputs),
         lm: LmSettings {
             max_iterations: 400,
             budget: 20_000,

@@ -8,13 +8,13 @@
 use std::path::Path;
 
 use sepval_common::effects::{EffectSet, MAX_EFFECT_PARAMS};
-use sepval_common::factors::Factors;
 use sepval_common::model::{CoefficientFn, Coefficients, Flow, RunSetup};
 use sepval_common::noise::{SIGMA_ATT_DEG, SIGMA_POS_M};
 use sepval_common::propagator::{Observation, propagate};
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
+use sepval_core::factors::Factors;
 use sepval_tests::{Gauss, REDUCED_BUDGET, ok, sepval};
 use serde_json::Value;
 

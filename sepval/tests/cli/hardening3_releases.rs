@@ -304,7 +304,7 @@ fn a_line_without_end_is_refused_after_the_line_bound() {
         refused(
             &sepval(&args, d),
             "zeros.csv: line 1 is longer than 65536 bytes, the limit of a telemetry line \
-             (sepval_common::limits; a row is a few hundred bytes): is it a telemetry file?",
+             (sepval_core::limits; a row is a few hundred bytes): is it a telemetry file?",
         );
     }
     assert!(!d.join("o").exists());

@@ -227,7 +227,7 @@ fn release(scenario: &Scenario, mach: f64, alpha_deg: f64, seed: u64) -> Traject
     s.flight.mach = mach;
     s.flight.alpha_deg = alpha_deg;
     let sim = sepval_common::simulation::Simulator::new(&s);
-    let factors = sepval_common::factors::Factors::from_json_str(TRUTH, &s.factors).unwrap();
+    let factors = sepval_core::factors::Factors::from_json_str(TRUTH, &s.factors).unwrap();
     let times: Vec<f64> = (0..=60).map(|k| k as f64 / 100.0).collect();
     let clean = sim
         .simulate(&factors, &sepval_common::effects::EffectSet::NONE, &times)

@@ -14,9 +14,9 @@
 
 pub mod operators;
 
-use sepval_common::encoding::Chromosome;
-use sepval_common::evaluation::{EvalError, Outcome};
-use sepval_common::factors::FactorSpec;
+use sepval_core::encoding::Chromosome;
+use sepval_core::factors::FactorSpec;
+use sepval_core::outcome::{EvalError, Outcome};
 use serde::{Deserialize, Serialize};
 
 use crate::best::BestSoFar;
@@ -25,7 +25,7 @@ use crate::ga::operators::{
 };
 use crate::pareto::{dominates, non_dominated_fronts, rank_and_crowding, select_best};
 use crate::rng::{RngState, RngStateError, SearchRng, seeded};
-use crate::run::{Ask, Progress, RunError, Solver};
+use crate::run::{Ask, Progress, RunError, SearchError, Solver};
 
 /// Settings of the genetic algorithm; the defaults are the study's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -135,7 +135,7 @@ impl Member {
 }
 
 /// The best of one generation. The goals are infinite when no member of the population
-/// finished; in JSON they are then the string `"inf"` ([`sepval_common::nonfinite`]). Its
+/// finished; in JSON they are then the string `"inf"` ([`sepval_core::nonfinite`]). Its
 /// fields after `generation` are [`BestSoFar`]'s, read through `Deref` as before
 /// (`stats.best_j_pos_m`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -362,7 +362,9 @@ impl Solver for GaSearch {
         if self.finished() {
             return Ok(None);
         }
-        let pending = self.draw().map_err(|e| RunError::Search(e.to_string()))?;
+        let pending = self
+            .draw()
+            .map_err(|e| RunError::Search(SearchError::State(std::sync::Arc::new(e))))?;
         let points = pending.values.clone();
         self.pending = Some(pending);
         Ok(Some(Ask {
@@ -376,10 +378,9 @@ impl Solver for GaSearch {
             chromosomes,
             values,
             rng,
-        } = self
-            .pending
-            .take()
-            .ok_or_else(|| RunError::Search("the GA was told without being asked".into()))?;
+        } = self.pending.take().ok_or_else(|| {
+            RunError::Search(SearchError::Protocol("the GA was told without being asked"))
+        })?;
         let members: Vec<Member> = chromosomes
             .into_iter()
             .zip(values)

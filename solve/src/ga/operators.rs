@@ -10,8 +10,8 @@
 //! whole search.
 
 use rand::RngExt;
-use sepval_common::encoding::Chromosome;
-use sepval_common::factors::FactorSpec;
+use sepval_core::encoding::Chromosome;
+use sepval_core::factors::FactorSpec;
 
 use crate::pareto::crowded_better;
 use crate::rng::SearchRng;
@@ -100,7 +100,7 @@ pub fn random_chromosome(rng: &mut SearchRng, len: usize) -> Chromosome {
 mod tests {
     use super::*;
     use crate::rng::seeded;
-    use sepval_common::factors::FactorTable;
+    use sepval_core::factors::FactorTable;
 
     #[test]
     fn creep_moves_exactly_one_step_and_stays_in_bounds() {

@@ -29,18 +29,14 @@ mod linear;
 mod stages;
 
 use nalgebra::DMatrix;
-use sepval_common::goals::Goals;
+use sepval_core::outcome::Goals;
 
 use crate::params::Params;
-use crate::run::{Ask, Progress, RunError, Solver};
+use crate::run::{Ask, Progress, RunError, SearchError, Solver};
 use linear::fd_steps;
 use stages::{Differencing, Parts, Stage};
 
 type Result<T> = std::result::Result<T, RunError>;
-
-fn search_error(what: impl std::fmt::Display) -> RunError {
-    RunError::Search(what.to_string())
-}
 
 /// [`LmResult::stop`] of a refinement that ran out of iterations before it converged or
 /// stalled: its cost is then only an upper bound of its optimum's.
@@ -227,16 +223,22 @@ impl<M: Measure> LmRun<M> {
             Stage::Jacobian(d) => self.differenced(d, out)?,
             Stage::Curvature(c) => self.curved(c, out),
             Stage::Trials(t) => self.tried(t, out),
-            Stage::Done => return Err(search_error("a finished refinement received values")),
+            Stage::Done => {
+                return Err(RunError::Search(SearchError::Protocol(
+                    "a finished refinement received values",
+                )));
+            }
         };
         Ok(())
     }
 
     /// The start point's residuals: the first Jacobian follows.
     fn started(&mut self, out: Vec<Option<Vec<f64>>>) -> Result<Stage> {
-        let r = out.into_iter().next().flatten().ok_or_else(|| {
-            search_error("the refinement's start does not simulate (diverged or invalid)")
-        })?;
+        let r = out
+            .into_iter()
+            .next()
+            .flatten()
+            .ok_or_else(|| RunError::Search(SearchError::StartDiverged))?;
         self.at.cost = r.iter().map(|v| v * v).sum();
         self.at.r = r;
         self.record();

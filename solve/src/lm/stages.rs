@@ -8,7 +8,8 @@ use std::ops::Range;
 use nalgebra::{DMatrix, DVector};
 
 use super::linear::solve_damped;
-use super::{ITERATION_LIMIT, LmRun, Measure, Result, search_error};
+use super::{ITERATION_LIMIT, LmRun, Measure, Result};
+use crate::run::{RunError, SearchError};
 
 /// A stage's points asked in parts: the part that starts at `next` of `len` points.
 #[derive(Debug, Clone, Copy)]
@@ -100,10 +101,9 @@ impl<M: Measure> LmRun<M> {
     ) -> Result<Stage> {
         for (i, ri) in d.parts.range(self.part).zip(out) {
             let ri = ri.ok_or_else(|| {
-                search_error(format!(
-                    "the derivative probe of {} did not simulate",
-                    self.params.names[i]
-                ))
+                RunError::Search(SearchError::ProbeDiverged {
+                    parameter: self.params.names[i].clone(),
+                })
             })?;
             for (k, v) in ri.iter().enumerate() {
                 d.jac[(k, i)] = (v - self.at.r[k]) / d.steps[i];

@@ -16,7 +16,7 @@
 //! | `sepval/worker/<node id>/wake` | event | "requests are waiting" (coordinator to worker) |
 //!
 //! Every node is built with iceoryx2's own signal handling off: SIGINT and SIGTERM set sepval's
-//! cancellation flag ([`sepval_common::cancel`]), which both ends check at every wake-up.
+//! cancellation flag ([`sepval_core::cancel`]), which both ends check at every wake-up.
 //!
 //! [`SetupHeader`]: crate::wire::SetupHeader
 //! [`Hello`]: crate::wire::Hello

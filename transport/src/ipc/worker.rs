@@ -18,8 +18,8 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
-use sepval_common::cancel;
 use sepval_common::evaluation::Job;
+use sepval_core::cancel;
 
 use super::{
     COORDINATOR_NODE, REQUEST_BUFFER, WORKER_NODE, create_chunk_service, names, node, presence,

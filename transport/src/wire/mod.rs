@@ -20,8 +20,8 @@ use sepval_common::correction::{CorrectionValues, MAX_CORRECTION_VALUES};
 use sepval_common::effects::{CATALOGUE, EffectSet, MAX_ACTIVE_EFFECTS, MAX_EFFECT_PARAMS};
 use sepval_common::evaluation::{Candidate, Evaluation, Job, MAX_REASON_BYTES, Outcome};
 use sepval_common::extension::{Axis, MAX_TERMS, Regressor, Term, TermSet};
-use sepval_common::factors::{FACTOR_COUNT, Factors};
 use sepval_common::propagator::Observation;
+use sepval_core::factors::{FACTOR_COUNT, Factors};
 
 /// Version of the coordinator-worker protocol. A coordinator and a worker refuse each other
 /// unless they agree on it. Version 2: one wire format for every transport (failure reasons of

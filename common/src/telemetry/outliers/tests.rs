@@ -1,9 +1,9 @@
 use super::*;
 use crate::effects::EffectSet;
-use crate::factors::Factors;
 use crate::scenario::Scenario;
 use crate::simulation::{Simulator, sample_times};
 use crate::synthetic::synthetic_flight_test;
+use sepval_core::factors::Factors;
 
 /// A release of the default store at Mach `mach` and alpha `alpha_deg`, `rate_hz`, noise from
 /// `seed` (none when `None`).

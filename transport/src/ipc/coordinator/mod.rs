@@ -30,8 +30,8 @@ use iceoryx2::config::Config;
 use iceoryx2::node::Node;
 use iceoryx2::port::listener::ListenerWaitError;
 use iceoryx2::prelude::*;
-use sepval_common::cancel;
 use sepval_common::evaluation::Job;
+use sepval_core::cancel;
 
 use super::{
     COORDINATOR_NODE, IN_FLIGHT_PER_WORKER, MAX_WORKERS, node, node_states, presence, run_config,

@@ -1,6 +1,6 @@
 //! The worker processes a coordinator spawns (`Launch::Spawn`): starting one for a run, and
 //! stopping them all when the link goes: SIGTERM first (it sets a worker's cancellation flag,
-//! [`sepval_common::cancel`], so it leaves as after Ctrl-C), then SIGKILL for any still running
+//! [`sepval_core::cancel`], so it leaves as after Ctrl-C), then SIGKILL for any still running
 //! after [`STOP_DEADLINE`].
 
 use std::path::Path;

@@ -5,23 +5,34 @@
 
 use std::path::Path;
 
-use anyhow::{Result, bail};
 use sepval_common::scenario::{Flight, Scenario};
 use sepval_common::telemetry::outliers::{self, CHANNELS, Outlier, Policy};
 use sepval_common::telemetry::{Numbered, Trajectory};
 
+use super::error::{InputError, Twice};
+
 /// The outliers named in a message before "and N more".
 const NAMED: usize = 5;
 
+/// A release read and screened for outliers, and what the screening left out, in words for
+/// the user (`None`: nothing).
+#[derive(Debug, Clone)]
+pub struct Screened {
+    /// The samples kept.
+    pub trajectory: Trajectory,
+    /// `--outliers drop: left out 3 row(s) of a.csv holding an outlier: ...`.
+    pub dropped: Option<String>,
+}
+
 /// Reads the telemetry file `path`, screened for outliers by `policy`: refused naming them, or
-/// their rows left out (said on stderr).
-pub fn read(path: &Path, policy: Policy) -> Result<Trajectory> {
+/// their rows left out.
+pub fn read(path: &Path, policy: Policy) -> Result<Screened, InputError> {
     let (numbered, found) = read_screened(path)?;
     screen(path, numbered, &found, &found, policy)
 }
 
 /// Reads the telemetry file `path` with the line of each sample and its outliers.
-pub fn read_screened(path: &Path) -> Result<(Numbered, Vec<Outlier>)> {
+pub fn read_screened(path: &Path) -> Result<(Numbered, Vec<Outlier>), InputError> {
     let numbered = Trajectory::read_numbered(path)?;
     let found = outliers::find(&numbered.trajectory);
     Ok((numbered, found))
@@ -35,9 +46,12 @@ pub fn screen(
     found: &[Outlier],
     left_out: &[Outlier],
     policy: Policy,
-) -> Result<Trajectory> {
+) -> Result<Screened, InputError> {
     if left_out.is_empty() {
-        return Ok(numbered.trajectory);
+        return Ok(Screened {
+            trajectory: numbered.trajectory,
+            dropped: None,
+        });
     }
     let file = path.display();
     let named: Vec<String> = found
@@ -50,25 +64,29 @@ pub fn screen(
         _ => String::new(),
     };
     match policy {
-        Policy::Refuse if !found.is_empty() => bail!(
-            "{file}: {} outlier(s), sample(s) far from the trend of their neighbours \
-             (docs/model.md section 6): {}{more}; correct the file, or give --outliers drop \
-             to leave out the rows that hold one",
-            found.len(),
-            named.join("; ")
-        ),
-        Policy::Refuse => Ok(numbered.trajectory),
+        Policy::Refuse if !found.is_empty() => Err(InputError::Outliers {
+            path: path.to_path_buf(),
+            count: found.len(),
+            named: format!("{}{more}", named.join("; ")),
+        }),
+        Policy::Refuse => Ok(Screened {
+            trajectory: numbered.trajectory,
+            dropped: None,
+        }),
         Policy::Drop => {
             let kept = outliers::without(&numbered.trajectory, left_out);
             let dropped = numbered.trajectory.len() - kept.len();
-            match found.is_empty() {
-                true => note!("--outliers drop: left out {dropped} row(s) of {file}"),
-                false => note!(
+            let said = match found.is_empty() {
+                true => format!("--outliers drop: left out {dropped} row(s) of {file}"),
+                false => format!(
                     "--outliers drop: left out {dropped} row(s) of {file} holding an outlier: {}{more}",
                     named.join("; ")
                 ),
-            }
-            Ok(kept)
+            };
+            Ok(Screened {
+                trajectory: kept,
+                dropped: Some(said),
+            })
         }
     }
 }
@@ -79,7 +97,7 @@ fn describe(o: &Outlier, line: usize) -> String {
     format!(
         "line {line}, {} = {} {unit}, {:.3} {unit} from the trend (threshold {} {unit})",
         CHANNELS[o.channel],
-        sepval_common::number_text::Shown(o.value),
+        sepval_core::number_text::Shown(o.value),
         o.departure,
         o.threshold
     )
@@ -89,7 +107,12 @@ fn describe(o: &Outlier, line: usize) -> String {
 /// given as `# store.mass_kg = 500` (or `# mass_kg = 500`) must agree with the scenario within
 /// one part in a million. The fields compared and the message are predict's
 /// ([`Scenario::store_difference`]).
-pub fn check_store(base: &Scenario, data: &Trajectory, name: &str, base_name: &str) -> Result<()> {
+pub fn check_store(
+    base: &Scenario,
+    data: &Trajectory,
+    name: &str,
+    base_name: &str,
+) -> Result<(), InputError> {
     let mut recorded = base.clone();
     for (field, value) in recorded.store.fields_mut() {
         let key = format!("store.{field}");
@@ -101,20 +124,24 @@ pub fn check_store(base: &Scenario, data: &Trajectory, name: &str, base_name: &s
             continue;
         };
         let Ok(v) = text.parse::<f64>() else {
-            bail!("{name}: metadata `# {key} = {text}` is not a number");
+            return Err(InputError::Metadata {
+                release: name.to_string(),
+                key: key.to_string(),
+                text: text.to_string(),
+            });
         };
         if (v - *value).abs() > 1e-6 * value.abs().max(v.abs()) || !v.is_finite() {
             *value = v;
         }
     }
-    if let Some(difference) = base.store_difference(&recorded) {
-        bail!(
-            "{name}: its metadata records another store than the one fitted ({base_name}): \
-             {difference}; releases of different stores are not pooled: fit each store with its \
-             own --scenario"
-        );
+    match base.store_difference(&recorded) {
+        Some(difference) => Err(InputError::OtherStore {
+            release: name.to_string(),
+            fitted: base_name.to_string(),
+            difference,
+        }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// One release as the duplicate check sees it.
@@ -143,17 +170,21 @@ fn same(a: &Release, b: &Release) -> bool {
 }
 
 /// Refuses `new` when it is one of `earlier`, naming both; `why` ends the message.
-pub fn refuse_twice(earlier: &[Release], new: &Release, why: &str) -> Result<()> {
-    if let Some(e) = earlier.iter().find(|e| same(e, new)) {
-        bail!("{} holds the same samples as {}: {why}", new.given, e.given);
+pub fn refuse_twice(earlier: &[Release], new: &Release, why: Twice) -> Result<(), InputError> {
+    match earlier.iter().find(|e| same(e, new)) {
+        Some(e) => Err(InputError::SameSamples {
+            given: new.given.clone(),
+            earlier: e.given.clone(),
+            why,
+        }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Refuses a release given twice among `releases`, naming both.
-pub fn refuse_duplicates(releases: &[Release]) -> Result<()> {
+pub fn refuse_duplicates(releases: &[Release]) -> Result<(), InputError> {
     for (i, r) in releases.iter().enumerate() {
-        refuse_twice(&releases[..i], r, "give each release once")?;
+        refuse_twice(&releases[..i], r, Twice::GivenTwice)?;
     }
     Ok(())
 }

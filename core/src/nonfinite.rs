@@ -1,5 +1,5 @@
 //! An `f64` that may be infinite or not a number, in JSON: use as
-//! `#[serde(with = "sepval_common::nonfinite")]`.
+//! `#[serde(with = "sepval_core::nonfinite")]`.
 //!
 //! JSON has no infinity: serde_json writes a non-finite `f64` as `null` and cannot read `null`
 //! back into an `f64`, so a checkpoint holding one (a generation in which no member finished

@@ -52,7 +52,7 @@ pub enum InputFileError {
     },
     /// The file is larger than the limit for its kind (or grew beyond it while read).
     #[error(
-        "{path}: the {label} is {size_bytes} bytes{growing}, more than the limit of {limit_bytes} bytes for a {label} (sepval_common::limits): check that it is the intended file, or split it",
+        "{path}: the {label} is {size_bytes} bytes{growing}, more than the limit of {limit_bytes} bytes for a {label} (sepval_core::limits): check that it is the intended file, or split it",
         growing = if *.grew { " or more (it grew while read)" } else { "" }
     )]
     TooLarge {
@@ -297,7 +297,7 @@ mod tests {
         assert_eq!(
             e,
             format!(
-                "{}: the test file is 5 bytes, more than the limit of 4 bytes for a test file (sepval_common::limits): check that it is the intended file, or split it",
+                "{}: the test file is 5 bytes, more than the limit of 4 bytes for a test file (sepval_core::limits): check that it is the intended file, or split it",
                 p.display()
             )
         );
