@@ -244,6 +244,26 @@ pub struct DiagnoseOptions {
     pub strict_tables: bool,
 }
 
+impl DiagnoseOptions {
+    /// A diagnosis as `sepval diagnose` makes it, into `out`: the baseline `fit`, each
+    /// candidate refined with `lm`'s settings within 400 iterations and 10 000 simulations; no
+    /// release held out, no extension given, a table left reported rather than refused.
+    pub fn new(fit: FitOptions, lm: &LmSettings, out: PathBuf) -> Self {
+        DiagnoseOptions {
+            fit,
+            out,
+            candidate_lm: LmSettings {
+                max_iterations: 400,
+                budget: 10_000,
+                ..lm.clone()
+            },
+            validation: None,
+            given_terms: Vec::new(),
+            strict_tables: false,
+        }
+    }
+}
+
 /// A fitted model: its effects, its free extension terms and its refinement.
 #[derive(Clone)]
 struct Fitted {

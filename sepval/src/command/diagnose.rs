@@ -107,16 +107,10 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
     };
     let fit = FitOptions::baseline(ga, sigma, &lm, &args.out.join("baseline"), inputs);
     let options = DiagnoseOptions {
-        fit,
-        out: args.out.clone(),
-        candidate_lm: LmSettings {
-            max_iterations: 400,
-            budget: 10_000,
-            ..lm
-        },
         validation,
         given_terms,
         strict_tables: args.tables.strict_tables,
+        ..DiagnoseOptions::new(fit, &lm, args.out.clone())
     };
     Ok(DiagnoseConfig { job, options })
 }
