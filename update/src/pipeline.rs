@@ -35,6 +35,25 @@ pub struct UpdateOptions {
     pub scenario: Scenario,
 }
 
+impl UpdateOptions {
+    /// An update as `sepval update` makes it of the store `scenario`: the baseline `fit`, the
+    /// refits with `lm`'s settings within 400 iterations and 20 000 simulations, every factor
+    /// free, no release held out.
+    pub fn new(fit: FitOptions, lm: &LmSettings, scenario: Scenario) -> Self {
+        UpdateOptions {
+            fit,
+            lm: LmSettings {
+                max_iterations: 400,
+                budget: 20_000,
+                ..lm.clone()
+            },
+            free: (0..sepval_core::factors::FACTOR_COUNT).collect(),
+            validation: None,
+            scenario,
+        }
+    }
+}
+
 /// The stall rule of the update's refits: ten iterations that lower the chi-square by less
 /// than 1e-5 of itself end a refit (below any difference the selection decides on).
 const STALL: Stall = Stall {

@@ -141,16 +141,11 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
         budget: args.lm_budget,
         ..LmSettings::default()
     };
+    let fit = FitOptions::baseline(ga, sigma, &lm, &args.out.join("baseline"), inputs);
     let options = UpdateOptions {
-        fit: FitOptions::baseline(ga, sigma, &lm, &args.out.join("baseline"), inputs),
-        lm: LmSettings {
-            max_iterations: 400,
-            budget: 20_000,
-            ..lm
-        },
         free,
         validation,
-        scenario,
+        ..UpdateOptions::new(fit, &lm, scenario)
     };
     Ok((options, job))
 }
