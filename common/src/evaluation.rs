@@ -350,6 +350,45 @@ impl From<Outcome> for Evaluation {
 pub type StartEvaluator<'a> =
     dyn FnMut(std::sync::Arc<Job>) -> Result<Box<dyn Evaluator>, EvalError> + 'a;
 
+/// An evaluator that counts the candidates it evaluates: how a pipeline knows how many
+/// simulations it ran, from the one place they all pass through, whatever its stages.
+pub struct Counted<'a> {
+    inner: &'a mut dyn Evaluator,
+    count: u64,
+}
+
+impl<'a> Counted<'a> {
+    /// `inner`, counted from 0.
+    pub fn new(inner: &'a mut dyn Evaluator) -> Self {
+        Counted { inner, count: 0 }
+    }
+
+    /// The candidates evaluated so far (one simulation each, over every event of the job).
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+}
+
+impl Evaluator for Counted<'_> {
+    fn evaluate(
+        &mut self,
+        batch: &[Candidate],
+        with_samples: bool,
+    ) -> Result<Vec<Evaluation>, EvalError> {
+        let out = self.inner.evaluate(batch, with_samples)?;
+        self.count += batch.len() as u64;
+        Ok(out)
+    }
+
+    fn job(&self) -> &Arc<Job> {
+        self.inner.job()
+    }
+
+    fn describe(&self) -> String {
+        self.inner.describe()
+    }
+}
+
 /// Evaluates batches of candidates for one job.
 pub trait Evaluator {
     /// Evaluates `batch` and returns one evaluation per candidate, in order. With

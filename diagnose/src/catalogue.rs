@@ -31,11 +31,9 @@ pub(super) fn converge(
     fitted: Fitted,
     noise: Noise,
     settings: &LmSettings,
-    evaluations: &mut u64,
     skipped: &mut Vec<SkippedRefit>,
 ) -> Result<Fitted> {
     let (lm, failure) = refine_from(evaluator, job, &fitted, &fitted.lm.x, noise, settings)?;
-    *evaluations += lm.evaluations;
     if let Some(reason) = failure {
         skipped.push(SkippedRefit {
             stage: "convergence".into(),
@@ -189,7 +187,6 @@ pub(super) fn select(
     baseline: &Fitted,
     noise: Noise,
     settings: &LmSettings,
-    evaluations: &mut u64,
     skipped: &mut Vec<SkippedRefit>,
 ) -> Result<CatalogueOutcome> {
     let mut current = Fitted {
@@ -229,7 +226,6 @@ pub(super) fn select(
                     continue;
                 }
             };
-            *evaluations += fitted.lm.evaluations;
             let report = judge.report(index, &fitted);
             if report.significant && best.is_none_or(|(_, b)| report.delta_bic < b) {
                 best = Some((index, report.delta_bic));
@@ -251,15 +247,7 @@ pub(super) fn select(
         let Some(picked) = fitted_by_index.remove(&index) else {
             break;
         };
-        current = converge(
-            evaluator,
-            job,
-            picked,
-            noise,
-            settings,
-            evaluations,
-            skipped,
-        )?;
+        current = converge(evaluator, job, picked, noise, settings, skipped)?;
     }
     Ok(CatalogueOutcome {
         fitted: current,

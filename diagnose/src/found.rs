@@ -128,8 +128,6 @@ pub(super) struct Discovery {
     pub notes: Vec<String>,
     /// Each step of the selection: what the regression ranked, what the refits gave.
     pub steps: Vec<DiscoveryStep>,
-    /// Simulations run.
-    pub evaluations: u64,
     /// The first step's refits and the library's mimics of the catalogue's answer, for the
     /// rival search.
     pub contenders: Vec<crate::contender::Contender>,

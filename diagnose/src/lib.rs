@@ -54,7 +54,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use sepval_common::effects::EffectSet;
-use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job};
+use sepval_common::evaluation::{Candidate, Counted, EvalError, Evaluator, Job};
 use sepval_common::extension::Term;
 use sepval_core::atomic_file::WriteError;
 
@@ -299,6 +299,10 @@ pub fn diagnose(
     progress: &mut dyn ProgressObserver,
 ) -> Result<Diagnosis> {
     let t0 = Instant::now();
+    // Every simulation of the diagnosis is one candidate through this evaluator: counted here,
+    // once, rather than by each stage.
+    let mut counted = Counted::new(evaluator);
+    let evaluator: &mut dyn Evaluator = &mut counted;
     stage_clock::start();
     let figures = options.out.join("figures");
     std::fs::create_dir_all(&figures).map_err(|source| DiagnoseError::Dir {
@@ -310,7 +314,6 @@ pub fn diagnose(
     let candidate_lm = at_bic_resolution(&options.candidate_lm, setting.m);
     let Baseline {
         fitted: baseline,
-        mut evaluations,
         mut skipped,
     } = baseline_fit(options, &setting, evaluator, progress)?;
     stage_clock::lap("baseline converged");
@@ -332,7 +335,6 @@ pub fn diagnose(
         baseline,
         setting.noise,
         &candidate_lm,
-        &mut evaluations,
         &mut skipped,
     )?;
     stage_clock::lap("catalogue");
@@ -346,7 +348,6 @@ pub fn diagnose(
         signature.as_deref(),
         yardstick,
     )?;
-    evaluations += disc.evaluations;
     stage_clock::lap("discovery");
     skipped.extend(disc.skipped);
     let selected = (!cat.chosen.is_empty()).then_some(Selected {
@@ -364,7 +365,7 @@ pub fn diagnose(
         &answer,
         contenders,
         &disc.classes,
-        (&candidate_lm, &mut evaluations),
+        &candidate_lm,
     )?;
     stage_clock::lap("rivals");
     let decided = Decided {
@@ -380,7 +381,7 @@ pub fn diagnose(
         skipped,
         tables_left,
         baseline_restart,
-        evaluations,
+        evaluations: counted.count(),
     };
     sepval_core::cancel::check().map_err(RunError::from)?;
     let analysis = analyse(options, &setting, decided, t0)?;
@@ -401,17 +402,9 @@ fn rival_search(
     answer: &Answer,
     contenders: Vec<contender::Contender>,
     classes: &[classes::ClassInfo],
-    (settings, evaluations): (&LmSettings, &mut u64),
+    settings: &LmSettings,
 ) -> Result<(Rivals, Vec<RivalClass>)> {
-    let searched = rivals::rivals(
-        evaluator,
-        setting,
-        baseline,
-        answer,
-        contenders,
-        settings,
-        evaluations,
-    )?;
+    let searched = rivals::rivals(evaluator, setting, baseline, answer, contenders, settings)?;
     let reports = if matches!(answer, Answer::Baseline) {
         Vec::new()
     } else {
@@ -445,8 +438,6 @@ fn discovery_inputs(
 struct Baseline {
     /// The converged baseline (no effects, no terms).
     fitted: Fitted,
-    /// Simulations run.
-    evaluations: u64,
     /// Its refinement to convergence, when that did not simulate.
     skipped: Vec<SkippedRefit>,
 }
@@ -472,12 +463,6 @@ fn baseline_fit(
         other => DiagnoseError::Baseline(other),
     })?;
     let lm = out.refined.ok_or(DiagnoseError::NoRefinedOptimum)?;
-    let mut evaluations: u64 = out
-        .result
-        .methods
-        .values()
-        .map(|m| m.best.evaluations)
-        .sum();
     let mut skipped = Vec::new();
     let fitted = catalogue::converge(
         evaluator,
@@ -489,12 +474,7 @@ fn baseline_fit(
         },
         setting.noise,
         &at_bic_resolution(&options.candidate_lm, setting.m),
-        &mut evaluations,
         &mut skipped,
     )?;
-    Ok(Baseline {
-        fitted,
-        evaluations,
-        skipped,
-    })
+    Ok(Baseline { fitted, skipped })
 }

@@ -48,18 +48,9 @@ pub(super) fn catalogue(
     baseline: Fitted,
     noise: Noise,
     settings: &LmSettings,
-    evaluations: &mut u64,
     skipped: &mut Vec<SkippedRefit>,
 ) -> Result<Catalogued> {
-    let outcome = catalogue::select(
-        evaluator,
-        job,
-        &baseline,
-        noise,
-        settings,
-        evaluations,
-        skipped,
-    )?;
+    let outcome = catalogue::select(evaluator, job, &baseline, noise, settings, skipped)?;
     let kept = |baseline, outcome| {
         Ok(Catalogued {
             baseline,
@@ -73,7 +64,6 @@ pub(super) fn catalogue(
     // The extension's parameters follow the baseline's in its vector (catalogue.rs).
     let from = &outcome.fitted.lm.x[..baseline.lm.x.len()];
     let (lm, failure) = catalogue::refine_from(evaluator, job, &baseline, from, noise, settings)?;
-    *evaluations += lm.evaluations;
     if let Some(reason) = failure {
         skipped.push(SkippedRefit {
             stage: "baseline restart".into(),
@@ -94,15 +84,7 @@ pub(super) fn catalogue(
         baseline.lm.cost, lm.cost, drop
     );
     let baseline = Fitted { lm, ..baseline };
-    let outcome = catalogue::select(
-        evaluator,
-        job,
-        &baseline,
-        noise,
-        settings,
-        evaluations,
-        skipped,
-    )?;
+    let outcome = catalogue::select(evaluator, job, &baseline, noise, settings, skipped)?;
     Ok(Catalogued {
         baseline,
         outcome,

@@ -125,7 +125,6 @@ pub(crate) fn rivals(
     answer: &Answer,
     contenders: Vec<Contender>,
     settings: &LmSettings,
-    evaluations: &mut u64,
 ) -> Result<RivalSearch> {
     let job = &setting.job;
     let mut classes: Vec<ClassTrial> = Vec::new();
@@ -156,7 +155,7 @@ pub(crate) fn rivals(
             });
         }
     }
-    converge_all(evaluator, job, &mut near, setting, settings, evaluations)?;
+    converge_all(evaluator, job, &mut near, setting, settings)?;
     let mut out: Vec<(Contender, RivalReport)> = Vec::new();
     for c in near {
         let delta_bic = setting.bic(&c.fitted) - answer_bic;
@@ -267,7 +266,6 @@ fn converge_all(
     near: &mut [Contender],
     setting: &Setting,
     settings: &LmSettings,
-    evaluations: &mut u64,
 ) -> Result<()> {
     let mut runs: Vec<ModelLm> = near
         .iter()
@@ -286,7 +284,6 @@ fn converge_all(
         // A refinement that failed on its own leaves the contender at its first refit.
         let failed = run.failure().is_some();
         let lm = run.finish();
-        *evaluations += lm.evaluations;
         if !failed && lm.cost < c.fitted.lm.cost {
             c.fitted.lm = lm;
         }

@@ -46,7 +46,6 @@ pub(super) fn free_held_locator(
     let terms = run.space().terms.clone();
     let failure = run.failure().map(ToString::to_string);
     let lm = run.finish();
-    trail.evaluations += lm.evaluations;
     let what = match entry.family() {
         Family::Wind => "its length",
         _ => "its frequency",

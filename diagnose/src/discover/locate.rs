@@ -62,7 +62,6 @@ pub(super) fn locate(
     s: &Screening,
     current: &Fitted,
     best: &[usize],
-    evaluations: &mut u64,
 ) -> Result<Vec<Located>> {
     let mut tried: Vec<Entry> = best.iter().map(|&b| s.entries[b].clone()).collect();
     let mut zoom_probes = Vec::new();
@@ -82,7 +81,6 @@ pub(super) fn locate(
     let zc = if zoom_probes.is_empty() {
         DMatrix::zeros(search.rows.len(), 0)
     } else {
-        *evaluations += zoom_probes.len() as u64;
         probe::columns(
             evaluator,
             search.job,

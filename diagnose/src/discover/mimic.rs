@@ -95,14 +95,7 @@ pub(super) fn as_contenders(
     if picked.is_empty() {
         return Ok(());
     }
-    let located = locate::locate(
-        evaluator,
-        search,
-        s,
-        current,
-        picked,
-        &mut trail.evaluations,
-    )?;
+    let located = locate::locate(evaluator, search, s, current, picked)?;
     let refits = refit_candidates(
         evaluator,
         search,

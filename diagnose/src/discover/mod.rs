@@ -87,7 +87,6 @@ pub(super) fn discover(
             found: None,
             notes: trail.notes,
             steps: Vec::new(),
-            evaluations: 0,
             contenders: Vec::new(),
             skipped: Vec::new(),
             classes: Vec::new(),
@@ -146,7 +145,6 @@ pub(super) fn discover(
         found,
         notes: trail.notes,
         steps: trail.steps,
-        evaluations: trail.evaluations,
         contenders: trail.contenders,
         skipped: trail.skipped,
         classes: trail.classes,
@@ -206,14 +204,7 @@ fn enter(
         trail.notes.push(s.nothing_significant(step));
         return Ok(None);
     }
-    let located = locate::locate(
-        evaluator,
-        search,
-        &s,
-        &sel.current,
-        &best,
-        &mut trail.evaluations,
-    )?;
+    let located = locate::locate(evaluator, search, &s, &sel.current, &best)?;
     crate::stage_clock::lap("  locators");
     let now = sel.picked.at(search.job, &sel.current)?;
     let refits = verify::refit_candidates(evaluator, search, &sel.current, &now, located, trail)?;
@@ -235,7 +226,6 @@ fn enter(
         winner.fitted.clone(),
         search.noise,
         search.settings,
-        &mut trail.evaluations,
         &mut trail.skipped,
     )?;
     crate::stage_clock::lap("  the winner converged");

@@ -55,7 +55,6 @@ pub(super) fn leave_one_out(
     for ((run, terms), entry) in runs.into_iter().zip(kept_terms).zip(picked.entries()) {
         let failure = run.failure().map(ToString::to_string);
         let lm = run.finish();
-        trail.evaluations += lm.evaluations;
         match failure {
             Some(reason) => {
                 trail.skip(

@@ -98,7 +98,7 @@ pub(super) fn screen(
     // the library's are made (issue 21, item 7: the two matrices are never held together).
     let reconstruction = if step == 0 {
         Some(reconstruction(
-            evaluator, search, sel, &base, &history, &linear, trail,
+            evaluator, search, sel, &base, &history, &linear,
         )?)
     } else {
         None
@@ -120,7 +120,6 @@ pub(super) fn screen(
         search.noise,
         &search.rows,
     )?;
-    trail.evaluations += probes.len() as u64;
 
     // F-to-enter against the Bonferroni threshold, and the PSE.
     let threshold = stepwise::ALPHA / entries.len() as f64;
@@ -147,7 +146,6 @@ fn reconstruction(
     base: &Candidate,
     history: &[Vec<Sample>],
     linear: &Linearisation,
-    trail: &mut Trail,
 ) -> Result<Vec<Reconstruction>> {
     let windows = library::windows(history);
     let win = probe::columns(
@@ -159,7 +157,6 @@ fn reconstruction(
         search.noise,
         &search.rows,
     )?;
-    trail.evaluations += windows.len() as u64;
     Ok(reconstruct_events(
         search.job,
         &search.rows,

@@ -98,8 +98,6 @@ pub(super) struct Trail {
     pub notes: Vec<String>,
     /// Each step's screening and refits.
     pub steps: Vec<DiscoveryStep>,
-    /// Simulations run.
-    pub evaluations: u64,
     /// The first step's refits (and mimics), for the rival search.
     pub contenders: Vec<crate::contender::Contender>,
     /// Refits that did not simulate and were left out.

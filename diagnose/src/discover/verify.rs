@@ -109,7 +109,6 @@ pub(super) fn refit_candidates(
         let space = run.space().clone();
         let failure = run.failure().map(ToString::to_string);
         let lm = run.finish();
-        trail.evaluations += lm.evaluations;
         if let Some(reason) = failure {
             trail.skip(
                 format!("discovery step {}", trail.steps.len() + 1),
