@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use sepval_common::scenario::hex_sha256;
 use sepval_core::atomic_file::{WriteError, write_atomically};
 use sepval_core::input_file::{InputFileError, read_string};
 use sepval_core::limits::MAX_JSON_BYTES;
@@ -181,6 +182,116 @@ fn differs(then: &BTreeMap<String, String>, now: &BTreeMap<String, String>) -> S
         "the grid differs".into()
     } else {
         words.join("; ")
+    }
+}
+
+/// What decides an envelope, as its progress file records it: the source's records, the
+/// geometry files, the extension, the held-out files named, the axes and the settings.
+#[derive(Debug, Clone)]
+pub struct SweepInputs<'a> {
+    /// The source directory (`--from`): its result.json or diagnosis.json.
+    pub from: &'a Path,
+    /// The aircraft's geometry file.
+    pub aircraft: &'a Path,
+    /// The store's shape file, when one is given.
+    pub store_shape: Option<&'a Path>,
+    /// The extension file, when one is given.
+    pub extension: Option<&'a Path>,
+    /// The releases held out, as named.
+    pub validate: &'a [PathBuf],
+    /// The axes swept: each one's flag and its `LO:HI:N` as typed.
+    pub axes: Vec<(&'static str, String)>,
+    /// Samples per condition.
+    pub samples: usize,
+    /// The seed of every draw.
+    pub seed: u64,
+    /// The clearance criterion \[mm\].
+    pub clearance_mm: f64,
+    /// Whether rows holding outliers are dropped.
+    pub outliers_drop: bool,
+}
+
+/// An input of the sweep that cannot be read for its digest.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot read {}", path.display())]
+pub struct DigestError {
+    /// The file.
+    pub path: PathBuf,
+    /// Why.
+    #[source]
+    pub source: std::io::Error,
+}
+
+impl SweepInputs<'_> {
+    /// The digest of the inputs ([`inputs_digest`]) and each of them by name: a file's
+    /// SHA-256, a setting's value ([`Progress::inputs`]).
+    pub fn digest(&self) -> Result<(String, BTreeMap<String, String>), DigestError> {
+        let read = |p: &Path| {
+            std::fs::read(p).map_err(|source| DigestError {
+                path: p.to_path_buf(),
+                source,
+            })
+        };
+        let mut parts: Vec<(String, Vec<u8>)> = Vec::new();
+        let mut named = BTreeMap::new();
+        let mut file = |label: &str, name: String, bytes: Vec<u8>| {
+            named.insert(name, hex_sha256(&bytes));
+            parts.push((label.into(), bytes));
+        };
+        for name in ["result.json", "diagnosis.json"] {
+            let p = self.from.join(name);
+            if p.is_file() {
+                file(name, format!("the source's {name}"), read(&p)?);
+            }
+        }
+        file(
+            "aircraft",
+            "the --aircraft file".into(),
+            read(self.aircraft)?,
+        );
+        if let Some(p) = self.store_shape {
+            file("store", "the --store-shape file".into(), read(p)?);
+        }
+        if let Some(p) = self.extension {
+            file("extension", "the --extension file".into(), read(p)?);
+        }
+        let validate: Vec<String> = self
+            .validate
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        let axes: Vec<String> = self
+            .axes
+            .iter()
+            .map(|(flag, text)| format!("{flag}={text}"))
+            .collect();
+        let mut settings = format!(
+            "samples={} seed={} clearance_mm={} validate={} axes={}",
+            self.samples,
+            self.seed,
+            self.clearance_mm,
+            validate.join(";"),
+            axes.join(";")
+        );
+        if self.outliers_drop {
+            // Only when given, so that the digest of an envelope without it stays as it was.
+            settings.push_str(" outliers=drop");
+        }
+        parts.push(("settings".into(), settings.into_bytes()));
+        named.insert("--samples".into(), self.samples.to_string());
+        named.insert("--seed".into(), self.seed.to_string());
+        named.insert("--clearance-mm".into(), self.clearance_mm.to_string());
+        if !validate.is_empty() {
+            named.insert("--validate".into(), validate.join(" "));
+        }
+        for (flag, text) in &self.axes {
+            named.insert((*flag).into(), text.clone());
+        }
+        let refs: Vec<(&str, &[u8])> = parts
+            .iter()
+            .map(|(l, b)| (l.as_str(), b.as_slice()))
+            .collect();
+        Ok((inputs_digest(&refs), named))
     }
 }
 

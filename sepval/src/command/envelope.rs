@@ -2,14 +2,13 @@
 //! conditions from a fit or a diagnosis, mapped as a separation envelope; `--resume` goes on
 //! with an interrupted sweep.
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use sepval_common::scenario::hex_sha256;
+use sepval_common::telemetry::outliers::Policy;
 use sepval_envelope::grid::{Axis, Grid};
-use sepval_envelope::progress::{Progress, inputs_digest, progress_path, remove_progress};
+use sepval_envelope::progress::{Progress, SweepInputs, progress_path, remove_progress};
 use sepval_envelope::{EnvelopeFile, Provenance, Sweep, sweep, write_outputs};
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
@@ -60,7 +59,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     let Some(clearance) = clearance::settings(&args.geometry, &base)? else {
         bail!("--aircraft FILE is required");
     };
-    let (digest, named) = digest(&args, &source.dir, &aircraft, &given)?;
+    let (digest, named) = sweep_inputs(&args, &source.dir, &aircraft, &given).digest()?;
     let inputs_sha256 = digest.clone();
     let read = inputs_read(&args, &source);
     let (run_dir, progress) = claim(&args, Progress::new(digest, named, grid.len()), &read)?;
@@ -174,76 +173,26 @@ fn claim(args: &EnvelopeArgs, fresh: Progress, read: &[Input]) -> Result<(RunDir
     Ok((super::claim_out(&args.out, request)?, progress))
 }
 
-/// The digest of what decides the envelope (the source's records, the geometry files, the
-/// extension, the held-out files named, the axes and the settings) and each of them by name: a
-/// file's SHA-256, a setting's value.
-fn digest(
-    args: &EnvelopeArgs,
-    from: &Path,
-    aircraft: &Path,
+/// What decides the envelope, as its progress file records it.
+fn sweep_inputs<'a>(
+    args: &'a EnvelopeArgs,
+    from: &'a Path,
+    aircraft: &'a Path,
     axes: &[(Quantity, &AxisArg)],
-) -> Result<(String, BTreeMap<String, String>)> {
-    let read = |p: &Path| -> Result<Vec<u8>> {
-        std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))
-    };
-    let mut parts: Vec<(String, Vec<u8>)> = Vec::new();
-    let mut named = BTreeMap::new();
-    let mut file = |label: &str, name: String, bytes: Vec<u8>| {
-        named.insert(name, hex_sha256(&bytes));
-        parts.push((label.into(), bytes));
-    };
-    for name in ["result.json", "diagnosis.json"] {
-        let p = from.join(name);
-        if p.is_file() {
-            file(name, format!("the source's {name}"), read(&p)?);
-        }
+) -> SweepInputs<'a> {
+    SweepInputs {
+        from,
+        aircraft,
+        store_shape: args.geometry.store_shape.as_deref(),
+        extension: args.extension.as_deref(),
+        validate: &args.validate,
+        axes: axes
+            .iter()
+            .map(|(q, a)| (q.flag(), a.text.clone()))
+            .collect(),
+        samples: args.samples,
+        seed: args.seed,
+        clearance_mm: args.geometry.clearance_mm,
+        outliers_drop: args.outliers.policy() == Policy::Drop,
     }
-    file("aircraft", "the --aircraft file".into(), read(aircraft)?);
-    if let Some(p) = &args.geometry.store_shape {
-        file("store", "the --store-shape file".into(), read(p)?);
-    }
-    if let Some(p) = &args.extension {
-        file("extension", "the --extension file".into(), read(p)?);
-    }
-    let validate: Vec<String> = args
-        .validate
-        .iter()
-        .map(|p: &PathBuf| p.display().to_string())
-        .collect();
-    let axes: Vec<String> = axes
-        .iter()
-        .map(|(q, a)| format!("{}={}", q.flag(), a.text))
-        .collect();
-    let mut settings = format!(
-        "samples={} seed={} clearance_mm={} validate={} axes={}",
-        args.samples,
-        args.seed,
-        args.geometry.clearance_mm,
-        validate.join(";"),
-        axes.join(";")
-    );
-    if args.outliers.policy() == sepval_common::telemetry::outliers::Policy::Drop {
-        // Only when given, so that the digest of an envelope without it stays as it was.
-        settings.push_str(" outliers=drop");
-    }
-    parts.push(("settings".into(), settings.into_bytes()));
-    named.insert("--samples".into(), args.samples.to_string());
-    named.insert("--seed".into(), args.seed.to_string());
-    named.insert(
-        "--clearance-mm".into(),
-        args.geometry.clearance_mm.to_string(),
-    );
-    if !validate.is_empty() {
-        named.insert("--validate".into(), validate.join(" "));
-    }
-    for a in &axes {
-        if let Some((flag, text)) = a.split_once('=') {
-            named.insert(flag.into(), text.into());
-        }
-    }
-    let refs: Vec<(&str, &[u8])> = parts
-        .iter()
-        .map(|(l, b)| (l.as_str(), b.as_slice()))
-        .collect();
-    Ok((inputs_digest(&refs), named))
 }
