@@ -16,12 +16,14 @@
 //! counted apart, and the verdict counts it as a failure to clear ([`ClearanceStats::p_fail`]):
 //! a release that tumbles has not separated cleanly.
 
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use sepval_common::scenario::Scenario;
 use sepval_core::cancel::{self, Cancelled};
-use sepval_geometry::{Geometry, Pose};
+use sepval_geometry::{Body, Geometry, GeometryError, Pose, Role};
 
 use crate::bands::quantile;
 use crate::sampling::{STREAM_BANDS, normal, sample_rng};
@@ -43,6 +45,100 @@ pub struct ClearanceSettings {
     /// The CG's travel from carriage after which the smallest clearance counts (the ejector's
     /// stroke) \[m\].
     pub free_after_m: f64,
+}
+
+/// The largest clearance criterion accepted \[mm\] (10 m: anything beyond is a unit mistake).
+pub const MAX_CRITERION_MM: f64 = 10_000.0;
+
+/// The geometry of a clearance that cannot be used; each names the flag it came from.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ClearanceInputError {
+    /// A criterion out of range.
+    #[error("--clearance-mm {mm}: expected a number of millimetres from 0 to {MAX_CRITERION_MM}")]
+    Criterion {
+        /// The criterion given \[mm\].
+        mm: f64,
+    },
+    /// The aircraft's file.
+    #[error("--aircraft {}", .path.display())]
+    Aircraft {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: GeometryError,
+    },
+    /// The store's shape file.
+    #[error("--store-shape {}", .path.display())]
+    StoreShape {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: GeometryError,
+    },
+    /// The default store shape of the scenario's diameter.
+    #[error("the default store shape, made of the scenario's store.diameter_m")]
+    DefaultStore(#[source] GeometryError),
+    /// The store and the aircraft together (the carriage check).
+    #[error("--aircraft {} with the store {store}", .aircraft.display())]
+    Together {
+        /// The aircraft's file.
+        aircraft: PathBuf,
+        /// The store, as given.
+        store: String,
+        /// Why.
+        #[source]
+        source: GeometryError,
+    },
+}
+
+impl ClearanceSettings {
+    /// The clearance of the store of `scenario` (its shape from `store_shape`, or the default
+    /// shape of its diameter) to the aircraft of the file `aircraft`, by `criterion_mm`: both
+    /// read, and checked together at carriage (docs/geometry.md); a signal stops the reading.
+    pub fn read(
+        aircraft: &Path,
+        store_shape: Option<&Path>,
+        criterion_mm: f64,
+        scenario: &Scenario,
+    ) -> Result<ClearanceSettings, ClearanceInputError> {
+        if !(0.0..=MAX_CRITERION_MM).contains(&criterion_mm) {
+            return Err(ClearanceInputError::Criterion { mm: criterion_mm });
+        }
+        let stop = &cancel::requested;
+        let plane = Body::read_until(aircraft, Role::Aircraft, stop).map_err(|source| {
+            ClearanceInputError::Aircraft {
+                path: aircraft.to_path_buf(),
+                source,
+            }
+        })?;
+        let store = match store_shape {
+            Some(p) => Body::read_until(p, Role::Store, stop).map_err(|source| {
+                ClearanceInputError::StoreShape {
+                    path: p.to_path_buf(),
+                    source,
+                }
+            })?,
+            None => Body::default_store(scenario.store.diameter_m)
+                .map_err(ClearanceInputError::DefaultStore)?,
+        };
+        let geometry = Geometry::new_until(store, plane, stop).map_err(|source| {
+            ClearanceInputError::Together {
+                aircraft: aircraft.to_path_buf(),
+                store: store_shape.map_or("of the scenario (default shape)".into(), |p| {
+                    p.display().to_string()
+                }),
+                source,
+            }
+        })?;
+        Ok(ClearanceSettings {
+            geometry: Arc::new(geometry),
+            criterion_m: 1e-3 * criterion_mm,
+            free_after_m: scenario.store.stroke_m,
+        })
+    }
 }
 
 /// Three percentiles of a quantity over the samples.
