@@ -71,6 +71,12 @@ pub enum CampaignError {
     /// A release refused.
     #[error("{0}")]
     Refused(String),
+    /// The campaign's scenario, as its settings name it.
+    #[error(transparent)]
+    Inputs(Box<sepval_fit::inputs::InputError>),
+    /// The campaign's geometry, as its settings name it.
+    #[error(transparent)]
+    Clearance(Box<sepval_predict::clearance::ClearanceInputError>),
     /// The directory is locked by another command.
     #[error(transparent)]
     Locked(#[from] sepval_fit::out_dir::OutDirError),

@@ -20,6 +20,7 @@ use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
 use sepval_envelope::grid::{Axis, Grid};
 use sepval_fit::conditions::Quantity;
+use sepval_fit::inputs;
 use sepval_fit::out_dir::DirLock;
 use sepval_predict::ClearanceSettings;
 use sepval_predict::ensemble::Ensemble;
@@ -56,9 +57,17 @@ pub struct Campaign {
     _lock: DirLock,
 }
 
-/// Loads the scenario and the clearance a campaign's settings name (the caller's readers).
-pub type Load<'a> =
-    dyn Fn(&SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError> + 'a;
+/// The scenario and the clearance a campaign's settings name, read as `init` read them (the
+/// embedded default scenario when the settings name none).
+fn load(s: &SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError> {
+    let scenario = inputs::scenario(s.scenario.as_ref().map(|r| Path::new(&r.path)), None)
+        .map_err(|e| CampaignError::Inputs(Box::new(e)))?;
+    let aircraft = Path::new(&s.aircraft.path);
+    let store_shape = s.store_shape.as_ref().map(|r| Path::new(&r.path));
+    let clearance = ClearanceSettings::read(aircraft, store_shape, s.clearance_mm, &scenario)
+        .map_err(|e| CampaignError::Clearance(Box::new(e)))?;
+    Ok((scenario, clearance))
+}
 
 /// The inputs of `init`, loaded and checked by the caller.
 pub struct Init {
@@ -169,10 +178,10 @@ pub fn init(
 }
 
 impl Campaign {
-    /// Opens the campaign in `dir`: its record read, its inputs loaded and checked unchanged
-    /// (`load` reads the scenario and the geometry of the settings), what an interrupted
-    /// command left removed, the directory locked.
-    pub fn open(dir: &Path, threads: usize, load: &Load<'_>) -> Result<Campaign, CampaignError> {
+    /// Opens the campaign in `dir`: its record read, its inputs (the scenario and the geometry
+    /// of its settings) read and checked unchanged, what an interrupted command left removed,
+    /// the directory locked.
+    pub fn open(dir: &Path, threads: usize) -> Result<Campaign, CampaignError> {
         let path = dir.join("campaign.json");
         if !path.is_file() {
             return Err(record_error(

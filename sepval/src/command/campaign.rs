@@ -4,19 +4,18 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use sepval_campaign::page;
 use sepval_campaign::prior::Prior;
 use sepval_campaign::program::{Campaign, Init, NewRelease, input_record};
 use sepval_campaign::record::SettingsRecord;
-use sepval_campaign::{CampaignError, page};
-use sepval_common::scenario::{Scenario, hex_sha256};
+use sepval_common::scenario::hex_sha256;
 use sepval_fit::inputs;
-use sepval_predict::ClearanceSettings;
 
 use super::starter;
 use super::{clearance, count, evaluator_spec, tell};
 use crate::cli::{
     CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignRehearseArgs,
-    CampaignStatusArgs, GeometryArgs,
+    CampaignStatusArgs,
 };
 
 /// Runs `sepval campaign SUBCOMMAND`.
@@ -160,24 +159,8 @@ fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
     Ok(())
 }
 
-/// Loads the scenario and the geometry a campaign's settings record.
-fn load(s: &SettingsRecord) -> Result<(Scenario, ClearanceSettings), CampaignError> {
-    let wrap = |e: anyhow::Error| CampaignError::Refused(format!("{e:#}"));
-    let scenario = inputs::scenario(s.scenario.as_ref().map(|r| Path::new(&r.path)), None)
-        .map_err(|e| wrap(e.into()))?;
-    let geometry = GeometryArgs {
-        aircraft: Some(s.aircraft.path.clone().into()),
-        store_shape: s.store_shape.as_ref().map(|r| r.path.clone().into()),
-        clearance_mm: s.clearance_mm,
-    };
-    let c = clearance::settings(&geometry, &scenario)
-        .map_err(wrap)?
-        .ok_or_else(|| CampaignError::Refused("no aircraft".into()))?;
-    Ok((scenario, c))
-}
-
 fn open(dir: &Path, threads: usize) -> Result<Campaign> {
-    Campaign::open(dir, threads, &load).with_context(|| format!("campaign {}", dir.display()))
+    Campaign::open(dir, threads).with_context(|| format!("campaign {}", dir.display()))
 }
 
 fn next(a: CampaignNextArgs) -> Result<()> {
