@@ -93,11 +93,7 @@ pub fn effects(specs: &[String]) -> Result<EffectSet, InputError> {
 
 /// Reads the release `path` screened by `policy`, telling what the screening left out.
 pub fn read(path: &Path, policy: Policy, tell: Tell) -> Result<Trajectory, InputError> {
-    let screened = screen::read(path, policy)?;
-    if let Some(said) = screened.dropped {
-        tell(said);
-    }
-    Ok(screened.trajectory)
+    Ok(screen::read(path, policy)?.told(tell))
 }
 
 /// `paths`, each to be read with `policy`.
@@ -268,15 +264,15 @@ pub fn validation_job(h: &HeldOut, tell: Tell) -> Result<Option<Job>, InputError
             flight: &e.simulator.scenario().flight,
         })
         .collect();
-    let mut read_ = Vec::with_capacity(h.held.len());
+    let mut held_read = Vec::with_capacity(h.held.len());
     for (p, policy) in h.held {
         let name = p.display().to_string();
         let data = read(p, *policy, tell).map_err(|e| e.given(format!("--validate {name}")))?;
         let scenario = event_scenario(&scen, &data, &name)?;
         check_store(&scen, &data, &name, &scenario_name(h.scenario_path))?;
-        read_.push((name, data, scenario));
+        held_read.push((name, data, scenario));
     }
-    let validating: Vec<Release> = read_
+    let validating: Vec<Release> = held_read
         .iter()
         .map(|(name, data, s)| Release {
             given: format!("--validate {name}"),
@@ -288,7 +284,7 @@ pub fn validation_job(h: &HeldOut, tell: Tell) -> Result<Option<Job>, InputError
         refuse_twice(&fitted_releases, r, Twice::Fitted)?;
         refuse_twice(&validating[..i], r, Twice::GivenTwice)?;
     }
-    let events: Vec<Event> = read_
+    let events: Vec<Event> = held_read
         .into_iter()
         .map(|(name, data, scenario)| Event {
             name,

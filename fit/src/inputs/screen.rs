@@ -24,6 +24,16 @@ pub struct Screened {
     pub dropped: Option<String>,
 }
 
+impl Screened {
+    /// The samples kept, what the screening left out told to `tell`.
+    pub fn told(self, tell: super::Tell) -> Trajectory {
+        if let Some(said) = self.dropped {
+            tell(said);
+        }
+        self.trajectory
+    }
+}
+
 /// Reads the telemetry file `path`, screened for outliers by `policy`: refused naming them, or
 /// their rows left out.
 pub fn read(path: &Path, policy: Policy) -> Result<Screened, InputError> {

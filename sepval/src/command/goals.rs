@@ -3,9 +3,10 @@
 use anyhow::{Context, Result};
 use sepval_common::goals::{Goals, goals_between};
 use sepval_common::telemetry::Trajectory;
+use sepval_fit::inputs::screen::{read_screened, screen};
 
+use super::tell;
 use crate::cli::GoalsArgs;
-use sepval_fit::inputs::screen::{Screened, read_screened, screen};
 
 /// Runs `sepval goals`. Both files are screened for outliers; `--outliers drop` leaves out the
 /// rows of either's outliers from both, so that their times still pair.
@@ -14,8 +15,8 @@ pub fn run(args: GoalsArgs) -> Result<()> {
     let (data, in_data) = read_screened(&args.data)?;
     let (sim, in_sim) = read_screened(&args.sim)?;
     let either: Vec<_> = in_data.iter().chain(&in_sim).copied().collect();
-    let data = told(screen(&args.data, data, &in_data, &either, policy)?);
-    let sim = told(screen(&args.sim, sim, &in_sim, &either, policy)?);
+    let data = screen(&args.data, data, &in_data, &either, policy)?.told(&mut tell());
+    let sim = screen(&args.sim, sim, &in_sim, &either, policy)?.told(&mut tell());
     let g = between(
         (&args.data.display().to_string(), &data),
         (&args.sim.display().to_string(), &sim),
@@ -23,14 +24,6 @@ pub fn run(args: GoalsArgs) -> Result<()> {
     say!("J_pos = {:.9} m", g.j_pos_m);
     say!("J_att = {:.9} deg", g.j_att_deg);
     Ok(())
-}
-
-/// The samples kept, what the screening left out told.
-fn told(s: Screened) -> Trajectory {
-    if let Some(said) = s.dropped {
-        note!("{said}");
-    }
-    s.trajectory
 }
 
 /// The goals of `sim` against `data`, each given with the name that errors use (a file's path).
