@@ -32,6 +32,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::lanes::Real;
+
 mod file;
 pub mod locator;
 mod set;
@@ -534,14 +536,28 @@ fn decay(s_m: f64, lambda_m: f64, s_end_m: f64) -> f64 {
     if s_m >= s_end_m {
         return 0.0;
     }
-    let e_end = crate::elementary::exp(-s_end_m / lambda_m);
-    (crate::elementary::exp(-s_m / lambda_m) - e_end) / (1.0 - e_end)
+    decay_inside(s_m, lambda_m, decay_end(s_end_m, lambda_m))
+}
+
+/// exp(-s_end / lambda): the decay shape's value at the cut-off, before it is taken off.
+#[inline(always)]
+pub(crate) fn decay_end<R: Real>(s_end_m: R, lambda_m: R) -> R {
+    crate::elementary::exp(-s_end_m / lambda_m)
+}
+
+/// f_lambda(s) inside the cut-off (s < s_end), `e_end` being [`decay_end`]: (exp(-s / lambda) -
+/// e_end) / (1 - e_end).
+#[inline(always)]
+pub(crate) fn decay_inside<R: Real>(s_m: R, lambda_m: R, e_end: R) -> R {
+    (crate::elementary::exp(-s_m / lambda_m) - e_end) / (R::splat(1.0) - e_end)
 }
 
 /// The smooth step (1 + tanh((t - t_on) / w)) / 2 = 1 / (1 + exp(-2 (t - t_on) / w)).
 #[inline(always)]
-fn step(t_s: f64, t_on_s: f64) -> f64 {
-    1.0 / (1.0 + crate::elementary::exp(-2.0 * (t_s - t_on_s) / STEP_WIDTH_S))
+pub(crate) fn step<R: Real>(t_s: R, t_on_s: R) -> R {
+    R::splat(1.0)
+        / (R::splat(1.0)
+            + crate::elementary::exp(R::splat(-2.0) * (t_s - t_on_s) / R::splat(STEP_WIDTH_S)))
 }
 
 #[cfg(test)]

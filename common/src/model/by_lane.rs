@@ -68,7 +68,8 @@ pub(super) fn flowfield_lanes<R: Real>(
 
 /// The extra terms of each lane's run ([`Parts::extra_terms`]) at that lane's flow, put back into
 /// the lanes (inlined, so that the tables' arithmetic is compiled with the propagator's target
-/// features; the catalogue's and the extension's terms are out of line).
+/// features; the catalogue's terms are out of line). The extension's terms are added after
+/// these, in the lanes together ([`super::term_lanes`]).
 #[inline(always)]
 pub(super) fn lane_by_lane_terms<R: Real>(
     parts: &[Parts],
@@ -127,17 +128,17 @@ pub(crate) struct Parts<'a> {
 }
 
 impl Parts<'_> {
-    /// Whether the run has terms beyond the linear coefficients (tables, catalogue terms,
-    /// extension terms).
+    /// Whether the run has terms beyond the linear coefficients that are evaluated lane by lane
+    /// (tables, corrections, catalogue terms; the extension's are evaluated in the lanes).
     pub(super) fn has_extra_terms(&self) -> bool {
         self.tables.is_some()
             || self.run.coefficient_term_count > 0
-            || !self.run.terms.is_empty()
             || !self.run.corrections.is_empty()
     }
 
-    /// The tables' terms (section 3), then the catalogue's extra terms (section 7) and the
-    /// extension's (section 11), at the flow `flow` and lateral offset `lateral_m`.
+    /// The tables' terms (section 3), the corrections, then the catalogue's extra terms
+    /// (section 7), at the flow `flow` and lateral offset `lateral_m` (the extension's terms,
+    /// section 11, come after these: [`super::term_lanes`]).
     #[inline(always)]
     pub(super) fn extra_terms(
         &self,
@@ -157,9 +158,6 @@ impl Parts<'_> {
         }
         if run.coefficient_term_count > 0 {
             k = run.add_coefficient_terms(*flow, k);
-        }
-        if !run.terms.is_empty() {
-            k = run.add_extension_terms(flow, k);
         }
         k
     }

@@ -28,6 +28,7 @@ use super::aero::{AeroConstants, Flow};
 use super::by_lane::{Parts, alike_fields, flowfield_lanes, lane_by_lane_terms, wind_lanes};
 use super::flowfield::{FieldLanes, FieldSums};
 use super::interference::DecayLanes;
+use super::term_lanes::TermLanes;
 use super::{Dcm, EjectorCurve, Model, RunSetup, STATE_LEN, StateVector};
 
 /// The constants of the force evaluation, one run per lane of `R`, with the products of the
@@ -57,8 +58,11 @@ pub(crate) struct Constants<R: Real> {
     diagonal: R::Mask,
     all_diagonal: bool,
     any_diagonal: bool,
-    /// Whether any lane has terms beyond the linear coefficients.
+    /// Whether any lane has terms beyond the linear coefficients that are evaluated lane by
+    /// lane (the tables', the corrections', the catalogue's).
     extra_terms: bool,
+    /// The lanes' extension terms (section 11).
+    terms: TermLanes<R>,
     /// Whether any lane has a wind (section 11.2: the air's velocity in L).
     wind: bool,
     /// The lanes' aircraft flowfields (section 3b), when every lane has one with the same
@@ -79,6 +83,11 @@ impl<R: Real> Constants<R> {
             [0, 1, 2].map(|r| [0, 1, 2].map(|c| gather::<R>(|i| f(runs(i))[(r, c)])))
         };
         let alike = alike_fields(parts);
+        let sets: Vec<_> = parts
+            .iter()
+            .map(|p| (&p.run.terms, p.run.decay.s_end_m))
+            .collect();
+        let terms = TermLanes::gather(&sets);
         Constants {
             accel_per_speed2: g(&|r| r.half_rho_area * r.inv_mass_per_kg),
             moment_per_speed2: g(&|r| r.half_rho_area * r.diameter_m),
@@ -101,6 +110,7 @@ impl<R: Real> Constants<R> {
             all_diagonal: parts.iter().all(|p| p.run.inertia_diagonal),
             any_diagonal: parts.iter().any(|p| p.run.inertia_diagonal),
             extra_terms: parts.iter().any(Parts::has_extra_terms),
+            terms,
             wind: parts.iter().any(|p| p.run.terms.has_wind()),
             field: alike.then(|| {
                 FieldLanes::gather(
@@ -298,12 +308,13 @@ fn derivative<R: Real>(
 ) -> [R; STATE_LEN] {
     let (flow, dcm, speed2, field) = flow_frame(c, parts, x, t_s);
     let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
-    // Section 3: the six coefficients, then the tables' terms, the catalogue's extra terms
-    // (section 7) and the extension's (section 11), lane by lane.
+    // Section 3: the six coefficients, then the tables' terms and the catalogue's extra terms
+    // (section 7), lane by lane, and the extension's (section 11), in the lanes together.
     let mut k = c.aero.coefficients(&flow, &c.interference_increments);
     if c.extra_terms {
         k = lane_by_lane_terms(parts, &flow, ry, k);
     }
+    k = c.terms.add(&flow, k);
     // Section 3b: the aircraft's flowfield, station by station, after every other term.
     if let (Some(f), Some(sums)) = (&c.field, field) {
         k = sums.add_loads(f, flow.alpha_rad, flow.beta_rad, k);

@@ -34,6 +34,7 @@ mod equations;
 pub mod flowfield;
 pub mod interference;
 pub mod tables;
+mod term_lanes;
 
 pub use dcm::Dcm;
 pub use equations::EquationsOfMotion;
@@ -45,7 +46,7 @@ use crate::atmosphere::isa_troposphere;
 use crate::correction::{Correction, CorrectionError, CorrectionRun};
 use crate::effect_error::{EffectError, MAX_EFFECT_PARAMS};
 use crate::elementary::{cos, sin};
-use crate::extension::{TermError, TermInput, TermSet};
+use crate::extension::{TermError, TermSet};
 use crate::scenario::Scenario;
 use crate::table::PreparedTables;
 use sepval_core::factors::{Factor, FactorError, Factors};
@@ -436,56 +437,6 @@ impl RunSetup {
         for (term, params) in &self.coefficient_terms[..self.coefficient_term_count] {
             term(params, &flow, &mut k);
         }
-        k
-    }
-
-    /// Adds the extension's coefficient increments (section 11; CA is positive aft, so
-    /// `CX -= dCA`). Out of line, as the catalogue's terms; on x86-64 hosts with AVX2 and FMA,
-    /// a copy compiled for them (as `frames::euler_321_deg`): the regressors' `exp`, `sin` and
-    /// `cos` are Horner chains of fused multiply-adds, each otherwise a call to the C library's
-    /// `fma` (the same bits either way, fma being correctly rounded; three quarters of a
-    /// simulation's time with a few terms went to those calls).
-    #[inline(never)]
-    fn add_extension_terms(&self, flow: &Flow, k: Coefficients) -> Coefficients {
-        if !self.terms.has_aero() {
-            return k;
-        }
-        #[cfg(target_arch = "x86_64")]
-        if host_has_fma() {
-            // SAFETY: the CPU supports the features `add_extension_terms_fma` is compiled for.
-            return unsafe { self.add_extension_terms_fma(flow, k) };
-        }
-        self.add_extension_terms_inline(flow, k)
-    }
-
-    /// [`RunSetup::add_extension_terms`] compiled for x86-64 hosts with AVX2 and FMA.
-    ///
-    /// # Safety
-    /// The CPU must support AVX2 and FMA.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn add_extension_terms_fma(&self, flow: &Flow, k: Coefficients) -> Coefficients {
-        self.add_extension_terms_inline(flow, k)
-    }
-
-    /// The body of [`RunSetup::add_extension_terms`].
-    #[inline(always)]
-    fn add_extension_terms_inline(&self, flow: &Flow, mut k: Coefficients) -> Coefficients {
-        let d = self.terms.aero_increments(&TermInput {
-            t_s: flow.t_s,
-            alpha_rad: flow.alpha_rad,
-            beta_rad: flow.beta_rad,
-            rates_hat: [flow.p_hat, flow.q_hat, flow.r_hat],
-            mach: flow.mach,
-            distance_m: flow.distance_m,
-            s_end_m: self.decay.s_end_m,
-        });
-        k.cx -= d[0];
-        k.cy += d[1];
-        k.cz += d[2];
-        k.cl += d[3];
-        k.cm += d[4];
-        k.cn += d[5];
         k
     }
 
