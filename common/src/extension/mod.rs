@@ -417,9 +417,9 @@ impl Term {
     }
 
     /// The regressor's value (aerodynamic axes; for a wind regressor, its shape in time).
-    /// Inlined always, as the kernels it calls: the simulation calls it from a copy compiled
-    /// for FMA units (`model::RunSetup::add_extension_terms`), and only code inlined there uses
-    /// them.
+    /// Inlined always, as the kernels it calls: the simulation calls it from the propagators'
+    /// copies compiled for FMA units (`model::term_lanes`, for lanes whose terms differ in
+    /// kind), and only code inlined there uses them.
     #[inline(always)]
     pub fn regressor_value(&self, x: &TermInput) -> f64 {
         let [a, b] = self.locator;

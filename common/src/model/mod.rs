@@ -440,8 +440,11 @@ impl RunSetup {
         k
     }
 
-    /// The extension's factor on a foot's force at displacement `s_i` (section 11); compiled
-    /// for AVX2 and FMA where the host has them, as [`RunSetup::add_extension_terms`].
+    /// The extension's factor on a foot's force at displacement `s_i` (section 11). Out of line
+    /// (only runs with an ejector term call it), so on x86-64 hosts with AVX2 and FMA, a copy
+    /// compiled for them: the regressors' `exp` is a Horner chain of fused multiply-adds, each
+    /// otherwise a call to the C library's `fma` (the same bits either way, fma being correctly
+    /// rounded).
     #[inline(never)]
     fn ejector_factor(&self, t_s: f64, s_i: f64) -> f64 {
         if !self.terms.has_ejector() {
@@ -465,7 +468,7 @@ pub(crate) fn host_has_fma() -> bool {
 }
 
 /// The extension's wind in L at `t_s` ([`TermSet::wind_l_m_s`]), compiled for AVX2 and FMA
-/// where the host has them, as [`RunSetup::add_extension_terms`].
+/// where the host has them, as [`RunSetup::ejector_factor`].
 #[inline(never)]
 pub(crate) fn wind_l_m_s(terms: &TermSet, t_s: f64) -> [f64; 3] {
     #[cfg(target_arch = "x86_64")]

@@ -393,7 +393,7 @@ mod tests {
     }
 
     /// The scalar evaluation's coefficients: `k` with `set`'s increments, as
-    /// `RunSetup::add_extension_terms` adds them.
+    /// the scalar force evaluation added them before the lanes did (`k.cx -= d[0]`, ...).
     fn scalar(set: &TermSet, flow: &Flow, s_end_m: f64, mut k: Coefficients) -> Coefficients {
         if !set.has_aero() {
             return k;
