@@ -143,6 +143,38 @@ impl<R: Real> TermLanes<R> {
         if self.len == 0 {
             return k;
         }
+        self.add_out_of_line(flow, k)
+    }
+
+    /// [`TermLanes::add`] for runs with terms: out of line, so that the regressors' `exp`,
+    /// `sin` and `cos` are compiled once per lane type rather than into every copy of the
+    /// propagators (a fresh build's compile time); on x86-64 hosts with AVX2 and FMA, a copy
+    /// compiled for them (their Horner chains of fused multiply-adds are otherwise calls to the
+    /// C library's `fma`: the same bits, fma being correctly rounded, at several times the
+    /// cost).
+    #[inline(never)]
+    fn add_out_of_line(&self, flow: &Flow<R>, k: Coefficients<R>) -> Coefficients<R> {
+        #[cfg(target_arch = "x86_64")]
+        if super::host_has_fma() {
+            // SAFETY: the CPU supports the features `add_fma` is compiled for.
+            return unsafe { self.add_fma(flow, k) };
+        }
+        self.add_inline(flow, k)
+    }
+
+    /// [`TermLanes::add_out_of_line`] compiled for x86-64 hosts with AVX2 and FMA.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn add_fma(&self, flow: &Flow<R>, k: Coefficients<R>) -> Coefficients<R> {
+        self.add_inline(flow, k)
+    }
+
+    /// The body of [`TermLanes::add`].
+    #[inline(always)]
+    fn add_inline(&self, flow: &Flow<R>, k: Coefficients<R>) -> Coefficients<R> {
         let mut d = [R::splat(0.0); 6];
         let mut pair = (R::splat(0.0), R::splat(0.0));
         for slot in self.slots[..self.len].iter().flatten() {
