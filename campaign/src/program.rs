@@ -18,6 +18,7 @@ use sepval_common::evaluation::{Event, Job};
 use sepval_common::scenario::{Scenario, hex_sha256};
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
+use sepval_common::telemetry::outliers::Policy;
 use sepval_envelope::grid::{Axis, Grid};
 use sepval_fit::conditions::Quantity;
 use sepval_fit::inputs;
@@ -81,7 +82,7 @@ pub struct Init {
     pub threads: usize,
 }
 
-/// A release to add, read and screened by the caller.
+/// A release to add, read and screened ([`NewRelease::read`]).
 pub struct NewRelease {
     /// The file given.
     pub given: PathBuf,
@@ -91,6 +92,30 @@ pub struct NewRelease {
     pub data: Trajectory,
     /// The campaign's scenario flown at its condition.
     pub scenario: Scenario,
+}
+
+impl NewRelease {
+    /// The release in `path`, read with `policy` (what it leaves out told through `tell`) and
+    /// flown at its own condition with the campaign's `scenario`, whose store it must carry.
+    pub fn read(
+        path: &Path,
+        scenario: &Scenario,
+        policy: Policy,
+        tell: inputs::Tell,
+    ) -> Result<NewRelease, CampaignError> {
+        let name = path.display().to_string();
+        let input = |e: inputs::InputError| CampaignError::Inputs(Box::new(e));
+        let bytes = std::fs::read(path).map_err(|e| record_error(path, e))?;
+        let data = inputs::read(path, policy, tell).map_err(input)?;
+        let flown = inputs::event_scenario(scenario, &data, &name).map_err(input)?;
+        inputs::check_store(scenario, &data, &name, "the campaign's scenario").map_err(input)?;
+        Ok(NewRelease {
+            given: path.to_path_buf(),
+            sha256: hex_sha256(&bytes),
+            data,
+            scenario: flown,
+        })
+    }
 }
 
 /// The file of `path` as the campaign records it.

@@ -18,6 +18,8 @@ use sepval_core::atomic_file::{WriteError, write_atomically};
 use sepval_core::input_file::{InputFileError, read_string};
 use sepval_core::limits::MAX_JSON_BYTES;
 
+use sepval_fit::out_dir::Claim;
+
 use crate::row::Row;
 
 /// The format of the progress file.
@@ -68,6 +70,71 @@ pub enum ProgressError {
     /// Cannot be written.
     #[error("cannot write {}", .0.path.display())]
     Write(#[from] WriteError),
+    /// `--resume` into a directory that holds no interrupted sweep.
+    #[error(
+        "--resume: {} {}",
+        out.display(),
+        if *finished {
+            "holds a finished sweep (envelope.json is written and no sweep/progress.json is left): there is nothing to resume; run without --resume into a new --out, or with --overwrite to sweep it again"
+        } else {
+            "holds no interrupted sweep (no sweep/progress.json): run without --resume"
+        }
+    )]
+    NothingToResume {
+        /// The output directory.
+        out: PathBuf,
+        /// Whether it holds a finished sweep.
+        finished: bool,
+    },
+    /// `--resume` with a progress file that cannot be gone on with.
+    #[error("--resume: the sweep in {} (run without --resume to start anew)", out.display())]
+    Resume {
+        /// The output directory.
+        out: PathBuf,
+        /// Why.
+        #[source]
+        source: Box<ProgressError>,
+    },
+}
+
+/// How a sweep into `out` claims it and what it starts from: with `resume`, the interrupted
+/// sweep's progress, which must record the same inputs as `fresh` (the claim names the
+/// progress file as what it resumes); else `fresh`, the directory cleared with `overwrite`
+/// or new. The third value is the hint a refused claim gives when `out` holds an interrupted
+/// sweep.
+pub fn claim_sweep(
+    out: &Path,
+    resume: bool,
+    overwrite: bool,
+    fresh: Progress,
+) -> Result<(Claim, Progress, Option<String>), ProgressError> {
+    let file = progress_path(out);
+    let hint = file
+        .is_file()
+        .then(|| "go on with its interrupted sweep (--resume)".to_string());
+    if !resume {
+        let claim = if overwrite {
+            Claim::Overwrite
+        } else {
+            Claim::Fresh
+        };
+        return Ok((claim, fresh, hint));
+    }
+    if !file.exists() {
+        return Err(ProgressError::NothingToResume {
+            out: out.to_path_buf(),
+            finished: out.join("envelope.json").is_file(),
+        });
+    }
+    let progress = Progress::read(&file, &fresh).map_err(|e| ProgressError::Resume {
+        out: out.to_path_buf(),
+        source: Box::new(e),
+    })?;
+    let claim = Claim::Resume {
+        checkpoint: file,
+        generation: 0,
+    };
+    Ok((claim, progress, hint))
 }
 
 /// The rows done so far.

@@ -42,6 +42,7 @@ pub mod record;
 pub mod refine;
 pub mod rerun;
 pub mod results;
+pub mod resume;
 pub mod sigma;
 pub mod space;
 

@@ -8,7 +8,6 @@ use sepval_campaign::page;
 use sepval_campaign::prior::Prior;
 use sepval_campaign::program::{Campaign, Init, NewRelease, input_record};
 use sepval_campaign::record::SettingsRecord;
-use sepval_common::scenario::hex_sha256;
 use sepval_fit::inputs;
 
 use super::starter;
@@ -182,18 +181,9 @@ fn add(a: CampaignAddArgs) -> Result<()> {
     let policy = a.outliers.policy();
     let mut new = Vec::new();
     for p in &a.data {
-        let name = p.display().to_string();
-        let bytes = std::fs::read(p).with_context(|| format!("--data {name}"))?;
-        let data =
-            inputs::read(p, policy, &mut tell()).with_context(|| format!("--data {name}"))?;
-        let scenario = inputs::event_scenario(&c.scenario, &data, &name)?;
-        inputs::check_store(&c.scenario, &data, &name, "the campaign's scenario")?;
-        new.push(NewRelease {
-            given: p.clone(),
-            sha256: hex_sha256(&bytes),
-            data,
-            scenario,
-        });
+        let release = NewRelease::read(p, &c.scenario, policy, &mut tell())
+            .with_context(|| format!("--data {}", p.display()))?;
+        new.push(release);
     }
     let mut start = starter(&spec);
     let checks =

@@ -5,12 +5,14 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use sepval_common::telemetry::outliers::Policy;
 use sepval_envelope::grid::{Axis, Grid};
-use sepval_envelope::progress::{Progress, SweepInputs, progress_path, remove_progress};
+use sepval_envelope::progress::{
+    Progress, SweepInputs, claim_sweep, progress_path, remove_progress,
+};
 use sepval_envelope::{EnvelopeFile, Provenance, Sweep, sweep, write_outputs};
-use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
+use sepval_fit::out_dir::{Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
 use sepval_predict::{Settings, Source, SourceInputs, source_inputs};
 
@@ -129,41 +131,8 @@ fn inputs_read(args: &EnvelopeArgs, source: &Source) -> Vec<Input> {
 /// whose progress must record the same inputs as `fresh`, the sweep not started) and returns
 /// the progress to go on from.
 fn claim(args: &EnvelopeArgs, fresh: Progress, read: &[Input]) -> Result<(RunDir, Progress)> {
-    let progress_file = progress_path(&args.out);
-    let (claim, progress) = if args.resume {
-        if !progress_file.exists() {
-            let done = args.out.join("envelope.json").is_file();
-            bail!(
-                "--resume: {} {}",
-                args.out.display(),
-                if done {
-                    "holds a finished sweep (envelope.json is written and no sweep/progress.json is left): there is nothing to resume; run without --resume into a new --out, or with --overwrite to sweep it again"
-                } else {
-                    "holds no interrupted sweep (no sweep/progress.json): run without --resume"
-                }
-            );
-        }
-        let p = Progress::read(&progress_file, &fresh).with_context(|| {
-            format!(
-                "--resume: the sweep in {} (run without --resume to start anew)",
-                args.out.display()
-            )
-        })?;
-        let checkpoint = progress_file.clone();
-        (
-            Claim::Resume {
-                checkpoint,
-                generation: 0,
-            },
-            p,
-        )
-    } else {
-        (super::fresh_or_overwrite(&args.overwrite), fresh)
-    };
-    // Only an interrupted sweep (its progress file there) can be gone on with.
-    let resume = progress_file
-        .is_file()
-        .then(|| "go on with its interrupted sweep (--resume)".to_string());
+    let (claim, progress, resume) =
+        claim_sweep(&args.out, args.resume, args.overwrite.overwrite, fresh)?;
     let request = Request {
         command: "envelope",
         claim,

@@ -1,14 +1,14 @@
 //! `sepval fit`: the factors fitted to measured data by the study's searches (and refinement).
 
-use std::path::Path;
 use std::sync::Arc;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use sepval_common::evaluation::Job;
 use sepval_fit::checkpoint::Checkpoint;
 use sepval_fit::inputs;
-use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
+use sepval_fit::out_dir::{Claim, Request, RunDir};
 use sepval_fit::pipeline::{FitOutput, write_fit_figures};
+use sepval_fit::resume::{self, InputPaths};
 use sepval_fit::sigma::Sigma;
 use sepval_fit::{FitOptions, Method, run_fit};
 use sepval_solve::ga::GaSettings;
@@ -100,22 +100,7 @@ fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
     read.extend(super::input_files("--truth-factors", &args.truth_factors));
     read.extend(super::geometry_inputs(&args.geometry));
     if let (Some(path), Some(c)) = (&args.resume, resume) {
-        // DIR/generations/gen-NNNN.json: DIR is the run's directory.
-        let dir = path
-            .parent()
-            .filter(|d| d.file_name().is_some_and(|n| n == "generations"));
-        if let Some(run) = dir.and_then(Path::parent) {
-            read.push(Input::resumed_run(path, run));
-        }
-        read.push(Input::file("--resume", path));
-        let whose = format!("--resume {}", path.display());
-        let recorded = c
-            .inputs
-            .data
-            .iter()
-            .chain(&c.inputs.scenario)
-            .chain(&c.inputs.extension);
-        read.extend(recorded.map(|p| Input::recorded(&whose, p)));
+        read.extend(resume::inputs_read(path, c));
     }
     let resume_hint = format!(
         "resume from one of its checkpoints (--resume {})",
@@ -137,23 +122,16 @@ fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
 fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
     // Inputs: the flags, or (when resuming without them) those recorded in the checkpoint.
     let given = &args.inputs;
-    let (data_paths, scenario_path, extension_path) = match (
-        &resume,
-        given.data.is_empty(),
-        &given.model.scenario,
-        &given.model.extension,
-    ) {
-        (Some(c), true, None, None) => (
-            c.inputs.data.clone(),
-            c.inputs.scenario.clone(),
-            c.inputs.extension.clone(),
-        ),
-        _ => (
-            given.data.clone(),
-            given.model.scenario.clone(),
-            given.model.extension.clone(),
-        ),
-    };
+    let InputPaths {
+        data: data_paths,
+        scenario: scenario_path,
+        extension: extension_path,
+    } = InputPaths {
+        data: given.data.clone(),
+        scenario: given.model.scenario.clone(),
+        extension: given.model.extension.clone(),
+    }
+    .or_recorded(resume.as_ref());
     let recorded = resume
         .as_ref()
         .map(|c| c.inputs.outliers)
@@ -165,17 +143,8 @@ fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
         given.outliers.or(recorded),
         &mut tell(),
     )?;
-    let method = match (args.method, &resume) {
-        (Some(m), _) => method(m),
-        (None, Some(c)) => Method::from_name(&c.method).ok_or_else(|| {
-            anyhow::anyhow!(
-                "checkpoint {}: unknown method `{}`",
-                args.resume.as_deref().expect("resuming").display(),
-                c.method
-            )
-        })?,
-        (None, None) => Method::Both,
-    };
+    let resumed = args.resume.as_deref().zip(resume.as_ref());
+    let method = resume::method(args.method.map(method), resumed)?;
     let Searches { ga, hill, sigma } = searches(args, resume.as_ref(), &job)?;
     ga.validate()?;
     let truth = match &args.truth_factors {
@@ -219,22 +188,8 @@ struct Searches {
 fn searches(args: &FitArgs, resume: Option<&Checkpoint>, job: &Job) -> Result<Searches> {
     if let Some(c) = resume {
         let path = args.resume.as_deref().expect("resume path");
-        c.check_job(job, path)?;
-        let mut ga = c.settings.clone();
-        if let Some(g) = args.generations {
-            if g < c.state.generation {
-                bail!(
-                    "--generations {g}: the checkpoint is already at generation {}",
-                    c.state.generation
-                );
-            }
-            ga.generations = g;
-        }
-        return Ok(Searches {
-            ga,
-            hill: c.hill.clone(),
-            sigma: c.sigma.clone(),
-        });
+        let (ga, hill, sigma) = resume::searches(c, path, job, args.generations)?;
+        return Ok(Searches { ga, hill, sigma });
     }
     let ga = GaSettings {
         population: args.population,
