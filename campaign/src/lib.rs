@@ -71,6 +71,12 @@ pub enum CampaignError {
     /// A release refused.
     #[error("{0}")]
     Refused(String),
+    /// The campaign's grid, as its settings name it.
+    #[error(transparent)]
+    Grid(#[from] sepval_envelope::GridError),
+    /// The releases flown as one job (refused as a job of the fit refuses them).
+    #[error(transparent)]
+    Job(#[from] sepval_common::evaluation::JobError),
     /// The campaign's scenario, as its settings name it.
     #[error(transparent)]
     Inputs(Box<sepval_fit::inputs::InputError>),

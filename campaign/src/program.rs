@@ -145,10 +145,10 @@ pub fn grid_of(settings: &SettingsRecord, scenario: &Scenario) -> Result<Grid, C
                 .iter()
                 .find(|q| q.flag() == flag)
                 .ok_or_else(|| CampaignError::Refused(format!("{flag}: not an axis")))?;
-            Axis::parse(*q, text).map_err(|e| CampaignError::Refused(e.to_string()))
+            Ok::<_, CampaignError>(Axis::parse(*q, text)?)
         })
         .collect::<Result<_, _>>()?;
-    Grid::of(scenario, &axes).map_err(|e| CampaignError::Refused(e.to_string()))
+    Ok(Grid::of(scenario, &axes)?)
 }
 
 /// Starts a campaign in `dir` (absent or empty): round 0, the envelope under the prior.
@@ -332,9 +332,7 @@ impl Campaign {
                 data,
             });
         }
-        Job::new(events)
-            .map(Some)
-            .map_err(|e| CampaignError::Refused(e.to_string()))
+        Ok(Some(Job::new(events)?))
     }
 
     /// What the current round believes: the prior, or the diagnosis in the last round's

@@ -16,8 +16,8 @@ pub enum WireError {
     #[error("effect index {0} is not in the catalogue")]
     EffectIndex(u32),
     /// Effect parameters the catalogue refuses.
-    #[error("{0}")]
-    Effect(String),
+    #[error(transparent)]
+    Effect(#[from] sepval_common::effects::EffectError),
     /// Extension terms that cannot be run.
     #[error("extension term {index}: {reason}")]
     Term {

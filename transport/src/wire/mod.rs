@@ -276,7 +276,7 @@ impl WireRequest {
             let params = &self.effect_params[k][..effect.params().len()];
             effects
                 .push(index as usize, params)
-                .map_err(|e| WireError::Effect(e.to_string()))?;
+                .map_err(WireError::Effect)?;
         }
         let n = self.term_count as usize;
         if n > MAX_TERMS {
