@@ -83,11 +83,7 @@ impl<R: Real> Constants<R> {
             [0, 1, 2].map(|r| [0, 1, 2].map(|c| gather::<R>(|i| f(runs(i))[(r, c)])))
         };
         let alike = alike_fields(parts);
-        let sets: Vec<_> = parts
-            .iter()
-            .map(|p| (&p.run.terms, p.run.decay.s_end_m))
-            .collect();
-        let terms = TermLanes::gather(&sets);
+        let terms = TermLanes::gather(parts.len(), |i| (&runs(i).terms, runs(i).decay.s_end_m));
         Constants {
             accel_per_speed2: g(&|r| r.half_rho_area * r.inv_mass_per_kg),
             moment_per_speed2: g(&|r| r.half_rho_area * r.diameter_m),

@@ -1,5 +1,5 @@
 //! The extension's coefficient terms (docs/model.md section 11) of the four runs of a batch
-//! evaluated in the lanes together, when the runs carry the same terms on the same axes (every
+//! evaluated in the lanes together where the runs carry the same terms on the same axes (every
 //! candidate of one refit or one Jacobian: only coefficients and locators differ).
 //!
 //! Each lane has the bits of [`crate::extension::TermSet::aero_increments`] of its run, added as
@@ -9,8 +9,9 @@
 //! and each lane's increments summed term by term from zero. What changes is the cost: a term's
 //! `exp`, `sin` and `cos` are computed once for the four lanes, and the decay shape's value at
 //! the cut-off, exp(-s_end / lambda), once per propagation rather than at every force
-//! evaluation (the same value: the same operations on the same inputs). Four runs whose terms
-//! differ in kind are evaluated lane by lane with the scalar code ([`super::by_lane`]).
+//! evaluation (the same value: the same operations on the same inputs). Where the runs' terms
+//! differ in kind at a position, each lane's term there is computed in its own lane with the
+//! scalar code ([`crate::extension::Term::regressor_value`]).
 
 use std::f64::consts::TAU;
 
@@ -67,33 +68,33 @@ pub(super) struct TermLanes<R: Real> {
 }
 
 impl<R: Real> TermLanes<R> {
-    /// The terms of `sets` (one per lane of `R`, with each run's cut-off distance), position by
-    /// position: where every lane has the same axis and regressor, gathered into the lanes.
-    pub(super) fn gather(sets: &[(&TermSet, f64)]) -> Self {
-        let terms: Vec<Vec<Term>> = sets
-            .iter()
-            .map(|(set, _)| {
-                set.iter()
-                    .filter(|t| t.axis.is_coefficient())
-                    .copied()
-                    .collect()
-            })
-            .collect();
-        let len = terms.iter().map(Vec::len).max().unwrap_or(0);
-        let s_end_m = gather::<R>(|i| sets[i].1);
+    /// The terms of the `lanes` runs (`set(i)`: lane `i`'s terms and cut-off distance; one per
+    /// lane of `R`), position by position: where every lane has the same axis and regressor,
+    /// gathered into the lanes. Nothing is allocated (a propagation starts here).
+    pub(super) fn gather<'a>(lanes: usize, set: impl Fn(usize) -> (&'a TermSet, f64)) -> Self {
+        // Each lane's coefficient terms, in order.
+        let mut terms = [[None; MAX_TERMS]; MAX_LANES];
+        let mut counts = [0; MAX_LANES];
+        for (i, (own, count)) in terms.iter_mut().zip(&mut counts).enumerate().take(lanes) {
+            for t in set(i).0.iter().filter(|t| t.axis.is_coefficient()) {
+                own[*count] = Some(*t);
+                *count += 1;
+            }
+        }
+        let len = counts[..lanes].iter().copied().max().unwrap_or(0);
+        let s_end_m = gather::<R>(|i| set(i).1);
         let mut slots = [None; MAX_TERMS];
-        let mut last_pair: Option<Vec<u64>> = None;
+        let mut last_pair: Option<R::Array> = None;
         for (j, slot) in slots.iter_mut().enumerate().take(len) {
-            let at = |i: usize| terms[i].get(j);
-            let kind = |i: usize| at(i).map(|t| (t.axis, t.regressor));
-            if !(1..terms.len()).all(|i| kind(i) == kind(0)) {
-                *slot = Some(Slot::ByLane(std::array::from_fn(|i| {
-                    at(i.min(terms.len() - 1)).copied()
-                })));
+            let kind = |i: usize| terms[i][j].map(|t| (t.axis, t.regressor));
+            if !(1..lanes).all(|i| kind(i) == kind(0)) {
+                *slot = Some(Slot::ByLane(std::array::from_fn(|i| terms[i][j])));
                 continue;
             }
-            let t = at(0).expect("a position below the longest list, alike in every lane");
-            let per_lane = |f: fn(&Term) -> f64| gather::<R>(|i| f(&terms[i][j]));
+            let t = terms[0][j].expect("a position below the longest list, alike in every lane");
+            let per_lane = |f: fn(&Term) -> f64| {
+                gather::<R>(|i| f(&terms[i][j].expect("alike in every lane")))
+            };
             let a = per_lane(|t| t.locator[0]);
             let decays = matches!(
                 t.regressor,
@@ -106,8 +107,12 @@ impl<R: Real> TermLanes<R> {
             );
             let mut shares_pair = false;
             if matches!(t.regressor, Regressor::Sin | Regressor::Cos) {
-                let now: Vec<u64> = a.to_array().as_ref().iter().map(|x| x.to_bits()).collect();
-                shares_pair = last_pair.as_ref() == Some(&now);
+                let now = a.to_array();
+                let same_bits = |p: &R::Array| {
+                    let pairs = p.as_ref().iter().zip(now.as_ref());
+                    pairs.into_iter().all(|(x, y)| x.to_bits() == y.to_bits())
+                };
+                shares_pair = last_pair.as_ref().is_some_and(same_bits);
                 if !shares_pair {
                     last_pair = Some(now);
                 }
@@ -130,8 +135,8 @@ impl<R: Real> TermLanes<R> {
             len,
             slots,
             s_end_m,
-            aero: mask::<R>(|i| !terms[i].is_empty()),
-            all_aero: terms.iter().all(|t| !t.is_empty()),
+            aero: mask::<R>(|i| counts[i] > 0),
+            all_aero: counts[..lanes].iter().all(|&n| n > 0),
         }
     }
 
@@ -314,6 +319,11 @@ mod tests {
     use crate::extension::{Axis, Term, TermInput};
     use crate::lanes::F64x4;
 
+    /// The lanes of `sets` (one per lane of `R`).
+    fn gathered<R: Real>(sets: &[(&TermSet, f64)]) -> TermLanes<R> {
+        TermLanes::gather(sets.len(), |i| sets[i])
+    }
+
     /// A small seeded generator (xorshift64*), uniform in [lo, hi).
     struct Draw(u64);
 
@@ -470,7 +480,7 @@ mod tests {
                 cn: g.within(-1.0, 1.0),
             });
             let pairs: Vec<_> = (0..4).map(|i| (&sets[i], s_end[i])).collect();
-            let lanes = TermLanes::<F64x4>::gather(&pairs);
+            let lanes = gathered::<F64x4>(&pairs);
             if lanes
                 .slots
                 .iter()
@@ -518,7 +528,7 @@ mod tests {
                 };
                 assert_eq!(bits(&got), bits(&want), "lane {i} of {:?}", sets[i]);
                 // One run alone (the scalar propagator's evaluation) gives the same bits.
-                let one = TermLanes::<f64>::gather(&[(&sets[i], s_end[i])]);
+                let one = gathered::<f64>(&[(&sets[i], s_end[i])]);
                 assert_eq!(bits(&one.add(&flow[i], k[i])), bits(&want));
             }
         }
@@ -536,7 +546,7 @@ mod tests {
         let a = TermSet::of(&[t(Regressor::F, Axis::Cm), t(Regressor::Beta, Axis::Cn)]).unwrap();
         let b = TermSet::of(&[t(Regressor::F, Axis::Cm), t(Regressor::Q, Axis::Cn)]).unwrap();
         let c = TermSet::of(&[t(Regressor::F, Axis::Cm)]).unwrap();
-        let lanes = TermLanes::<F64x4>::gather(&[(&a, 1.0), (&b, 1.0), (&c, 1.0), (&a, 2.0)]);
+        let lanes = gathered::<F64x4>(&[(&a, 1.0), (&b, 1.0), (&c, 1.0), (&a, 2.0)]);
         assert_eq!(lanes.len, 2);
         assert!(matches!(lanes.slots[0], Some(Slot::Alike(_))));
         let Some(Slot::ByLane(own)) = lanes.slots[1] else {
@@ -552,8 +562,7 @@ mod tests {
             ]
         );
         assert!(lanes.all_aero);
-        let none =
-            TermLanes::<F64x4>::gather(&[(&a, 1.0), (&TermSet::NONE, 1.0), (&a, 1.0), (&a, 1.0)]);
+        let none = gathered::<F64x4>(&[(&a, 1.0), (&TermSet::NONE, 1.0), (&a, 1.0), (&a, 1.0)]);
         assert!(!none.all_aero);
     }
 }
