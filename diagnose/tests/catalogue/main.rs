@@ -6,26 +6,26 @@
 //! Each case is the diagnosis that `sepval diagnose --data d.csv --generations 20 --evaluator
 //! inproc --threads 2` makes of what `sepval simulate --factors base.json --noise-seed S
 //! --effect ...` writes: the data are simulated, written and read back by the same library
-//! functions the commands call, and diagnosed with the command's own options
-//! ([`DiagnoseOptions::new`]), so the diagnosis is the command's to the last bit. The binary's
-//! own test of the command (`sepval/tests/cli/diagnose.rs`) keeps one such case end to end.
+//! functions the commands call (`support/simulate.rs`), and diagnosed with the command's own
+//! options (`DiagnoseOptions::new`, `support/command.rs`), so the diagnosis is the command's to
+//! the last bit. The binary's own test of the command (`sepval/tests/cli/diagnose.rs`) keeps
+//! one such case end to end.
 
 use std::path::Path;
-use std::sync::Arc;
 
-use sepval_common::evaluation::InProcess;
 use sepval_common::scenario::Scenario;
-use sepval_common::simulation::{Simulator, sample_times};
-use sepval_common::synthetic::synthetic_flight_test_logged;
-use sepval_common::telemetry::outliers::Policy;
-use sepval_core::factors::Factors;
-use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose};
-use sepval_fit::FitOptions;
-use sepval_fit::inputs;
-use sepval_fit::sigma::Sigma;
-use sepval_solve::ga::GaSettings;
-use sepval_solve::lm::LmSettings;
-use sepval_solve::run::NoProgress;
+use sepval_diagnose::Diagnosis;
+
+// Shared with the other test binaries that diagnose; this one diagnoses without a
+// `--validate`, a `--scenario` or an `--extension`, so it reads no diagnosis.json back.
+#[allow(dead_code)]
+#[path = "../support/command.rs"]
+mod command;
+#[path = "../support/simulate.rs"]
+mod simulate;
+
+use command::Diagnose;
+use simulate::Simulate;
 
 /// Factors of the base model of these tests (not the default truth).
 const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerfac": 1.03,
@@ -33,47 +33,23 @@ const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerf
  "cloff": -0.05, "caintfac": 1.1, "cyintfac": 1.4, "czintfac": 0.9, "cmintfac": 1.3,
  "cnintfac": 0.8, "clintfac": 1.6}"#;
 
-/// `sepval simulate --factors base.json --noise-seed seed --effect ...` of `truth` (the
-/// embedded default scenario when `None`) into `path`.
-fn simulate(path: &Path, effects: &[&str], seed: u64, truth: Option<Scenario>) {
-    let scenario = truth.unwrap_or_else(Scenario::embedded_default);
-    let specs: Vec<String> = effects.iter().map(|e| e.to_string()).collect();
-    let effects = inputs::effects(&specs).unwrap();
-    let factors = Factors::from_json_str(BASE, &scenario.factors).unwrap();
-    let sim = Simulator::new(&scenario);
-    let times = sample_times(scenario.integrator.t_end_s, scenario.integrator.rate_hz);
-    let (traj, _) =
-        synthetic_flight_test_logged(&sim, &factors, &effects, &times, Some(seed)).unwrap();
-    traj.write(path).unwrap();
-}
-
-/// `sepval diagnose --data d.csv --generations 20 --evaluator inproc --threads 2` of the
-/// data `simulate` writes (the embedded default scenario fitted).
-fn hidden(effects: &[&str], seed: u64, truth: Option<Scenario>) -> Diagnosis {
+/// `sepval diagnose --data d.csv --generations 20 --evaluator inproc --threads 2` of what
+/// `sepval simulate --factors base.json --noise-seed seed [--scenario truth] --effect ...`
+/// writes (the embedded default scenario fitted).
+fn hidden(effects: &[&str], seed: u64, truth: Option<&Path>) -> Diagnosis {
     let dir = tempfile::tempdir().unwrap();
-    let data = dir.path().join("d.csv");
-    simulate(&data, effects, seed, truth);
-    let (job, record) = inputs::job(&[data], None, None, Policy::Refuse, &mut |said| {
-        panic!("{said}")
-    })
-    .unwrap();
+    let (base, data) = (dir.path().join("base.json"), dir.path().join("d.csv"));
+    std::fs::write(&base, BASE).unwrap();
+    Simulate {
+        factors: base.to_str().unwrap(),
+        scenario: truth,
+        effects,
+        noise_seed: Some(seed),
+        ..Simulate::default()
+    }
+    .run(&data);
     let out = dir.path().join("diag");
-    std::fs::create_dir(&out).unwrap();
-    let ga = GaSettings {
-        population: 100,
-        generations: 20,
-        seed: 1,
-        ..GaSettings::default()
-    };
-    let lm = LmSettings {
-        budget: 3000,
-        ..LmSettings::default()
-    };
-    let sigma = Sigma::resolve(&job, None, None).unwrap();
-    let fit = FitOptions::baseline(ga, sigma, &lm, &out.join("baseline"), record);
-    let options = DiagnoseOptions::new(fit, &lm, out.clone());
-    let mut evaluator = InProcess::new(Arc::new(job), 2);
-    let d = diagnose(&options, &mut evaluator, &mut NoProgress).unwrap();
+    let d = Diagnose::of(vec![data]).run(&out);
     // The files a diagnosis writes: the page says the verdict, the residuals are drawn.
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains(d.verdict.split(',').next().unwrap()));
@@ -202,7 +178,7 @@ fn an_effect_outside_the_catalogue_is_not_explained() {
         return;
     }
     // Pitch damping five times the scenario's: no catalogue effect is that. The scenario as
-    // `sepval scenario` writes it, edited, and read as `--scenario` reads it.
+    // `sepval scenario` writes it, edited, and given as `--scenario` to simulate.
     let dir = tempfile::tempdir().unwrap();
     let text = Scenario::embedded_default().to_toml_string();
     assert!(text.contains("cm_q_per_rad = -80.0"), "{text}");
@@ -212,8 +188,7 @@ fn an_effect_outside_the_catalogue_is_not_explained() {
         text.replace("cm_q_per_rad = -80.0", "cm_q_per_rad = -400.0"),
     )
     .unwrap();
-    let truth = inputs::scenario(Some(&path), None).unwrap();
-    let d = hidden(&[], 3, Some(truth));
+    let d = hidden(&[], 3, Some(&path));
     assert!(!d.explained, "{}", d.verdict);
     assert!(d.verdict.starts_with("not explained"));
 }
