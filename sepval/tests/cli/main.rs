@@ -8,7 +8,6 @@
 mod campaign;
 mod checkpoint;
 mod cli;
-mod closing;
 mod daveml;
 mod diagnose;
 mod discover;

@@ -1,20 +1,52 @@
-//! The loop closed (issue 22, item 4): a hidden cause on one release that a mimic fits as well,
-//! diagnosed; `sepval plan` asked where to fly next; the "flight" made at the plan's top
+//! The loop closed (issue 22, item 4), in process: a hidden cause on one release that a mimic
+//! fits as well, diagnosed; a plan of where to fly next; the "flight" made at the plan's top
 //! condition with the same hidden cause; both releases diagnosed together. The true cause must
-//! be named and the mimic dropped. The data come from `discover`'s generator (the scenario's
-//! own aerodynamics or initial state changed, on a base that is not the default truth, with the
+//! be named and the mimic dropped. Slow tier (`SEPVAL_SLOW_TESTS=1`): each loop is two
+//! diagnoses and a plan, 15 to 45 s alone on two cores.
+//!
+//! Each diagnosis is the one `sepval diagnose ... --generations 20 --evaluator inproc --threads
+//! 2` makes (`diagnose/tests/support/command.rs`: the command's own options), and each plan the
+//! one `sepval plan --from diag --out plan ... --evaluator inproc --threads 2` makes of it (the
+//! library calls of `sepval/src/command/plan.rs`: `read_diagnosis`, `prepare`, `plan`,
+//! `plan_file`, `write_outputs`), so both are the commands' to the last bit. The data come
+//! from the tests' own generator (`diagnose/tests/support/generator.rs`: the scenario's own
+//! aerodynamics or initial state changed, on a base that is not the default truth, with the
 //! generator's own noise), never from the catalogue's or the extension's code; a gust, which no
-//! coefficient function can make, comes from `gust`'s releases (the extension's wind).
+//! coefficient function can make, comes from simulate's library calls through an extension's
+//! wind (`diagnose/tests/support/gusts.rs`). No two loops diagnose the same releases, so no
+//! diagnosis is shared between them. Moved from `sepval/tests/cli/closing.rs`, each assertion
+//! kept; the binary's own test of `plan` (`sepval/tests/cli/plan.rs`) runs the command end to
+//! end (a plan made here and one made by the binary from the same diagnosis were the same
+//! plan.json but for its wall time and `from`, 2026-11-28).
 
 use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
 
+use sepval_common::evaluation::InProcess;
 use sepval_common::scenario::{Aero, Scenario};
 use sepval_common::table::DerivativeCoefficient;
-use sepval_tests::{ok, sepval};
+use sepval_fit::inputs;
+use sepval_plan::{Quantity, Range, plan_file, prepare, read_diagnosis, write_outputs};
+use sepval_solve::run::NoProgress;
 use serde_json::Value;
 
-use super::discover::{default_scenario, diagnose, release};
-use super::gust::{PULSE, gust_release, terms};
+#[path = "../../../diagnose/tests/support/command.rs"]
+mod command;
+#[path = "../../../diagnose/tests/support/generator.rs"]
+mod generator;
+// Shared with `diagnose/tests/discovery`, which makes every gust of it; a loop makes one.
+#[allow(dead_code)]
+#[path = "../../../diagnose/tests/support/gusts.rs"]
+mod gusts;
+#[path = "../../../diagnose/tests/support/releases.rs"]
+mod releases;
+#[path = "../../../diagnose/tests/support/simulate.rs"]
+mod simulate;
+
+use command::diagnosis_of;
+use gusts::{PULSE, gust_release, terms};
+use releases::{default_scenario, diagnose, release};
 
 /// `model` with the damping derivative `pick` chooses scaled by `scale` (the hidden cause).
 fn damped(
@@ -51,9 +83,9 @@ fn at_top(truth: &Scenario, plan: &Value) -> Scenario {
     next
 }
 
-/// Diagnoses one release of `truth` (modelled by `model`), plans over `ranges` from it, flies
+/// Diagnoses one release of `truth` (modelled by `model`), plans over `grid` from it, flies
 /// `truth` at the plan's top condition and diagnoses the two releases together.
-fn close_loop(model: &Scenario, truth: &Scenario, seeds: [u64; 2], ranges: &[&str]) -> Loop {
+fn close_loop(model: &Scenario, truth: &Scenario, seeds: [u64; 2], grid: Grid) -> Loop {
     let one = tempfile::tempdir().unwrap();
     let first = diagnose(
         one.path(),
@@ -61,7 +93,7 @@ fn close_loop(model: &Scenario, truth: &Scenario, seeds: [u64; 2], ranges: &[&st
         1,
         Some(model),
     );
-    let plan = plan(one.path(), ranges);
+    let plan = plan(one.path(), &grid);
     let next = at_top(truth, &plan);
     let two = tempfile::tempdir().unwrap();
     let releases = [
@@ -76,14 +108,42 @@ fn close_loop(model: &Scenario, truth: &Scenario, seeds: [u64; 2], ranges: &[&st
     Loop { first, plan, both }
 }
 
-/// `sepval plan --from diag --out plan` over `ranges` in `dir`, in process; returns plan.json.
-fn plan(dir: &Path, ranges: &[&str]) -> Value {
-    let mut args = vec!["plan", "--from", "diag", "--out", "plan"];
-    args.extend(ranges);
-    args.extend(["--evaluator", "inproc", "--threads", "2"]);
-    let stdout = ok(&sepval(&args, dir));
-    eprintln!("{stdout}");
-    serde_json::from_slice(&std::fs::read(dir.join("plan/plan.json")).unwrap()).unwrap()
+/// The grid of a plan: `--mach LO:HI` and the like, and `--points N`.
+struct Grid {
+    /// The ranges given, in the order of `[flight]` (as `sepval plan` gathers its flags).
+    ranges: Vec<Range>,
+    /// Points per axis.
+    points: usize,
+}
+
+/// The grid over `ranges` (each quantity with its low and high ends), `points` per axis.
+fn grid(ranges: &[(Quantity, f64, f64)], points: usize) -> Grid {
+    let mut ranges: Vec<Range> = ranges
+        .iter()
+        .map(|&(quantity, lo, hi)| Range { quantity, lo, hi })
+        .collect();
+    ranges.sort_by_key(|r| Quantity::ALL.iter().position(|q| *q == r.quantity));
+    Grid { ranges, points }
+}
+
+/// `sepval plan --from diag --out plan RANGES --evaluator inproc --threads 2` in `dir`, in
+/// process (the command's library calls, in its order); returns plan.json.
+fn plan(dir: &Path, grid: &Grid) -> Value {
+    let (from, out) = (dir.join("diag"), dir.join("plan"));
+    let diagnosis = read_diagnosis(&from).unwrap();
+    // The releases the diagnosis was made from, read as its record names them.
+    let r = &diagnosis.inputs;
+    let (scenario, extension) = (r.scenario.as_deref(), r.extension.as_deref());
+    let mut tell = |said: String| eprintln!("{said}");
+    let (flown, _) = inputs::job(&r.data, scenario, extension, r.outliers, &mut tell).unwrap();
+    let prepared = prepare(diagnosis, &flown, &grid.ranges, grid.points).unwrap();
+    let start = Instant::now();
+    let mut evaluator = InProcess::new(Arc::new(prepared.job.clone()), 2);
+    let found = sepval_plan::plan(&prepared, &mut evaluator, &mut NoProgress).unwrap();
+    drop(evaluator);
+    let file = plan_file(&prepared, &found, &from, start.elapsed().as_secs_f64());
+    write_outputs(&prepared, &found, &file, &out).unwrap();
+    serde_json::from_slice(&std::fs::read(out.join("plan.json")).unwrap()).unwrap()
 }
 
 /// Every explanation a diagnosis leaves open, in words: the answer first, then each rival
@@ -154,7 +214,10 @@ fn weaker_roll_damping_is_named_after_the_planned_release() {
         &model,
         &truth,
         [31, 33],
-        &["--beta-deg", "-6:6", "--mach", "0.6:0.95", "--points", "5"],
+        grid(
+            &[(Quantity::BetaDeg, -6.0, 6.0), (Quantity::Mach, 0.6, 0.95)],
+            5,
+        ),
     );
     let first = open(&l.first);
     assert!(first.contains(&"Cl p".to_string()), "{}", shown(&l.first));
@@ -188,7 +251,7 @@ fn weaker_roll_damping_is_named_after_the_planned_release() {
 
 /// Pitch damping changed (issue 36, item 2: on releases of an independent simulator, one
 /// release at Mach 0.95 and the planned one gave a `Cm` flow-angle term with no rivals where the
-/// cause was `Cm q d/2V`). Here from `discover`'s generator, pitch damping at 0.4 of the model's,
+/// cause was `Cm q d/2V`). Here from the tests' own generator, pitch damping at 0.4 of the model's,
 /// on seeds other than the other loops': after the plan's top condition is flown, the cause is
 /// the answer or among the rivals, never missing from what the two releases leave open.
 #[test]
@@ -202,7 +265,10 @@ fn weaker_pitch_damping_is_named_or_open_after_the_planned_release() {
         &model,
         &truth,
         [41, 43],
-        &["--mach", "0.6:1.1", "--alpha-deg", "-2:4", "--points", "4"],
+        grid(
+            &[(Quantity::Mach, 0.6, 1.1), (Quantity::AlphaDeg, -2.0, 4.0)],
+            4,
+        ),
     );
     eprintln!("first: {}", shown(&l.first));
     eprintln!("plan top: {}", l.plan["conditions"][0]);
@@ -269,7 +335,10 @@ fn rates_at_release_are_named_after_the_planned_release() {
         &model,
         &truth,
         [32, 34],
-        &["--beta-deg", "-6:6", "--mach", "0.6:0.95", "--points", "5"],
+        grid(
+            &[(Quantity::BetaDeg, -6.0, 6.0), (Quantity::Mach, 0.6, 0.95)],
+            5,
+        ),
     );
     assert_eq!(open(&l.first)[0], "release_rates", "{}", shown(&l.first));
     let mimic = &l.first["rivals"]
@@ -299,7 +368,7 @@ fn a_gust_is_named_and_its_coefficient_mimics_dropped_after_the_planned_release(
     let dir = tempfile::tempdir().unwrap();
     let dir = dir.path();
     gust_release(dir, PULSE, None, 7, "gust.csv");
-    let first = super::gust::diagnose(dir, &["gust.csv"], "diag");
+    let first = diagnosis_of(dir, &["gust.csv"], "diag");
     let wind = vec![("wind_y".to_string(), "wind".to_string())];
     assert_eq!(terms(&first["model"]), wind, "{}", shown(&first));
     let coefficient_rival = |d: &Value| {
@@ -312,7 +381,10 @@ fn a_gust_is_named_and_its_coefficient_mimics_dropped_after_the_planned_release(
     assert!(coefficient_rival(&first), "{}", shown(&first));
     let plan = plan(
         dir,
-        &["--mach", "0.6:0.95", "--beta-deg", "-6:6", "--points", "5"],
+        &grid(
+            &[(Quantity::Mach, 0.6, 0.95), (Quantity::BetaDeg, -6.0, 6.0)],
+            5,
+        ),
     );
     assert!(
         !plan["conditions"][0]["separates"]
@@ -325,7 +397,7 @@ fn a_gust_is_named_and_its_coefficient_mimics_dropped_after_the_planned_release(
     let next = at_top(&default_scenario(), &plan);
     std::fs::write(dir.join("next.toml"), next.to_toml_string()).unwrap();
     gust_release(dir, PULSE, Some("next.toml"), 8, "next.csv");
-    let both = super::gust::diagnose(dir, &["gust.csv", "next.csv"], "both");
+    let both = diagnosis_of(dir, &["gust.csv", "next.csv"], "both");
     eprintln!(
         "wall_s: first diagnosis {}, plan {}, both {}",
         first["wall_s"], plan["wall_s"], both["wall_s"]
