@@ -7,10 +7,12 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use sepval_common::scenario::Scenario;
+use sepval_common::telemetry::Trajectory;
 use sepval_tests::{REDUCED_BUDGET, ok, refused, sepval};
 use serde_json::{Value, json};
 
-use super::discover::{default_scenario, diagnose, release};
+use super::generator::{default_scenario, release, write};
 
 /// Factors of the base model of these tests (not the default truth).
 const BASE: &str = r#"{"fwdfac": 0.45, "aftfac": 0.65, "xinerfac": 0.98, "yinerfac": 1.03,
@@ -61,9 +63,10 @@ pub(crate) fn with_rivals() -> &'static Path {
     static DAMPING: OnceLock<()> = OnceLock::new();
     let p = fixture();
     DAMPING.get_or_init(|| {
-        // Real rivals: roll damping half the model's, on one release (`rivals`' first case, by
-        // `discover`'s generator): the catalogue's roll_due_to_sideslip and the library's Cl
-        // terms, the true `Cl p` among them, cannot be told apart.
+        // Real rivals: roll damping half the model's, on one release (the first case of
+        // `diagnose/tests/discovery/rivals.rs`, by the tests' own generator): the catalogue's
+        // roll_due_to_sideslip and the library's Cl terms, the true `Cl p` among them, cannot
+        // be told apart.
         let model = default_scenario();
         let mut truth = model.clone();
         truth.aero.cl_p_per_rad = sepval_common::table::DerivativeCoefficient::constant(
@@ -79,6 +82,33 @@ pub(crate) fn with_rivals() -> &'static Path {
         assert_eq!(d["ambiguous"], true, "{}", d["verdict"]);
     });
     p
+}
+
+/// Writes the releases of the tests' generator into `dir` and diagnoses them through the
+/// binary, `sepval diagnose` with the reduced budget (the first `fit` of them fitted, the rest
+/// validated), with `scenario` (the embedded default when `None`); returns the diagnosis,
+/// having checked its page, its figures and its summary: at most 12 lines, none over 160
+/// characters (the rivals' line among them).
+fn diagnose(dir: &Path, releases: &[Trajectory], fit: usize, scenario: Option<&Scenario>) -> Value {
+    let mut args: Vec<String> = vec!["diagnose".into()];
+    for (flag, name) in write(dir, releases, fit, scenario) {
+        args.extend([flag.to_string(), name]);
+    }
+    for a in REDUCED_BUDGET.into_iter().chain(["--out", "diag"]) {
+        args.push(a.into());
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = sepval(&args, dir);
+    ok(&out);
+    let d: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("diag/diagnosis.json")).unwrap()).unwrap();
+    let html = std::fs::read_to_string(dir.join("diag/report.html")).unwrap();
+    assert!(html.contains(d["verdict"].as_str().unwrap().split(',').next().unwrap()));
+    assert!(dir.join("diag/figures/increments.png").exists());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.lines().count() <= 12, "{stdout}");
+    assert!(stdout.lines().all(|l| l.chars().count() <= 160), "{stdout}");
+    d
 }
 
 /// Runs `sepval plan --from FROM --out OUT` with `extra` flags in the fixture, in process;

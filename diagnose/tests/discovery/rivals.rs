@@ -1,12 +1,13 @@
 //! When one release cannot tell causes apart, the diagnosis says so: its `rivals` list every
 //! explanation within the BIC margin of the answer, from the catalogue and from the library,
-//! so that a mimic comes with the cause it mimics. The data come from `discover`'s generator
-//! (a coefficient function or a changed scenario, never the catalogue's or the extension's
-//! code, on a base that is not the default truth, with the generator's own noise).
+//! so that a mimic comes with the cause it mimics. The data come from the tests' own generator
+//! (`support/generator.rs`: a changed scenario, never the catalogue's or the extension's code, on
+//! a base that is not the default truth, with the generator's own noise). Moved from
+//! `sepval/tests/cli/rivals.rs`, each assertion kept.
 
 use serde_json::Value;
 
-use super::discover::{default_scenario, diagnose, release};
+use crate::releases::{default_scenario, diagnose, release};
 
 /// Every explanation the diagnosis leaves open: the answer's and each rival's
 /// (effects, `axis regressor` of each term).
