@@ -3,20 +3,26 @@
 //! CAMP/figures/state-NN.png (each round's map of states, the releases flown by then marked
 //! in the title), CAMP/figures/counts.png (the counts of states against the releases flown)
 //! and CAMP/report.html (the answer first, then the map, the history of the counts per round,
-//! the releases and what is left undecided).
+//! the releases and what is left undecided; the template `templates/campaign.html` in
+//! sepval-report's layout). They are written through [`Written::after_commit`]: each file
+//! atomically, and all of them whatever a signal asks, since they derive from campaign.json,
+//! already committed when they are written.
 
 use std::path::Path;
 
+use serde::Serialize;
+
 use sepval_core::atomic_file::write_atomically;
 use sepval_envelope::row::CSV_HEADER;
-use sepval_report::figures::{MapAxis, RoundCounts, state_counts_figure};
-use sepval_report::html::escape_html;
+use sepval_report::figures::{FigureError, MapAxis, RoundCounts, state_counts_figure};
+use sepval_report::html::{PageTemplate, render_page};
 use sepval_report::words::significant;
+use sepval_report::{OutputError, Written};
 
 use sepval_envelope::Grid;
 
 use crate::CampaignError;
-use crate::record::{CampaignFile, STATUS_FORMAT, StatusFile, record_error, write_json};
+use crate::record::{CampaignFile, STATUS_FORMAT, StatusFile, record_error};
 use crate::state::{Assessed, Counts, State};
 
 /// What the derived files are made of: the campaign's directory, its record and its grid.
@@ -49,8 +55,8 @@ impl View<'_> {
     }
 }
 
-/// Writes an envelope of the campaign as CSV: `sepval envelope`'s columns and `state`.
-pub fn write_envelope_csv(path: &Path, assessed: &[Assessed]) -> Result<(), CampaignError> {
+/// An envelope of the campaign as CSV: `sepval envelope`'s columns and `state`.
+pub fn envelope_csv(assessed: &[Assessed]) -> String {
     let mut s = format!("{CSV_HEADER},state\n");
     for a in assessed {
         s.push_str(&a.row.csv_line());
@@ -58,7 +64,13 @@ pub fn write_envelope_csv(path: &Path, assessed: &[Assessed]) -> Result<(), Camp
         s.push_str(a.state.name());
         s.push('\n');
     }
-    write_atomically(path, s.as_bytes()).map_err(|e| record_error(path, e))
+    s
+}
+
+/// Writes an envelope of the campaign as CSV ([`envelope_csv`]) at `path`, atomically (a
+/// round's, staged before it is committed).
+pub fn write_envelope_csv(path: &Path, assessed: &[Assessed]) -> Result<(), CampaignError> {
+    write_atomically(path, envelope_csv(assessed).as_bytes()).map_err(|e| record_error(path, e))
 }
 
 /// The status of the campaign.
@@ -94,19 +106,20 @@ pub fn headline(c: &CampaignFile) -> String {
     )
 }
 
-/// Writes every derived file.
+/// Writes every derived file, in the order of the module documentation.
 pub fn render(c: &View<'_>) -> Result<(), CampaignError> {
     let current = c.current()?;
-    write_envelope_csv(&c.dir.join("envelope.csv"), &current)?;
-    write_json(&c.dir.join("status.json"), &status(c.file))?;
-    let figures = c.dir.join("figures");
-    std::fs::create_dir_all(&figures).map_err(|e| record_error(&figures, e))?;
+    let mut w = Written::after_commit(c.dir);
+    w.file("envelope.csv", envelope_csv(&current).as_bytes())?;
+    w.json("status.json", &status(c.file))?;
+    let figures = w.figures()?;
     for r in &c.file.rounds {
-        let path = figures.join(format!("state-{:02}.png", r.round));
         let assessed = c.round(&r.dir)?;
-        state_map(c, &assessed, r.round, r.releases_flown, &path)?;
+        let path = figures.join(format!("state-{:02}.png", r.round));
+        w.figure(path, |path| {
+            state_map(c, &assessed, r.round, r.releases_flown, path)
+        })?;
     }
-    let path = figures.join("counts.png");
     let rounds: Vec<RoundCounts> = c
         .file
         .rounds
@@ -116,10 +129,12 @@ pub fn render(c: &View<'_>) -> Result<(), CampaignError> {
             counts: MAP_ORDER.map(|s| r.counts.of_state(s)),
         })
         .collect();
-    state_counts_figure(&path, &rounds, c.grid.len()).map_err(|e| record_error(&path, e))?;
-    let html = page(c, &current);
-    let path = c.dir.join("report.html");
-    write_atomically(&path, html.as_bytes()).map_err(|e| record_error(&path, e))
+    w.figure(figures.join("counts.png"), |path| {
+        state_counts_figure(path, &rounds, c.grid.len())
+    })?;
+    let html = render_page(&CAMPAIGN, &page(c, &current)).map_err(OutputError::from)?;
+    w.file("report.html", html.as_bytes())?;
+    Ok(())
 }
 
 /// The states in the order of `sepval_report`'s state map and counts figure, best to worst:
@@ -139,7 +154,7 @@ fn state_map(
     round: usize,
     flown: usize,
     path: &Path,
-) -> Result<(), CampaignError> {
+) -> Result<(), FigureError> {
     let axes = c.grid.map_axes();
     let one = [c.grid.flight(0).mach];
     let (xq, xv) = axes
@@ -175,76 +190,120 @@ fn state_map(
         &cells,
         &releases,
     )
-    .map_err(|e| record_error(path, e))
 }
 
-/// report.html.
-fn page(c: &View<'_>, current: &[Assessed]) -> String {
-    let e = escape_html;
-    let mut h = String::from(
-        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>sepval campaign</title>\
-         <style>body{font-family:sans-serif;max-width:1100px;margin:2em auto}table{border-collapse:collapse}\
-         td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}img{max-width:100%}</style></head><body>",
-    );
-    h.push_str(&format!("<h1>{}</h1>", e(&headline(c.file))));
-    h.push_str(&format!("<p>{}</p>", e(&c.file.words)));
-    if let Some(r) = c.file.rounds.last() {
-        h.push_str(&format!(
-            "<img src=\"figures/state-{:02}.png\" alt=\"the map of states\">",
-            r.round
-        ));
+/// The page's template.
+const CAMPAIGN: PageTemplate = PageTemplate {
+    name: "campaign.html",
+    source: include_str!("../templates/campaign.html"),
+};
+
+/// What report.html shows, as the template reads it.
+#[derive(Serialize)]
+struct Page {
+    headline: String,
+    words: String,
+    /// The current round's map of states, relative to the page.
+    map: Option<String>,
+    rounds: Vec<RoundView>,
+    releases: Vec<ReleaseView>,
+    /// Each undecided condition and why, in words.
+    undecided: Vec<String>,
+}
+
+#[derive(Serialize)]
+struct RoundView {
+    round: usize,
+    releases_flown: usize,
+    cleared: usize,
+    fails: usize,
+    undecided: usize,
+    /// `yes` or `no`.
+    settled: &'static str,
+}
+
+#[derive(Serialize)]
+struct ReleaseView {
+    file: String,
+    given: String,
+    mach: String,
+    altitude_m: String,
+    alpha_deg: String,
+    check: String,
+}
+
+/// report.html's content.
+fn page(c: &View<'_>, current: &[Assessed]) -> Page {
+    Page {
+        headline: headline(c.file),
+        words: c.file.words.clone(),
+        map: c
+            .file
+            .rounds
+            .last()
+            .map(|r| format!("figures/state-{:02}.png", r.round)),
+        rounds: c
+            .file
+            .rounds
+            .iter()
+            .map(|r| RoundView {
+                round: r.round,
+                releases_flown: r.releases_flown,
+                cleared: r.counts.cleared,
+                fails: r.counts.fails,
+                undecided: r.counts.undecided,
+                settled: if r.settled { "yes" } else { "no" },
+            })
+            .collect(),
+        releases: c
+            .file
+            .releases
+            .iter()
+            .map(|r| ReleaseView {
+                file: r.file.clone(),
+                given: r.given.clone(),
+                mach: number(r.condition.mach),
+                altitude_m: number(r.condition.altitude_m),
+                alpha_deg: number(r.condition.alpha_deg),
+                check: r.check.clone(),
+            })
+            .collect(),
+        undecided: current
+            .iter()
+            .filter(|a| a.state == State::Undecided)
+            .map(undecided_words)
+            .collect(),
     }
-    h.push_str("<h2>Rounds</h2><img src=\"figures/counts.png\" alt=\"the counts of states against the releases flown\"><table><tr><th>round</th><th>releases flown</th><th>cleared</th><th>fails</th><th>undecided</th><th>settled</th></tr>");
-    for r in &c.file.rounds {
-        let k = &r.counts;
-        h.push_str(&format!(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            r.round, r.releases_flown, k.cleared, k.fails, k.undecided, r.settled
-        ));
-    }
-    h.push_str("</table><h2>Releases flown, in order</h2><table><tr><th>file</th><th>given</th><th>Mach</th><th>altitude [m]</th><th>alpha [deg]</th><th>check</th></tr>");
-    for r in &c.file.releases {
-        let k = &r.condition;
-        h.push_str(&format!(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td style=\"text-align:left\">{}</td></tr>",
-            e(&r.file), e(&r.given), number(k.mach), number(k.altitude_m), number(k.alpha_deg), e(&r.check)
-        ));
-    }
-    h.push_str("</table><h2>Undecided, and why</h2>");
-    if c.file.releases.is_empty() {
-        h.push_str(
-            "<p>No release has checked the model yet: nothing is cleared before the first \
-             release, whatever the prior predicts (docs/campaign.md, \"States\").</p>",
-        );
-    }
-    if !current.iter().any(|a| a.state == State::Undecided) {
-        h.push_str("<p>None: every condition is cleared or fails.</p>");
-    }
-    h.push_str("<ul>");
-    for a in current.iter().filter(|a| a.state == State::Undecided) {
-        let k = &a.row.condition;
-        let reach = if a.reach.is_finite() {
-            format!("reach {:.2} beyond what the releases showed", a.reach)
-        } else {
-            "no release flown".to_string()
-        };
-        let share = |part: f64| 100.0 * (part / a.spread_mm).min(1.0);
-        let rivals = if a.rival_spread_mm > 0.0 {
-            format!(
-                " (within which {:.0} % the rivals' disagreement)",
-                share(a.rival_spread_mm)
-            )
-        } else {
-            String::new()
-        };
-        h.push_str(&format!(
-            "<li>Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'{rivals}), {reach}</li>",
-            number(k.mach), number(k.altitude_m), number(k.alpha_deg), a.row.p_fail, a.row.clearance_p50_mm, a.spread_mm,
-            share(a.factor_spread_mm)
-        ));
-    }
-    h.push_str("</ul></body></html>\n");
-    h
+}
+
+/// Why a condition is undecided, in words: its probability of failing, its clearance and
+/// spread (and the factors' and rivals' shares of it), how far it lies beyond the releases.
+fn undecided_words(a: &Assessed) -> String {
+    let k = &a.row.condition;
+    let reach = if a.reach.is_finite() {
+        format!("reach {:.2} beyond what the releases showed", a.reach)
+    } else {
+        "no release flown".to_string()
+    };
+    let share = |part: f64| 100.0 * (part / a.spread_mm).min(1.0);
+    let rivals = if a.rival_spread_mm > 0.0 {
+        format!(
+            " (within which {:.0} % the rivals' disagreement)",
+            share(a.rival_spread_mm)
+        )
+    } else {
+        String::new()
+    };
+    format!(
+        "Mach {}, altitude {} m, alpha {} deg: P(fail) {:.3}, median clearance {:.1} mm (spread {:.1} mm, {:.0} % of it the factors'{rivals}), {reach}",
+        number(k.mach),
+        number(k.altitude_m),
+        number(k.alpha_deg),
+        a.row.p_fail,
+        a.row.clearance_p50_mm,
+        a.spread_mm,
+        share(a.factor_spread_mm)
+    )
 }
 
 /// A number for a reader: six significant digits at most ([`significant`]).

@@ -34,20 +34,6 @@ pub enum OutputError {
 }
 
 impl OutputError {
-    /// Creates `out/name` (and `out`) and returns it (`figures/` is the first step of every
-    /// command that writes figures). The cancellation flag is asked first, so an interrupted
-    /// command leaves no empty directory behind (a run directory that received nothing is
-    /// removed).
-    pub fn subdir(out: &std::path::Path, name: &str) -> Result<PathBuf, OutputError> {
-        OutputError::check_cancel()?;
-        let dir = out.join(name);
-        std::fs::create_dir_all(&dir).map_err(|source| OutputError::Dir {
-            path: dir.clone(),
-            source,
-        })?;
-        Ok(dir)
-    }
-
     /// [`OutputError::Interrupted`] once a signal asked the process to stop (checked before
     /// each file, so an interrupted command stops between files, never inside one).
     pub fn check_cancel() -> Result<(), OutputError> {

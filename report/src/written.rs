@@ -1,7 +1,10 @@
 //! The one way a command writes its directory's files: the cancellation flag asked before each
 //! file (an interrupted command stops between files, never inside one), each file written
 //! atomically (a temporary file renamed into place: never a partial file), and the files
-//! recorded in the order written, for the command to report.
+//! recorded in the order written, for the command to report. Files derived from a record
+//! already committed ([`Written::after_commit`]: a campaign's pages after its campaign.json)
+//! are written to the end whatever a signal asks, since stopping between them would leave pages
+//! that contradict the record; each is still written atomically.
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +19,8 @@ use crate::OutputError;
 pub struct Written {
     out: PathBuf,
     files: Vec<PathBuf>,
+    /// Whether the cancellation flag is asked before each file.
+    cancellable: bool,
 }
 
 impl Written {
@@ -24,6 +29,16 @@ impl Written {
         Written {
             out: out.to_path_buf(),
             files: Vec::new(),
+            cancellable: true,
+        }
+    }
+
+    /// Nothing written yet into `out`, whose files derive from a record already committed:
+    /// the cancellation flag is not asked (see the module documentation).
+    pub fn after_commit(out: &Path) -> Written {
+        Written {
+            cancellable: false,
+            ..Written::into(out)
         }
     }
 
@@ -34,7 +49,22 @@ impl Written {
 
     /// `out/name`, created (the cancellation flag asked first).
     pub fn dir(&self, name: &str) -> Result<PathBuf, OutputError> {
-        OutputError::subdir(&self.out, name)
+        self.check_cancel()?;
+        let dir = self.out.join(name);
+        std::fs::create_dir_all(&dir).map_err(|source| OutputError::Dir {
+            path: dir.clone(),
+            source,
+        })?;
+        Ok(dir)
+    }
+
+    /// [`OutputError::Interrupted`] once a signal asked the process to stop, unless the files
+    /// derive from a committed record.
+    fn check_cancel(&self) -> Result<(), OutputError> {
+        if self.cancellable {
+            OutputError::check_cancel()?;
+        }
+        Ok(())
     }
 
     /// Draws a figure with `draw` at `path` (the figure writes its own file atomically), once
@@ -47,7 +77,7 @@ impl Written {
     where
         OutputError: From<E>,
     {
-        OutputError::check_cancel()?;
+        self.check_cancel()?;
         draw(&path)?;
         self.files.push(path);
         Ok(())
@@ -62,17 +92,31 @@ impl Written {
     where
         OutputError: From<E>,
     {
-        OutputError::check_cancel()?;
+        self.check_cancel()?;
         if let Some(path) = make()? {
             self.files.push(path);
         }
         Ok(())
     }
 
+    /// Records the files `make` wrote (a set of figures drawn together), once the cancellation
+    /// flag is asked.
+    pub fn several<E>(
+        &mut self,
+        make: impl FnOnce() -> Result<Vec<PathBuf>, E>,
+    ) -> Result<(), OutputError>
+    where
+        OutputError: From<E>,
+    {
+        self.check_cancel()?;
+        self.files.extend(make()?);
+        Ok(())
+    }
+
     /// `out/name` (`name` relative to `out`, its directory there already) with `bytes`,
     /// written atomically once the cancellation flag is asked.
     pub fn file(&mut self, name: impl AsRef<Path>, bytes: &[u8]) -> Result<PathBuf, OutputError> {
-        OutputError::check_cancel()?;
+        self.check_cancel()?;
         let path = self.out.join(name);
         write_atomically(&path, bytes).map_err(OutputError::Write)?;
         self.files.push(path.clone());

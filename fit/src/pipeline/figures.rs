@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use sepval_common::evaluation::Job;
 use sepval_common::telemetry::Trajectory;
 use sepval_core::factors::Factor;
+use sepval_report::Written;
 use sepval_report::figures::{
-    Series, Track, convergence_figure, correlation_figure, factor_figure, pareto_figure,
-    trajectory_figures,
+    FigureError, Series, Track, convergence_figure, correlation_figure, factor_figure,
+    pareto_figure, trajectory_figures,
 };
 
 use super::outputs::plot_stride;
@@ -18,34 +19,38 @@ use crate::results::{FitResult, MethodResult};
 
 /// Writes the fit's figures into DIR/figures: the study's Figures 1-6 (trajectories of the
 /// first event against each method's best), Figure 7 (factors beside the truth, when known),
-/// the Pareto fronts and the convergence histories. Returns the files written.
+/// the Pareto fronts and the convergence histories, through [`Written`] (each atomically, the
+/// cancellation flag asked before each). Returns the files written.
 pub fn write_fit_figures(
     dir: &Path,
     job: &Job,
     output: &FitOutput,
 ) -> Result<Vec<PathBuf>, FitError> {
-    let fig_dir = dir.join("figures");
-    std::fs::create_dir_all(&fig_dir).map_err(|source| FitError::Dir {
-        path: fig_dir.clone(),
-        source,
-    })?;
+    let mut w = Written::into(dir);
+    let fig_dir = w.figures()?;
     let r = &output.result;
-    let mut written = write_trajectories(&fig_dir, job, output)?;
-    written.push(write_factors(&fig_dir, job, r)?);
-    written.push(write_fronts(&fig_dir, r)?);
-    written.push(write_convergence(&fig_dir, r)?);
+    w.several(|| write_trajectories(&fig_dir, job, output))?;
+    w.figure(fig_dir.join("fig7_factors.png"), |path| {
+        write_factors(path, job, r)
+    })?;
+    w.figure(fig_dir.join("pareto_front.png"), |path| {
+        write_fronts(path, r)
+    })?;
+    w.figure(fig_dir.join("convergence.png"), |path| {
+        write_convergence(path, r)
+    })?;
     if let Some(id) = &r.identifiability {
         let names: Vec<&str> = id.names.iter().map(String::as_str).collect();
-        let path = fig_dir.join("correlation.png");
-        correlation_figure(
-            &path,
-            &names,
-            &id.correlation,
-            "Correlation of the refined estimates (|rho| > 0.9: compensating)",
-        )?;
-        written.push(path);
+        w.figure(fig_dir.join("correlation.png"), |path| {
+            correlation_figure(
+                path,
+                &names,
+                &id.correlation,
+                "Correlation of the refined estimates (|rho| > 0.9: compensating)",
+            )
+        })?;
     }
-    Ok(written)
+    Ok(w.done())
 }
 
 /// A method's name as the legends write it.
@@ -80,7 +85,7 @@ fn write_trajectories(
     fig_dir: &Path,
     job: &Job,
     output: &FitOutput,
-) -> Result<Vec<PathBuf>, FitError> {
+) -> Result<Vec<PathBuf>, FigureError> {
     let first = &job.events()[0];
     let stride = plot_stride(job);
     let pick = |n: usize| (0..n).step_by(stride);
@@ -116,7 +121,7 @@ fn write_trajectories(
             traj: track(t),
         })
         .collect();
-    Ok(trajectory_figures(fig_dir, track(&data), &series)?)
+    trajectory_figures(fig_dir, track(&data), &series)
 }
 
 /// A trajectory as the figures draw it.
@@ -129,7 +134,7 @@ fn track(t: &Trajectory) -> Track<'_> {
 }
 
 /// Figure 7: each method's factors beside the truth, when known.
-fn write_factors(fig_dir: &Path, job: &Job, r: &FitResult) -> Result<PathBuf, FitError> {
+fn write_factors(path: &Path, job: &Job, r: &FitResult) -> Result<(), FigureError> {
     let ranges: Vec<(f64, f64)> = job
         .factor_table()
         .0
@@ -138,43 +143,37 @@ fn write_factors(fig_dir: &Path, job: &Job, r: &FitResult) -> Result<PathBuf, Fi
         .collect();
     let values = per_method(r, |v| v.best.factors.0.to_vec());
     let truth = r.truth.map(|t| t.0.to_vec());
-    let path = fig_dir.join("fig7_factors.png");
     factor_figure(
-        &path,
+        path,
         &Factor::NAMES,
         &ranges,
         &borrowed(&values),
         truth.as_deref(),
-    )?;
-    Ok(path)
+    )
 }
 
 /// Each method's Pareto front, with the noise levels.
-fn write_fronts(fig_dir: &Path, r: &FitResult) -> Result<PathBuf, FitError> {
+fn write_fronts(path: &Path, r: &FitResult) -> Result<(), FigureError> {
     let fronts = per_method(r, |v| {
         v.pareto_front
             .iter()
             .map(|p| [p.j_pos_m, p.j_att_deg])
             .collect()
     });
-    let path = fig_dir.join("pareto_front.png");
     pareto_figure(
-        &path,
+        path,
         &borrowed(&fronts),
         Some((r.sigma_pos_m, r.sigma_att_deg)),
-    )?;
-    Ok(path)
+    )
 }
 
 /// Each method's best weighted goal against its simulations.
-fn write_convergence(fig_dir: &Path, r: &FitResult) -> Result<PathBuf, FitError> {
+fn write_convergence(path: &Path, r: &FitResult) -> Result<(), FigureError> {
     let histories = per_method(r, |v| {
         v.history
             .iter()
             .map(|h| (h.best.evaluations, h.best.best_weighted))
             .collect()
     });
-    let path = fig_dir.join("convergence.png");
-    convergence_figure(&path, &borrowed(&histories), Some(2.0))?;
-    Ok(path)
+    convergence_figure(path, &borrowed(&histories), Some(2.0))
 }

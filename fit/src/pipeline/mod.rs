@@ -137,6 +137,10 @@ pub enum FitError {
     /// A figure that cannot be drawn.
     #[error(transparent)]
     Figure(#[from] FigureError),
+    /// The figures' directory or a figure in it (or a signal asked the process to stop
+    /// between them).
+    #[error(transparent)]
+    Outputs(#[from] sepval_report::OutputError),
     /// The hill climber's start does not simulate (why: its divergence or failure).
     #[error(
         "the hill climber's start, the nominal factors (clamped to their bounds), does not \

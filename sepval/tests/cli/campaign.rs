@@ -68,6 +68,32 @@ fn init_on(
     ok(&sepval(&args, dir));
 }
 
+/// The campaign's derived files agree with its records: report.html says status.json's counts
+/// and names every release flown, and every round has its map.
+fn pages_agree(camp: &Path) {
+    let file = json(&camp.join("campaign.json"));
+    let status = json(&camp.join("status.json"));
+    let html = std::fs::read_to_string(camp.join("report.html")).unwrap();
+    let counts = format!(
+        "cleared {} of {} conditions, {} fail, {} undecided",
+        status["cleared"], status["conditions"], status["fails"], status["undecided"]
+    );
+    assert!(html.contains(&counts), "{counts} not in {html}");
+    let releases = file["releases"].as_array().unwrap();
+    assert_eq!(status["releases_flown"], releases.len());
+    for r in releases {
+        assert!(html.contains(r["file"].as_str().unwrap()), "{r}");
+    }
+    if releases.is_empty() {
+        assert!(html.contains("No release has checked the model yet"));
+    }
+    for r in file["rounds"].as_array().unwrap() {
+        let map = format!("figures/state-{:02}.png", r["round"].as_u64().unwrap());
+        assert!(camp.join(&map).is_file(), "{map}");
+    }
+    assert!(camp.join("figures/counts.png").is_file());
+}
+
 fn json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -79,6 +105,7 @@ fn next_plans_only_safe_distinct_conditions_and_says_when_none_is_safe() {
     init(dir, "c", "108", "2");
     let env = std::fs::read_to_string(dir.join("c/envelope.csv")).unwrap();
     assert!(env.lines().next().unwrap().ends_with(",state"), "{env}");
+    pages_agree(&dir.join("c"));
     ok(&sepval(&["campaign", "next", "c", "--count", "3"], dir));
     let next = json(&dir.join("c/next.json"));
     assert_eq!(next["format"], "sepval-campaign-next/1");
@@ -303,6 +330,7 @@ fn rehearse(dir: &Path, out: &str, criterion: &str, extra: &[&str]) -> Value {
 fn a_rehearsal_of_a_null_truth_settles_with_no_false_clear_or_fail() {
     let tmp = tempfile::tempdir().unwrap();
     let r = rehearse(tmp.path(), "null", "25.4", &[]);
+    pages_agree(&tmp.path().join("null"));
     assert_eq!(r["format"], "sepval-campaign-rehearsal/1");
     assert_eq!(r["settled"], true, "{r}");
     for round in r["rounds"].as_array().unwrap() {
