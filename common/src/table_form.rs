@@ -18,7 +18,9 @@
 //!   the exponential by at most 0.01^2 / (8 lambda^2) = 3.5e-5 of dC0 there (the trajectory
 //!   difference this makes is measured by the test `default_as_tables_*`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use sepval_core::atomic_file::write_atomically;
 
 use crate::model::InterferenceDecay;
 use crate::scenario::Scenario;
@@ -239,4 +241,86 @@ pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, 
         }
     }
     Ok(TableForm { scenario: s, files })
+}
+
+/// Why a scenario in table form could not be written into its directory. Nothing was written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum TableDirError {
+    /// The directory exists.
+    #[error("{}: exists; choose a new directory (nothing was written)", .0.display())]
+    Exists(PathBuf),
+    /// A file or directory that cannot be made.
+    #[error("cannot write {}", path.display())]
+    Io {
+        /// Where.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file that cannot be written.
+    #[error(transparent)]
+    Write(#[from] sepval_core::atomic_file::WriteError),
+    /// What was written does not read back (a defect: what sepval writes it must read).
+    #[error("the scenario written as tables does not read back (a defect; nothing was written)")]
+    ReadBack(#[source] crate::scenario::ScenarioError),
+    /// What was written reads back as another scenario (a defect).
+    #[error(
+        "{}: the scenario written does not read back as it was (a defect; nothing was written)",
+        .0.display()
+    )]
+    Differs(PathBuf),
+}
+
+impl TableForm {
+    /// Writes the form into the new directory `dir` (refused if anything is there already):
+    /// `dir/scenario.toml` (the scenario, after `header`, a comment ending in a newline) and
+    /// each table file, staged in a temporary directory beside `dir`, read back (and, with
+    /// `expected`, compared with it), then renamed into place, so that a refusal or a failure
+    /// leaves nothing (no partial file, no partial directory).
+    pub fn write_new_dir(
+        &self,
+        dir: &Path,
+        header: &str,
+        expected: Option<&Scenario>,
+    ) -> Result<(), TableDirError> {
+        if dir.exists() {
+            return Err(TableDirError::Exists(dir.to_path_buf()));
+        }
+        let parent = match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| TableDirError::Io { path, source }
+        };
+        let stage = tempfile::Builder::new()
+            .prefix(".sepval-tmp-")
+            .tempdir_in(parent)
+            .map_err(io(dir))?;
+        for (p, text) in &self.files {
+            let path = stage.path().join(p);
+            if let Some(d) = path.parent() {
+                std::fs::create_dir_all(d).map_err(io(d))?;
+            }
+            write_atomically(&path, text.as_bytes())?;
+        }
+        let toml = stage.path().join("scenario.toml");
+        let text = format!("{header}{}", self.scenario.to_toml_string());
+        write_atomically(&toml, text.as_bytes())?;
+        let back = Scenario::load(&toml).map_err(TableDirError::ReadBack)?;
+        if expected.is_some_and(|s| &back != s) {
+            return Err(TableDirError::Differs(dir.to_path_buf()));
+        }
+        let staged = stage.keep();
+        std::fs::rename(&staged, dir).map_err(|e| {
+            let _ = std::fs::remove_dir_all(&staged);
+            TableDirError::Io {
+                path: dir.to_path_buf(),
+                source: e,
+            }
+        })
+    }
 }

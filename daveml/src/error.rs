@@ -104,6 +104,9 @@ pub enum DavemlError {
     /// Writing failed.
     #[error(transparent)]
     Write(#[from] sepval_core::atomic_file::WriteError),
+    /// The scenario in table form could not be written into its directory.
+    #[error(transparent)]
+    Tables(#[from] sepval_common::table_form::TableDirError),
     /// Writing a staged directory failed.
     #[error("cannot write {path}")]
     Io {

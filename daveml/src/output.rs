@@ -1,7 +1,8 @@
 //! Stage 5, **write**: the imported scenario as a directory in table form (`scenario.toml` and
 //! `tables/*.csv`, docs/model.md section 1 "Tables"), staged in a temporary directory beside
-//! the target, read back and compared, then renamed into place: a refusal or a failure leaves
-//! nothing (no partial file, no partial directory).
+//! the target, read back and compared, then renamed into place by
+//! [`TableForm::write_new_dir`]: a refusal or a failure leaves nothing (no partial file, no
+//! partial directory).
 
 use std::path::{Path, PathBuf};
 
@@ -9,7 +10,6 @@ use sepval_common::correction::Target;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{Coefficient, Kind, TableFile, write_csv};
 use sepval_common::table_form::TableForm;
-use sepval_core::atomic_file::write_atomically;
 
 use crate::assemble::{field, set_field};
 use crate::error::DavemlError;
@@ -48,55 +48,14 @@ pub fn table_dir(s: &Scenario) -> TableForm {
     TableForm { scenario, files }
 }
 
-/// Writes `s` in table form into the new directory `dir` (refused if it exists), with a header
-/// naming `source`; the directory appears only once complete and read back equal to `s`.
+/// Writes `s` in table form into the new directory `dir` (refused if it exists and is not
+/// empty), with a header naming `source`; the directory appears only once complete and read
+/// back equal to `s` ([`TableForm::write_new_dir`]).
 pub fn write_table_dir(s: &Scenario, dir: &Path, source: &str) -> Result<TableForm, DavemlError> {
     let form = table_dir(s);
-    if dir.exists() {
-        return Err(DavemlError::Output {
-            path: dir.to_path_buf(),
-            message: "exists; choose a new directory (nothing was written)".to_string(),
-        });
-    }
-    let parent = match dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| DavemlError::Io { path, source }
-    };
-    let stage = tempfile::Builder::new()
-        .prefix(".sepval-tmp-")
-        .tempdir_in(parent)
-        .map_err(io(dir))?;
-    std::fs::create_dir(stage.path().join("tables")).map_err(io(dir))?;
-    for (p, text) in &form.files {
-        write_atomically(&stage.path().join(p), text.as_bytes())?;
-    }
-    let toml = format!(
-        "# sepval scenario (SI units, angles in degrees) imported from the DAVE-ML model {source}\n# (docs/daveml.md); docs/model.md section 1 describes each field, CSV files are relative to this file.\n{}",
-        form.scenario.to_toml_string()
+    let header = format!(
+        "# sepval scenario (SI units, angles in degrees) imported from the DAVE-ML model {source}\n# (docs/daveml.md); docs/model.md section 1 describes each field, CSV files are relative to this file.\n"
     );
-    let staged_toml = stage.path().join("scenario.toml");
-    write_atomically(&staged_toml, toml.as_bytes())?;
-    let back = Scenario::load(&staged_toml).map_err(|source| DavemlError::Scenario {
-        file: staged_toml.display().to_string(),
-        source,
-    })?;
-    if &back != s {
-        return Err(DavemlError::Output {
-            path: dir.to_path_buf(),
-            message: "the scenario written does not read back as imported (a defect; nothing was written)".to_string(),
-        });
-    }
-    let staged = stage.keep();
-    std::fs::rename(&staged, dir).map_err(|e| {
-        let _ = std::fs::remove_dir_all(&staged);
-        DavemlError::Io {
-            path: dir.to_path_buf(),
-            source: e,
-        }
-    })?;
+    form.write_new_dir(dir, &header, Some(s))?;
     Ok(form)
 }

@@ -168,6 +168,7 @@ mod restart;
 mod rivals;
 mod stage_clock;
 mod stepwise;
+mod summary;
 mod tables;
 mod validation;
 mod verdict;
@@ -186,6 +187,7 @@ pub use residuals::{
 };
 pub use restart::RESTART_BIC;
 pub use rivals::rival_name;
+pub use summary::summary;
 pub use validation::{AlternativePrediction, ValidationReport};
 pub use verdict::fmt_discovered;
 

@@ -332,3 +332,47 @@ fn rms_of(sums: [f64; 6], n: usize) -> ChannelRms {
         yaw_deg: v[5],
     }
 }
+
+impl FitResult {
+    /// The tables the best fit left, one line per event and table.
+    pub fn tables_left(&self) -> Vec<String> {
+        self.events
+            .iter()
+            .flat_map(|e| {
+                e.tables_left
+                    .iter()
+                    .map(move |x| format!("{}: {x}", e.name))
+            })
+            .collect()
+    }
+
+    /// The terminal summary: the releases and the noise levels, then one line per method (its
+    /// best J_pos, J_att and weighted goal, simulations and wall time).
+    pub fn summary(&self) -> String {
+        let names: Vec<&str> = self.events.iter().map(|e| e.name.as_str()).collect();
+        let mut s = format!(
+            "fit of {} ({} samples), sigma_pos {:.4} m, sigma_att {:.4} deg ({})\n",
+            names.join(", "),
+            self.events.iter().map(|e| e.samples).sum::<usize>(),
+            self.sigma_pos_m,
+            self.sigma_att_deg,
+            self.sigma_source
+        );
+        s.push_str(&format!(
+            "{:<6} {:>12} {:>12} {:>10} {:>12} {:>9}\n",
+            "method", "J_pos [m]", "J_att [deg]", "weighted", "simulations", "wall [s]"
+        ));
+        for (name, m) in &self.methods {
+            s.push_str(&format!(
+                "{:<6} {:>12.6} {:>12.5} {:>10.3} {:>12} {:>9.1}\n",
+                name,
+                m.best.j_pos_m,
+                m.best.j_att_deg,
+                m.best.weighted,
+                m.best.evaluations,
+                m.best.wall_s
+            ));
+        }
+        s
+    }
+}

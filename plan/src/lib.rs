@@ -31,6 +31,7 @@ pub mod record;
 pub mod refit;
 pub mod separation;
 pub mod simulate;
+mod summary;
 pub mod tables;
 
 use std::path::{Path, PathBuf};
@@ -45,6 +46,7 @@ pub use models::Models;
 pub use outputs::write_outputs;
 pub use ranking::Ranking;
 pub use record::{PLAN_FORMAT, PlanFile, plan_file};
+pub use summary::summary;
 
 /// A plan that cannot be made.
 #[derive(Debug, thiserror::Error)]

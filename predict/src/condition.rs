@@ -6,7 +6,11 @@
 //! least [`min_samples`] of the level (20 / (1 - level)), at most [`MAX_SAMPLES`], and their
 //! trajectories at the band's points fit [`MAX_VALUE_BYTES`].
 
+use std::path::Path;
+
 use sepval_common::scenario::{Scenario, StoreDifference};
+use sepval_common::telemetry::outliers::Policy;
+use sepval_fit::inputs;
 use sepval_core::number_text::Shown;
 
 /// The most samples of one prediction.
@@ -57,6 +61,81 @@ pub enum ConditionError {
         /// The fitted scenario's name.
         fitted: String,
     },
+}
+
+/// A flown release (`--data`) that cannot be checked against a prediction.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FlownError {
+    /// The flown release (`--data`) that cannot be read.
+    #[error("--data {name}")]
+    Read {
+        /// Its file.
+        name: String,
+        /// Why.
+        #[source]
+        source: Box<sepval_fit::inputs::InputError>,
+    },
+    /// Its metadata that does not read, or its store that is not the condition's (the error
+    /// names the file).
+    #[error(transparent)]
+    Release(Box<sepval_fit::inputs::InputError>),
+    /// The flown release's metadata names another condition than the prediction's.
+    #[error(
+        "--data {name}: its metadata says it was flown at {flown}, not at the condition of --scenario ({condition})"
+    )]
+    Elsewhere {
+        /// Its file.
+        name: String,
+        /// The condition its metadata names, in words.
+        flown: String,
+        /// The prediction's condition, in words.
+        condition: String,
+    },
+}
+
+/// A flight condition in the words of [`FlownError::Elsewhere`].
+fn condition_words(f: &sepval_common::scenario::Flight) -> String {
+    format!(
+        "Mach {}, altitude {} m, alpha {} deg, beta {} deg, gamma {} deg",
+        f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg
+    )
+}
+
+impl crate::Flown {
+    /// The flown release at `path` (`--data`), read with `policy` (what the screening left
+    /// out told to `tell`), of the store of `condition` (the scenario `scenario_name`), and, when
+    /// its metadata names one, flown at `condition`'s flight condition (to 1e-9 relative).
+    pub fn read(
+        path: &Path,
+        (scenario_name, condition): (&str, &Scenario),
+        policy: Policy,
+        tell: sepval_fit::inputs::Tell,
+    ) -> Result<crate::Flown, FlownError> {
+        let name = path.display().to_string();
+        let data = inputs::read(path, policy, tell).map_err(|source| FlownError::Read {
+            name: name.clone(),
+            source: Box::new(source),
+        })?;
+        let release = |e| FlownError::Release(Box::new(e));
+        let named = inputs::event_scenario(condition, &data, &name).map_err(release)?;
+        inputs::check_store(condition, &data, &name, scenario_name).map_err(release)?;
+        let (a, b) = (&named.flight, &condition.flight);
+        let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + x.abs().max(y.abs()));
+        if !(same(a.mach, b.mach)
+            && same(a.altitude_m, b.altitude_m)
+            && same(a.alpha_deg, b.alpha_deg)
+            && same(a.beta_deg, b.beta_deg)
+            && same(a.gamma_deg, b.gamma_deg))
+        {
+            return Err(FlownError::Elsewhere {
+                name,
+                flown: condition_words(a),
+                condition: condition_words(b),
+            });
+        }
+        Ok(crate::Flown { name, data })
+    }
 }
 
 /// How a prediction is made.

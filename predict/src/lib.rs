@@ -42,6 +42,7 @@ pub mod releases;
 pub mod sampling;
 pub mod simulate;
 pub mod source;
+mod summary;
 
 use sepval_common::evaluation::{Evaluator, Event, Job};
 use sepval_common::scenario::Scenario;
@@ -51,12 +52,13 @@ use sepval_solve::run::ProgressObserver;
 pub use bands::{Bands, ChannelBand, Shares};
 pub use check::Check;
 pub use clearance::{ClearanceSettings, ClearanceStats};
-pub use condition::{ConditionError, Settings, check_condition};
+pub use condition::{ConditionError, FlownError, Settings, check_condition};
 pub use discrepancy::Discrepancy;
 pub use ensemble::Ensemble;
 pub use outputs::write_outputs;
 pub use record::{PREDICTION_FORMAT, PredictionFile, prediction_file};
 pub use sampling::Sampler;
+pub use summary::summary;
 pub use source::{
     Source, SourceError, SourceInputs, SourceInputsError, SourceKind, read_source, source_inputs,
 };

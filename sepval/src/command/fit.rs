@@ -63,7 +63,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     render(&args, evaluator.job(), &output)?;
     drop(run_dir);
     // Tables left by the best fit: reported, or an error with --strict-tables.
-    let left = tables_left(&output);
+    let left = output.result.tables_left();
     if args.tables.strict_tables && !left.is_empty() {
         anyhow::bail!(
             "--strict-tables: the best fit {} (result.json records it)",
@@ -238,62 +238,12 @@ fn best_clearance(
 
 /// The summary on stdout, the figures (unless --no-figures), and where the result is.
 fn render(args: &FitArgs, job: &Job, output: &FitOutput) -> Result<()> {
-    print_summary(output);
+    crate::front::out(&output.result.summary());
     if !args.no_figures {
         figures(&args.out, job, output)?;
     }
     say!("results in {}", args.out.join("result.json").display());
     Ok(())
-}
-
-/// The tables the best fit left, one line per event and table.
-fn tables_left(output: &FitOutput) -> Vec<String> {
-    output
-        .result
-        .events
-        .iter()
-        .flat_map(|e| {
-            e.tables_left
-                .iter()
-                .map(move |x| format!("{}: {x}", e.name))
-        })
-        .collect()
-}
-
-fn print_summary(output: &FitOutput) {
-    let r = &output.result;
-    say!(
-        "fit of {} ({} samples), sigma_pos {:.4} m, sigma_att {:.4} deg ({})",
-        r.events
-            .iter()
-            .map(|e| e.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", "),
-        r.events.iter().map(|e| e.samples).sum::<usize>(),
-        r.sigma_pos_m,
-        r.sigma_att_deg,
-        r.sigma_source
-    );
-    say!(
-        "{:<6} {:>12} {:>12} {:>10} {:>12} {:>9}",
-        "method",
-        "J_pos [m]",
-        "J_att [deg]",
-        "weighted",
-        "simulations",
-        "wall [s]"
-    );
-    for (name, m) in &r.methods {
-        say!(
-            "{:<6} {:>12.6} {:>12.5} {:>10.3} {:>12} {:>9.1}",
-            name,
-            m.best.j_pos_m,
-            m.best.j_att_deg,
-            m.best.weighted,
-            m.best.evaluations,
-            m.best.wall_s
-        );
-    }
 }
 
 fn figures(dir: &std::path::Path, job: &Job, output: &FitOutput) -> Result<()> {

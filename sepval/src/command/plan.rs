@@ -1,12 +1,11 @@
 //! `sepval plan`: the next release to fly, from a diagnosis.
 
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use sepval_fit::out_dir::Request;
-use sepval_plan::{PlanFile, Range, plan, plan_file, prepare, read_diagnosis, write_outputs};
+use sepval_plan::{Range, plan, plan_file, prepare, read_diagnosis, write_outputs};
 
 use super::{evaluator_spec, notices, tell};
 use crate::cli::PlanArgs;
@@ -55,7 +54,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
     // Cleared (--overwrite) only now: a run stopped while it computed leaves the earlier one.
     run_dir.prepare()?;
     write_outputs(&prepared, &found, &file, &args.out)?;
-    crate::front::out(&summary_lines(&file, &args.out));
+    crate::front::out(&sepval_plan::summary(&file, &args.out));
     drop(run_dir);
     Ok(())
 }
@@ -73,41 +72,4 @@ fn ranges(args: &PlanArgs) -> Vec<Range> {
     .flatten()
     .cloned()
     .collect()
-}
-
-/// The terminal summary: a few short lines.
-fn summary_lines(file: &PlanFile, out: &Path) -> String {
-    let mut s = String::new();
-    match file.conditions.first() {
-        Some(c) => {
-            s.push_str(&format!(
-                "recommend: Mach {}, altitude {} m, alpha {} deg, beta {} deg, gamma {} deg\n",
-                c.mach, c.altitude_m, c.alpha_deg, c.beta_deg, c.gamma_deg
-            ));
-            if file.ranked_by == "separation" {
-                s.push_str(&format!(
-                    "separates: {} of {} pair(s) (separation {:.1}, threshold {})\n",
-                    c.separates.len(),
-                    c.pairs.len(),
-                    c.separation.unwrap_or(f64::NAN),
-                    file.threshold
-                ));
-            } else {
-                s.push_str("rivals:    none: planned for information alone\n");
-            }
-            s.push_str(&format!(
-                "gain:      {:.3} in ln det of the answer's information\n",
-                c.information_gain.unwrap_or(f64::NAN)
-            ));
-        }
-        None => s.push_str("recommend: nothing (no condition)\n"),
-    }
-    s.push_str(&format!(
-        "plan:      {} conditions, {} simulations, {:.1} s\n",
-        file.conditions.len(),
-        file.evaluations,
-        file.wall_s
-    ));
-    s.push_str(&format!("report:    {}\n", out.join("plan.html").display()));
-    s
 }

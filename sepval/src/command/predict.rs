@@ -1,15 +1,14 @@
 //! `sepval predict`: a release not flown, with its bands, from a fit or a diagnosis; with
 //! `--data`, the post-flight check of a flown release against them.
 
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use sepval_fit::inputs;
 use sepval_fit::out_dir::Request;
 use sepval_predict::{
-    Flown, PredictionFile, Settings, SourceInputs, predict, prediction_file, prepare,
+    Flown, Settings, SourceInputs, predict, prediction_file, prepare,
     source_inputs, write_outputs,
 };
 
@@ -54,7 +53,11 @@ pub fn run(args: PredictArgs) -> Result<()> {
     sepval_predict::check_condition(fitted.events()[0].simulator.scenario(), &condition)
         .with_context(|| format!("--scenario {}", args.scenario.display()))?;
     let flown = match &args.data {
-        Some(path) => Some(flown(path, (args.scenario.as_path(), &condition), policy)?),
+        Some(path) => {
+            let scenario_name = format!("--scenario {}", args.scenario.display());
+            let at = (scenario_name.as_str(), &condition);
+            Some(Flown::read(path, at, policy, &mut tell())?)
+        }
         None => None,
     };
     let clearance = clearance::settings(&args.geometry, &condition)?;
@@ -84,94 +87,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
     // Cleared (--overwrite) only now: a run stopped while it computed leaves the earlier one.
     run_dir.prepare()?;
     write_outputs(&found, &file, &args.out)?;
-    crate::front::out(&summary_lines(&file, &args.out));
+    crate::front::out(&sepval_predict::summary(&file, &args.out));
     drop(run_dir);
     Ok(())
-}
-
-/// The flown release of `--data`, whose metadata (when it names one) must give the condition
-/// of `--scenario`.
-fn flown(
-    path: &Path,
-    (scenario_path, condition): (&Path, &sepval_common::scenario::Scenario),
-    policy: sepval_common::telemetry::outliers::Policy,
-) -> Result<Flown> {
-    let name = path.display().to_string();
-    let data = inputs::read(path, policy, &mut tell()).with_context(|| format!("--data {name}"))?;
-    let named = inputs::event_scenario(condition, &data, &name)?;
-    let scenario_name = format!("--scenario {}", scenario_path.display());
-    inputs::check_store(condition, &data, &name, &scenario_name)?;
-    let (a, b) = (&named.flight, &condition.flight);
-    let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + x.abs().max(y.abs()));
-    if !(same(a.mach, b.mach)
-        && same(a.altitude_m, b.altitude_m)
-        && same(a.alpha_deg, b.alpha_deg)
-        && same(a.beta_deg, b.beta_deg)
-        && same(a.gamma_deg, b.gamma_deg))
-    {
-        bail!(
-            "--data {name}: its metadata says it was flown at Mach {}, altitude {} m, alpha {} deg, beta {} deg, gamma {} deg, not at the condition of --scenario (Mach {}, altitude {} m, alpha {} deg, beta {} deg, gamma {} deg)",
-            a.mach,
-            a.altitude_m,
-            a.alpha_deg,
-            a.beta_deg,
-            a.gamma_deg,
-            b.mach,
-            b.altitude_m,
-            b.alpha_deg,
-            b.beta_deg,
-            b.gamma_deg
-        );
-    }
-    Ok(Flown { name, data })
-}
-
-/// The terminal summary: a few short lines.
-fn summary_lines(file: &PredictionFile, out: &Path) -> String {
-    let k = file.t_s.len().saturating_sub(1);
-    let ch = file.channels();
-    let mut s = file
-        .extrapolation
-        .as_ref()
-        .map_or(String::new(), |w| format!("warning:   {w}\n"));
-    s.push_str(&format!(
-        "predict:   t = {:.3} s: x {:.3} m [{:.3}, {:.3}], z {:.3} m [{:.3}, {:.3}], pitch {:.2} deg [{:.2}, {:.2}] ({:.0} % bands)\n",
-        file.t_s.get(k).copied().unwrap_or(f64::NAN),
-        ch[0].mid[k],
-        ch[0].lo[k],
-        ch[0].hi[k],
-        ch[2].mid[k],
-        ch[2].lo[k],
-        ch[2].hi[k],
-        ch[4].mid[k],
-        ch[4].lo[k],
-        ch[4].hi[k],
-        100.0 * file.level
-    ));
-    let src = &file.sources;
-    s.push_str(&format!(
-        "sources:   factors {:.0} %, model form {:.0} %, measurement {:.0} % (most: {})\n",
-        100.0 * src.factors.share,
-        100.0 * src.model_form.share,
-        100.0 * src.measurement.share,
-        src.dominant.replace('_', " ")
-    ));
-    if let Some(c) = &file.check {
-        s.push_str(&format!("check:     {}\n", c.verdict));
-    }
-    if let Some(c) = &file.clearance {
-        s.push_str(&format!(
-            "clearance: {}\n",
-            sepval_predict::clearance::words(c)
-        ));
-    }
-    s.push_str(&format!(
-        "samples:   {} ({} ran), {} simulations, {:.1} s\n",
-        file.samples, file.samples_used, file.evaluations, file.wall_s
-    ));
-    s.push_str(&format!(
-        "report:    {}\n",
-        out.join("report.html").display()
-    ));
-    s
 }

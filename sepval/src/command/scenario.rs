@@ -3,7 +3,7 @@
 //! `--from-daveml` and `--to-daveml` read and write the store's aerodynamics as DAVE-ML
 //! (docs/daveml.md, the crate `sepval_daveml`).
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use sepval_common::scenario::Scenario;
 use sepval_core::atomic_file::write_atomically;
 use sepval_fit::inputs;
@@ -42,37 +42,12 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
         .map_err(anyhow::Error::msg)
         .context("--tables")?;
     let dir = &args.out;
-    let toml_path = dir.join("scenario.toml");
-    if dir.exists() && !dir.is_dir() {
-        bail!(
-            "--out {} with --tables: expected a directory",
-            dir.display()
-        );
-    }
-    for p in std::iter::once(toml_path.clone()).chain(form.files.iter().map(|(p, _)| dir.join(p))) {
-        if p.exists() {
-            bail!(
-                "--out {}: {} exists; choose a new directory (nothing was written)",
-                dir.display(),
-                p.display()
-            );
-        }
-    }
-    for (p, text) in &form.files {
-        let path = dir.join(p);
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent)
-                .with_context(|| format!("cannot create {}", parent.display()))?;
-        }
-        write_atomically(&path, text.as_bytes())?;
-    }
-    let text = format!(
-        "{HEADER}# Tables: docs/model.md section 1 (\"Tables\"); CSV files are relative to this file.\n{}",
-        form.scenario.to_toml_string()
+    let header = format!(
+        "{HEADER}# Tables: docs/model.md section 1 (\"Tables\"); CSV files are relative to this file.\n"
     );
-    write_atomically(&toml_path, text.as_bytes())?;
-    // What was written reads back.
-    Scenario::load(&toml_path).context("the scenario written as tables does not read back")?;
+    form.write_new_dir(dir, &header, None)
+        .with_context(|| format!("--out {}", dir.display()))?;
+    let toml_path = dir.join("scenario.toml");
     note!(
         "wrote {} and {} table files in {}",
         toml_path.display(),

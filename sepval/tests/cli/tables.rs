@@ -28,6 +28,13 @@ fn scenario_tables_writes_a_starting_point_that_simulates_as_the_default() {
         &sepval(&["scenario", "--tables", "--out", "mine"], d),
         "exists; choose a new directory (nothing was written)",
     );
+    // Nor into an empty directory that exists: the tables appear only as a whole new one.
+    std::fs::create_dir(d.join("empty")).unwrap();
+    refused(
+        &sepval(&["scenario", "--tables", "--out", "empty"], d),
+        "exists; choose a new directory (nothing was written)",
+    );
+    assert_eq!(std::fs::read_dir(d.join("empty")).unwrap().count(), 0);
     ok(&sepval(
         &[
             "scenario",
