@@ -18,7 +18,8 @@ use std::collections::BTreeSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Outcome};
+use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job, Outcome};
+use sepval_common::telemetry::outliers::Policy;
 
 use crate::checkpoint::{Checkpoint, CheckpointError};
 use crate::problem::factors_of;
@@ -213,6 +214,27 @@ pub enum RerunError {
         /// Why.
         message: String,
     },
+    /// The inputs of the rerun (its releases, scenario or extension) that cannot be read.
+    #[error(transparent)]
+    Inputs(#[from] crate::inputs::InputError),
+    /// The extension given is not the one the checkpoint was made with (the releases and the
+    /// scenario are).
+    #[error(
+        "checkpoint {} was made with another extension: --extension {} is not {}; give that extension file, or leave --extension out to use the recorded one",
+        path.display(), given.display(),
+        recorded.as_ref().map_or(
+            "none (the checkpoint was made without an extension)".into(),
+            |p| format!("the one it was made with ({})", p.display())
+        )
+    )]
+    OtherExtension {
+        /// The checkpoint.
+        path: PathBuf,
+        /// `--extension`.
+        given: PathBuf,
+        /// The extension it records.
+        recorded: Option<PathBuf>,
+    },
     /// The checkpoint does not reproduce ([`confirm`]).
     #[error("checkpoint {path} does not reproduce: {failures}")]
     NotReproduced {
@@ -221,6 +243,46 @@ pub enum RerunError {
         /// [`Report::failures`].
         failures: String,
     },
+}
+
+/// The job of a rerun of `checkpoint` (at `path`): each input given (`given`, `outliers`) or,
+/// where not given, the one the checkpoint records, independently of the others; checked to be
+/// the checkpoint's job (when only the extension given differs from the recorded one, the
+/// error says so rather than "another scenario").
+pub fn job(
+    checkpoint: &Checkpoint,
+    path: &Path,
+    given: &crate::resume::InputPaths,
+    outliers: Option<Policy>,
+    tell: crate::inputs::Tell,
+) -> Result<Job, RerunError> {
+    let recorded = &checkpoint.inputs;
+    let data = if given.data.is_empty() {
+        &recorded.data
+    } else {
+        &given.data
+    };
+    let scenario = given.scenario.as_deref().or(recorded.scenario.as_deref());
+    let extension = given.extension.as_deref().or(recorded.extension.as_deref());
+    let policy = outliers.unwrap_or(recorded.outliers);
+    let (job, _) = crate::inputs::job(data, scenario, extension, policy, tell)?;
+    let Err(e) = checkpoint.check_job(&job, path) else {
+        return Ok(job);
+    };
+    if let (Some(x), CheckpointError::OtherJob { .. }) = (&given.extension, &e) {
+        let recorded_x = recorded.extension.as_deref();
+        let same_but_extension = job.data_sha256() == checkpoint.data_sha256
+            && crate::inputs::job(data, scenario, recorded_x, policy, &mut |_| {})
+                .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
+        if same_but_extension {
+            return Err(RerunError::OtherExtension {
+                path: path.to_path_buf(),
+                given: x.clone(),
+                recorded: recorded.extension.clone(),
+            });
+        }
+    }
+    Err(e.into())
 }
 
 /// Re-evaluates the checkpoint's population and archive with `evaluator` (whose job must be

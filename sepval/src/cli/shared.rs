@@ -50,11 +50,15 @@ impl OutlierArgs {
 
     /// The policy given, else `recorded`.
     pub fn or(&self, recorded: Policy) -> Policy {
-        match self.outliers {
-            Some(OutlierArg::Refuse) => Policy::Refuse,
-            Some(OutlierArg::Drop) => Policy::Drop,
-            None => recorded,
-        }
+        self.given().unwrap_or(recorded)
+    }
+
+    /// The policy given, if one is.
+    pub fn given(&self) -> Option<Policy> {
+        self.outliers.map(|o| match o {
+            OutlierArg::Refuse => Policy::Refuse,
+            OutlierArg::Drop => Policy::Drop,
+        })
     }
 }
 
