@@ -47,4 +47,4 @@ pub mod sigma;
 pub mod space;
 
 pub use method::Method;
-pub use pipeline::{FitError, FitOptions, FitOutput, run_fit};
+pub use pipeline::{BaselineSearch, FitError, FitOptions, FitOutput, run_fit};

@@ -10,8 +10,8 @@ use std::path::Path;
 
 use sepval_common::scenario::{Scenario, StoreDifference};
 use sepval_common::telemetry::outliers::Policy;
-use sepval_fit::inputs;
 use sepval_core::number_text::Shown;
+use sepval_fit::inputs;
 
 /// The most samples of one prediction.
 pub const MAX_SAMPLES: usize = 100_000;

@@ -58,10 +58,10 @@ pub use ensemble::Ensemble;
 pub use outputs::write_outputs;
 pub use record::{PREDICTION_FORMAT, PredictionFile, prediction_file};
 pub use sampling::Sampler;
-pub use summary::summary;
 pub use source::{
     Source, SourceError, SourceInputs, SourceInputsError, SourceKind, read_source, source_inputs,
 };
+pub use summary::summary;
 
 use simulate::{Grid, GridTrajectory};
 

@@ -39,10 +39,7 @@ pub fn summary(file: &PredictionFile, out: &Path) -> String {
         s.push_str(&format!("check:     {}\n", c.verdict));
     }
     if let Some(c) = &file.clearance {
-        s.push_str(&format!(
-            "clearance: {}\n",
-            crate::clearance::words(c)
-        ));
+        s.push_str(&format!("clearance: {}\n", crate::clearance::words(c)));
     }
     s.push_str(&format!(
         "samples:   {} ({} ran), {} simulations, {:.1} s\n",

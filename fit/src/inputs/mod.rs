@@ -294,3 +294,52 @@ pub fn validation_job(h: &HeldOut, tell: Tell) -> Result<Option<Job>, InputError
         .collect();
     Ok(Some(Job::new(events)?))
 }
+
+/// The releases of a command that fits them before it works (diagnose, update): those fitted
+/// (`--data`; none: the embedded default) and those held out (`--validate`), each read with
+/// one policy against the same scenario and extension.
+#[derive(Debug, Clone, Copy)]
+pub struct Releases<'a> {
+    /// `--data`.
+    pub data: &'a [PathBuf],
+    /// `--validate`.
+    pub validate: &'a [PathBuf],
+    /// `--scenario`.
+    pub scenario: Option<&'a Path>,
+    /// `--extension`.
+    pub extension: Option<&'a Path>,
+    /// `--outliers`.
+    pub policy: Policy,
+}
+
+/// [`Releases`] read and checked.
+#[derive(Debug)]
+pub struct ReadReleases {
+    /// The releases fitted.
+    pub job: Job,
+    /// Where they came from, as the fit's record keeps it.
+    pub record: InputsRecord,
+    /// The releases held out, if any.
+    pub validation: Option<Job>,
+}
+
+impl Releases<'_> {
+    /// Reads the releases fitted ([`job`]) and those held out ([`validation_job`]).
+    pub fn read(&self, tell: Tell) -> Result<ReadReleases, InputError> {
+        let (job, record) = job(self.data, self.scenario, self.extension, self.policy, tell)?;
+        let held = with_policy(self.validate, self.policy);
+        let held_out = HeldOut {
+            held: &held,
+            data_paths: self.data,
+            fitted: &job,
+            scenario_path: self.scenario,
+            extension_path: self.extension,
+        };
+        let validation = validation_job(&held_out, tell)?;
+        Ok(ReadReleases {
+            job,
+            record,
+            validation,
+        })
+    }
+}

@@ -95,6 +95,43 @@ impl FitOptions {
     }
 }
 
+/// The baseline search of a command that fits before it works (diagnose, update): its
+/// genetic search, the LM budget of its refinement, and the noise levels given (any not given
+/// is estimated from the releases).
+#[derive(Debug, Clone)]
+pub struct BaselineSearch {
+    /// The genetic search.
+    pub ga: GaSettings,
+    /// The refinement's budget of simulations.
+    pub lm_budget: u64,
+    /// `--sigma-pos-m`.
+    pub sigma_pos_m: Option<f64>,
+    /// `--sigma-att-deg`.
+    pub sigma_att_deg: Option<f64>,
+}
+
+impl BaselineSearch {
+    /// The options of the baseline fit of `job` (its record `inputs`) into `out`, and the
+    /// refinement's settings (the stages after the baseline refine with them too); the GA's
+    /// settings and the noise levels are checked.
+    pub fn options(
+        &self,
+        job: &Job,
+        out: &std::path::Path,
+        inputs: InputsRecord,
+    ) -> Result<(FitOptions, LmSettings), FitError> {
+        self.ga.validate()?;
+        let sigma =
+            Sigma::resolve(job, self.sigma_pos_m, self.sigma_att_deg).map_err(FitError::Sigma)?;
+        let lm = LmSettings {
+            budget: self.lm_budget,
+            ..LmSettings::default()
+        };
+        let fit = FitOptions::baseline(self.ga.clone(), sigma, &lm, out, inputs);
+        Ok((fit, lm))
+    }
+}
+
 /// The floor is reached when both goals are within this factor of their noise sigma.
 pub const FLOOR_FACTOR: f64 = 1.1;
 
@@ -137,6 +174,9 @@ pub enum FitError {
     /// A figure that cannot be drawn.
     #[error(transparent)]
     Figure(#[from] FigureError),
+    /// The noise levels given, or their estimate from the releases.
+    #[error("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")]
+    Sigma(#[source] crate::sigma::SigmaError),
     /// The figures' directory or a figure in it (or a signal asked the process to stop
     /// between them).
     #[error(transparent)]

@@ -2,17 +2,13 @@
 
 use std::sync::Arc;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, diagnose};
-use sepval_fit::FitOptions;
-use sepval_fit::inputs::{self, HeldOut};
+use sepval_fit::inputs::{ReadReleases, Releases};
 use sepval_fit::out_dir::Request;
-use sepval_fit::sigma::Sigma;
-use sepval_solve::ga::GaSettings;
-use sepval_solve::lm::LmSettings;
 
-use super::{clearance, evaluator_spec, notices, tell};
+use super::{baseline_search, clearance, evaluator_spec, notices, tell};
 use crate::cli::DiagnoseArgs;
 
 /// Runs `sepval diagnose`. The output directory is claimed (locked and checked) before anything
@@ -69,43 +65,32 @@ struct DiagnoseConfig {
 
 /// The flags as a validated configuration.
 fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
-    let ga = GaSettings {
-        population: args.population,
-        generations: args.generations,
-        seed: args.seed,
-        ..GaSettings::default()
-    };
-    ga.validate()?;
     let given = &args.inputs;
-    let policy = given.outliers.policy();
-    let (job, inputs) = inputs::job(
-        &given.data,
-        given.model.scenario.as_deref(),
-        given.model.extension.as_deref(),
-        policy,
-        &mut tell(),
-    )?;
+    let releases = Releases {
+        data: &given.data,
+        validate: &args.validate,
+        scenario: given.model.scenario.as_deref(),
+        extension: given.model.extension.as_deref(),
+        policy: given.outliers.policy(),
+    };
+    let ReadReleases {
+        job,
+        record,
+        validation,
+    } = releases.read(&mut tell())?;
     // The --extension terms, written again with the discovered ones to DIR/extension.toml.
-    let given_terms = match given.model.extension.as_deref() {
+    let given_terms = match releases.extension {
         Some(path) => sepval_common::extension::load_extension(path)?,
         None => Vec::new(),
     };
-    let held = inputs::with_policy(&args.validate, policy);
-    let held_out = HeldOut {
-        held: &held,
-        data_paths: &given.data,
-        fitted: &job,
-        scenario_path: given.model.scenario.as_deref(),
-        extension_path: given.model.extension.as_deref(),
-    };
-    let validation = inputs::validation_job(&held_out, &mut tell())?;
-    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
-        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
-    let lm = LmSettings {
-        budget: args.lm_budget,
-        ..LmSettings::default()
-    };
-    let fit = FitOptions::baseline(ga, sigma, &lm, &args.out.join("baseline"), inputs);
+    let search = baseline_search(
+        args.seed,
+        args.population,
+        args.generations,
+        args.lm_budget,
+        &args.noise,
+    );
+    let (fit, lm) = search.options(&job, &args.out.join("baseline"), record)?;
     let options = DiagnoseOptions {
         validation,
         given_terms,

@@ -8,8 +8,7 @@ use anyhow::{Context, Result};
 use sepval_fit::inputs;
 use sepval_fit::out_dir::Request;
 use sepval_predict::{
-    Flown, Settings, SourceInputs, predict, prediction_file, prepare,
-    source_inputs, write_outputs,
+    Flown, Settings, SourceInputs, predict, prediction_file, prepare, source_inputs, write_outputs,
 };
 
 use super::{clearance, count, evaluator_spec, input_files, notices, tell};

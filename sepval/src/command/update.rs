@@ -3,19 +3,14 @@
 
 use std::sync::Arc;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use sepval_common::evaluation::Job;
 use sepval_core::factors::Factor;
-use sepval_fit::FitOptions;
-use sepval_fit::inputs::{self, HeldOut};
+use sepval_fit::inputs::{self, ReadReleases, Releases};
 use sepval_fit::out_dir::Request;
-use sepval_fit::sigma::Sigma;
-use sepval_solve::ga::GaSettings;
-use sepval_solve::lm::LmSettings;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
-use super::starter;
-use super::{evaluator_spec, tell};
+use super::{baseline_search, evaluator_spec, starter, tell};
 use crate::cli::{FactorNames, UpdateArgs};
 
 /// Runs `sepval update`. Every input is checked before the output directory is claimed or a
@@ -106,42 +101,27 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
     }
     let free = free_factors(args.free.as_ref())?;
     let given = &args.inputs;
-    let (scenario_path, extension_path) = (
-        given.model.scenario.as_deref(),
-        given.model.extension.as_deref(),
+    let releases = Releases {
+        data: &given.data,
+        validate: &args.validate,
+        scenario: given.model.scenario.as_deref(),
+        extension: given.model.extension.as_deref(),
+        policy: given.outliers.policy(),
+    };
+    let ReadReleases {
+        job,
+        record,
+        validation,
+    } = releases.read(&mut tell())?;
+    let scenario = inputs::scenario(releases.scenario, releases.extension)?;
+    let search = baseline_search(
+        args.seed,
+        args.population,
+        args.generations,
+        args.lm_budget,
+        &args.noise,
     );
-    let policy = given.outliers.policy();
-    let (job, inputs) = inputs::job(
-        &given.data,
-        scenario_path,
-        extension_path,
-        policy,
-        &mut tell(),
-    )?;
-    let scenario = inputs::scenario(scenario_path, extension_path)?;
-    let held = inputs::with_policy(&args.validate, policy);
-    let held_out = HeldOut {
-        held: &held,
-        data_paths: &given.data,
-        fitted: &job,
-        scenario_path,
-        extension_path,
-    };
-    let validation = inputs::validation_job(&held_out, &mut tell())?;
-    let sigma = Sigma::resolve(&job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
-        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
-    let ga = GaSettings {
-        population: args.population,
-        generations: args.generations,
-        seed: args.seed,
-        ..GaSettings::default()
-    };
-    ga.validate()?;
-    let lm = LmSettings {
-        budget: args.lm_budget,
-        ..LmSettings::default()
-    };
-    let fit = FitOptions::baseline(ga, sigma, &lm, &args.out.join("baseline"), inputs);
+    let (fit, lm) = search.options(&job, &args.out.join("baseline"), record)?;
     let options = UpdateOptions {
         free,
         validation,
