@@ -29,6 +29,7 @@ pub mod prior;
 pub mod program;
 pub mod record;
 pub mod rehearse;
+pub mod request;
 pub mod rivals;
 pub mod state;
 
@@ -68,9 +69,12 @@ pub enum CampaignError {
         /// What is wrong.
         message: String,
     },
-    /// A release refused.
+    /// A release or a flag refused.
     #[error("{0}")]
     Refused(String),
+    /// The prior (`--prior`).
+    #[error(transparent)]
+    Prior(#[from] PriorError),
     /// The campaign's grid, as its settings name it.
     #[error(transparent)]
     Grid(#[from] sepval_envelope::GridError),

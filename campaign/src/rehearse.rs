@@ -99,6 +99,38 @@ pub struct Rehearsal {
     pub words: String,
 }
 
+impl Rehearsal {
+    /// What `sepval campaign rehearse` says of it on the terminal: each release flown, each
+    /// round against the truth, and the verdict.
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (k, f) in self.flown.iter().enumerate() {
+            out.push(format!(
+                "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {})",
+                k + 1,
+                crate::page::number(f.condition.mach),
+                crate::page::number(f.condition.altitude_m),
+                crate::page::number(f.condition.alpha_deg),
+                f.p_fail_planned,
+                if f.truly_safe { "safe" } else { "UNSAFE" }
+            ));
+        }
+        for round in &self.rounds {
+            out.push(format!(
+                "round {}:   cleared {}, fails {}, undecided {}; false clears {}, false fails {}",
+                round.round,
+                round.counts.cleared,
+                round.counts.fails,
+                round.counts.undecided,
+                round.false_clears,
+                round.false_fails
+            ));
+        }
+        out.push(format!("rehearsal: {}", self.words));
+        out
+    }
+}
+
 /// The truth at every condition of the campaign's grid.
 pub fn truth_envelope(c: &Campaign, truth: &Truth) -> Result<Vec<TruthCondition>, CampaignError> {
     let base = &truth.scenario;

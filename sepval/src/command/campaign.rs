@@ -5,13 +5,12 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use sepval_campaign::page;
-use sepval_campaign::prior::Prior;
-use sepval_campaign::program::{Campaign, Init, NewRelease, input_record};
-use sepval_campaign::record::SettingsRecord;
+use sepval_campaign::program::{Campaign, NewRelease};
+use sepval_campaign::request::InitRequest;
 use sepval_fit::inputs;
 
 use super::starter;
-use super::{clearance, count, evaluator_spec, tell};
+use super::{count, evaluator_spec, tell};
 use crate::cli::{
     CampaignAddArgs, CampaignCommand, CampaignInitArgs, CampaignNextArgs, CampaignRehearseArgs,
     CampaignStatusArgs,
@@ -28,14 +27,6 @@ pub fn run(c: CampaignCommand) -> Result<()> {
     }
 }
 
-/// A probability flag in (0, 0.5).
-fn probability(flag: &str, p: f64) -> Result<f64> {
-    if !(p > 0.0 && p < 0.5) {
-        bail!("{flag} {p}: expected a probability above 0 and below 0.5");
-    }
-    Ok(p)
-}
-
 fn init(a: CampaignInitArgs) -> Result<()> {
     let spec = evaluator_spec(&a.eval)?;
     let mut start = starter(&spec);
@@ -50,60 +41,26 @@ fn begin(
     a: &CampaignInitArgs,
     start: &mut sepval_campaign::StartEvaluator<'_>,
 ) -> Result<Campaign> {
-    let threads = count("--threads", a.eval.threads)?;
-    let allowed = probability("--allowed", a.allowed)?;
-    let fly_risk = probability("--fly-risk", a.fly_risk)?;
-    if a.samples < 20 {
-        bail!("--samples {}: at least 20 samples per condition", a.samples);
-    }
-    let Some(aircraft) = a.geometry.aircraft.clone() else {
-        bail!(
-            "--aircraft FILE is required: the aircraft's geometry (e.g. examples/geometry/aircraft.toml)"
-        );
-    };
-    let scenario = inputs::scenario(a.scenario.as_deref(), None)?;
-    let axes: Vec<(String, String)> = a
-        .grid
-        .given()
-        .into_iter()
-        .map(|(q, a)| (q.flag().to_string(), a.text.clone()))
-        .collect();
-    if axes.is_empty() {
-        bail!(
-            "give at least one axis: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N"
-        );
-    }
-    let prior = match &a.prior {
-        Some(p) => Prior::read(p, &scenario.factors)?,
-        None => Prior::default_of(&scenario.factors),
-    };
-    let Some(clearance) = clearance::settings(&a.geometry, &scenario)? else {
-        bail!("--aircraft FILE is required");
-    };
-    let settings = SettingsRecord {
-        scenario: a.scenario.as_deref().map(input_record).transpose()?,
-        aircraft: input_record(&aircraft)?,
-        store_shape: a
-            .geometry
-            .store_shape
-            .as_deref()
-            .map(input_record)
-            .transpose()?,
-        axes,
+    let request = InitRequest {
+        scenario: a.scenario.as_deref(),
+        aircraft: a.geometry.aircraft.as_deref(),
+        store_shape: a.geometry.store_shape.as_deref(),
+        axes: a
+            .grid
+            .given()
+            .into_iter()
+            .map(|(q, a)| (q.flag().to_string(), a.text.clone()))
+            .collect(),
         clearance_mm: a.geometry.clearance_mm,
-        allowed,
-        fly_risk,
+        allowed: a.allowed,
+        fly_risk: a.fly_risk,
         samples: a.samples,
         seed: a.seed,
         generations: a.generations,
-        prior,
+        prior: a.prior.as_deref(),
+        threads: count("--threads", a.eval.threads)?,
     };
-    let init = Init {
-        settings,
-        scenario,
-        clearance,
-        threads,
-    };
+    let init = request.read()?;
     let c = sepval_campaign::program::init(&a.out, init, start, &mut *crate::front::progress())?;
     Ok(c)
 }
@@ -131,29 +88,9 @@ fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
         &mut start,
         &mut *crate::front::progress(),
     )?;
-    for (k, f) in r.flown.iter().enumerate() {
-        say!(
-            "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {})",
-            k + 1,
-            page::number(f.condition.mach),
-            page::number(f.condition.altitude_m),
-            page::number(f.condition.alpha_deg),
-            f.p_fail_planned,
-            if f.truly_safe { "safe" } else { "UNSAFE" }
-        );
+    for l in r.lines() {
+        say!("{l}");
     }
-    for round in &r.rounds {
-        say!(
-            "round {}:   cleared {}, fails {}, undecided {}; false clears {}, false fails {}",
-            round.round,
-            round.counts.cleared,
-            round.counts.fails,
-            round.counts.undecided,
-            round.false_clears,
-            round.false_fails
-        );
-    }
-    say!("rehearsal: {}", r.words);
     say!("report:    {}", a.init.out.join("report.html").display());
     Ok(())
 }
