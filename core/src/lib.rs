@@ -23,6 +23,7 @@ pub mod cancel;
 pub mod defect;
 pub mod encoding;
 pub mod factors;
+pub mod flag_value;
 pub mod input_file;
 pub mod limits;
 pub mod nonfinite;

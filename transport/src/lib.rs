@@ -22,6 +22,7 @@
 pub mod bench;
 pub mod codec;
 pub mod dispatch;
+pub mod flags;
 pub mod ipc;
 pub mod link;
 pub mod run_id;

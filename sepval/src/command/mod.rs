@@ -24,15 +24,11 @@ pub mod update;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{EvalError, Evaluator, Job};
-use sepval_core::number_text::Shown;
 use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
-use sepval_transport::RunId;
-use sepval_transport::dispatch::DispatchOptions;
-use sepval_transport::ipc::{IpcOptions, Launch, MAX_WORKERS};
+use sepval_transport::flags::{EvaluatorFlags, Kind};
 use sepval_transport::link::{Notice, Notices};
 use sepval_transport::spec::{EvaluatorSpec, Starter};
 
@@ -41,34 +37,7 @@ use crate::cli::{EvalArgs, EvaluatorKind};
 /// `front::progress()`, which is the bar on the terminal and the callback in Python.
 pub use crate::front::Bar;
 
-/// A count given on the command line: at least 1; the number of cores when absent.
-pub fn count(flag: &str, requested: Option<usize>) -> Result<usize> {
-    match requested {
-        Some(0) => bail!("{flag} 0: expected at least 1"),
-        Some(n) => Ok(n),
-        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
-    }
-}
-
-/// A strictly positive, finite number given on the command line.
-pub fn positive(flag: &str, value: f64) -> Result<f64> {
-    if !(value.is_finite() && value > 0.0) {
-        bail!("{flag} = {}: expected a finite number > 0", Shown(value));
-    }
-    Ok(value)
-}
-
-/// A duration in seconds given on the command line (finite, > 0, at most a year).
-pub fn seconds(flag: &str, value: f64) -> Result<Duration> {
-    let v = positive(flag, value)?;
-    if v > 3.2e7 {
-        bail!(
-            "{flag} = {}: expected at most 32 000 000 s (a year)",
-            Shown(value)
-        );
-    }
-    Ok(Duration::from_secs_f64(v))
-}
+pub use sepval_core::flag_value::{count, positive, seconds};
 
 /// The worker executable: $SEPVAL_WORKER, the front end's (the Python package finds one on
 /// the PATH), or `sepval-worker` beside this executable.
@@ -90,110 +59,36 @@ pub fn worker_executable() -> Result<PathBuf> {
     Ok(worker)
 }
 
+/// The evaluation flags as given, for the transport to check ([`EvaluatorFlags::spec`]).
+pub fn evaluator_flags(args: &EvalArgs) -> EvaluatorFlags {
+    EvaluatorFlags {
+        kind: match args.evaluator {
+            EvaluatorKind::Inproc => Kind::InProcess,
+            EvaluatorKind::Ipc => Kind::Ipc,
+            EvaluatorKind::Zenoh => Kind::Zenoh,
+        },
+        workers: args.workers,
+        threads: args.threads,
+        listen: args.listen.clone(),
+        zenoh_config: args.zenoh_config.clone(),
+        attach: args.attach.clone(),
+        run_id: args.run_id.clone(),
+        worker_timeout_s: args.worker_timeout,
+        join_timeout_s: args.join_timeout,
+        announce_protocol: args.announce_protocol,
+    }
+}
+
 /// The evaluator of the shared evaluation flags, validated (nothing is started yet).
 pub fn evaluator_spec(args: &EvalArgs) -> Result<EvaluatorSpec> {
-    if args.evaluator != EvaluatorKind::Zenoh
-        && (args.listen.is_some() || args.zenoh_config.is_some())
-    {
-        bail!("--listen and --zenoh-config are for --evaluator zenoh");
-    }
-    let chunk_deadline = seconds("--worker-timeout", args.worker_timeout)?;
-    let join_timeout = seconds("--join-timeout", args.join_timeout)?;
-    match args.evaluator {
-        EvaluatorKind::Inproc => Ok(EvaluatorSpec::InProcess {
-            threads: count("--threads", args.threads)?,
-        }),
-        EvaluatorKind::Ipc => {
-            let workers = count("--workers", args.workers)?;
-            if workers > MAX_WORKERS {
-                bail!("--workers {workers}: expected at most {MAX_WORKERS}");
-            }
-            let (run_id, launch) = match &args.attach {
-                Some(id) => (id.clone(), Launch::Attach),
-                None => (
-                    args.run_id.clone().unwrap_or_else(RunId::fresh),
-                    Launch::Spawn {
-                        executable: worker_executable()?,
-                    },
-                ),
-            };
-            Ok(EvaluatorSpec::Ipc {
-                link: IpcOptions {
-                    run_id,
-                    workers,
-                    launch,
-                    max_respawns: 2 * workers + 2,
-                    join_timeout,
-                    announce_protocol: args.announce_protocol,
-                },
-                dispatch: DispatchOptions {
-                    min_workers: workers,
-                    join_timeout,
-                    chunk_deadline,
-                },
-            })
-        }
-        EvaluatorKind::Zenoh => zenoh_spec(args, join_timeout, chunk_deadline),
-    }
+    let worker = || worker_executable().map_err(|e| format!("{e:#}"));
+    Ok(evaluator_flags(args).spec(worker)?)
 }
 
-#[cfg(feature = "zenoh")]
-fn zenoh_spec(
-    args: &EvalArgs,
-    join_timeout: Duration,
-    chunk_deadline: Duration,
-) -> Result<EvaluatorSpec> {
-    use sepval_transport::zenoh::{ZenohOptions, validate_endpoint};
-    let listen = args
-        .listen
-        .clone()
-        .context("--evaluator zenoh needs --listen ENDPOINT (e.g. tcp/0.0.0.0:7447)")?;
-    validate_endpoint(&listen).context("--listen")?;
-    if args.attach.is_some() {
-        bail!("--attach is for --evaluator ipc; zenoh workers always join by themselves");
-    }
-    let workers = match args.workers {
-        Some(0) => bail!("--workers 0: expected at least 1"),
-        Some(n) => n,
-        None => 1,
-    };
-    Ok(EvaluatorSpec::Zenoh {
-        link: ZenohOptions {
-            run_id: args.run_id.clone().unwrap_or_else(RunId::fresh),
-            listen,
-            workers,
-            join_timeout,
-            zenoh_config: args.zenoh_config.clone(),
-            announce_protocol: args.announce_protocol,
-        },
-        dispatch: DispatchOptions {
-            min_workers: workers,
-            join_timeout,
-            chunk_deadline,
-        },
-    })
-}
-
-#[cfg(not(feature = "zenoh"))]
-fn zenoh_spec(_: &EvalArgs, _: Duration, _: Duration) -> Result<EvaluatorSpec> {
-    bail!(
-        "--evaluator zenoh: this sepval was built without the zenoh transport; \
-         rebuild with `cargo build --release --features zenoh`"
-    )
-}
-
-/// Refuses `--attach` for `command`, which evaluates several jobs one after another (an
-/// envelope's conditions, an update's rounds): iceoryx2 workers attached by hand serve one job
-/// and leave with it, so the next would wait for workers that never come back.
+/// Refuses `--attach` for `command`, which evaluates several jobs one after another
+/// ([`EvaluatorFlags::several_jobs`]).
 pub fn several_jobs(args: &EvalArgs, command: &str, jobs: &str) -> Result<()> {
-    if let Some(run) = &args.attach {
-        bail!(
-            "--attach {run}: workers attached by hand serve one job of a run, and `{command}` runs \
-             {jobs}; leave out --attach (sepval starts the iceoryx2 workers of each job) or use \
-             --evaluator zenoh, whose workers serve every job of the run"
-        );
-    }
-    Ok(())
+    Ok(evaluator_flags(args).several_jobs(command, jobs)?)
 }
 
 /// The baseline search of diagnose and update: the study's GA with `seed`, `population` and
