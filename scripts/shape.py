@@ -46,7 +46,7 @@ MAY_USE = {
     "sepval-envelope": {"sepval-core", "sepval-common", "sepval-solve", "sepval-fit",
                         "sepval-predict", "sepval-geometry", "sepval-report"},
     "sepval-update": {"sepval-core", "sepval-common", "sepval-solve", "sepval-fit",
-                      "sepval-diagnose", "sepval-report"},
+                      "sepval-diagnose", "sepval-report", "sepval-daveml"},
     "sepval-campaign": {"sepval-core", "sepval-common", "sepval-solve", "sepval-fit",
                         "sepval-diagnose", "sepval-predict", "sepval-envelope", "sepval-report"},
     "sepval": {"sepval-core", "sepval-common", "sepval-transport", "sepval-solve", "sepval-fit",

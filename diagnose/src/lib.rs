@@ -58,8 +58,9 @@ use sepval_common::evaluation::{Candidate, Counted, EvalError, Evaluator, Job};
 use sepval_common::extension::Term;
 use sepval_core::atomic_file::WriteError;
 
+use sepval_fit::inputs::Releases;
 use sepval_fit::space::{FreeTerm, ParamSpace};
-use sepval_fit::{FitError, FitOptions, Method, run_fit};
+use sepval_fit::{BaselineSearch, FitError, FitOptions, Method, run_fit};
 use sepval_report::OutputError;
 use sepval_report::figures::FigureError;
 use sepval_report::html::HtmlError;
@@ -86,6 +87,15 @@ pub enum DiagnoseError {
     /// The baseline fit failed.
     #[error("the baseline fit failed")]
     Baseline(#[source] FitError),
+    /// The releases (`--data`, `--validate`) that cannot be read.
+    #[error(transparent)]
+    Inputs(Box<sepval_fit::inputs::InputError>),
+    /// The extension given (`--extension`) that cannot be read.
+    #[error(transparent)]
+    GivenExtension(sepval_common::extension::ExtensionError),
+    /// The baseline search's settings or noise levels refused.
+    #[error(transparent)]
+    Search(FitError),
     /// A refinement failed.
     #[error(transparent)]
     Run(#[from] RunError),
@@ -263,6 +273,37 @@ impl DiagnoseOptions {
             given_terms: Vec::new(),
             strict_tables: false,
         }
+    }
+}
+
+impl DiagnoseOptions {
+    /// A diagnosis as `sepval diagnose` configures it: `releases` read (what the screening
+    /// leaves out told to `tell`), the extension given loaded (its terms written again with the
+    /// discovered ones), the baseline fitted by `search` into `out/baseline`. Returns the job of
+    /// the releases fitted and the options.
+    pub fn configure(
+        releases: &Releases,
+        search: &BaselineSearch,
+        out: PathBuf,
+        tell: sepval_fit::inputs::Tell,
+    ) -> Result<(Job, DiagnoseOptions)> {
+        let read = releases
+            .read(tell)
+            .map_err(|e| DiagnoseError::Inputs(Box::new(e)))?;
+        let given_terms = match releases.extension {
+            Some(path) => sepval_common::extension::load_extension(path)
+                .map_err(DiagnoseError::GivenExtension)?,
+            None => Vec::new(),
+        };
+        let (fit, lm) = search
+            .options(&read.job, &out.join("baseline"), read.record)
+            .map_err(DiagnoseError::Search)?;
+        let options = DiagnoseOptions {
+            validation: read.validation,
+            given_terms,
+            ..DiagnoseOptions::new(fit, &lm, out)
+        };
+        Ok((read.job, options))
     }
 }
 

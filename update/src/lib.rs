@@ -31,6 +31,7 @@
 
 pub mod assemble;
 pub mod crossval;
+pub mod daveml;
 pub mod explored;
 pub mod jobs;
 pub mod outcome;
@@ -107,6 +108,22 @@ pub enum UpdateError {
     /// A list of free factors that is empty or names no factor: refused before anything runs.
     #[error("the free factors {0:?}: expected at least one, each the index of one of the 17")]
     Free(Vec<usize>),
+    /// A name of `--free` that is not a factor's.
+    #[error(
+        "--free {0}: not one of the 17 factors (expected a comma-separated list of {names})",
+        names = sepval_core::factors::Factor::NAMES.join(", ")
+    )]
+    FreeName(String),
+    /// A name of `--free` given twice.
+    #[error("--free {0}: given twice")]
+    FreeTwice(String),
+    /// The releases (`--data`, `--validate`) or the store (`--scenario`, `--extension`) that
+    /// cannot be read.
+    #[error(transparent)]
+    Inputs(Box<sepval_fit::inputs::InputError>),
+    /// The baseline search's settings or noise levels refused.
+    #[error(transparent)]
+    Search(sepval_fit::FitError),
 }
 
 impl From<EvalError> for UpdateError {

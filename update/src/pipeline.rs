@@ -6,9 +6,10 @@ use std::time::Instant;
 use sepval_common::evaluation::{Evaluator, Job};
 use sepval_common::scenario::Scenario;
 use sepval_core::factors::{Factor, Factors};
+use sepval_fit::inputs::{self, Releases};
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
-use sepval_fit::{FitError, FitOptions, Method, run_fit};
+use sepval_fit::{BaselineSearch, FitError, FitOptions, Method, run_fit};
 use sepval_solve::lm::{LmSettings, Stall};
 use sepval_solve::run::{ProgressObserver, RunError};
 
@@ -52,6 +53,52 @@ impl UpdateOptions {
             scenario,
         }
     }
+}
+
+impl UpdateOptions {
+    /// An update as `sepval update` configures it: `releases` read (what the screening leaves
+    /// out told to `tell`), the store as given read, the baseline fitted by `search` into
+    /// `out/baseline`, the factors named `free` fitted (all 17 when `None`). Returns the job of
+    /// the releases fitted and the options.
+    pub fn configure(
+        releases: &Releases,
+        search: &BaselineSearch,
+        free: Option<&[String]>,
+        out: &std::path::Path,
+        tell: sepval_fit::inputs::Tell,
+    ) -> Result<(Job, UpdateOptions)> {
+        let free = free_factors(free)?;
+        let input = |e| UpdateError::Inputs(Box::new(e));
+        let read = releases.read(tell).map_err(input)?;
+        let scenario = inputs::scenario(releases.scenario, releases.extension).map_err(input)?;
+        let (fit, lm) = search
+            .options(&read.job, &out.join("baseline"), read.record)
+            .map_err(UpdateError::Search)?;
+        let options = UpdateOptions {
+            free,
+            validation: read.validation,
+            ..UpdateOptions::new(fit, &lm, scenario)
+        };
+        Ok((read.job, options))
+    }
+}
+
+/// The factors named (all 17 when `None`), as indices in order; a name that is not a factor's
+/// or is given twice is refused.
+pub fn free_factors(names: Option<&[String]>) -> Result<Vec<usize>> {
+    let Some(names) = names else {
+        return Ok((0..Factor::ALL.len()).collect());
+    };
+    let mut out = Vec::new();
+    for name in names {
+        let f = Factor::from_name(name).ok_or_else(|| UpdateError::FreeName(name.clone()))?;
+        if out.contains(&f.index()) {
+            return Err(UpdateError::FreeTwice(name.clone()));
+        }
+        out.push(f.index());
+    }
+    out.sort_unstable();
+    Ok(out)
 }
 
 /// The stall rule of the update's refits: ten iterations that lower the chi-square by less

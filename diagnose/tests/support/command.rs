@@ -1,7 +1,7 @@
 //! `sepval diagnose` in process, for the test binaries that diagnose (included by `#[path]` in
 //! `diagnose/tests/catalogue`, `diagnose/tests/discovery` and `plan/tests/closing`): the flags
-//! turned into the command's own options as `sepval/src/command/diagnose.rs` does (the inputs
-//! read by `sepval_fit::inputs`, [`FitOptions::baseline`], [`DiagnoseOptions::new`]), with the
+//! turned into the command's own options by the function `sepval/src/command/diagnose.rs`
+//! calls ([`DiagnoseOptions::configure`] of the releases and the baseline search), with the
 //! CLI tests' reduced budget (`sepval_tests::REDUCED_BUDGET`: 20 generations, in process on two
 //! threads) and the command's defaults (population 100, seed 1, LM budget 3000, outliers
 //! refused), so that a diagnosis made here is the command's to the last bit. What only the
@@ -12,14 +12,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use sepval_common::evaluation::InProcess;
-use sepval_common::extension::load_extension;
 use sepval_common::telemetry::outliers::Policy;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose};
-use sepval_fit::FitOptions;
-use sepval_fit::inputs::{self, HeldOut};
-use sepval_fit::sigma::Sigma;
+use sepval_fit::BaselineSearch;
+use sepval_fit::inputs::Releases;
 use sepval_solve::ga::GaSettings;
-use sepval_solve::lm::LmSettings;
 use sepval_solve::run::NoProgress;
 use serde_json::Value;
 
@@ -51,38 +48,27 @@ impl Diagnose {
 
     /// The diagnosis, its files written into `out` (created).
     pub fn run(&self, out: &Path) -> Diagnosis {
-        let ga = GaSettings {
-            population: 100,
-            generations: self.generations,
-            seed: 1,
-            ..GaSettings::default()
+        let releases = Releases {
+            data: &self.data,
+            validate: &self.validate,
+            scenario: self.scenario.as_deref(),
+            extension: self.extension.as_deref(),
+            policy: Policy::Refuse,
         };
-        ga.validate().unwrap();
-        let (scenario, extension) = (self.scenario.as_deref(), self.extension.as_deref());
+        let search = BaselineSearch {
+            ga: GaSettings {
+                population: 100,
+                generations: self.generations,
+                seed: 1,
+                ..GaSettings::default()
+            },
+            lm_budget: 3000,
+            sigma_pos_m: None,
+            sigma_att_deg: None,
+        };
         let mut tell = |said: String| eprintln!("{said}");
-        let (job, record) =
-            inputs::job(&self.data, scenario, extension, Policy::Refuse, &mut tell).unwrap();
-        let given_terms = extension.map_or_else(Vec::new, |p| load_extension(p).unwrap());
-        let held = inputs::with_policy(&self.validate, Policy::Refuse);
-        let held_out = HeldOut {
-            held: &held,
-            data_paths: &self.data,
-            fitted: &job,
-            scenario_path: scenario,
-            extension_path: extension,
-        };
-        let validation = inputs::validation_job(&held_out, &mut tell).unwrap();
-        let sigma = Sigma::resolve(&job, None, None).unwrap();
-        let lm = LmSettings {
-            budget: 3000,
-            ..LmSettings::default()
-        };
-        let fit = FitOptions::baseline(ga, sigma, &lm, &out.join("baseline"), record);
-        let options = DiagnoseOptions {
-            validation,
-            given_terms,
-            ..DiagnoseOptions::new(fit, &lm, out.to_path_buf())
-        };
+        let (job, options) =
+            DiagnoseOptions::configure(&releases, &search, out.to_path_buf(), &mut tell).unwrap();
         std::fs::create_dir_all(out).unwrap();
         let mut evaluator = InProcess::new(Arc::new(job), 2);
         diagnose(&options, &mut evaluator, &mut NoProgress).unwrap()

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, diagnose};
-use sepval_fit::inputs::{ReadReleases, Releases};
+use sepval_fit::inputs::Releases;
 use sepval_fit::out_dir::Request;
 
 use super::{baseline_search, clearance, evaluator_spec, notices, tell};
@@ -73,29 +73,13 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
         extension: given.model.extension.as_deref(),
         policy: given.outliers.policy(),
     };
-    let ReadReleases {
-        job,
-        record,
-        validation,
-    } = releases.read(&mut tell())?;
-    // The --extension terms, written again with the discovered ones to DIR/extension.toml.
-    let given_terms = match releases.extension {
-        Some(path) => sepval_common::extension::load_extension(path)?,
-        None => Vec::new(),
-    };
-    let search = baseline_search(
-        args.seed,
-        args.population,
-        args.generations,
-        args.lm_budget,
-        &args.noise,
-    );
-    let (fit, lm) = search.options(&job, &args.out.join("baseline"), record)?;
+    let (g, a) = (&args.generations, args);
+    let search = baseline_search(a.seed, a.population, *g, a.lm_budget, &a.noise);
+    let (job, options) =
+        DiagnoseOptions::configure(&releases, &search, args.out.clone(), &mut tell())?;
     let options = DiagnoseOptions {
-        validation,
-        given_terms,
         strict_tables: args.tables.strict_tables,
-        ..DiagnoseOptions::new(fit, &lm, args.out.clone())
+        ..options
     };
     Ok(DiagnoseConfig { job, options })
 }

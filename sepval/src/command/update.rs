@@ -5,8 +5,7 @@ use std::sync::Arc;
 
 use anyhow::{Result, bail};
 use sepval_common::evaluation::Job;
-use sepval_core::factors::Factor;
-use sepval_fit::inputs::{self, ReadReleases, Releases};
+use sepval_fit::inputs::Releases;
 use sepval_fit::out_dir::Request;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
@@ -40,7 +39,10 @@ pub fn run(args: UpdateArgs) -> Result<()> {
     )?;
     write_outputs(&u, &args.out)?;
     if args.daveml {
-        write_daveml(&u, &args)?;
+        let command = format!("sepval update --out {}", args.out.display());
+        let data = args.inputs.data.iter().map(|p| p.display().to_string());
+        let path = sepval_update::daveml::write_daveml(&u, &args.out, command, data.collect())?;
+        say!("daveml:    {}", path.display());
     }
     drop(run_dir);
     say!("update:    {}", u.file.verdict);
@@ -62,36 +64,6 @@ pub fn run(args: UpdateArgs) -> Result<()> {
     Ok(())
 }
 
-/// `--daveml`: the updated store as DIR/store.dml, each correction's standard deviation as
-/// its table's uncertainty.
-fn write_daveml(u: &sepval_update::Update, args: &UpdateArgs) -> Result<()> {
-    let store = sepval_common::scenario::Scenario::load(&args.out.join("scenario.toml"))?;
-    let spreads: Vec<sepval_daveml::CorrectionSpread> = u
-        .file
-        .corrections
-        .iter()
-        .map(|c| sepval_daveml::CorrectionSpread {
-            field: c.field.clone(),
-            variable: c.variable.clone(),
-            breakpoints: c.breakpoints.clone(),
-            std: c.std.clone(),
-        })
-        .collect();
-    let bands = sepval_daveml::bands(&store, &spreads)?;
-    let prov = sepval_daveml::Provenance::now(
-        format!("sepval update --out {}", args.out.display()),
-        args.inputs
-            .data
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect(),
-    );
-    let path = args.out.join("store.dml");
-    sepval_daveml::write_model(&path, &store, &bands, &prov)?;
-    say!("daveml:    {}", path.display());
-    Ok(())
-}
-
 /// The flags as a validated configuration, and the job of the `--data` releases.
 fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
     if args.inputs.data.is_empty() {
@@ -99,7 +71,6 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
             "--data FILE.csv is required (repeat it for each release): the releases that update the store's data"
         );
     }
-    let free = free_factors(args.free.as_ref())?;
     let given = &args.inputs;
     let releases = Releases {
         data: &given.data,
@@ -108,47 +79,13 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
         extension: given.model.extension.as_deref(),
         policy: given.outliers.policy(),
     };
-    let ReadReleases {
-        job,
-        record,
-        validation,
-    } = releases.read(&mut tell())?;
-    let scenario = inputs::scenario(releases.scenario, releases.extension)?;
-    let search = baseline_search(
-        args.seed,
-        args.population,
-        args.generations,
-        args.lm_budget,
-        &args.noise,
-    );
-    let (fit, lm) = search.options(&job, &args.out.join("baseline"), record)?;
-    let options = UpdateOptions {
-        free,
-        validation,
-        ..UpdateOptions::new(fit, &lm, scenario)
-    };
+    let (g, a) = (&args.generations, args);
+    let search = baseline_search(a.seed, a.population, *g, a.lm_budget, &a.noise);
+    let free = args
+        .free
+        .as_ref()
+        .map(|FactorNames(names)| names.as_slice());
+    let (job, options) =
+        UpdateOptions::configure(&releases, &search, free, &args.out, &mut tell())?;
     Ok((options, job))
-}
-
-/// The factors of `--free NAME,...` (all 17 when absent), as indices; the list holds no empty
-/// name (refused as the flags were parsed).
-fn free_factors(list: Option<&FactorNames>) -> Result<Vec<usize>> {
-    let Some(FactorNames(names)) = list else {
-        return Ok((0..Factor::ALL.len()).collect());
-    };
-    let mut out = Vec::new();
-    for name in names {
-        let Some(f) = Factor::from_name(name) else {
-            bail!(
-                "--free {name}: not one of the 17 factors (expected a comma-separated list of {})",
-                Factor::NAMES.join(", ")
-            );
-        };
-        if out.contains(&f.index()) {
-            bail!("--free {name}: given twice");
-        }
-        out.push(f.index());
-    }
-    out.sort_unstable();
-    Ok(out)
 }
