@@ -30,6 +30,7 @@
 
 pub mod checkpoint;
 pub mod conditions;
+pub mod configure;
 pub mod domain;
 pub mod inputs;
 pub mod method;

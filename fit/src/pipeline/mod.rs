@@ -174,6 +174,12 @@ pub enum FitError {
     /// A figure that cannot be drawn.
     #[error(transparent)]
     Figure(#[from] FigureError),
+    /// The releases, the scenario, the extension or the truth's factors that cannot be read.
+    #[error(transparent)]
+    Inputs(Box<crate::inputs::InputError>),
+    /// The checkpoint resumed from does not fit the run asked for.
+    #[error(transparent)]
+    Resume(#[from] crate::resume::ResumeError),
     /// The noise levels given, or their estimate from the releases.
     #[error("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")]
     Sigma(#[source] crate::sigma::SigmaError),

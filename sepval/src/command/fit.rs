@@ -2,18 +2,15 @@
 
 use std::sync::Arc;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use sepval_common::evaluation::Job;
 use sepval_fit::checkpoint::Checkpoint;
-use sepval_fit::inputs;
+use sepval_fit::configure::FitRequest;
 use sepval_fit::out_dir::{Claim, Request, RunDir};
 use sepval_fit::pipeline::{FitOutput, write_fit_figures};
 use sepval_fit::resume::{self, InputPaths};
-use sepval_fit::sigma::Sigma;
 use sepval_fit::{FitOptions, Method, run_fit};
 use sepval_solve::ga::GaSettings;
-use sepval_solve::hill::HillSettings;
-use sepval_solve::lm::LmSettings;
 
 use super::{clearance, evaluator_spec, notices, tell};
 use crate::cli::{FitArgs, MethodArg};
@@ -117,95 +114,36 @@ fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
     )
 }
 
-/// The flags (and the checkpoint resumed from) as a validated configuration: the inputs read
-/// and checked against the checkpoint, the settings of the searches, the truth for the report.
+/// The flags (and the checkpoint resumed from) as a validated configuration
+/// ([`sepval_fit::configure`]).
 fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
-    // Inputs: the flags, or (when resuming without them) those recorded in the checkpoint.
     let given = &args.inputs;
-    let InputPaths {
-        data: data_paths,
-        scenario: scenario_path,
-        extension: extension_path,
-    } = InputPaths {
-        data: given.data.clone(),
-        scenario: given.model.scenario.clone(),
-        extension: given.model.extension.clone(),
-    }
-    .or_recorded(resume.as_ref());
-    let recorded = resume
-        .as_ref()
-        .map(|c| c.inputs.outliers)
-        .unwrap_or_default();
-    let (job, inputs) = inputs::job(
-        &data_paths,
-        scenario_path.as_deref(),
-        extension_path.as_deref(),
-        given.outliers.or(recorded),
-        &mut tell(),
-    )?;
-    let resumed = args.resume.as_deref().zip(resume.as_ref());
-    let method = resume::method(args.method.map(method), resumed)?;
-    let Searches { ga, hill, sigma } = searches(args, resume.as_ref(), &job)?;
-    ga.validate()?;
-    let truth = match &args.truth_factors {
-        Some(p) => Some(inputs::factors(
-            &p.display().to_string(),
-            job.factor_table(),
-        )?),
-        None if data_paths.is_empty() => Some(sepval_core::factors::Factors::TRUTH),
-        None => None,
-    };
-    let options = FitOptions {
-        method,
-        ga,
-        hill,
-        sigma,
-        truth,
+    let request = FitRequest {
+        inputs: InputPaths {
+            data: given.data.clone(),
+            scenario: given.model.scenario.clone(),
+            extension: given.model.extension.clone(),
+        },
+        outliers: given.outliers.given(),
+        method: args.method.map(method),
+        resume: args.resume.as_deref().zip(resume),
+        ga: GaSettings {
+            population: args.population,
+            generations: args.generations.unwrap_or(500),
+            p_crossover: args.p_crossover,
+            p_jump: args.p_jump,
+            p_creep: args.p_creep,
+            seed: args.seed,
+        },
+        generations: args.generations,
+        hill_budget: args.hill_budget,
+        lm_budget: args.lm_budget,
+        sigma: (args.noise.sigma_pos_m, args.noise.sigma_att_deg),
+        truth_factors: args.truth_factors.as_deref(),
         out: args.out.clone(),
-        resume,
-        inputs,
-        lm: LmSettings {
-            budget: args.lm_budget,
-            ..LmSettings::default()
-        },
-        lm_probe: LmSettings {
-            budget: args.lm_budget.min(800),
-            ..LmSettings::default()
-        },
     };
+    let (job, options) = sepval_fit::configure::configure(request, &mut tell())?;
     Ok(FitConfig { job, options })
-}
-
-/// The settings of the searches and the noise levels that weight the goals.
-struct Searches {
-    ga: GaSettings,
-    hill: HillSettings,
-    sigma: Sigma,
-}
-
-/// The checkpoint's searches when resuming (after checking it against the job; only the
-/// generations may grow), else those of the flags.
-fn searches(args: &FitArgs, resume: Option<&Checkpoint>, job: &Job) -> Result<Searches> {
-    if let Some(c) = resume {
-        let path = args.resume.as_deref().expect("resume path");
-        let (ga, hill, sigma) = resume::searches(c, path, job, args.generations)?;
-        return Ok(Searches { ga, hill, sigma });
-    }
-    let ga = GaSettings {
-        population: args.population,
-        generations: args.generations.unwrap_or(500),
-        p_crossover: args.p_crossover,
-        p_jump: args.p_jump,
-        p_creep: args.p_creep,
-        seed: args.seed,
-    };
-    let hill = HillSettings {
-        budget: args.hill_budget,
-        ..HillSettings::default()
-    };
-    let sigma = Sigma::resolve(job, args.noise.sigma_pos_m, args.noise.sigma_att_deg)
-        .context("the noise levels that weight the goals (--sigma-pos-m, --sigma-att-deg)")?;
-    Ok(Searches { ga, hill, sigma })
 }
 
 /// The clearance of the best fit's trajectories (`--aircraft`): clearance.csv, the figure and
