@@ -6,6 +6,8 @@
 //! diverge.
 //!
 //! The sweep is a pipeline of named stages:
+//! 0. [`mod@prepare`]: the sweep asked for read and checked ([`Prepared`]): the source, the
+//!    grid, the geometry and the digest of its inputs;
 //! 1. [`grid`]: the axes `LO:HI:N` and the conditions, checked before anything runs
 //!    ([`Grid`]);
 //! 2. [`mod@sweep`]: the held-out evidence of the model form computed once ([`Evidence`]), then
@@ -29,6 +31,7 @@
 pub mod grid;
 pub mod outputs;
 mod page;
+pub mod prepare;
 pub mod progress;
 pub mod record;
 pub mod row;
@@ -37,6 +40,7 @@ pub mod sweep;
 
 pub use grid::{Axis, Grid, GridError};
 pub use outputs::write_outputs;
+pub use prepare::{PrepareError, Prepared, prepare};
 pub use progress::{Progress, ProgressError};
 pub use record::{ENVELOPE_FORMAT, EnvelopeFile, Provenance};
 pub use row::Row;

@@ -7,16 +7,14 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use sepval_common::telemetry::outliers::Policy;
-use sepval_envelope::grid::{Axis, Grid};
-use sepval_envelope::progress::{
-    Progress, SweepInputs, claim_sweep, progress_path, remove_progress,
-};
-use sepval_envelope::{EnvelopeFile, Provenance, Sweep, sweep, write_outputs};
+use sepval_envelope::grid::Axis;
+use sepval_envelope::progress::{Progress, SweepInputs, claim_sweep, remove_progress};
+use sepval_envelope::{EnvelopeFile, Prepared, prepare, sweep, write_outputs};
 use sepval_fit::out_dir::{Input, Request, RunDir};
 use sepval_plan::conditions::Quantity;
-use sepval_predict::{Settings, Source, SourceInputs, source_inputs};
+use sepval_predict::Source;
 
-use super::{clearance, count, evaluator_spec, starter, tell};
+use super::{count, evaluator_spec, starter, tell};
 use crate::cli::AxisArg;
 use crate::cli::EnvelopeArgs;
 
@@ -25,14 +23,7 @@ use crate::cli::EnvelopeArgs;
 pub fn run(args: EnvelopeArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     super::several_jobs(&args.eval, "envelope", "one per condition")?;
-    let settings = Settings {
-        samples: args.samples,
-        level: 0.95,
-        seed: args.seed,
-        with_noise: false,
-        threads: count("--threads", args.eval.threads)?,
-    };
-    settings.check()?;
+    let threads = count("--threads", args.eval.threads)?;
     let Some(aircraft) = args.geometry.aircraft.clone() else {
         bail!(
             "--aircraft FILE is required: the aircraft's geometry (e.g. examples/geometry/aircraft.toml)"
@@ -45,37 +36,18 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         );
     }
     let axes: Vec<Axis> = given.iter().map(|(_, a)| a.axis).collect();
-    let SourceInputs {
-        source,
-        fitted,
-        held_out,
-    } = source_inputs(
-        &args.from,
-        args.extension.as_deref(),
-        &args.validate,
-        args.outliers.policy(),
-        &mut tell(),
-    )?;
-    let base = fitted.events()[0].simulator.scenario().clone();
-    let grid = Grid::of(&base, &axes)?;
-    let Some(clearance) = clearance::settings(&args.geometry, &base)? else {
-        bail!("--aircraft FILE is required");
-    };
-    let (digest, named) = sweep_inputs(&args, &source.dir, &aircraft, &given).digest()?;
-    let inputs_sha256 = digest.clone();
-    let read = inputs_read(&args, &source);
-    let (run_dir, progress) = claim(&args, Progress::new(digest, named, grid.len()), &read)?;
+    let inputs = sweep_inputs(&args, &aircraft, &given);
+    let Prepared {
+        sweep: sweep_inputs,
+        digest,
+        named,
+        provenance,
+    } = prepare(&inputs, &axes, threads, &args.out, &mut tell())?;
+    let read = inputs_read(&args, &sweep_inputs.source);
+    let progress = Progress::new(digest, named, sweep_inputs.grid.len());
+    let (run_dir, progress) = claim(&args, progress, &read)?;
     run_dir.prepare()?;
     let start = Instant::now();
-    let sweep_inputs = Sweep {
-        source,
-        fitted,
-        held_out,
-        settings,
-        grid,
-        clearance,
-        progress_path: progress_path(&args.out),
-    };
     let mut start_evaluator = starter(&spec);
     let swept = sweep(
         &sweep_inputs,
@@ -83,18 +55,6 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
         &mut start_evaluator,
         &mut *crate::front::progress(),
     )?;
-    let provenance = Provenance {
-        samples: args.samples,
-        seed: args.seed,
-        inputs_sha256,
-        from: args.from.display().to_string(),
-        aircraft: aircraft.display().to_string(),
-        store_shape: args
-            .geometry
-            .store_shape
-            .as_ref()
-            .map_or("default".into(), |p| p.display().to_string()),
-    };
     let wall_s = start.elapsed().as_secs_f64();
     let criterion_mm = args.geometry.clearance_mm;
     let (file, summary) = EnvelopeFile::of(&sweep_inputs, swept, criterion_mm, provenance, wall_s);
@@ -145,12 +105,11 @@ fn claim(args: &EnvelopeArgs, fresh: Progress, read: &[Input]) -> Result<(RunDir
 /// What decides the envelope, as its progress file records it.
 fn sweep_inputs<'a>(
     args: &'a EnvelopeArgs,
-    from: &'a Path,
     aircraft: &'a Path,
     axes: &[(Quantity, &AxisArg)],
 ) -> SweepInputs<'a> {
     SweepInputs {
-        from,
+        from: &args.from,
         aircraft,
         store_shape: args.geometry.store_shape.as_deref(),
         extension: args.extension.as_deref(),
