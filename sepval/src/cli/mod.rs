@@ -14,8 +14,8 @@ pub use campaign::{
 use sepval_plan::conditions::{Quantity, Range};
 use sepval_transport::RunId;
 pub use shared::{
-    AxisArg, EvalArgs, GeometryArgs, GridArgs, InputArgs, ModelArgs, NoiseArgs, OutlierArg,
-    OutlierArgs, OverwriteArgs, TablesArgs,
+    AxisArg, BaselineArgs, EvalArgs, GeometryArgs, GridArgs, InputArgs, ModelArgs, NoiseArgs,
+    OutlierArg, OutlierArgs, OverwriteArgs, TablesArgs,
 };
 
 #[derive(Parser)]
@@ -164,25 +164,12 @@ pub struct DiagnoseArgs {
     /// and their errors are reported, the honest measure of an extension.
     #[arg(long, value_name = "FILE.csv")]
     pub validate: Vec<PathBuf>,
-    /// Seed of the baseline fit's genetic search.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Generations of the baseline fit's genetic search (it stops earlier when its refinement
-    /// reaches the noise floor).
-    #[arg(long, default_value_t = 60)]
-    pub generations: usize,
-    /// Population of the baseline fit's genetic search.
-    #[arg(long, default_value_t = 100)]
-    pub population: usize,
-    /// Simulation budget of each refinement.
-    #[arg(long, default_value_t = 3000)]
-    pub lm_budget: u64,
+    #[command(flatten)]
+    pub baseline: BaselineArgs,
     #[command(flatten)]
     pub eval: EvalArgs,
     #[command(flatten)]
     pub geometry: GeometryArgs,
-    #[command(flatten)]
-    pub noise: NoiseArgs,
     #[command(flatten)]
     pub tables: TablesArgs,
     /// Output directory (diagnosis.json, report.html, figures/, baseline/).
@@ -385,22 +372,10 @@ pub struct UpdateArgs {
     /// stay at the baseline fit's values.
     #[arg(long, value_name = "NAME,...", value_parser = factor_names)]
     pub free: Option<FactorNames>,
-    /// Seed of the baseline fit's genetic search.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Generations of the baseline fit's genetic search.
-    #[arg(long, default_value_t = 60)]
-    pub generations: usize,
-    /// Population of the baseline fit's genetic search.
-    #[arg(long, default_value_t = 100)]
-    pub population: usize,
-    /// Simulation budget of the baseline's refinement.
-    #[arg(long, default_value_t = 3000)]
-    pub lm_budget: u64,
+    #[command(flatten)]
+    pub baseline: BaselineArgs,
     #[command(flatten)]
     pub eval: EvalArgs,
-    #[command(flatten)]
-    pub noise: NoiseArgs,
     /// Also write the updated store as a DAVE-ML 2.0 model, DIR/store.dml: its tables, each
     /// correction's standard deviation as an uncertainty (normalPDF), and checkData
     /// (docs/daveml.md).

@@ -196,6 +196,44 @@ pub struct OverwriteArgs {
     pub overwrite: bool,
 }
 
+/// The baseline fit of a command that fits its releases before it works (diagnose, update).
+#[derive(clap::Args)]
+pub struct BaselineArgs {
+    /// Seed of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Generations of the baseline fit's genetic search (it stops earlier when its refinement
+    /// reaches the noise floor).
+    #[arg(long, default_value_t = 60)]
+    pub generations: usize,
+    /// Population of the baseline fit's genetic search.
+    #[arg(long, default_value_t = 100)]
+    pub population: usize,
+    /// Simulation budget of the baseline fit's refinement.
+    #[arg(long, default_value_t = 3000)]
+    pub lm_budget: u64,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+}
+
+impl BaselineArgs {
+    /// The baseline search the flags ask for: the study's GA, refined within the budget,
+    /// weighted by the noise levels given (any not given is estimated from the releases).
+    pub fn search(&self) -> sepval_fit::BaselineSearch {
+        sepval_fit::BaselineSearch {
+            ga: sepval_solve::ga::GaSettings {
+                population: self.population,
+                generations: self.generations,
+                seed: self.seed,
+                ..Default::default()
+            },
+            lm_budget: self.lm_budget,
+            sigma_pos_m: self.noise.sigma_pos_m,
+            sigma_att_deg: self.noise.sigma_att_deg,
+        }
+    }
+}
+
 /// The measurement noise that weights the goals (shared by every search command).
 #[derive(clap::Args)]
 pub struct NoiseArgs {

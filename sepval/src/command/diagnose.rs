@@ -8,7 +8,7 @@ use sepval_diagnose::{DiagnoseOptions, diagnose};
 use sepval_fit::inputs::Releases;
 use sepval_fit::out_dir::Request;
 
-use super::{baseline_search, clearance, evaluator_spec, notices, tell};
+use super::{clearance, evaluator_spec, notices, tell};
 use crate::cli::DiagnoseArgs;
 
 /// Runs `sepval diagnose`. The output directory is claimed (locked and checked) before anything
@@ -73,8 +73,7 @@ fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
         extension: given.model.extension.as_deref(),
         policy: given.outliers.policy(),
     };
-    let (g, a) = (&args.generations, args);
-    let search = baseline_search(a.seed, a.population, *g, a.lm_budget, &a.noise);
+    let search = args.baseline.search();
     let (job, options) =
         DiagnoseOptions::configure(&releases, &search, args.out.clone(), &mut tell())?;
     let options = DiagnoseOptions {

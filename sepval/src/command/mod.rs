@@ -91,29 +91,6 @@ pub fn several_jobs(args: &EvalArgs, command: &str, jobs: &str) -> Result<()> {
     Ok(evaluator_flags(args).several_jobs(command, jobs)?)
 }
 
-/// The baseline search of diagnose and update: the study's GA with `seed`, `population` and
-/// `generations`, refined with `lm_budget` simulations, weighted by the noise levels given
-/// (any not given is estimated from the releases).
-pub fn baseline_search(
-    seed: u64,
-    population: usize,
-    generations: usize,
-    lm_budget: u64,
-    noise: &crate::cli::NoiseArgs,
-) -> sepval_fit::BaselineSearch {
-    sepval_fit::BaselineSearch {
-        ga: sepval_solve::ga::GaSettings {
-            population,
-            generations,
-            seed,
-            ..Default::default()
-        },
-        lm_budget,
-        sigma_pos_m: noise.sigma_pos_m,
-        sigma_att_deg: noise.sigma_att_deg,
-    }
-}
-
 /// Where the libraries' words about what they read go (what `--outliers drop` left out):
 /// stderr, through the front end.
 pub fn tell() -> impl FnMut(String) {

@@ -9,7 +9,7 @@ use sepval_fit::inputs::Releases;
 use sepval_fit::out_dir::Request;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
-use super::{baseline_search, evaluator_spec, starter, tell};
+use super::{evaluator_spec, starter, tell};
 use crate::cli::{FactorNames, UpdateArgs};
 
 /// Runs `sepval update`. Every input is checked before the output directory is claimed or a
@@ -79,8 +79,7 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
         extension: given.model.extension.as_deref(),
         policy: given.outliers.policy(),
     };
-    let (g, a) = (&args.generations, args);
-    let search = baseline_search(a.seed, a.population, *g, a.lm_budget, &a.noise);
+    let search = args.baseline.search();
     let free = args
         .free
         .as_ref()
