@@ -355,17 +355,27 @@ pub type StartEvaluator<'a> =
 pub struct Counted<'a> {
     inner: &'a mut dyn Evaluator,
     count: u64,
+    simulations: u64,
 }
 
 impl<'a> Counted<'a> {
     /// `inner`, counted from 0.
     pub fn new(inner: &'a mut dyn Evaluator) -> Self {
-        Counted { inner, count: 0 }
+        Counted {
+            inner,
+            count: 0,
+            simulations: 0,
+        }
     }
 
     /// The candidates evaluated so far (one simulation each, over every event of the job).
     pub fn count(&self) -> u64 {
         self.count
+    }
+
+    /// The simulations asked for so far: each candidate flies every event of the job.
+    pub fn simulations(&self) -> u64 {
+        self.simulations
     }
 }
 
@@ -377,6 +387,7 @@ impl Evaluator for Counted<'_> {
     ) -> Result<Vec<Evaluation>, EvalError> {
         let out = self.inner.evaluate(batch, with_samples)?;
         self.count += batch.len() as u64;
+        self.simulations += (batch.len() * self.inner.job().events().len()) as u64;
         Ok(out)
     }
 

@@ -20,7 +20,9 @@
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
-use sepval_common::evaluation::{Candidate, EvalError, Evaluation, Evaluator, Event, Job, Outcome};
+use sepval_common::evaluation::{
+    Candidate, Counted, EvalError, Evaluation, Evaluator, Event, Job, Outcome,
+};
 use sepval_common::goals::residual;
 use sepval_common::propagator::Observation;
 use sepval_common::telemetry::Trajectory;
@@ -168,12 +170,12 @@ pub fn simulate(
             .sum::<usize>();
     let mut runner = Runner {
         job: &job,
-        evaluator,
+        evaluator: Counted::new(evaluator),
         progress,
         part,
         step: 0,
         steps,
-        evaluations: 0,
+        reruns: 0,
     };
     runner.progress.start("plan", Some(steps));
     let nominals: Vec<Candidate> = models.list.iter().map(|m| m.candidate).collect();
@@ -206,19 +208,21 @@ pub fn simulate(
         runs,
         flown,
         samples: job.events().iter().map(|e| e.data.len()).collect(),
-        evaluations: runner.evaluations,
+        evaluations: runner.evaluations(),
     })
 }
 
 /// Runs candidates in parts and keeps each one's samples per event.
 struct Runner<'a> {
     job: &'a Arc<Job>,
-    evaluator: &'a mut dyn Evaluator,
+    /// The evaluator, counting the simulations it is asked for.
+    evaluator: Counted<'a>,
     progress: &'a mut dyn ProgressObserver,
     part: usize,
     step: usize,
     steps: usize,
-    evaluations: u64,
+    /// Events re-run one by one in this process (a run that did not finish).
+    reruns: u64,
 }
 
 /// Per event, the samples of a run or why there are none.
@@ -227,6 +231,11 @@ type EventSamples = Vec<Result<Vec<Observation>, String>>;
 type EventColumns = Vec<Result<Vec<Vec<f64>>, String>>;
 
 impl Runner<'_> {
+    /// The simulations run: the evaluator's, and the events re-run in this process.
+    fn evaluations(&self) -> u64 {
+        self.evaluator.simulations() + self.reruns
+    }
+
     /// The samples of each candidate at each event.
     fn run(&mut self, batch: &[Candidate]) -> Result<Vec<EventSamples>, SimulateError> {
         let mut out = Vec::with_capacity(batch.len());
@@ -238,7 +247,6 @@ impl Runner<'_> {
 
     fn run_part(&mut self, chunk: &[Candidate]) -> Result<Vec<EventSamples>, SimulateError> {
         let evaluations = self.evaluator.evaluate(chunk, true)?;
-        self.evaluations += (chunk.len() * self.job.events().len()) as u64;
         let mut out = Vec::with_capacity(chunk.len());
         for (c, e) in chunk.iter().zip(evaluations) {
             out.push(self.per_event(c, e)?);
@@ -247,7 +255,7 @@ impl Runner<'_> {
         self.progress.progress(&Progress {
             step: self.step,
             steps: Some(self.steps),
-            evaluations: self.evaluations,
+            evaluations: self.evaluations(),
             best: [f64::NAN; 2],
         });
         Ok(out)
@@ -264,7 +272,7 @@ impl Runner<'_> {
             sepval_core::cancel::check().map_err(|_| EvalError::Interrupted)?;
             let one = Job::new(vec![event.clone()])?;
             let ev = one.evaluate_with_samples(c);
-            self.evaluations += 1;
+            self.reruns += 1;
             out.push(match (ev.outcome, ev.samples) {
                 (_, Some(mut s)) => Ok(s.remove(0)),
                 (Outcome::Diverged { t_s, .. }, None) => {

@@ -9,7 +9,9 @@
 //! A sample that diverges (the store tumbles, docs/model.md section 3) or fails has no
 //! trajectory; it is counted and left out of the bands.
 
-use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Event, Job, JobError, Outcome};
+use sepval_common::evaluation::{
+    Candidate, Counted, EvalError, Evaluator, Event, Job, JobError, Outcome,
+};
 use sepval_common::frames::wrap_deg;
 use sepval_common::propagator::Observation;
 use sepval_common::scenario::Scenario;
@@ -115,6 +117,7 @@ pub fn run_candidates(
     let samples = evaluator.job().sample_count().max(1);
     let part = (SAMPLE_BUDGET / samples).max(1);
     let steps = n.div_ceil(part);
+    let mut evaluator = Counted::new(evaluator);
     let mut runs = Runs {
         trajectories: Vec::with_capacity(n),
         evaluations: 0,
@@ -122,7 +125,7 @@ pub fn run_candidates(
     for (step, start) in (0..n).step_by(part).enumerate() {
         let batch: Vec<Candidate> = (start..(start + part).min(n)).map(candidate).collect();
         let evaluations = evaluator.evaluate(&batch, true)?;
-        runs.evaluations += batch.len() as u64;
+        runs.evaluations = evaluator.count();
         for e in evaluations {
             runs.trajectories.push(match (e.samples, e.outcome) {
                 (Some(s), _) => Ok(on_grid(&s[0], grid)),
