@@ -42,6 +42,18 @@ pub mod table;
 pub mod table_form;
 pub mod telemetry;
 
+/// Kernels and helpers inside the crate, re-exported for the model library's own tests
+/// (`common/tests/model/units`), which live outside it so that it compiles once when tested.
+/// Not part of the API.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::elementary::trig::MEDIUM_MAX;
+    pub use crate::elementary::{ASIN_A_MAX, ATAN_T_MAX, exp_dd};
+    pub use crate::model::term_lanes::TermLanes;
+    pub use crate::telemetry::lines::{BoundedLines, too_long};
+    pub use crate::telemetry::outliers::{fit, unwrap_deg};
+}
+
 /// The version of the simulation's arithmetic, raised whenever a change moves any bit of a
 /// result (recorded in checkpoints, so that one that no longer reproduces can say why):
 /// 1, the host's C library for the elementary functions (wire protocol 3 and earlier); 2,

@@ -340,6 +340,3 @@ pub fn weights(b: &[f64], x: f64) -> Vec<f64> {
     w[i + 1] = t;
     w
 }
-
-#[cfg(test)]
-mod tests;

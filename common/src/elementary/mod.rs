@@ -128,7 +128,7 @@ pub fn exp<R: Real>(x: R) -> R {
 
 /// e^(hi + lo) for a double-double argument (|lo| <= ulp(hi)), as [`exp`].
 #[inline(always)]
-fn exp_dd<R: Real>(hi: R, lo: R) -> R {
+pub fn exp_dd<R: Real>(hi: R, lo: R) -> R {
     exp_general(hi, lo)
 }
 
@@ -376,9 +376,10 @@ const ASIN_Q: [f64; 5] = [
     1.395_105_614_657_485_7e2,
     -4.918_853_881_490_881e1,
 ];
-/// Cephes's ranges without reduction: atan for |t| <= 0.66, asin for |a| <= 0.625.
-const ATAN_T_MAX: f64 = 0.66;
-const ASIN_A_MAX: f64 = 0.625;
+/// Cephes's range of atan without reduction: |t| <= 0.66.
+pub const ATAN_T_MAX: f64 = 0.66;
+/// Cephes's range of asin without reduction: |a| <= 0.625.
+pub const ASIN_A_MAX: f64 = 0.625;
 
 /// z P(z) / Q(z) of Cephes atan.c (for z = t^2 <= 0.66^2).
 #[inline(always)]
@@ -555,9 +556,6 @@ fn pair<T>(f: impl FnMut(usize) -> T) -> [T; 2] {
     std::array::from_fn(f)
 }
 
-mod trig;
+pub(crate) mod trig;
 
 pub use trig::{cos, sin, sin_cos};
-
-#[cfg(test)]
-mod tests;

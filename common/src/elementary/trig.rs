@@ -11,7 +11,7 @@ const PIO2_2: f64 = 6.077_100_506_303_966e-11;
 const PIO2_3: f64 = 2.022_266_248_711_166_5e-21;
 const PIO2_4: f64 = 8.478_427_660_368_9e-32;
 /// Above this |x| the reduction is Payne and Hanek's.
-pub(super) const MEDIUM_MAX: f64 = 1_048_576.0; // 2^20
+pub const MEDIUM_MAX: f64 = 1_048_576.0; // 2^20
 
 /// fdlibm `k_sin.c`: sin(x) ~ x + S1 x^3 + ... + S6 x^13 on [-pi/4, pi/4].
 const SIN: [f64; 6] = [

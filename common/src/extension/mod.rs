@@ -559,6 +559,3 @@ pub(crate) fn step<R: Real>(t_s: R, t_on_s: R) -> R {
         / (R::splat(1.0)
             + crate::elementary::exp(R::splat(-2.0) * (t_s - t_on_s) / R::splat(STEP_WIDTH_S)))
 }
-
-#[cfg(test)]
-mod tests;

@@ -41,20 +41,3 @@ impl EjectorCurve {
         f0 + (f1 - f0) * (s_m - s0) / (s1 - s0)
     }
 }
-
-#[cfg(test)]
-#[allow(clippy::float_cmp)] // these tests check exact values on purpose
-mod tests {
-    use super::*;
-
-    #[test]
-    fn linear_between_points() {
-        let c = EjectorCurve::new(&[[0.0, 100.0], [0.1, 50.0], [0.2, 50.0]]);
-        assert_eq!(c.force_n(0.0), 100.0);
-        assert!((c.force_n(0.05) - 75.0).abs() < 1e-12);
-        assert_eq!(c.force_n(0.1), 50.0);
-        assert_eq!(c.force_n(0.15), 50.0);
-        assert_eq!(c.force_n(0.3), 50.0);
-        assert_eq!(c.force_n(-1.0), 100.0);
-    }
-}

@@ -34,7 +34,7 @@ mod equations;
 pub mod flowfield;
 pub mod interference;
 pub mod tables;
-mod term_lanes;
+pub(crate) mod term_lanes;
 
 pub use dcm::Dcm;
 pub use equations::EquationsOfMotion;

@@ -504,6 +504,3 @@ mod validate;
 pub use flowfield::{FlowfieldSpec, MAX_STATIONS, MachScaling};
 
 pub use same_store::StoreDifference;
-
-#[cfg(test)]
-mod tests;

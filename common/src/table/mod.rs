@@ -474,7 +474,3 @@ pub use csv::*;
 pub use error::*;
 pub use excursion::*;
 pub use prepared::*;
-
-#[cfg(test)]
-#[allow(clippy::float_cmp)] // exact values on purpose: interpolation of representable data
-mod tests;

@@ -32,7 +32,7 @@ use sepval_core::limits::{MAX_SAMPLES, MAX_TELEMETRY_BYTES, MAX_TELEMETRY_LINE_B
 use sepval_core::units::M_PER_FT;
 
 mod error;
-mod lines;
+pub(crate) mod lines;
 pub mod outliers;
 pub use error::{Bound, TelemetryError};
 use lines::{BoundedLines, too_long as line_too_long};
@@ -158,7 +158,8 @@ impl Trajectory {
 
     /// Parses telemetry lines (without their `\n`), at most `max_samples` samples; `file`
     /// names the source in errors.
-    fn parse_lines(
+    #[doc(hidden)]
+    pub fn parse_lines(
         lines: impl Iterator<Item = std::io::Result<Vec<u8>>>,
         file: &str,
         max_samples: usize,
@@ -492,7 +493,3 @@ fn parse_header(fields: &[&str], line: usize, file: &str) -> Result<ColumnMap, T
     }
     Ok(out)
 }
-
-#[cfg(test)]
-#[allow(clippy::float_cmp)] // these tests check exact values on purpose
-mod tests;

@@ -137,7 +137,7 @@ pub fn without(t: &Trajectory, outliers: &[Outlier]) -> Trajectory {
 }
 
 /// Angles made continuous: each step taken the short way round.
-fn unwrap_deg(values: &[f64]) -> Vec<f64> {
+pub fn unwrap_deg(values: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(values.len());
     for (k, &v) in values.iter().enumerate() {
         match k {
@@ -217,20 +217,23 @@ fn in_channel(times: &[f64], values: &[f64], floor: f64) -> Vec<(usize, f64, f64
 /// A sample's departure from the quadratic through its neighbours, and the standard deviation
 /// of that departure in units of the noise (sqrt(1 + the prediction's variance factor)).
 #[derive(Debug, Clone, Copy)]
-struct Fit {
-    departure: f64,
-    spread: f64,
+pub struct Fit {
+    /// The value minus the quadratic's prediction.
+    pub departure: f64,
+    /// The departure's standard deviation in units of the noise.
+    pub spread: f64,
 }
 
 impl Fit {
-    fn score(&self) -> f64 {
+    /// The departure in units of its spread.
+    pub fn score(&self) -> f64 {
         self.departure / self.spread
     }
 }
 
 /// The fit of sample `k` from its [`NEIGHBOURS`] nearest valid samples (none when there are
 /// too few, or the quadratic is not determined).
-fn fit(times: &[f64], values: &[f64], valid: &[bool], k: usize) -> Option<Fit> {
+pub fn fit(times: &[f64], values: &[f64], valid: &[bool], k: usize) -> Option<Fit> {
     let mut before = (0..k).rev().filter(|&j| valid[j]);
     let mut after = (k + 1..values.len()).filter(|&j| valid[j]);
     let mut picked: Vec<usize> = Vec::with_capacity(NEIGHBOURS);
@@ -305,6 +308,3 @@ fn median(x: &mut [f64]) -> f64 {
     let (_, m, _) = x.select_nth_unstable_by(mid, f64::total_cmp);
     *m
 }
-
-#[cfg(test)]
-mod tests;

@@ -14,5 +14,6 @@ mod input_files;
 mod lanes;
 mod locators;
 mod tables;
+mod units;
 mod verification;
 mod wind;

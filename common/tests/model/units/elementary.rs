@@ -1,13 +1,16 @@
+//! The unit tests of `sepval_common::elementary`:
 //! The kernels against the standard library (dense sweeps, error reported), their special
-//! values, and the rule of [`crate::lanes`]: each lane of [`F64x4`] gives the scalar bits, in
+//! values, and the rule of [`sepval_common::lanes`]: each lane of [`F64x4`] gives the scalar bits, in
 //! the portable build and in the AVX2/FMA build the propagator dispatches to. The accuracy
 //! against a high-precision reference is `common/tests/model/elementary.rs`.
 
 #![allow(clippy::float_cmp)] // these tests check exact values on purpose
 
-use super::trig::MEDIUM_MAX;
-use super::*;
-use crate::lanes::F64x4;
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+
+use sepval_common::elementary::*;
+use sepval_common::internals::{ASIN_A_MAX, ATAN_T_MAX, MEDIUM_MAX, exp_dd};
+use sepval_common::lanes::F64x4;
 
 /// Distance from `b` in units in the last place of `b`.
 pub(super) fn ulps(a: f64, b: f64) -> f64 {
@@ -114,24 +117,24 @@ fn same_bits(a: f64, b: f64) -> bool {
 macro_rules! kernels {
     ($($name:ident: |$($arg:ident),+| $body:expr;)+) => {
         mod scalar {
-            use super::super::*;
+            use sepval_common::elementary::*;
             $(pub fn $name($($arg: f64),+) -> f64 { $body })+
         }
         mod lanes4 {
-            use super::super::*;
-            use crate::lanes::F64x4;
+            use sepval_common::elementary::*;
+            use sepval_common::lanes::F64x4;
             $(pub fn $name($($arg: F64x4),+) -> F64x4 { $body })+
         }
         #[cfg(target_arch = "x86_64")]
         mod avx2 {
-            use super::super::*;
-            use crate::lanes::F64x4;
+            use sepval_common::elementary::*;
+            use sepval_common::lanes::F64x4;
             $(
                 #[target_feature(enable = "avx2,fma")]
                 pub fn $name($($arg: F64x4),+) -> F64x4 { $body }
             )+
             pub mod scalar {
-                use super::super::super::*;
+                use sepval_common::elementary::*;
                 $(
                     #[target_feature(enable = "avx2,fma")]
                     pub fn $name($($arg: f64),+) -> f64 { $body }
@@ -142,15 +145,15 @@ macro_rules! kernels {
 }
 
 kernels! {
-    exp: |x| crate::elementary::exp(x);
-    ln: |x| crate::elementary::ln(x);
-    sin: |x| crate::elementary::sin(x);
-    cos: |x| crate::elementary::cos(x);
-    asin: |x| crate::elementary::asin(x);
-    atan2: |y, x| crate::elementary::atan2(y, x);
-    pow: |x, y| crate::elementary::pow(x, y);
-    flow_alpha: |w, u, a| atan2_asin(w, u, a, a * a, crate::lanes::Real::splat(1.0)).0;
-    flow_beta: |w, u, a| atan2_asin(w, u, a, a * a, crate::lanes::Real::splat(1.0)).1;
+    exp: |x| sepval_common::elementary::exp(x);
+    ln: |x| sepval_common::elementary::ln(x);
+    sin: |x| sepval_common::elementary::sin(x);
+    cos: |x| sepval_common::elementary::cos(x);
+    asin: |x| sepval_common::elementary::asin(x);
+    atan2: |y, x| sepval_common::elementary::atan2(y, x);
+    pow: |x, y| sepval_common::elementary::pow(x, y);
+    flow_alpha: |w, u, a| atan2_asin(w, u, a, a * a, sepval_common::lanes::Real::splat(1.0)).0;
+    flow_beta: |w, u, a| atan2_asin(w, u, a, a * a, sepval_common::lanes::Real::splat(1.0)).1;
 }
 
 fn avx2_available() -> bool {

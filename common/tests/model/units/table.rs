@@ -1,4 +1,8 @@
-use super::*;
+//! The unit tests of `sepval_common::table`.
+
+#![allow(clippy::float_cmp)]
+
+use sepval_common::table::*;
 
 fn at(alpha_rad: f64, beta_rad: f64) -> Inputs {
     Inputs {

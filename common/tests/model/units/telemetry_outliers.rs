@@ -1,8 +1,12 @@
-use super::*;
-use crate::effects::EffectSet;
-use crate::scenario::Scenario;
-use crate::simulation::{Simulator, sample_times};
-use crate::synthetic::synthetic_flight_test;
+//! The unit tests of `sepval_common::telemetry::outliers`.
+
+use sepval_common::effects::EffectSet;
+use sepval_common::internals::{fit, unwrap_deg};
+use sepval_common::scenario::Scenario;
+use sepval_common::simulation::{Simulator, sample_times};
+use sepval_common::synthetic::synthetic_flight_test;
+use sepval_common::telemetry::Trajectory;
+use sepval_common::telemetry::outliers::*;
 use sepval_core::factors::Factors;
 
 /// A release of the default store at Mach `mach` and alpha `alpha_deg`, `rate_hz`, noise from
@@ -128,7 +132,7 @@ fn clean_records_trip_nothing() {
         assert!(find(&t).is_empty(), "seed {seed}");
         closest = closest.max(closest_call(&t));
     }
-    let t = crate::synthetic::default_flight_test();
+    let t = sepval_common::synthetic::default_flight_test();
     assert!(find(&t).is_empty());
     // Measured 0.787 (2026-11-26): the floors leave about a fifth of themselves.
     println!("closest call: {closest:.3} of a floor");

@@ -1,4 +1,6 @@
-use super::*;
+//! The unit tests of `sepval_common::extension`.
+
+use sepval_common::extension::*;
 
 fn input() -> TermInput {
     TermInput {

@@ -1,4 +1,7 @@
-use super::*;
+//! The unit tests of `sepval_common::correction`.
+
+use sepval_common::correction::*;
+use sepval_common::table::Variable;
 
 fn record(field: &str, variable: &str, breakpoints: &[f64]) -> CorrectionRecord {
     CorrectionRecord {

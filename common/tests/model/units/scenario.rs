@@ -1,4 +1,7 @@
-use super::*;
+//! The unit tests of `sepval_common::scenario`.
+
+use sepval_common::scenario::*;
+use sepval_core::factors::{Factor, FactorTable};
 use sepval_core::units::*;
 
 #[test]

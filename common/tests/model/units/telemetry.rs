@@ -1,4 +1,10 @@
-use super::*;
+//! The unit tests of `sepval_common::telemetry`.
+
+#![allow(clippy::float_cmp)]
+
+use std::path::Path;
+
+use sepval_common::telemetry::*;
 
 const GOOD: &str = "# event = drop 1\n# mach: 0.95\n# free text\n\
     t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n\
