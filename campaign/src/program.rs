@@ -389,6 +389,26 @@ impl Campaign {
         ))
     }
 
+    /// What `sepval campaign status` says: the answer, in words, and the releases next.json
+    /// plans, if any.
+    pub fn status_lines(&self) -> Result<String, CampaignError> {
+        let mut s = format!("{}\n{}\n", page::headline(&self.file), self.file.words);
+        let next = self.dir.join("next.json");
+        if next.is_file() {
+            let n: NextFile = crate::record::read_json(&next, NEXT_FORMAT)?;
+            for r in &n.releases {
+                s.push_str(&format!(
+                    "next:      Mach {}, altitude {} m, alpha {} deg: {}\n",
+                    page::number(r.mach),
+                    page::number(r.altitude_m),
+                    page::number(r.alpha_deg),
+                    r.why
+                ));
+            }
+        }
+        Ok(s)
+    }
+
     /// Plans `count` releases and writes next.json.
     pub fn next(&self, count: usize) -> Result<NextFile, CampaignError> {
         let p = self.plan(count)?;

@@ -130,3 +130,23 @@ fn flown(s: &Sweep) -> Vec<(f64, f64)> {
         })
         .collect()
 }
+
+impl EnvelopeFile {
+    /// What `sepval envelope` says on the terminal of the envelope written in `out`, with its
+    /// `summary`: the answer, a line per row of the map, the work done, where the report is.
+    pub fn terminal(&self, summary: &crate::summary::Summary, out: &std::path::Path) -> String {
+        let mut s = format!("envelope:  {}\n", summary.headline);
+        for l in &summary.lines {
+            s.push_str(&format!("           {l}\n"));
+        }
+        s.push_str(&format!(
+            "conditions: {} ({} resumed), {} samples each, {} simulations, {:.1} s\n",
+            self.conditions, self.resumed, self.provenance.samples, self.evaluations, self.wall_s
+        ));
+        s.push_str(&format!(
+            "report:    {}\n",
+            out.join("report.html").display()
+        ));
+        s
+    }
+}

@@ -51,3 +51,27 @@ pub struct PanelData {
     /// The reconstruction's windows as evidence: (variable, value, standard deviation).
     pub evidence: Vec<(f64, f64, f64)>,
 }
+
+impl Update {
+    /// What `sepval update` says on the terminal of the update written in `out`: the verdict,
+    /// what the releases cannot tell, where the store, the factors and the report are.
+    pub fn summary(&self, out: &std::path::Path) -> String {
+        let mut s = format!("update:    {}\n", self.file.verdict);
+        for c in &self.file.cannot_tell {
+            s.push_str(&format!("open:      {c}\n"));
+        }
+        s.push_str(&format!(
+            "store:     {} ({} table files), factors {}\n",
+            out.join("scenario.toml").display(),
+            self.store.files.len(),
+            out.join("factors.json").display()
+        ));
+        s.push_str(&format!(
+            "report:    {} ({} simulations, {:.1} s)\n",
+            out.join("report.html").display(),
+            self.file.evaluations,
+            self.file.wall_s
+        ));
+        s
+    }
+}

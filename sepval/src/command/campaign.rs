@@ -135,21 +135,6 @@ fn add(a: CampaignAddArgs) -> Result<()> {
 
 fn status(a: CampaignStatusArgs) -> Result<()> {
     let c = open(&a.campaign, 1)?;
-    say!("{}", page::headline(&c.file));
-    say!("{}", c.file.words);
-    let next = a.campaign.join("next.json");
-    if next.is_file() {
-        let n: sepval_campaign::NextFile =
-            sepval_campaign::record::read_json(&next, sepval_campaign::NEXT_FORMAT)?;
-        for r in &n.releases {
-            say!(
-                "next:      Mach {}, altitude {} m, alpha {} deg: {}",
-                page::number(r.mach),
-                page::number(r.altitude_m),
-                page::number(r.alpha_deg),
-                r.why
-            );
-        }
-    }
+    crate::front::out(&c.status_lines()?);
     Ok(())
 }

@@ -60,19 +60,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     let (file, summary) = EnvelopeFile::of(&sweep_inputs, swept, criterion_mm, provenance, wall_s);
     write_outputs(&sweep_inputs.grid, &file, &args.out)?;
     remove_progress(&args.out);
-    say!("envelope:  {}", summary.headline);
-    for l in &summary.lines {
-        say!("           {l}");
-    }
-    say!(
-        "conditions: {} ({} resumed), {} samples each, {} simulations, {:.1} s",
-        file.conditions,
-        file.resumed,
-        file.provenance.samples,
-        file.evaluations,
-        file.wall_s
-    );
-    say!("report:    {}", args.out.join("report.html").display());
+    crate::front::out(&file.terminal(&summary, &args.out));
     drop(run_dir);
     Ok(())
 }

@@ -45,22 +45,7 @@ pub fn run(args: UpdateArgs) -> Result<()> {
         say!("daveml:    {}", path.display());
     }
     drop(run_dir);
-    say!("update:    {}", u.file.verdict);
-    for c in &u.file.cannot_tell {
-        say!("open:      {c}");
-    }
-    say!(
-        "store:     {} ({} table files), factors {}",
-        args.out.join("scenario.toml").display(),
-        u.store.files.len(),
-        args.out.join("factors.json").display()
-    );
-    say!(
-        "report:    {} ({} simulations, {:.1} s)",
-        args.out.join("report.html").display(),
-        u.file.evaluations,
-        u.file.wall_s
-    );
+    crate::front::out(&u.summary(&args.out));
     Ok(())
 }
 
