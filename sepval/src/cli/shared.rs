@@ -23,6 +23,19 @@ pub struct InputArgs {
     pub outliers: OutlierArgs,
 }
 
+impl InputArgs {
+    /// The releases these flags fit, and `validate` held out, each read with `--outliers`.
+    pub fn releases<'a>(&'a self, validate: &'a [PathBuf]) -> sepval_fit::inputs::Releases<'a> {
+        sepval_fit::inputs::Releases {
+            data: &self.data,
+            validate,
+            scenario: self.model.scenario.as_deref(),
+            extension: self.model.extension.as_deref(),
+            policy: self.outliers.policy(),
+        }
+    }
+}
+
 /// What is done with outliers in the telemetry a command reads (docs/model.md section 6).
 #[derive(clap::Args)]
 pub struct OutlierArgs {

@@ -5,7 +5,6 @@ use std::sync::Arc;
 use anyhow::Result;
 use sepval_common::evaluation::Job;
 use sepval_diagnose::{DiagnoseOptions, diagnose};
-use sepval_fit::inputs::Releases;
 use sepval_fit::out_dir::Request;
 
 use super::{clearance, evaluator_spec, notices, tell};
@@ -65,14 +64,7 @@ struct DiagnoseConfig {
 
 /// The flags as a validated configuration.
 fn configure(args: &DiagnoseArgs) -> Result<DiagnoseConfig> {
-    let given = &args.inputs;
-    let releases = Releases {
-        data: &given.data,
-        validate: &args.validate,
-        scenario: given.model.scenario.as_deref(),
-        extension: given.model.extension.as_deref(),
-        policy: given.outliers.policy(),
-    };
+    let releases = args.inputs.releases(&args.validate);
     let search = args.baseline.search();
     let (job, options) =
         DiagnoseOptions::configure(&releases, &search, args.out.clone(), &mut tell())?;

@@ -5,7 +5,6 @@ use std::sync::Arc;
 
 use anyhow::{Result, bail};
 use sepval_common::evaluation::Job;
-use sepval_fit::inputs::Releases;
 use sepval_fit::out_dir::Request;
 use sepval_update::{UpdateOptions, update, write_outputs};
 
@@ -56,14 +55,7 @@ fn configure(args: &UpdateArgs) -> Result<(UpdateOptions, Job)> {
             "--data FILE.csv is required (repeat it for each release): the releases that update the store's data"
         );
     }
-    let given = &args.inputs;
-    let releases = Releases {
-        data: &given.data,
-        validate: &args.validate,
-        scenario: given.model.scenario.as_deref(),
-        extension: given.model.extension.as_deref(),
-        policy: given.outliers.policy(),
-    };
+    let releases = args.inputs.releases(&args.validate);
     let search = args.baseline.search();
     let free = args
         .free
