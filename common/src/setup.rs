@@ -10,7 +10,7 @@
 
 use sepval_core::factors::Factors;
 
-use crate::correction::{CorrectionRun, CorrectionValues};
+use crate::correction::{CorrectionError, CorrectionRun, CorrectionValues};
 use crate::effects::EffectSet;
 use crate::extension::TermSet;
 use crate::model::{Model, ModelError, RunSetup};
@@ -81,6 +81,10 @@ impl RunSetup {
         a.cl_p += d[4];
         a.cm_q += d[5];
         a.cn_r += d[6];
+        if let Some(field) = run.flowfield {
+            let changed = field.with_shape_change(folded.field_shape);
+            run.flowfield = Some(changed.map_err(CorrectionError::Values)?);
+        }
         run.corrections = corrections;
         Ok(run)
     }

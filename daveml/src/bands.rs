@@ -38,7 +38,8 @@ pub fn bands(s: &Scenario, corrections: &[CorrectionSpread]) -> Result<Vec<Band>
             field: c.field.clone(),
             message,
         };
-        let target = Target::of_field(&c.field).ok_or_else(|| refuse("not a field".into()))?;
+        let target = Target::table_of_field(&c.field)
+            .ok_or_else(|| refuse("not a field of the store's tables".into()))?;
         let variable = Variable::ALL
             .into_iter()
             .find(|v| v.key() == c.variable)

@@ -57,6 +57,9 @@ pub fn kind_of(t: Target) -> Kind {
         Target::Static(_) => Kind::Static,
         Target::Derivative(_) => Kind::Derivative,
         Target::Interference(_) => Kind::Interference,
+        Target::Field(_) => unreachable!(
+            "the flowfield's shape is not a table: DAVE-ML carries the tables (Target::all)"
+        ),
     }
 }
 

@@ -179,7 +179,7 @@ impl Map {
             map.roles.insert(name, Role::Input(v));
         }
         for (name, o) in parsed.outputs {
-            let target = Target::of_field(&o.field).ok_or_else(|| {
+            let target = Target::table_of_field(&o.field).ok_or_else(|| {
                 err(format!(
                     "[outputs] {name}: field `{}` is not a field of the scenario's tables (aero.ca0, aero.cy ... aero.cn, aero.cz_alpha_per_rad ... aero.cn_r_per_rad, interference.dcx0 ... interference.dcn0)",
                     o.field

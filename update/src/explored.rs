@@ -16,7 +16,7 @@
 //!   other counted once). A static coefficient over Mach needs two of them (one would be a
 //!   constant); a derivative may be corrected at one (a constant change of its slope).
 
-use sepval_common::correction::{Derivative, Target};
+use sepval_common::correction::{Derivative, FieldShape, Target};
 use sepval_common::evaluation::Job;
 use sepval_common::table::Variable;
 use sepval_diagnose::Sample;
@@ -134,6 +134,12 @@ impl Proposal {
             Target::Static(k) => AXES[k].to_string(),
             Target::Interference(k) => format!("interference {}", INCREMENTS[k]),
             Target::Derivative(d) => derivative_name(d).to_string(),
+            Target::Field(FieldShape::HalfDepth) => {
+                return "the flowfield's half depth (1 / L_z)".to_string();
+            }
+            Target::Field(FieldShape::Reversal) => {
+                return "the flowfield's reversal depth (1 / z_r)".to_string();
+            }
         };
         let over = match self.variable {
             Variable::Distance => "distance",
@@ -171,6 +177,24 @@ fn even(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     (0..n)
         .map(|j| lo + (hi - lo) * j as f64 / (n - 1) as f64)
         .collect()
+}
+
+/// The corrections of the flowfield's shape (docs/update.md section 15.3a), when the scenario
+/// has a field: its inverse half depth and inverse reversal depth, each one constant (a field
+/// is the aircraft's, one shape for every release), at the first release's Mach.
+pub fn field_proposals(explored: &Explored) -> Vec<Proposal> {
+    if !explored.flowfield {
+        return Vec::new();
+    }
+    let mach = explored.machs.first().copied().unwrap_or(0.0);
+    FieldShape::ALL
+        .map(|part| Proposal {
+            target: Target::Field(part),
+            variable: Variable::Mach,
+            breakpoints: vec![mach],
+            pinned: vec![false],
+        })
+        .to_vec()
 }
 
 /// Every correction of axis `axis` (0 CA, ..., 5 Cn) that the explored ranges allow.

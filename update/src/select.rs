@@ -259,8 +259,9 @@ pub fn select(s: &Setting, start: &mut StartEvaluator<'_>) -> Result<Selected> {
         }
         let mut record = RoundRecord::of(round, &screening, current.cv);
         drop(evaluator);
-        let Some((best, others)) = round_trials(s, start, &current, &screening, &mut evaluations)?
-        else {
+        let shape = field_picks(&explored, &current);
+        let trials = round_trials(s, start, &current, &screening, &shape, &mut evaluations)?;
+        let Some((best, others)) = trials else {
             rounds.push(record);
             evaluator = start_with(s, start, &current)?;
             break;
@@ -397,14 +398,39 @@ fn start_with(
     start(job).map_err(UpdateError::Start)
 }
 
-/// The round's picks refitted side by side (each added to the current model, in one job that
-/// holds them all, the others held at 0): the best by its cross-validated chi-square, and the
-/// others; `None` when the screening picked nothing.
+/// The corrections of the flowfield's shape (docs/update.md section 15.3a) that `current` does
+/// not hold yet, as picks of every round: not screened (the field's shape acts on every axis
+/// through the stations, which the linearised screening of one axis's increments does not
+/// see), refitted beside the screening's picks and kept by the same rule; no penalty (one
+/// constant each).
+fn field_picks(explored: &Explored, current: &Model) -> Vec<Pick> {
+    crate::explored::field_proposals(explored)
+        .into_iter()
+        .filter(|p| {
+            !current
+                .corrections
+                .proposals
+                .iter()
+                .any(|q| q.target == p.target)
+        })
+        .map(|proposal| Pick {
+            proposal,
+            gain: 0.0,
+            lambda: 0.0,
+            scale: 0.0,
+        })
+        .collect()
+}
+
+/// The round's picks (the screening's, then `shape`'s) refitted side by side (each added to
+/// the current model, in one job that holds them all, the others held at 0): the best by its
+/// cross-validated chi-square, and the others; `None` when there is none.
 fn round_trials(
     s: &Setting,
     start: &mut StartEvaluator<'_>,
     current: &Model,
     screening: &Screening,
+    shape: &[Pick],
     evaluations: &mut u64,
 ) -> Result<Option<(Model, Vec<Model>)>> {
     let mut picks: Vec<&Pick> = Vec::new();
@@ -414,7 +440,7 @@ fn round_trials(
         .iter()
         .map(|p| p.breakpoints.len())
         .sum();
-    for p in &screening.picks {
+    for p in screening.picks.iter().chain(shape) {
         if values + p.proposal.breakpoints.len() <= MAX_CORRECTION_VALUES {
             values += p.proposal.breakpoints.len();
             picks.push(p);

@@ -3,7 +3,7 @@
 //! penalty on the values as rows appended to the residual vector.
 
 use nalgebra::DMatrix;
-use sepval_common::correction::{Correction, CorrectionValues, Derivative, Target};
+use sepval_common::correction::{Correction, CorrectionValues, Derivative, FieldShape, Target};
 use sepval_common::evaluation::Candidate;
 use sepval_common::model::Model;
 use sepval_core::factors::{Factor, FactorTable, Factors};
@@ -55,8 +55,8 @@ pub struct UpdateSpace {
     corrections: Vec<Proposal>,
     /// The penalty's square root: (rows, free values); the residual vector gains L v.
     root: DMatrix<f64>,
-    /// Each correction's bound on its values (either sign).
-    bounds: Vec<f64>,
+    /// Each correction's bounds on its values (lowest, highest).
+    bounds: Vec<(f64, f64)>,
 }
 
 impl UpdateSpace {
@@ -86,20 +86,15 @@ impl UpdateSpace {
             params.push(Factor::NAMES[i], "-", f.min, f.max);
         }
         for p in corrections {
-            let bound = bound(model, p.target);
+            let (lo, hi) = bound(model, p.target);
             for (k, (&b, &pinned)) in p.breakpoints.iter().zip(&p.pinned).enumerate() {
                 if !pinned {
-                    let unit = if matches!(p.target, Target::Derivative(_)) {
-                        "1/rad"
-                    } else {
-                        "-"
+                    let unit = match p.target {
+                        Target::Derivative(_) => "1/rad",
+                        Target::Field(_) => "1/m",
+                        _ => "-",
                     };
-                    params.push(
-                        format!("{}[{k}]@{b}", p.target.field()),
-                        unit,
-                        -bound,
-                        bound,
-                    );
+                    params.push(format!("{}[{k}]@{b}", p.target.field()), unit, lo, hi);
                 }
             }
         }
@@ -126,8 +121,8 @@ impl UpdateSpace {
         }
     }
 
-    /// The bound on correction `k`'s values (either sign).
-    pub fn bound(&self, k: usize) -> f64 {
+    /// The bounds on correction `k`'s values (lowest, highest).
+    pub fn bounds(&self, k: usize) -> (f64, f64) {
         self.bounds[k]
     }
 
@@ -271,7 +266,7 @@ pub fn taken_over(corrections: &[Proposal]) -> Vec<usize> {
         .filter(|p| p.free_values() > 0)
         .filter_map(|p| match p.target {
             Target::Static(k) => Some(OFFSETS[k].index()),
-            Target::Interference(_) | Target::Derivative(_) => None,
+            Target::Interference(_) | Target::Derivative(_) | Target::Field(_) => None,
         })
         .collect()
 }
@@ -298,12 +293,15 @@ pub fn penalty_root(b: &[f64]) -> DMatrix<f64> {
     root
 }
 
-/// The bound of a correction of `target` on `model`'s scenario: the larger of a floor and twice
-/// the size of what it corrects at the flight condition.
-fn bound(model: &Model, target: Target) -> f64 {
+/// The bounds of a correction of `target` on `model`'s scenario: for the aerodynamic data,
+/// either sign of the larger of a floor and twice the size of what it corrects at the flight
+/// condition; for the flowfield's shape ([`field_bounds`]), what keeps it a field that decays.
+fn bound(model: &Model, target: Target) -> (f64, f64) {
+    let symmetric = |b: f64| (-b, b);
     let a = &model.aero_at_mach;
     match target {
-        Target::Static(_) => STATIC_BOUND,
+        Target::Field(part) => field_bounds(model, part),
+        Target::Static(_) => symmetric(STATIC_BOUND),
         Target::Derivative(d) => {
             let base = match d {
                 Derivative::CzAlpha => a.cz_alpha_per_rad,
@@ -314,10 +312,36 @@ fn bound(model: &Model, target: Target) -> f64 {
                 Derivative::CmQ => a.cm_q_per_rad,
                 Derivative::CnR => a.cn_r_per_rad,
             };
-            DERIVATIVE_BOUND.max(2.0 * base.abs())
+            symmetric(DERIVATIVE_BOUND.max(2.0 * base.abs()))
         }
         Target::Interference(k) => {
-            INTERFERENCE_BOUND.max(2.0 * model.interference_at_carriage[k].abs())
+            symmetric(INTERFERENCE_BOUND.max(2.0 * model.interference_at_carriage[k].abs()))
+        }
+    }
+}
+
+/// The depths \[m\] between which a corrected flowfield's half depth and reversal depth may
+/// lie: from a tenth of the store's diameter (a field halving closer to carriage than that is
+/// not resolved by stations along the store) to a hundred metres (no decay or reversal within
+/// any release: an inverse of 0.01 per m).
+pub const FIELD_DEPTH_M: (f64, f64) = (0.05, 100.0);
+
+/// The bounds of a correction of the flowfield's `part` (it adds to the inverse depth): the
+/// corrected half depth within [`FIELD_DEPTH_M`]; the corrected reversal depth beyond its
+/// shallowest, or none (an inverse of 0).
+fn field_bounds(model: &Model, part: FieldShape) -> (f64, f64) {
+    let Some(field) = model.scenario().flowfield.as_ref() else {
+        return (0.0, 0.0);
+    };
+    let (shallowest, deepest) = FIELD_DEPTH_M;
+    match part {
+        FieldShape::HalfDepth => {
+            let inverse = 1.0 / field.half_depth_m;
+            (1.0 / deepest - inverse, 1.0 / shallowest - inverse)
+        }
+        FieldShape::Reversal => {
+            let inverse = field.reversal_m.map_or(0.0, |z_r| 1.0 / z_r);
+            (-inverse, 1.0 / shallowest - inverse)
         }
     }
 }

@@ -13,7 +13,7 @@
 
 use std::path::PathBuf;
 
-use sepval_common::correction::{Correction, Derivative, Target, interpolate};
+use sepval_common::correction::{Correction, Derivative, FieldShape, Target, interpolate};
 use sepval_common::model::InterferenceDecay;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{
@@ -40,6 +40,9 @@ fn kind(target: Target) -> Kind {
         Target::Static(_) => Kind::Static,
         Target::Derivative(_) => Kind::Derivative,
         Target::Interference(_) => Kind::Interference,
+        Target::Field(_) => {
+            unreachable!("the flowfield's shape is not a table (Target::all lists the tables)")
+        }
     }
 }
 
@@ -56,6 +59,9 @@ fn current(s: &Scenario, target: Target) -> Coefficient {
         ),
         Target::Derivative(d) => value(derivative(a, d).map(|c| &c.value)),
         Target::Interference(k) => s.interference.increments()[k].1.value.clone(),
+        Target::Field(_) => {
+            unreachable!("the flowfield's shape is not a table (Target::all lists the tables)")
+        }
     }
 }
 
@@ -101,7 +107,36 @@ fn set(s: &mut Scenario, target: Target, c: Coefficient) {
             }
         }
         Target::Interference(k) => *s.interference.increments_mut()[k].1 = tabulated(c),
+        Target::Field(_) => {
+            unreachable!("the flowfield's shape is not a table (Target::all lists the tables)")
+        }
     }
+}
+
+/// The flowfield's `part` of `s` corrected by `change` \[1/m\], added to its inverse (a
+/// constant: the one breakpoint's value): the half depth 1 / (1 / L_z + change); the reversal
+/// depth 1 / (1 / z_r + change), or none when that is 0.
+fn set_field_shape(s: &mut Scenario, part: FieldShape, change: f64) -> Result<(), String> {
+    let Some(field) = s.flowfield.as_mut() else {
+        return Err("the scenario has no [flowfield]".into());
+    };
+    match part {
+        FieldShape::HalfDepth => {
+            let inverse = 1.0 / field.half_depth_m + change;
+            if !(inverse > 0.0) {
+                return Err(format!("1 / half_depth_m would be {inverse} per m"));
+            }
+            field.half_depth_m = 1.0 / inverse;
+        }
+        FieldShape::Reversal => {
+            let inverse = field.reversal_m.map_or(0.0, |z_r| 1.0 / z_r) + change;
+            if inverse < 0.0 {
+                return Err(format!("1 / reversal_m would be {inverse} per m"));
+            }
+            field.reversal_m = (inverse > 0.0).then(|| 1.0 / inverse);
+        }
+    }
+    Ok(())
 }
 
 /// Sorted union of breakpoint lists.
@@ -208,6 +243,14 @@ pub fn updated_store(
             message,
         })?;
         set(&mut s, target, c);
+    }
+    for (c, v) in corrections {
+        if let Target::Field(part) = c.target {
+            set_field_shape(&mut s, part, v[0]).map_err(|message| UpdateError::Merge {
+                field: c.target.field(),
+                message,
+            })?;
+        }
     }
     s.validate("the updated store")
         .map_err(UpdateError::Store)?;

@@ -85,6 +85,10 @@ pub fn verdict(file: &UpdateFile) -> String {
             .corrections
             .iter()
             .map(|c| {
+                if c.field.starts_with("flowfield.") {
+                    // The aircraft's field: one shape for every release, not a range.
+                    return format!("{} (one for every release)", c.name);
+                }
                 format!(
                     "{} ({} to {})",
                     c.name,
@@ -165,14 +169,14 @@ pub fn notes(selected: &Selected, uncertainty: &Uncertainty, file: &UpdateFile) 
     }
     let values = model.space.values(&model.fit.lm.x);
     for (k, c) in model.space.corrections().iter().enumerate() {
-        if values[k]
-            .iter()
-            .any(|v| v.abs() >= 0.999 * model.space.bound(k))
-        {
+        let (lo, hi) = model.space.bounds(k);
+        let near = |v: f64, b: f64| (v - b).abs() <= 5e-4 * (hi - lo);
+        if values[k].iter().any(|&v| near(v, lo) || near(v, hi)) {
             out.push(format!(
-                "{} reaches the bound of its values (±{}): the data want a larger change than the update allows",
+                "{} reaches a bound of its values ({} to {}): the data want a larger change than the update allows",
                 c.name(),
-                number(model.space.bound(k), 3)
+                number(lo, 3),
+                number(hi, 3)
             ));
         }
     }

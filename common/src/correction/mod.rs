@@ -23,6 +23,13 @@
 //! | `aero.cy` ... `aero.cn` | `mach`, `alpha_deg`, `beta_deg` | CY += c, ... |
 //! | `aero.cz_alpha_per_rad` ... `aero.cn_r_per_rad` | `mach` | the derivative += c |
 //! | `interference.dcx0` ... `interference.dcn0` | `distance_m` | the increment += c, times its multiplier |
+//! | `flowfield.half_depth_m`, `flowfield.reversal_m` | `mach` | 1 / L_z += c, 1 / z_r += c \[1/m\] |
+//!
+//! The last two change the shape of the aircraft's flowfield (docs/model.md section 3b), the
+//! depth below carriage at which it has halved and where it changes sign, through their
+//! inverses, so that a correction is a smooth change of g(z) = (1 - z / z_r) / (1 + z / L_z)
+//! whatever its size (an inverse of 0: no decay, no reversal); a scenario with such a correction
+//! must have a `[flowfield]`.
 //!
 //! Mach is the flight condition's, fixed for a run, so a correction over Mach is folded into the
 //! run's constants when it is set up ([`CorrectionRun::new`] returns them as [`Folded`]); the
@@ -93,6 +100,31 @@ pub enum Target {
     Derivative(Derivative),
     /// An interference increment: 0 dCX, ..., 5 dCn.
     Interference(usize),
+    /// The shape of the aircraft's flowfield (docs/model.md section 3b).
+    Field(FieldShape),
+}
+
+/// A part of the flowfield's shape a correction may change, through its inverse.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FieldShape {
+    /// The depth at which the field has halved, L_z: the correction adds to 1 / L_z \[1/m\].
+    HalfDepth,
+    /// The depth at which it changes sign, z_r: the correction adds to 1 / z_r \[1/m\] (0:
+    /// none).
+    Reversal,
+}
+
+impl FieldShape {
+    /// Both parts, in the scenario's order.
+    pub const ALL: [FieldShape; 2] = [FieldShape::HalfDepth, FieldShape::Reversal];
+
+    /// Its scenario field's name within `[flowfield]`.
+    pub fn key(self) -> &'static str {
+        match self {
+            FieldShape::HalfDepth => "half_depth_m",
+            FieldShape::Reversal => "reversal_m",
+        }
+    }
 }
 
 /// Names of the static coefficients' fields within `[aero]`, CA first.
@@ -101,7 +133,8 @@ const STATIC_KEYS: [&str; 6] = ["ca0", "cy", "cz", "cl", "cm", "cn"];
 const INTERFERENCE_KEYS: [&str; 6] = ["dcx0", "dcy0", "dcz0", "dcl0", "dcm0", "dcn0"];
 
 impl Target {
-    /// Every target, in the order of the scenario's fields.
+    /// Every target of the store's aerodynamic data (its tables), in the order of the
+    /// scenario's fields.
     pub fn all() -> Vec<Target> {
         (0..6)
             .map(Target::Static)
@@ -110,18 +143,32 @@ impl Target {
             .collect()
     }
 
+    /// Every target, the flowfield's shape after the aerodynamic data.
+    pub fn every() -> Vec<Target> {
+        let mut out = Target::all();
+        out.extend(FieldShape::ALL.map(Target::Field));
+        out
+    }
+
     /// The field's TOML path, e.g. `aero.cm` or `interference.dcz0`.
     pub fn field(self) -> String {
         match self {
             Target::Static(k) => format!("aero.{}", STATIC_KEYS[k]),
             Target::Derivative(d) => format!("aero.{}", d.key()),
             Target::Interference(k) => format!("interference.{}", INTERFERENCE_KEYS[k]),
+            Target::Field(f) => format!("flowfield.{}", f.key()),
         }
+    }
+
+    /// The target of a field of the store's tables (not the flowfield's shape), by its TOML
+    /// path.
+    pub fn table_of_field(field: &str) -> Option<Target> {
+        Target::all().into_iter().find(|t| t.field() == field)
     }
 
     /// The target of a field's TOML path.
     pub fn of_field(field: &str) -> Option<Target> {
-        Target::all().into_iter().find(|t| t.field() == field)
+        Target::every().into_iter().find(|t| t.field() == field)
     }
 
     /// The variables a correction of this field may span.
@@ -130,14 +177,17 @@ impl Target {
             Target::Static(_) => &[Variable::Mach, Variable::Alpha, Variable::Beta],
             Target::Derivative(_) => &[Variable::Mach],
             Target::Interference(_) => &[Variable::Distance],
+            Target::Field(_) => &[Variable::Mach],
         }
     }
 
     /// The coefficient axis it acts on: 0 CA (or dCX), ..., 5 Cn; for a derivative, the axis of
-    /// its coefficient (CZ for CZ_alpha, ...).
+    /// its coefficient (CZ for CZ_alpha, ...); for the flowfield's shape, which acts on every
+    /// axis, CZ's (that of its upwash, the field's largest part).
     pub fn axis(self) -> usize {
         match self {
             Target::Static(k) | Target::Interference(k) => k,
+            Target::Field(_) => 2,
             Target::Derivative(d) => match d {
                 Derivative::CzAlpha => 2,
                 Derivative::CyBeta => 1,
@@ -181,7 +231,7 @@ pub struct Correction {
 pub enum CorrectionError {
     /// A field no correction can change.
     #[error(
-        "`field` `{0}` is not a field a correction can change (expected aero.ca0, aero.cy ... aero.cn, a derivative such as aero.cm_alpha_per_rad, or interference.dcx0 ... interference.dcn0)"
+        "`field` `{0}` is not a field a correction can change (expected aero.ca0, aero.cy ... aero.cn, a derivative such as aero.cm_alpha_per_rad, interference.dcx0 ... interference.dcn0, flowfield.half_depth_m or flowfield.reversal_m)"
     )]
     Field(String),
     /// A variable the field cannot be corrected over.

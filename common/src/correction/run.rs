@@ -3,8 +3,8 @@
 //! a run is set up without allocation.
 
 use super::{
-    Correction, CorrectionError, Derivative, MAX_CORRECTION_VALUES, MAX_CORRECTIONS, Target,
-    interpolate,
+    Correction, CorrectionError, Derivative, FieldShape, MAX_CORRECTION_VALUES, MAX_CORRECTIONS,
+    Target, interpolate,
 };
 use crate::table::Variable;
 
@@ -87,13 +87,16 @@ const NO_RUNTIME: Runtime = Runtime {
 };
 
 /// What the corrections over Mach give a run, folded into its constants: each static
-/// coefficient's offset (CA positive aft, as the field) and each derivative's change.
+/// coefficient's offset (CA positive aft, as the field), each derivative's change, and the
+/// change of the flowfield's shape.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Folded {
     /// Added to CA, CY, CZ, Cl, Cm, Cn.
     pub statics: [f64; 6],
     /// Added to each derivative, in [`Derivative::ALL`] order.
     pub derivatives: [f64; 7],
+    /// Added to the flowfield's 1 / L_z and 1 / z_r \[1/m\], in [`FieldShape::ALL`] order.
+    pub field_shape: [f64; 2],
 }
 
 /// One run's corrections evaluated at each force evaluation (those over alpha, beta and
@@ -162,6 +165,10 @@ impl CorrectionRun {
                             let i = Derivative::ALL.iter().position(|&e| e == d).unwrap_or(0);
                             folded.derivatives[i] += x;
                         }
+                        Target::Field(f) => {
+                            let i = FieldShape::ALL.iter().position(|&e| e == f).unwrap_or(0);
+                            folded.field_shape[i] += x;
+                        }
                         Target::Interference(_) => {}
                     }
                     continue;
@@ -173,7 +180,7 @@ impl CorrectionRun {
             let slot = match c.target {
                 Target::Static(k) => k,
                 Target::Interference(k) => 6 + k,
-                Target::Derivative(_) => continue,
+                Target::Derivative(_) | Target::Field(_) => continue,
             };
             let start = run.count_values();
             for (j, (&b, &x)) in c.breakpoints.iter().zip(own).enumerate() {

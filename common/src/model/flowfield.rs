@@ -55,8 +55,11 @@ pub struct FlowfieldRun {
     /// L_z: the depth below carriage at which the field has halved \[m\] (the effect
     /// `interference_decay` scales it).
     pub half_depth_m: f64,
-    /// 1 / z_r \[1/m\] (0: the field never changes sign).
+    /// 1 / z_r \[1/m\] (0: the field never changes sign), with any correction of it.
     pub inv_reversal_per_m: f64,
+    /// A correction's change of 1 / L_z \[1/m\] (docs/update.md): 0 but in an update's
+    /// refits.
+    pub inv_half_depth_change_per_m: f64,
     /// CZ_alpha and CY_beta \[1/rad\], the slopes the field acts through.
     pub slopes_per_rad: [f64; 2],
     /// 1 / d \[1/m\].
@@ -117,9 +120,37 @@ impl FlowfieldRun {
             roll_cl: fx(Factor::Clintfac) * s_m * spec.roll_cl,
             half_depth_m: spec.half_depth_m,
             inv_reversal_per_m: spec.reversal_m.map_or(0.0, |z_r| 1.0 / z_r),
+            inv_half_depth_change_per_m: 0.0,
             slopes_per_rad: [aero.cz_alpha_per_rad, aero.cy_beta_per_rad],
             inv_diameter_per_m: 1.0 / diameter_m,
         }
+    }
+
+    /// 1 / L_z \[1/m\], with any correction of it.
+    pub fn inv_half_depth_per_m(&self) -> f64 {
+        // Without a change, 1 / L_z to the bit (a positive number plus 0).
+        1.0 / self.half_depth_m + self.inv_half_depth_change_per_m
+    }
+
+    /// The shape changed by `change` \[1/m\] (added to 1 / L_z and 1 / z_r: a correction of
+    /// the field's shape, docs/update.md); refused when 1 / L_z would not stay above 0 or
+    /// 1 / z_r below 0 (the field would not decay, or would grow with depth).
+    pub fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, String> {
+        let inv_half_depth = 1.0 / self.half_depth_m + change[0];
+        let inv_reversal = self.inv_reversal_per_m + change[1];
+        if !(inv_half_depth > 0.0 && inv_half_depth.is_finite()) {
+            return Err(format!(
+                "the flowfield's corrected 1 / half_depth_m is {inv_half_depth} per m: expected above 0"
+            ));
+        }
+        if !(inv_reversal >= 0.0 && inv_reversal.is_finite()) {
+            return Err(format!(
+                "the flowfield's corrected 1 / reversal_m is {inv_reversal} per m: expected 0 or above"
+            ));
+        }
+        self.inv_half_depth_change_per_m += change[0];
+        self.inv_reversal_per_m = inv_reversal;
+        Ok(self)
     }
 
     /// The field at the point `p_m` of L: (alpha_i \[rad\], beta_i \[rad\], eta).
@@ -194,7 +225,7 @@ impl<R: Real> FieldLanes<R> {
             sidewash: [g(&|r| r.sidewash[0]), g(&|r| r.sidewash[1])],
             dynamic_pressure: g(&|r| r.dynamic_pressure),
             roll_cl: g(&|r| r.roll_cl),
-            inv_half_depth_per_m: g(&|r| 1.0 / r.half_depth_m),
+            inv_half_depth_per_m: g(&|r| r.inv_half_depth_per_m()),
             inv_reversal_per_m: g(&|r| r.inv_reversal_per_m),
             slopes_per_rad: [g(&|r| r.slopes_per_rad[0]), g(&|r| r.slopes_per_rad[1])],
             slopes_per_rad_m: [

@@ -25,8 +25,22 @@ impl Scenario {
         c.integrator(&self.integrator)?;
         c.initial(&self.initial)?;
         c.extension(&self.extension)?;
-        crate::correction::check_all(&self.correction)
+        let corrections = crate::correction::check_all(&self.correction)
             .map_err(|(k, e)| c.bad(&format!("correction[{k}]"), e.to_string()))?;
+        let field_shape = |x: &crate::correction::Correction| {
+            matches!(x.target, crate::correction::Target::Field(_))
+        };
+        if self.flowfield.is_none()
+            && let Some(k) = corrections.iter().position(field_shape)
+        {
+            return Err(c.bad(
+                &format!("correction[{k}]"),
+                format!(
+                    "`field` `{}`: the scenario has no [flowfield] to correct",
+                    self.correction[k].field
+                ),
+            ));
+        }
         self.factors
             .validate()
             .map_err(|e| c.bad("factors", e.to_string()))

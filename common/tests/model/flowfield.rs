@@ -349,3 +349,57 @@ fn lanes_whose_fields_differ_in_kind_keep_the_scalar_runs_bits() {
         "the field moves the store"
     );
 }
+
+#[test]
+fn lanes_equal_scalar_runs_bit_for_bit_with_corrections_of_the_fields_shape() {
+    use sepval_common::correction::CorrectionValues;
+    use sepval_common::extension::TermSet;
+    use sepval_common::model::RunSetup;
+    use sepval_common::propagator::{LANES, propagate, propagate_lanes};
+    // docs/update.md section 15.3a: an update's refits carry the shape's corrections, each
+    // candidate its own.
+    let text = format!(
+        "{EXAMPLE}\n[[correction]]\nfield = \"flowfield.half_depth_m\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n\
+         \n[[correction]]\nfield = \"flowfield.reversal_m\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n"
+    );
+    let sim = Simulator::new(&Scenario::from_toml_str(&text, "shape").unwrap());
+    let times = sim.default_times();
+    let runs: Vec<RunSetup> = [[0.0, 0.0], [0.4, -0.2], [-0.6, 0.3], [1.5, 0.0], [0.1, 0.9]]
+        .iter()
+        .map(|v| {
+            let values = CorrectionValues::of(v).unwrap();
+            let none = (&EffectSet::NONE, &TermSet::NONE);
+            RunSetup::with_corrections(sim.model(), &Factors::TRUTH, none.0, none.1, &values)
+                .unwrap()
+        })
+        .collect();
+    for batch in runs.chunks(LANES) {
+        let mut sinks = vec![crate::lanes::Samples::new(); batch.len()];
+        let results = propagate_lanes(sim.model(), batch, &times, &mut sinks);
+        for (i, run) in batch.iter().enumerate() {
+            let mut s = crate::lanes::Samples::new();
+            let r = propagate(sim.model(), run, &times, &mut s);
+            assert!(
+                crate::lanes::bits(&s, &r) == crate::lanes::bits(&sinks[i], &results[i]),
+                "lane {i} differs from its scalar run"
+            );
+        }
+    }
+    // A shape corrected to the field's own at another reversal depth flies as that field (to
+    // the rounding of the inverse).
+    let mut s2 = crate::lanes::Samples::new();
+    let corrected = &runs[1];
+    propagate(sim.model(), corrected, &times, &mut s2).unwrap();
+    let to = format!("reversal_m = {}", 1.0 / (0.5 - 0.2));
+    let as_given = Scenario::from_toml_str(&example_with("reversal_m = 2.0", &to), "z_r").unwrap();
+    let other = Simulator::new(&as_given);
+    let mut run = other.run_setup(&Factors::TRUTH, &EffectSet::NONE).unwrap();
+    let field = run.flowfield.as_mut().unwrap();
+    field.half_depth_m = 1.0 / (1.0 / 0.8 + 0.4);
+    let mut s3 = crate::lanes::Samples::new();
+    propagate(other.model(), &run, &times, &mut s3).unwrap();
+    let last = |s: &crate::lanes::Samples| s.last().unwrap().0;
+    for (a, b) in last(&s2).pos_m.iter().zip(last(&s3).pos_m) {
+        assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+    }
+}

@@ -15,11 +15,11 @@ const BASE: Factors = Factors([
     1.6,
 ]);
 
-type Samples = Vec<(Observation, StateVector)>;
+pub(crate) type Samples = Vec<(Observation, StateVector)>;
 
 /// Every bit of a run's samples and outcome, for exact comparison (NaN payloads aside: a
 /// diverged run records no sample after its divergence).
-fn bits(
+pub(crate) fn bits(
     samples: &Samples,
     result: &Result<sepval_common::propagator::RunLog, sepval_common::propagator::Diverged>,
 ) -> Vec<u64> {

@@ -226,3 +226,97 @@ fn a_field_fitted_at_two_conditions_predicts_a_third() {
         "the decay model: {decay_pos} m, {decay_att} deg, against the field's {pos} m, {att} deg"
     );
 }
+
+/// `sepval simulate --scenario SCENARIO --factors FACTORS [--noise-seed SEED] --out OUT` in `d`.
+fn simulated(d: &Path, scenario: &str, factors: &str, seed: Option<&str>, out: &str) {
+    let mut args = vec![
+        "simulate",
+        "--scenario",
+        scenario,
+        "--factors",
+        factors,
+        "--out",
+        out,
+    ];
+    args.extend(seed.iter().flat_map(|s| ["--noise-seed", *s]));
+    ok(&sepval(&args, d));
+}
+
+#[test]
+fn update_finds_the_fields_reversal_depth_from_three_conditions_and_predicts_a_fourth() {
+    if skip_slow_tests() {
+        return;
+    }
+    // docs/update.md section 15.3a. The truth is the example's field (halving at 0.8 m,
+    // reversing at 2 m); the store given to the update says the field halves at 0.5 m and never
+    // reverses. Releases at three conditions with the default flight test's noise; Mach 0.85,
+    // alpha 1.5 deg, never flown, predicted by the updated store.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let truth = std::fs::read_to_string(example()).unwrap();
+    assert!(truth.contains("\nreversal_m = 2.0"));
+    let given: String = at_condition(&truth, 0.95, 0.0)
+        .lines()
+        .filter(|l| !l.starts_with("reversal_m"))
+        .map(|l| {
+            if l.starts_with("half_depth_m") {
+                "half_depth_m = 0.5".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(d.join("given.toml"), &given).unwrap();
+    let conditions = [(0.80, 0.0, "11"), (0.95, 3.0, "12"), (0.90, -2.0, "13")];
+    let mut update = vec!["update", "--scenario", "given.toml"];
+    let names: Vec<String> = (0..3).map(|k| format!("r{k}.csv")).collect();
+    for (k, (mach, alpha, seed)) in conditions.into_iter().enumerate() {
+        std::fs::write(d.join("t.toml"), at_condition(&truth, mach, alpha)).unwrap();
+        simulated(d, "t.toml", "truth", Some(seed), &names[k]);
+        update.extend(["--data", &names[k]]);
+    }
+    std::fs::write(d.join("t4.toml"), at_condition(&truth, 0.85, 1.5)).unwrap();
+    simulated(d, "t4.toml", "truth", None, "c4.csv");
+    update.extend(["--evaluator", "inproc", "--threads", "2", "--out", "up"]);
+    ok(&sepval(&update, d));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("up/update.json")).unwrap()).unwrap();
+    let kept: Vec<&str> = record["corrections"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["field"].as_str().unwrap())
+        .collect();
+    assert!(kept.contains(&"flowfield.reversal_m"), "{kept:?}");
+    // The store written has the reversal depth found, near the truth's 2 m.
+    let store = std::fs::read_to_string(d.join("up/scenario.toml")).unwrap();
+    let z_r: f64 = store
+        .lines()
+        .find_map(|l| l.strip_prefix("reversal_m = "))
+        .and_then(|v| v.split_whitespace().next()?.parse().ok())
+        .expect("the updated store has a reversal depth");
+    assert!((z_r - 2.0).abs() < 0.2, "reversal depth {z_r} m");
+    // The condition never flown, predicted by the updated store with its factors: within the
+    // noise of the flight test where the store as given, its factors fitted, misses by more.
+    std::fs::write(d.join("up/c4.toml"), at_condition(&store, 0.85, 1.5)).unwrap();
+    simulated(&d.join("up"), "c4.toml", "factors.json", None, "c4.csv");
+    let (pos, att) = goals(d, "c4.csv", "up/c4.csv");
+    assert!(pos < 0.003 && att < 0.1, "{pos} m, {att} deg");
+    // The baseline: the factors alone fitted to the store as given (DIR/baseline).
+    let baseline: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("up/baseline/result.json")).unwrap())
+            .unwrap();
+    let factors = &baseline["methods"]["ga+lm"]["best"]["factors"];
+    std::fs::write(d.join("base.json"), factors.to_string()).unwrap();
+    std::fs::write(d.join("g4.toml"), at_condition(&given, 0.85, 1.5)).unwrap();
+    simulated(d, "g4.toml", "base.json", None, "g4.csv");
+    let (pos_given, att_given) = goals(d, "c4.csv", "g4.csv");
+    eprintln!(
+        "Mach 0.85, alpha 1.5 deg: updated (z_r {z_r:.3} m) {pos:.6} m, {att:.5} deg; the store as given, its factors fitted, {pos_given:.6} m, {att_given:.5} deg"
+    );
+    assert!(
+        pos_given > 2.0 * pos && att_given > 2.0 * att,
+        "the store as given: {pos_given} m, {att_given} deg; updated: {pos} m, {att} deg"
+    );
+}

@@ -39,6 +39,14 @@ fn every_field_names_itself_and_back() {
         assert_eq!(Target::of_field(&t.field()), Some(t));
     }
     assert_eq!(Target::all().len(), 19);
+    for t in Target::every() {
+        assert_eq!(Target::of_field(&t.field()), Some(t));
+    }
+    assert_eq!(
+        Target::of_field("flowfield.reversal_m"),
+        Some(Target::Field(FieldShape::Reversal))
+    );
+    assert_eq!(Target::table_of_field("flowfield.half_depth_m"), None);
     assert_eq!(
         Target::of_field("aero.cm_q_per_rad").map(Target::axis),
         Some(4)
@@ -125,4 +133,74 @@ fn a_run_folds_mach_corrections_and_keeps_the_others_for_the_force_evaluation() 
         CorrectionRun::new(&corrections, &CorrectionValues::of(&bad).unwrap(), 0.9).unwrap_err();
     assert!(e.to_string().contains("correction value 5 is inf"), "{e}");
     assert!(CorrectionValues::of(&[0.0; 65]).is_err());
+}
+
+/// The guide's example store under a field with corrections of its shape over Mach.
+fn field_store_with_shape_corrections() -> sepval_common::scenario::Scenario {
+    let mut text = include_str!("../../../../examples/flowfield-store/scenario.toml").to_string();
+    text.push_str(
+        "\n[[correction]]\nfield = \"flowfield.half_depth_m\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n\
+         \n[[correction]]\nfield = \"flowfield.reversal_m\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n",
+    );
+    sepval_common::scenario::Scenario::from_toml_str(&text, "field").unwrap()
+}
+
+#[test]
+fn the_fields_shape_is_corrected_through_its_inverses_and_kept_a_field_that_decays() {
+    use sepval_common::effects::EffectSet;
+    use sepval_common::extension::TermSet;
+    use sepval_common::model::RunSetup;
+    use sepval_common::simulation::Simulator;
+    use sepval_core::factors::Factors;
+    let s = field_store_with_shape_corrections();
+    let sim = Simulator::new(&s);
+    let run = |v: &[f64]| {
+        let values = CorrectionValues::of(v).unwrap();
+        RunSetup::with_corrections(
+            sim.model(),
+            &Factors::TRUTH,
+            &EffectSet::NONE,
+            &TermSet::NONE,
+            &values,
+        )
+    };
+    // The example's field halves at 0.8 m and reverses at 2 m.
+    let field = run(&[0.25, -0.1]).unwrap().flowfield.unwrap();
+    assert!((field.inv_half_depth_per_m() - (1.0 / 0.8 + 0.25)).abs() < 1e-15);
+    assert!((field.inv_reversal_per_m - (0.5 - 0.1)).abs() < 1e-15);
+    // Without values the field is the scenario's, to the bit.
+    let plain = run(&[]).unwrap().flowfield.unwrap();
+    assert_eq!(
+        plain.inv_half_depth_per_m().to_bits(),
+        (1.0f64 / 0.8).to_bits()
+    );
+    // A field that would not decay, or would grow with depth, is refused, naming the part.
+    let refused = |v: &[f64]| match run(v) {
+        Ok(_) => panic!("{v:?} was not refused"),
+        Err(e) => e.to_string(),
+    };
+    let e = refused(&[-1.25, 0.0]);
+    assert!(e.contains("1 / half_depth_m"), "{e}");
+    let e = refused(&[0.0, -0.6]);
+    assert!(e.contains("1 / reversal_m"), "{e}");
+}
+
+#[test]
+fn a_correction_of_the_fields_shape_needs_a_field() {
+    use sepval_common::scenario::Scenario;
+    let text = Scenario::embedded_default().to_toml_string()
+        + "\n[[correction]]\nfield = \"flowfield.reversal_m\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n";
+    let e = Scenario::from_toml_str(&text, "no field").unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("the scenario has no [flowfield] to correct"),
+        "{e}"
+    );
+    let e = record("flowfield.reversal_m", "depth_m", &[0.0, 1.0])
+        .correction()
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("may be corrected over mach only"),
+        "{e}"
+    );
 }
