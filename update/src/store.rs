@@ -123,7 +123,7 @@ fn set_field_shape(s: &mut Scenario, part: FieldShape, change: f64) -> Result<()
     match part {
         FieldShape::HalfDepth => {
             let inverse = 1.0 / field.half_depth_m + change;
-            if !(inverse > 0.0) {
+            if inverse.is_nan() || inverse <= 0.0 {
                 return Err(format!("1 / half_depth_m would be {inverse} per m"));
             }
             field.half_depth_m = 1.0 / inverse;
