@@ -278,7 +278,8 @@ fn update_finds_the_fields_reversal_depth_from_three_conditions_and_predicts_a_f
     }
     std::fs::write(d.join("t4.toml"), at_condition(&truth, 0.85, 1.5)).unwrap();
     simulated(d, "t4.toml", "truth", None, "c4.csv");
-    update.extend(["--evaluator", "inproc", "--threads", "2", "--out", "up"]);
+    update.extend(sepval_tests::REDUCED_BUDGET);
+    update.extend(["--out", "up"]);
     ok(&sepval(&update, d));
     let record: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("up/update.json")).unwrap()).unwrap();
