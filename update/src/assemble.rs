@@ -78,7 +78,10 @@ pub fn assemble(p: Parts) -> Update {
             explored,
             lambda: model.corrections.lambdas[k],
         });
-        panels.push(panel(&p, k, c, v, explored));
+        // The flowfield's shape is one constant for every release: a value, not a curve.
+        if !matches!(c.target, sepval_common::correction::Target::Field(_)) {
+            panels.push(panel(&p, k, c, v, explored));
+        }
     }
     let file = record(&p, corrections);
     Update {

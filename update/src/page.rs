@@ -164,7 +164,12 @@ fn correction_rows(file: &UpdateFile) -> Vec<Correction> {
         .map(|c| Correction {
             name: c.name.clone(),
             field: c.field.clone(),
-            explored: format!("{} to {}", number(c.explored.0, 3), number(c.explored.1, 3)),
+            // The flowfield's shape: one for every release, its value per metre of depth.
+            explored: if c.field.starts_with("flowfield.") {
+                "every release (per m)".to_string()
+            } else {
+                format!("{} to {}", number(c.explored.0, 3), number(c.explored.1, 3))
+            },
             lambda: number(c.lambda, 2),
             values: c
                 .breakpoints

@@ -323,9 +323,10 @@ fn smoothness(
     current: Model,
     evaluations: &mut u64,
 ) -> Result<(Model, Vec<(f64, f64)>)> {
-    if current.corrections.proposals.is_empty() {
+    // The first correction with a penalty (the flowfield's shape has none) names the weights.
+    let Some(first) = current.corrections.lambdas.iter().position(|&l| l > 0.0) else {
         return Ok((current, Vec::new()));
-    }
+    };
     let base = current.space.factors(&current.fit.lm.x);
     let trials: Vec<Trial> = SMOOTHNESS
         .iter()
@@ -353,7 +354,7 @@ fn smoothness(
     all.extend(models);
     let mut scores: Vec<(f64, f64)> = all
         .iter()
-        .map(|m| (m.corrections.lambdas[0], m.cv))
+        .map(|m| (m.corrections.lambdas[first], m.cv))
         .collect();
     scores.sort_by(|a, b| a.0.total_cmp(&b.0));
     let best = (0..all.len())

@@ -161,7 +161,7 @@ pub fn notes(selected: &Selected, uncertainty: &Uncertainty, file: &UpdateFile) 
     let best = (0..tried.len()).min_by(|&a, &b| tried[a].1.total_cmp(&tried[b].1));
     if let Some(best) = best.filter(|&b| tried.len() > 1 && (b == 0 || b + 1 == tried.len())) {
         out.push(format!(
-            "the corrections' smoothness is at the {} edge of the weights tried (lambda {} for the first): the cross-validation may prefer {} still",
+            "the corrections' smoothness is at the {} edge of the weights tried (lambda {} for the first that is smoothed): the cross-validation may prefer {} still",
             if best == 0 { "weak" } else { "strong" },
             number(tried[best].0, 2),
             if best == 0 { "less" } else { "more" },
