@@ -105,8 +105,8 @@ fn next(a: CampaignNextArgs) -> Result<()> {
     }
     let c = open(&a.campaign, count("--threads", None)?)?;
     let n = c.next(a.count)?;
-    let text = serde_json::to_string_pretty(&n)?;
-    println!("{text}");
+    // Through the front end, as every command's words (Python collects them).
+    say!("{}", serde_json::to_string_pretty(&n)?);
     note!("next:      {}", a.campaign.join("next.json").display());
     Ok(())
 }

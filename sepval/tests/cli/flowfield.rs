@@ -182,6 +182,11 @@ fn a_field_fitted_at_two_conditions_predicts_a_third() {
                 "ga+lm",
                 "--seed",
                 "1",
+                // The decay model never reaches the noise floor, so its GA would run all 500
+                // generations: refined after 80 it predicts the fourth condition to the same
+                // 0.6345 deg as after 500 (measured 2026-11-28), at a fifth of the time.
+                "--generations",
+                "80",
                 "--no-figures",
                 "--evaluator",
                 "inproc",
@@ -217,6 +222,9 @@ fn a_field_fitted_at_two_conditions_predicts_a_third() {
     let [(pos, att), (decay_pos, decay_att)] = errors[..] else {
         unreachable!()
     };
+    eprintln!(
+        "Mach 0.85, alpha 1.5 deg: field {pos} m, {att} deg; decay {decay_pos} m, {decay_att} deg"
+    );
     assert!(
         pos < 0.005 && att < 0.2,
         "the field fitted at Mach 0.80 and 0.95 predicts Mach 0.85 alpha 1.5 to {pos} m, {att} deg"
