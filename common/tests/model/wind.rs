@@ -11,7 +11,8 @@ use sepval_common::propagator::{LANES, Observation, propagate, propagate_lanes};
 use sepval_common::scenario::Scenario;
 use sepval_common::{Factors, Simulator};
 
-fn gust(axis: Axis, regressor: Regressor, t_on_s: f64, rise_s: f64, w_m_s: f64) -> Term {
+/// A gust term: the wind along `axis` starting at `t_on_s`, rising over `rise_s`, of `w_m_s`.
+pub(crate) fn gust(axis: Axis, regressor: Regressor, t_on_s: f64, rise_s: f64, w_m_s: f64) -> Term {
     Term {
         axis,
         regressor,

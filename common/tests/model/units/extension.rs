@@ -2,6 +2,8 @@
 
 use sepval_common::extension::*;
 
+use crate::wind::gust;
+
 fn input() -> TermInput {
     TermInput {
         t_s: 0.3,
@@ -145,15 +147,6 @@ fn extension_files_round_trip_and_bad_ones_name_line_and_field() {
         )),
         "extension e.toml: line 3, term 1, `t_on_s` is missing: step needs it"
     );
-}
-
-fn gust(axis: Axis, regressor: Regressor, t_on_s: f64, rise_s: f64, w_m_s: f64) -> Term {
-    Term {
-        axis,
-        regressor,
-        locator: [t_on_s, rise_s],
-        coefficient: w_m_s,
-    }
 }
 
 #[test]
