@@ -2,7 +2,7 @@
 //! (the current round's, the columns of `sepval envelope` and `state`), CAMP/status.json,
 //! CAMP/figures/state-NN.png (each round's map of states, the releases flown by then marked
 //! in the title), CAMP/figures/counts.png (the counts of states against the releases flown)
-//! and CAMP/report.html (the answer first, then the map, the history of the counts per round,
+//! and CAMP/report.html (the answer first, a rehearsal's comparison with its truth, then the map, the history of the counts per round,
 //! the releases and what is left undecided; the template `templates/campaign.html` in
 //! sepval-report's layout). They are written through [`Written::after_commit`]: each file
 //! atomically, and all of them whatever a signal asks, since they derive from campaign.json,
@@ -33,6 +33,55 @@ pub struct View<'a> {
     pub file: &'a CampaignFile,
     /// The grid.
     pub grid: &'a Grid,
+    /// A rehearsal's comparison with its truth, shown first when the page is a rehearsal's.
+    pub rehearsal: Option<&'a RehearsalSection>,
+}
+
+/// A rehearsal against its truth as the page shows it (made by `Rehearsal::section`).
+#[derive(Debug, Clone, Serialize)]
+pub struct RehearsalSection {
+    /// The verdict against the truth, in words.
+    pub words: String,
+    /// Each round: its counts and its false clears and false fails.
+    pub rounds: Vec<RehearsalRound>,
+    /// Each release flown: where, the failure probability planned, and what the truth says.
+    pub flown: Vec<RehearsalRelease>,
+}
+
+/// One round of a rehearsal against its truth.
+#[derive(Debug, Clone, Serialize)]
+pub struct RehearsalRound {
+    /// The round.
+    pub round: usize,
+    /// Releases flown by then.
+    pub releases_flown: usize,
+    /// Conditions cleared, failed and undecided.
+    pub cleared: usize,
+    /// Conditions that fail.
+    pub fails: usize,
+    /// Conditions undecided.
+    pub undecided: usize,
+    /// Conditions cleared that the truth fails.
+    pub false_clears: usize,
+    /// Conditions failed that the truth clears.
+    pub false_fails: usize,
+}
+
+/// One release of a rehearsal.
+#[derive(Debug, Clone, Serialize)]
+pub struct RehearsalRelease {
+    /// Its place in the order flown, from 1.
+    pub release: usize,
+    /// Its condition, in words.
+    pub mach: String,
+    /// Altitude \[m\].
+    pub altitude_m: String,
+    /// Aircraft angle of attack \[deg\].
+    pub alpha_deg: String,
+    /// The probability of failing there that the plan gave.
+    pub p_fail_planned: String,
+    /// `safe` or `UNSAFE`: what the truth does there.
+    pub truth: &'static str,
 }
 
 impl View<'_> {
@@ -200,9 +249,10 @@ const CAMPAIGN: PageTemplate = PageTemplate {
 
 /// What report.html shows, as the template reads it.
 #[derive(Serialize)]
-struct Page {
+struct Page<'a> {
     headline: String,
     words: String,
+    rehearsal: Option<&'a RehearsalSection>,
     /// The current round's map of states, relative to the page.
     map: Option<String>,
     rounds: Vec<RoundView>,
@@ -233,10 +283,11 @@ struct ReleaseView {
 }
 
 /// report.html's content.
-fn page(c: &View<'_>, current: &[Assessed]) -> Page {
+fn page<'a>(c: &View<'a>, current: &[Assessed]) -> Page<'a> {
     Page {
         headline: headline(c.file),
         words: c.file.words.clone(),
+        rehearsal: c.rehearsal,
         map: c
             .file
             .rounds

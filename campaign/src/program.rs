@@ -290,6 +290,7 @@ impl Campaign {
             dir: &self.dir,
             file: &self.file,
             grid: &self.grid,
+            rehearsal: None,
         }
     }
 

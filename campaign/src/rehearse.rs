@@ -25,6 +25,7 @@ use sepval_solve::run::ProgressObserver;
 
 use crate::CampaignError;
 use crate::assess::StartEvaluator;
+use crate::page::{self, RehearsalRelease, RehearsalRound, RehearsalSection};
 use crate::program::{Campaign, NewRelease};
 use crate::record::{record_error, write_json};
 use crate::state::{Counts, State};
@@ -128,6 +129,39 @@ impl Rehearsal {
         }
         out.push(format!("rehearsal: {}", self.words));
         out
+    }
+
+    /// What the campaign's page shows of it.
+    pub fn section(&self) -> RehearsalSection {
+        RehearsalSection {
+            words: self.words.clone(),
+            rounds: self
+                .rounds
+                .iter()
+                .map(|r| RehearsalRound {
+                    round: r.round,
+                    releases_flown: r.releases_flown,
+                    cleared: r.counts.cleared,
+                    fails: r.counts.fails,
+                    undecided: r.counts.undecided,
+                    false_clears: r.false_clears,
+                    false_fails: r.false_fails,
+                })
+                .collect(),
+            flown: self
+                .flown
+                .iter()
+                .enumerate()
+                .map(|(k, f)| RehearsalRelease {
+                    release: k + 1,
+                    mach: crate::page::number(f.condition.mach),
+                    altitude_m: crate::page::number(f.condition.altitude_m),
+                    alpha_deg: crate::page::number(f.condition.alpha_deg),
+                    p_fail_planned: format!("{:.3}", f.p_fail_planned),
+                    truth: if f.truly_safe { "safe" } else { "UNSAFE" },
+                })
+                .collect(),
+        }
     }
 }
 
@@ -251,5 +285,12 @@ pub fn rehearse(
         r.flown.len()
     );
     write_json(&c.dir.join("rehearsal.json"), &r)?;
+    // The page again, now with the comparison with the truth first.
+    let section = r.section();
+    let view = page::View {
+        rehearsal: Some(&section),
+        ..c.view()
+    };
+    page::render(&view)?;
     Ok(r)
 }

@@ -331,6 +331,19 @@ fn a_rehearsal_of_a_null_truth_settles_with_no_false_clear_or_fail() {
     let tmp = tempfile::tempdir().unwrap();
     let r = rehearse(tmp.path(), "null", "25.4", &[]);
     pages_agree(&tmp.path().join("null"));
+    // The page shows the comparison with the truth first, round by round, as rehearsal.json
+    // records it.
+    let html = std::fs::read_to_string(tmp.path().join("null/report.html")).unwrap();
+    let section = html
+        .find("Against the truth (a rehearsal)")
+        .expect("the rehearsal's section");
+    assert!(section < html.find("figures/state-").unwrap(), "first");
+    assert!(html.contains(r["words"].as_str().unwrap()), "{html}");
+    let rounds = r["rounds"].as_array().unwrap().len();
+    let flown = r["flown"].as_array().unwrap().len();
+    let told = html.matches("<td>safe</td>").count() + html.matches("<td>UNSAFE</td>").count();
+    assert_eq!(told, flown, "{html}");
+    assert!(rounds >= 2, "{r}");
     assert_eq!(r["format"], "sepval-campaign-rehearsal/1");
     assert_eq!(r["settled"], true, "{r}");
     for round in r["rounds"].as_array().unwrap() {
