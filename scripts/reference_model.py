@@ -24,6 +24,7 @@ Run:
     python3 scripts/reference_model.py --json    # the flowfield case's values as JSON
 """
 
+import bisect
 import json
 import math
 import sys
@@ -63,6 +64,12 @@ TIMES = [0.05, 0.10, 0.25, 0.50, 1.00]
 # (examples/flowfield-store/scenario.toml, whose [flowfield] is the section's, verbatim).
 EXAMPLE = SCENARIO.parent.parent.parent / "examples" / "flowfield-store" / "scenario.toml"
 FLOWFIELD_CASE = tomllib.loads(EXAMPLE.read_text())["flowfield"]
+# Section 3b, "The shape as a table": the same field with its shape given as a table over depth
+# (one the analytic shape cannot take: a kink, a sign change and a return to 0), in place of
+# half_depth_m and reversal_m.
+SHAPE_TABLE = {"depth_m": [0.0, 0.3, 0.9, 1.6, 2.5], "g": [1.0, 0.62, 0.2, -0.07, 0.0]}
+SHAPE_TABLE_CASE = {k: v for k, v in FLOWFIELD_CASE.items()
+                    if k not in ("half_depth_m", "reversal_m")} | {"shape": SHAPE_TABLE}
 
 # Task item 5: the documented state at which the flowfield's increments are printed.
 _q = (0.99, 0.02, 0.08, -0.03)
@@ -123,8 +130,10 @@ class Flowfield:
         self.Bx = fac["cnintfac"] * s_m * b_x
         self.E = fac["caintfac"] * s_m * (ff.get("dynamic_pressure_ratio", 1.0) - 1.0)
         self.Lr = fac["clintfac"] * s_m * ff.get("roll_cl", 0.0)
-        self.Lz = ff["half_depth_m"]
-        self.zr = ff.get("reversal_m")                                # None: never reverses
+        self.table = ff.get("shape")                                  # None: the analytic shape
+        if self.table is None:
+            self.Lz = ff["half_depth_m"]
+            self.zr = ff.get("reversal_m")                            # None: never reverses
         # Stations at the middles of N equal segments of [tail, nose]; linear weights.
         aero, d = sc["aero"], sc["store"]["diameter_m"]
         self.cz_a, self.cy_b, self.d = aero["cz_alpha_per_rad"], aero["cy_beta_per_rad"], d
@@ -137,8 +146,16 @@ class Flowfield:
         self.v = [1.0 / N + (x_s - x_bar) * (x - x_bar) / D for x in self.xs]
 
     def g(self, z):
-        """Depth profile g(z) (section 3b)."""
+        """Depth profile g(z) (section 3b): analytic, or the table's (linear between its depths,
+        its last value below the last)."""
         zp = max(z, 0.0)
+        if self.table is not None:
+            zs, gs = self.table["depth_m"], self.table["g"]
+            if zp >= zs[-1]:
+                return gs[-1]
+            k = bisect.bisect_right(zs, zp) - 1
+            u = (zp - zs[k]) / (zs[k + 1] - zs[k])
+            return gs[k] + u * (gs[k + 1] - gs[k])
         e = 1.0 / (1.0 + zp / self.Lz)
         return e if self.zr is None else (1.0 - zp / self.zr) * e
 
@@ -354,15 +371,16 @@ def load_scenario(flowfield=False):
     return sc
 
 
-def flowfield_model(fac=TRUTH):
+def flowfield_model(fac=TRUTH, case=None):
     sc = load_scenario(flowfield=True)
-    return Model(sc, fac, Flowfield(FLOWFIELD_CASE, sc, fac))
+    return Model(sc, fac, Flowfield(FLOWFIELD_CASE if case is None else case, sc, fac))
 
 
-def flowfield_increments(state, t=0.0, fac=TRUTH):
+def flowfield_increments(state, t=0.0, fac=TRUTH, case=None):
     """Section 3b's increments (dCX, dCY, dCZ, dCl, dCm, dCn) at a 13-number state, flowfield
-    conformance scenario. The model is autonomous: t does not enter (kept for the interface)."""
-    _, incr, _, _ = flowfield_model(fac).aero_coefficients(list(state))
+    conformance scenario (or `case`). The model is autonomous: t does not enter (kept for the
+    interface)."""
+    _, incr, _, _ = flowfield_model(fac, case).aero_coefficients(list(state))
     return incr
 
 
@@ -408,15 +426,20 @@ def main(argv):
     ok = check_section8(verbose=not as_json)
     rows, log = flowfield_model().simulate(TIMES)
     incr = flowfield_increments(TEST_STATE, TEST_TIME)
+    table_rows, _ = flowfield_model(case=SHAPE_TABLE_CASE).simulate(TIMES)
+    table_incr = flowfield_increments(TEST_STATE, TEST_TIME, case=SHAPE_TABLE_CASE)
     names = ["dCX", "dCY", "dCZ", "dCl", "dCm", "dCn"]
+    columns = ["t_s", "x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"]
     if as_json:
         print(json.dumps({
             "section8_conforms": ok,
-            "flowfield_case": [dict(zip(["t_s", "x_m", "y_m", "z_m", "roll_deg", "pitch_deg",
-                                         "yaw_deg"], r)) for r in rows],
+            "flowfield_case": [dict(zip(columns, r)) for r in rows],
             "stroke_end_s": log,
             "test_state": {"t_s": TEST_TIME, "state": TEST_STATE,
-                           "increments": dict(zip(names, incr))}}, indent=2))
+                           "increments": dict(zip(names, incr))},
+            "shape_table_case": {"shape": SHAPE_TABLE,
+                                 "rows": [dict(zip(columns, r)) for r in table_rows],
+                                 "increments": dict(zip(names, table_incr))}}, indent=2))
     else:
         print("## Section 3b flowfield conformance case (truth factors, noise-free)\n")
         print(markdown_table(rows))
@@ -429,6 +452,12 @@ def main(argv):
         for lab, val in zip(labels, TEST_STATE):
             print(f"  {lab:4s} = {val:.15g}")
         for n, val in zip(names, incr):
+            print(f"  {n} = {val:.15g}")
+        print("\n## Section 3b with the shape as a table (truth factors, noise-free)\n")
+        print(f"shape: depth_m {SHAPE_TABLE['depth_m']}, g {SHAPE_TABLE['g']}\n")
+        print(markdown_table(table_rows))
+        print("\nincrements at the test state:")
+        for n, val in zip(names, table_incr):
             print(f"  {n} = {val:.15g}")
         print("\nsection 8:", "conforms" if ok else "DOES NOT CONFORM")
     return 0 if ok else 1

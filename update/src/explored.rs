@@ -47,6 +47,8 @@ pub struct Explored {
     /// 3b), whose increments over distance are 0 by definition: no correction over distance
     /// is proposed then (it would bring back the model the field replaces).
     pub flowfield: bool,
+    /// Whether that field's shape is a table over depth (its shape is then not corrected).
+    pub field_shape_table: bool,
 }
 
 impl Explored {
@@ -79,6 +81,12 @@ impl Explored {
             machs,
             s_end_m: job.events()[0].simulator.scenario().interference.s_end_m,
             flowfield: job.events()[0].simulator.scenario().flowfield.is_some(),
+            field_shape_table: job.events()[0]
+                .simulator
+                .scenario()
+                .flowfield
+                .as_ref()
+                .is_some_and(|f| f.shape.is_some()),
         }
     }
 
@@ -183,7 +191,8 @@ fn even(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 /// has a field: its inverse half depth and inverse reversal depth, each one constant (a field
 /// is the aircraft's, one shape for every release), at the first release's Mach.
 pub fn field_proposals(explored: &Explored) -> Vec<Proposal> {
-    if !explored.flowfield {
+    // A shape given as a table has no half depth or reversal depth to correct.
+    if !explored.flowfield || explored.field_shape_table {
         return Vec::new();
     }
     let mach = explored.machs.first().copied().unwrap_or(0.0);

@@ -336,7 +336,11 @@ fn field_bounds(model: &Model, part: FieldShape) -> (f64, f64) {
     let (shallowest, deepest) = FIELD_DEPTH_M;
     match part {
         FieldShape::HalfDepth => {
-            let inverse = 1.0 / field.half_depth_m;
+            // A table's shape is never corrected (no proposal is made for it): no room.
+            let Some(l_z) = field.half_depth_m else {
+                return (0.0, 0.0);
+            };
+            let inverse = 1.0 / l_z;
             (1.0 / deepest - inverse, 1.0 / shallowest - inverse)
         }
         FieldShape::Reversal => {

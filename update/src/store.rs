@@ -122,13 +122,21 @@ fn set_field_shape(s: &mut Scenario, part: FieldShape, change: f64) -> Result<()
     };
     match part {
         FieldShape::HalfDepth => {
-            let inverse = 1.0 / field.half_depth_m + change;
+            let Some(l_z) = field.half_depth_m else {
+                return Err("the flowfield's shape is a table: no half depth to correct".into());
+            };
+            let inverse = 1.0 / l_z + change;
             if inverse.is_nan() || inverse <= 0.0 {
                 return Err(format!("1 / half_depth_m would be {inverse} per m"));
             }
-            field.half_depth_m = 1.0 / inverse;
+            field.half_depth_m = Some(1.0 / inverse);
         }
         FieldShape::Reversal => {
+            if field.shape.is_some() {
+                return Err(
+                    "the flowfield's shape is a table: no reversal depth to correct".into(),
+                );
+            }
             let inverse = field.reversal_m.map_or(0.0, |z_r| 1.0 / z_r) + change;
             if inverse < 0.0 {
                 return Err(format!("1 / reversal_m would be {inverse} per m"));

@@ -31,6 +31,9 @@ impl Effect for InterferenceDecayFactor {
         // With an aircraft flowfield (docs/model.md section 3b), its depth L_z scales instead.
         if let Some(field) = run.flowfield.as_mut() {
             field.half_depth_m *= p[0];
+            if let Some(t) = field.shape.as_mut() {
+                t.scale_depth(p[0]);
+            }
         }
         Ok(())
     }

@@ -8,7 +8,6 @@ use crate::lanes::{Real, lane};
 use crate::table::{Inputs, PreparedTables, TableState};
 
 use super::aero::{Coefficients, Flow};
-use super::flowfield::FieldLanes;
 use super::{EjectorCurve, RunSetup};
 
 /// Each lane's wind in L at its time (section 11.2; +0.0 in lanes without one), from the
@@ -31,7 +30,13 @@ pub(super) fn wind_lanes<R: Real>(parts: &[Parts], t_s: R) -> [R; 3] {
 /// Whether every lane has a field with the same number of stations, so that the fields are
 /// evaluated in the lanes together.
 pub(super) fn alike_fields(parts: &[Parts]) -> bool {
-    let stations = |p: &Parts| p.run.flowfield.map(|f| f.stations);
+    // A field whose shape is a table is evaluated one run at a time (its lookups are scalar).
+    let stations = |p: &Parts| {
+        p.run
+            .flowfield
+            .filter(|f| f.shape.is_none())
+            .map(|f| f.stations)
+    };
     stations(&parts[0]).is_some() && parts.iter().all(|p| stations(p) == stations(&parts[0]))
 }
 
@@ -54,9 +59,10 @@ pub(super) fn flowfield_lanes<R: Real>(
             continue;
         };
         let k_i = lane_of::<R>(&c, i);
-        let k_i = FieldLanes::<f64>::gather(|_| field, part.run.aero_reference_x_m).add_loads(
+        let k_i = field.add_loads(
             r_m.map(|v| lane(v, i)),
             axis_l.map(|v| lane(v, i)),
+            part.run.aero_reference_x_m,
             lane(flow.alpha_rad, i),
             lane(flow.beta_rad, i),
             k_i,

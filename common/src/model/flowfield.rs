@@ -24,7 +24,7 @@
 use super::aero::Coefficients;
 use super::tables::AeroAtMach;
 use crate::lanes::Real;
-use crate::scenario::{FlowfieldSpec, MAX_STATIONS, MachScaling};
+use crate::scenario::{FlowfieldSpec, MAX_SHAPE_POINTS, MAX_STATIONS, MachScaling};
 use sepval_core::factors::{Factor, Factors};
 
 /// Pg(M) of docs/model.md section 3b: 1 / sqrt(max(|1 - M^2|, 0.1)), or 1 without scaling.
@@ -32,6 +32,61 @@ pub fn mach_factor(scaling: MachScaling, mach: f64) -> f64 {
     match scaling {
         MachScaling::PrandtlGlauert => 1.0 / (1.0 - mach * mach).abs().max(0.1).sqrt(),
         MachScaling::None => 1.0,
+    }
+}
+
+/// The field's shape g(z) as a table over depth (docs/model.md section 3b, "The shape as a
+/// table"): linear between the depths, held at the last value below the last.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeRun {
+    points: usize,
+    depth_m: [f64; MAX_SHAPE_POINTS],
+    g: [f64; MAX_SHAPE_POINTS],
+}
+
+impl ShapeRun {
+    /// The table of `depth_m` and `g` (checked with the scenario: from 0, increasing).
+    pub fn new(depth_m: &[f64], g: &[f64]) -> Self {
+        let mut t = ShapeRun {
+            points: depth_m.len().min(MAX_SHAPE_POINTS),
+            depth_m: [0.0; MAX_SHAPE_POINTS],
+            g: [0.0; MAX_SHAPE_POINTS],
+        };
+        t.depth_m[..t.points].copy_from_slice(&depth_m[..t.points]);
+        t.g[..t.points].copy_from_slice(&g[..t.points]);
+        t
+    }
+
+    /// Its depths scaled by `k` (the effect `interference_decay`: g(z / k)).
+    pub fn scale_depth(&mut self, k: f64) {
+        for z in &mut self.depth_m[..self.points] {
+            *z *= k;
+        }
+    }
+
+    /// g at the depth `z_m` \[m\], 0 or more (NaN gives NaN).
+    pub fn at(&self, z_m: f64) -> f64 {
+        let n = self.points;
+        if z_m >= self.depth_m[n - 1] {
+            return self.g[n - 1];
+        }
+        let k = self.depth_m[1..n - 1]
+            .iter()
+            .take_while(|&&d| d <= z_m)
+            .count();
+        let (z0, z1) = (self.depth_m[k], self.depth_m[k + 1]);
+        let (g0, g1) = (self.g[k], self.g[k + 1]);
+        (g1 - g0).mul_add((z_m - z0) / (z1 - z0), g0)
+    }
+
+    /// g at each lane's depth.
+    #[inline(always)]
+    fn lanes<R: Real>(&self, z_m: R) -> R {
+        let mut a = z_m.to_array();
+        for z in a.as_mut() {
+            *z = self.at(*z);
+        }
+        R::from_array(a)
     }
 }
 
@@ -53,8 +108,11 @@ pub struct FlowfieldRun {
     /// Lr: the rolling-moment coefficient at carriage.
     pub roll_cl: f64,
     /// L_z: the depth below carriage at which the field has halved \[m\] (the effect
-    /// `interference_decay` scales it).
+    /// `interference_decay` scales it); infinite when the shape is a table.
     pub half_depth_m: f64,
+    /// The shape as a table over depth, in place of L_z and z_r (the effect
+    /// `interference_decay` scales its depths).
+    pub shape: Option<ShapeRun>,
     /// 1 / z_r \[1/m\] (0: the field never changes sign), with any correction of it.
     pub inv_reversal_per_m: f64,
     /// A correction's change of 1 / L_z \[1/m\] (docs/update.md): 0 but in an update's
@@ -118,7 +176,8 @@ impl FlowfieldRun {
             ],
             dynamic_pressure: fx(Factor::Caintfac) * s_m * (spec.dynamic_pressure_ratio - 1.0),
             roll_cl: fx(Factor::Clintfac) * s_m * spec.roll_cl,
-            half_depth_m: spec.half_depth_m,
+            half_depth_m: spec.half_depth_m.unwrap_or(f64::INFINITY),
+            shape: spec.shape.as_ref().map(|t| ShapeRun::new(&t.depth_m, &t.g)),
             inv_reversal_per_m: spec.reversal_m.map_or(0.0, |z_r| 1.0 / z_r),
             inv_half_depth_change_per_m: 0.0,
             slopes_per_rad: [aero.cz_alpha_per_rad, aero.cy_beta_per_rad],
@@ -136,6 +195,12 @@ impl FlowfieldRun {
     /// the field's shape, docs/update.md); refused when 1 / L_z would not stay above 0 or
     /// 1 / z_r below 0 (the field would not decay, or would grow with depth).
     pub fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, String> {
+        if self.shape.is_some() {
+            return Err(
+                "the flowfield's shape is a table: it has no half depth or reversal depth to correct"
+                    .to_string(),
+            );
+        }
         let inv_half_depth = 1.0 / self.half_depth_m + change[0];
         let inv_reversal = self.inv_reversal_per_m + change[1];
         if !(inv_half_depth > 0.0 && inv_half_depth.is_finite()) {
@@ -155,12 +220,18 @@ impl FlowfieldRun {
 
     /// The field at the point `p_m` of L: (alpha_i \[rad\], beta_i \[rad\], eta).
     pub fn at(&self, p_m: [f64; 3]) -> [f64; 3] {
-        FieldLanes::<f64>::gather(|_| self, 0.0).at(p_m)
+        let f = FieldLanes::<f64>::gather(|_| self, 0.0);
+        match &self.shape {
+            Some(t) => f.at_with(p_m, |z| FieldLanes::table_shape(t, z)),
+            None => f.at_with(p_m, |z| f.analytic_shape(z)),
+        }
     }
 
     /// The coefficients `k` with the field's loads added (docs/model.md section 3b), for the
     /// CG at `r_m` (L), the store's axis `axis_l` (C_LB's first column), the moment reference
     /// point `x_ref_m` ahead of the CG, and the stage's flow angles.
+    /// Inlined, so that its fused multiply-adds are compiled with the caller's target features.
+    #[inline(always)]
     pub fn add_loads(
         &self,
         r_m: [f64; 3],
@@ -170,7 +241,12 @@ impl FlowfieldRun {
         beta_rad: f64,
         k: Coefficients,
     ) -> Coefficients {
-        FieldLanes::<f64>::gather(|_| self, x_ref_m).add_loads(r_m, axis_l, alpha_rad, beta_rad, k)
+        let f = FieldLanes::<f64>::gather(|_| self, x_ref_m);
+        let sums = match &self.shape {
+            Some(t) => f.sums_with(r_m, axis_l, |z| FieldLanes::table_shape(t, z)),
+            None => f.sums(r_m, axis_l),
+        };
+        sums.add_loads(&f, alpha_rad, beta_rad, k)
     }
 }
 
@@ -239,36 +315,30 @@ impl<R: Real> FieldLanes<R> {
 
     /// g(z) = (1 - z+ / z_r) / (1 + z+ / L_z), z+ = max(z, 0).
     #[inline(always)]
-    fn shape(&self, z_m: R) -> R {
+    fn analytic_shape(&self, z_m: R) -> R {
         let zero = R::splat(0.0);
         let z = R::select(z_m.lt(zero), zero, z_m);
         (-z).mul_add(self.inv_reversal_per_m, R::splat(1.0))
             / z.mul_add(self.inv_half_depth_per_m, R::splat(1.0))
     }
 
-    /// (alpha_i, beta_i, eta) at the point `p_m` of L (the field does not vary with y).
+    /// g(z+) of the table, z+ = max(z, 0).
     #[inline(always)]
-    fn at(&self, p_m: [R; 3]) -> [R; 3] {
-        let g = self.shape(p_m[2]);
+    fn table_shape(table: &ShapeRun, z_m: R) -> R {
+        let zero = R::splat(0.0);
+        table.lanes(R::select(z_m.lt(zero), zero, z_m))
+    }
+
+    /// (alpha_i, beta_i, eta) at the point `p_m` of L (the field does not vary with y), with
+    /// the shape `shape`.
+    #[inline(always)]
+    fn at_with(&self, p_m: [R; 3], shape: impl Fn(R) -> R) -> [R; 3] {
+        let g = shape(p_m[2]);
         [
             self.upwash[1].mul_add(p_m[0], self.upwash[0]) * g,
             self.sidewash[1].mul_add(p_m[0], self.sidewash[0]) * g,
             self.dynamic_pressure.mul_add(g, R::splat(1.0)),
         ]
-    }
-
-    /// The loads of docs/model.md section 3b added to `k`.
-    #[inline(always)]
-    pub(crate) fn add_loads(
-        &self,
-        r_m: [R; 3],
-        axis_l: [R; 3],
-        alpha_rad: R,
-        beta_rad: R,
-        k: Coefficients<R>,
-    ) -> Coefficients<R> {
-        self.sums(r_m, axis_l)
-            .add_loads(self, alpha_rad, beta_rad, k)
     }
 
     /// The sums over the stations that need the field alone, for the CG at `r_m` and the
@@ -280,6 +350,13 @@ impl<R: Real> FieldLanes<R> {
     /// evaluation), which then enter by one multiply-add each ([`FieldSums::add_loads`]).
     #[inline(always)]
     pub(crate) fn sums(&self, r_m: [R; 3], axis_l: [R; 3]) -> FieldSums<R> {
+        self.sums_with(r_m, axis_l, |z| self.analytic_shape(z))
+    }
+
+    /// [`FieldLanes::sums`] with the shape `shape` (a field whose shape is a table is
+    /// evaluated one run at a time, through [`FlowfieldRun::add_loads`]).
+    #[inline(always)]
+    fn sums_with(&self, r_m: [R; 3], axis_l: [R; 3], shape: impl Fn(R) -> R) -> FieldSums<R> {
         let zero = R::splat(0.0);
         // alpha_i / g = A + A_x p_x with p_x = r_x + C_LB[0][0] arm: at each station
         // (A + A_x r_x) + (A_x C_LB[0][0]) arm, one multiply-add (likewise beta_i).
@@ -297,7 +374,7 @@ impl<R: Real> FieldLanes<R> {
         let mut e_sum = zero;
         for i in 0..self.stations {
             let arm = self.arm_m[i];
-            let g = self.shape(axis_l[2].mul_add(arm, r_m[2]));
+            let g = shape(axis_l[2].mul_add(arm, r_m[2]));
             let e_k = self.dynamic_pressure * g;
             let eta_g = e_k.mul_add(g, g);
             let alpha_k = upwash[1].mul_add(arm, upwash[0]) * eta_g;
@@ -320,7 +397,7 @@ impl<R: Real> FieldLanes<R> {
             field,
             e_sum,
             roll_cl: if self.any_roll {
-                self.roll_cl * self.shape(r_m[2])
+                self.roll_cl * shape(r_m[2])
             } else {
                 zero
             },

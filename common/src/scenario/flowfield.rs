@@ -10,6 +10,78 @@ use crate::table::Coefficient;
 /// The most stations along the store (docs/model.md section 3b).
 pub const MAX_STATIONS: usize = 16;
 
+/// The most points of a shape given as a table over depth (docs/model.md section 3b).
+pub const MAX_SHAPE_POINTS: usize = 32;
+
+/// The field's shape g(z) given as a table over the depth below carriage (docs/model.md
+/// section 3b, "The shape as a table"), in place of `half_depth_m` and `reversal_m`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeTable {
+    /// Depths z below carriage \[m\]: the first 0, then increasing.
+    pub depth_m: Vec<f64>,
+    /// g at each depth: 1 at carriage; held at the last value below the last depth.
+    pub g: Vec<f64>,
+}
+
+impl ShapeTable {
+    fn check(&self) -> Result<(), Refusal> {
+        let n = self.depth_m.len();
+        if !(2..=MAX_SHAPE_POINTS).contains(&n) {
+            return Err(refuse(
+                "shape.depth_m",
+                format!("has {n} depths: expected 2 to {MAX_SHAPE_POINTS}"),
+            ));
+        }
+        if self.g.len() != n {
+            return Err(refuse(
+                "shape.g",
+                format!(
+                    "has {} values for {n} depths: expected one per depth",
+                    self.g.len()
+                ),
+            ));
+        }
+        if self.depth_m[0] != 0.0 {
+            return Err(refuse(
+                "shape.depth_m",
+                format!(
+                    "starts at {}: expected 0, the carriage position",
+                    self.depth_m[0]
+                ),
+            ));
+        }
+        for k in 1..n {
+            let (a, b) = (self.depth_m[k - 1], self.depth_m[k]);
+            if !(b.is_finite() && b > a) {
+                return Err(refuse(
+                    "shape.depth_m",
+                    format!("[{k}] = {b}: expected finite and above the depth before it ({a})"),
+                ));
+            }
+        }
+        if let Some(k) = self.g.iter().position(|v| !v.is_finite()) {
+            return Err(refuse(
+                "shape.g",
+                format!("[{k}] = {}: expected a finite value", self.g[k]),
+            ));
+        }
+        // Exactly 1: the field's values are those at carriage, not rescaled by the table.
+        #[allow(clippy::float_cmp)]
+        let at_carriage_is_one = self.g[0] == 1.0;
+        if !at_carriage_is_one {
+            return Err(refuse(
+                "shape.g",
+                format!(
+                    "[0] = {}: expected 1 (the field's values are those at carriage)",
+                    self.g[0]
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// How the field's strength scales with the flight Mach number (docs/model.md section 3b).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
@@ -64,8 +136,10 @@ pub struct FlowfieldSpec {
     /// l0: rolling-moment coefficient the field induces at carriage.
     #[serde(default)]
     pub roll_cl: f64,
-    /// L_z: the depth below carriage at which the field has halved \[m\].
-    pub half_depth_m: f64,
+    /// L_z: the depth below carriage at which the field has halved \[m\] (none: the shape
+    /// is a table, [`FlowfieldSpec::shape`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_depth_m: Option<f64>,
     /// z_r: depth below carriage where the field changes sign \[m\] (none: it never does).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reversal_m: Option<f64>,
@@ -77,6 +151,9 @@ pub struct FlowfieldSpec {
     /// How the field scales with Mach.
     #[serde(default)]
     pub mach_scaling: MachScaling,
+    /// The shape g(z) as a table over depth, in place of `half_depth_m` and `reversal_m`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeTable>,
 }
 
 /// A field of `[flowfield]` (its TOML path) and why its value is refused.
@@ -179,11 +256,53 @@ impl FlowfieldSpec {
         finite("roll_cl", self.roll_cl)?;
         finite("reference_alpha_deg", self.reference_alpha_deg)?;
         positive("dynamic_pressure_ratio", self.dynamic_pressure_ratio)?;
-        positive("half_depth_m", self.half_depth_m)?;
         positive("reference_mach", self.reference_mach)?;
-        if let Some(z_r) = self.reversal_m {
-            positive("reversal_m", z_r)?;
+        self.check_shape()
+    }
+
+    /// The shape: analytic (`half_depth_m`, and `reversal_m` if any) or a table, not both.
+    fn check_shape(&self) -> Result<(), Refusal> {
+        match (&self.shape, self.half_depth_m) {
+            (None, Some(l_z)) => {
+                if !(l_z.is_finite() && l_z > 0.0) {
+                    return Err(refuse(
+                        "half_depth_m",
+                        format!("= {l_z}: expected a finite value > 0"),
+                    ));
+                }
+                if let Some(z_r) = self.reversal_m
+                    && !(z_r.is_finite() && z_r > 0.0)
+                {
+                    return Err(refuse(
+                        "reversal_m",
+                        format!("= {z_r}: expected a finite value > 0"),
+                    ));
+                }
+                Ok(())
+            }
+            (None, None) => Err(refuse(
+                "half_depth_m",
+                "is missing: give the depth at which the field halves, or its shape as a table \
+                 (shape = { depth_m = [...], g = [...] })"
+                    .to_string(),
+            )),
+            (Some(_), Some(_)) => Err(refuse(
+                "shape",
+                "and half_depth_m are both given: the shape is a table or the analytic \
+                 (1 - z / z_r) / (1 + z / L_z), not both"
+                    .to_string(),
+            )),
+            (Some(t), None) => {
+                if self.reversal_m.is_some() {
+                    return Err(refuse(
+                        "reversal_m",
+                        "is given with a shape table: where the field changes sign is the \
+                         table's (a value below 0)"
+                            .to_string(),
+                    ));
+                }
+                t.check()
+            }
         }
-        Ok(())
     }
 }

@@ -501,6 +501,6 @@ mod flowfield;
 mod same_store;
 mod validate;
 
-pub use flowfield::{FlowfieldSpec, MAX_STATIONS, MachScaling};
+pub use flowfield::{FlowfieldSpec, MAX_SHAPE_POINTS, MAX_STATIONS, MachScaling, ShapeTable};
 
 pub use same_store::StoreDifference;

@@ -30,16 +30,21 @@ impl Scenario {
         let field_shape = |x: &crate::correction::Correction| {
             matches!(x.target, crate::correction::Target::Field(_))
         };
-        if self.flowfield.is_none()
-            && let Some(k) = corrections.iter().position(field_shape)
-        {
-            return Err(c.bad(
-                &format!("correction[{k}]"),
-                format!(
-                    "`field` `{}`: the scenario has no [flowfield] to correct",
-                    self.correction[k].field
+        if let Some(k) = corrections.iter().position(field_shape) {
+            let why = match &self.flowfield {
+                None => Some("the scenario has no [flowfield] to correct"),
+                Some(f) if f.shape.is_some() => Some(
+                    "the [flowfield]'s shape is a table, with no half depth or reversal depth to \
+                     correct",
                 ),
-            ));
+                Some(_) => None,
+            };
+            if let Some(why) = why {
+                return Err(c.bad(
+                    &format!("correction[{k}]"),
+                    format!("`field` `{}`: {why}", self.correction[k].field),
+                ));
+            }
         }
         self.factors
             .validate()

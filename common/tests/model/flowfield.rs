@@ -18,12 +18,12 @@ pub(crate) fn conformance_scenario() -> Scenario {
 }
 
 /// [`EXAMPLE`] with `from` (which it holds) replaced by `to`.
-fn example_with(from: &str, to: &str) -> String {
+pub(crate) fn example_with(from: &str, to: &str) -> String {
     assert!(EXAMPLE.contains(from), "the example has `{from}`");
     EXAMPLE.replacen(from, to, 1)
 }
 
-fn refusal(text: &str) -> String {
+pub(crate) fn refusal(text: &str) -> String {
     Scenario::from_toml_str(text, "f.toml")
         .unwrap_err()
         .to_string()
@@ -216,14 +216,6 @@ fn the_conformance_case_agrees_with_the_independent_implementation() {
 
 #[test]
 fn the_loads_off_carriage_agree_with_the_independent_implementation() {
-    // The reference's test state (`scripts/reference_model.py --json`): the store below and
-    // beside carriage, pitched, yawed and rolled, moving and turning.
-    let n = [0.99_f64, 0.02, 0.08, -0.03];
-    let norm = n.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let q = n.map(|v| v / norm);
-    let x = [
-        0.3, -0.1, 0.6, 1.0, 0.5, 8.0, q[0], q[1], q[2], q[3], 0.2, 0.5, -0.3,
-    ];
     let expected = [
         0.09979289137980427,
         0.09475866791346009,
@@ -232,7 +224,26 @@ fn the_loads_off_carriage_agree_with_the_independent_implementation() {
         -0.039486893089889764,
         -0.019190245628808625,
     ];
-    let sim = Simulator::new(&conformance_scenario());
+    let got = loads_at_the_reference_test_state(&conformance_scenario());
+    for (name, (g, e)) in ["dCX", "dCY", "dCZ", "dCl", "dCm", "dCn"]
+        .iter()
+        .zip(got.iter().zip(expected))
+    {
+        assert!((g - e).abs() < 1e-13, "{name}: {g} vs the reference's {e}");
+    }
+}
+
+/// The field's increments (dCX ... dCn) of `scenario` at the reference's test state
+/// (`scripts/reference_model.py --json`): the store below and beside carriage, pitched, yawed
+/// and rolled, moving and turning; truth factors.
+pub(crate) fn loads_at_the_reference_test_state(scenario: &Scenario) -> [f64; 6] {
+    let n = [0.99_f64, 0.02, 0.08, -0.03];
+    let norm = n.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let q = n.map(|v| v / norm);
+    let x = [
+        0.3, -0.1, 0.6, 1.0, 0.5, 8.0, q[0], q[1], q[2], q[3], 0.2, 0.5, -0.3,
+    ];
+    let sim = Simulator::new(scenario);
     let run = sim.run_setup(&Factors::TRUTH, &EffectSet::NONE).unwrap();
     let flow = EquationsOfMotion::new(&run, &sim.model().curve).flow(&x, 0.0);
     let c = sepval_common::frames::dcm_from_quaternion(q);
@@ -248,13 +259,7 @@ fn the_loads_off_carriage_agree_with_the_independent_implementation() {
         flow.beta_rad,
         base,
     );
-    let got = [k.cx - base.cx, k.cy, k.cz, k.cl, k.cm, k.cn];
-    for (name, (g, e)) in ["dCX", "dCY", "dCZ", "dCl", "dCm", "dCn"]
-        .iter()
-        .zip(got.iter().zip(expected))
-    {
-        assert!((g - e).abs() < 1e-13, "{name}: {g} vs the reference's {e}");
-    }
+    [k.cx - base.cx, k.cy, k.cz, k.cl, k.cm, k.cn]
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! The aircraft's flowfield through the binary (docs/model.md section 3b): the guide's example
-//! scenario simulates to its conformance values, a scenario that keeps its decay increments
+//! scenario simulates to its conformance values (and with its shape as a table, to that case's),
+//! a scenario that keeps its decay increments
 //! beside a field or asks for the field as DAVE-ML is refused with nothing written, and (slow
 //! tier) a field fitted at two flight conditions predicts a third within 5 mm and 0.2 deg,
 //! where today's decay model fitted to the same releases misses by more.
@@ -84,6 +85,69 @@ fn a_field_beside_decay_increments_or_as_daveml_is_refused_with_nothing_written(
         "flowfield",
     );
     assert!(!d.join("f.dml").exists());
+}
+
+#[test]
+fn a_shape_table_simulates_as_written_and_a_bad_one_is_refused_with_nothing_written() {
+    // docs/model.md section 3b, "The shape as a table": the example with its conformance table.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = std::fs::read_to_string(example()).unwrap();
+    let table: String = text
+        .lines()
+        .filter(|l| !l.starts_with("reversal_m"))
+        .map(|l| {
+            if l.starts_with("half_depth_m") {
+                "shape = { depth_m = [0.0, 0.3, 0.9, 1.6, 2.5], g = [1.0, 0.62, 0.2, -0.07, 0.0] }"
+                    .to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(d.join("t.toml"), &table).unwrap();
+    ok(&sepval(
+        &["simulate", "--scenario", "t.toml", "--out", "t.csv"],
+        d,
+    ));
+    // The conformance values at t = 1 s.
+    let expected = [
+        1.0,
+        -4.462230092,
+        0.236617998,
+        4.589613639,
+        36.5311826,
+        49.2409399,
+        14.5139342,
+    ];
+    let row = last_row(&d.join("t.csv"));
+    for (j, (got, want)) in row.iter().zip(expected).enumerate() {
+        assert!((got - want).abs() < 2e-6, "column {j}: {got} vs {want}");
+    }
+    // Written back by `sepval scenario`, the table flies the same release to the bit.
+    ok(&sepval(
+        &["scenario", "--scenario", "t.toml", "--out", "w.toml"],
+        d,
+    ));
+    ok(&sepval(
+        &["simulate", "--scenario", "w.toml", "--out", "w.csv"],
+        d,
+    ));
+    assert_eq!(
+        std::fs::read(d.join("t.csv")).unwrap(),
+        std::fs::read(d.join("w.csv")).unwrap()
+    );
+    // g not 1 at carriage: refused naming the field, nothing written.
+    std::fs::write(d.join("bad.toml"), table.replace("g = [1.0,", "g = [0.8,")).unwrap();
+    refused(
+        &sepval(
+            &["simulate", "--scenario", "bad.toml", "--out", "bad.csv"],
+            d,
+        ),
+        "flowfield.shape.g",
+    );
+    assert!(!d.join("bad.csv").exists());
 }
 
 /// The example's text at flight condition (`mach`, `alpha_deg`).
