@@ -199,12 +199,18 @@ const CONFORMANCE: [[f64; 7]; 5] = [
 
 #[test]
 fn the_conformance_case_agrees_with_the_independent_implementation() {
-    let sim = Simulator::new(&conformance_scenario());
-    let times: Vec<f64> = CONFORMANCE.iter().map(|row| row[0]).collect();
+    assert_flies(&conformance_scenario(), &CONFORMANCE);
+}
+
+/// `scenario` at the truth factors, noise-free, flies through `rows` (t, x, y, z [m], roll,
+/// pitch, yaw [deg]) to their printed digits: 2e-9 m and 2e-7 deg.
+pub(crate) fn assert_flies(scenario: &Scenario, rows: &[[f64; 7]]) {
+    let sim = Simulator::new(scenario);
+    let times: Vec<f64> = rows.iter().map(|row| row[0]).collect();
     let traj = sim
         .simulate(&Factors::TRUTH, &EffectSet::NONE, &times)
         .unwrap();
-    for (k, row) in CONFORMANCE.iter().enumerate() {
+    for (k, row) in rows.iter().enumerate() {
         for j in 0..3 {
             let d = (traj.pos_m[k][j] - row[1 + j]).abs();
             assert!(d < 2e-9, "t = {} s, position {j}: off by {d} m", row[0]);

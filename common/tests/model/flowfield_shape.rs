@@ -8,7 +8,7 @@ use sepval_common::scenario::Scenario;
 use sepval_common::{EffectSet, Factors, Simulator};
 
 use crate::flowfield::{
-    conformance_scenario, example_with, loads_at_the_reference_test_state, refusal,
+    assert_flies, conformance_scenario, example_with, loads_at_the_reference_test_state, refusal,
 };
 
 /// [`EXAMPLE`] with its shape as a table over depth (the analytic g at the depths given) in
@@ -104,19 +104,7 @@ const SHAPE_TABLE_INCREMENTS: [f64; 6] = [
 fn a_shape_table_agrees_with_the_independent_implementation() {
     let text = example_with_shape(&SHAPE_TABLE.0, &SHAPE_TABLE.1);
     let scenario = Scenario::from_toml_str(&text, "shape table").unwrap();
-    let sim = Simulator::new(&scenario);
-    let times: Vec<f64> = SHAPE_TABLE_ROWS.iter().map(|row| row[0]).collect();
-    let traj = sim
-        .simulate(&Factors::TRUTH, &EffectSet::NONE, &times)
-        .unwrap();
-    for (k, row) in SHAPE_TABLE_ROWS.iter().enumerate() {
-        for j in 0..3 {
-            let d = (traj.pos_m[k][j] - row[1 + j]).abs();
-            assert!(d < 2e-9, "t = {} s, position {j}: off by {d} m", row[0]);
-            let d = (traj.att_deg[k][j] - row[4 + j]).abs();
-            assert!(d < 2e-7, "t = {} s, angle {j}: off by {d} deg", row[0]);
-        }
-    }
+    assert_flies(&scenario, &SHAPE_TABLE_ROWS);
     let got = loads_at_the_reference_test_state(&scenario);
     for (name, (g, e)) in ["dCX", "dCY", "dCZ", "dCl", "dCm", "dCn"]
         .iter()
