@@ -23,6 +23,7 @@
 
 use super::aero::Coefficients;
 use super::tables::AeroAtMach;
+use crate::correction::interpolate;
 use crate::lanes::Real;
 use crate::scenario::{FlowfieldSpec, MAX_SHAPE_POINTS, MAX_STATIONS, MachScaling};
 use sepval_core::factors::{Factor, Factors};
@@ -64,22 +65,15 @@ impl ShapeRun {
         }
     }
 
-    /// g at the depth `z_m` \[m\], 0 or more (NaN gives NaN).
+    /// g at the depth `z_m` \[m\]: section 1's piecewise-linear interpolation held at the
+    /// ends, so g(0) = 1 above carriage as z+ = max(z, 0) asks (NaN gives NaN).
+    #[inline(always)]
     pub fn at(&self, z_m: f64) -> f64 {
         let n = self.points;
-        if z_m >= self.depth_m[n - 1] {
-            return self.g[n - 1];
-        }
-        let k = self.depth_m[1..n - 1]
-            .iter()
-            .take_while(|&&d| d <= z_m)
-            .count();
-        let (z0, z1) = (self.depth_m[k], self.depth_m[k + 1]);
-        let (g0, g1) = (self.g[k], self.g[k + 1]);
-        (g1 - g0).mul_add((z_m - z0) / (z1 - z0), g0)
+        interpolate(&self.depth_m[..n], &self.g[..n], z_m)
     }
 
-    /// g at each lane's depth.
+    /// g at each lane's depth (held at g(0) above carriage, as z+ = max(z, 0) asks).
     #[inline(always)]
     fn lanes<R: Real>(&self, z_m: R) -> R {
         let mut a = z_m.to_array();
@@ -222,7 +216,7 @@ impl FlowfieldRun {
     pub fn at(&self, p_m: [f64; 3]) -> [f64; 3] {
         let f = FieldLanes::<f64>::gather(|_| self, 0.0);
         match &self.shape {
-            Some(t) => f.at_with(p_m, |z| FieldLanes::table_shape(t, z)),
+            Some(t) => f.at_with(p_m, |z| t.lanes(z)),
             None => f.at_with(p_m, |z| f.analytic_shape(z)),
         }
     }
@@ -243,7 +237,7 @@ impl FlowfieldRun {
     ) -> Coefficients {
         let f = FieldLanes::<f64>::gather(|_| self, x_ref_m);
         let sums = match &self.shape {
-            Some(t) => f.sums_with(r_m, axis_l, |z| FieldLanes::table_shape(t, z)),
+            Some(t) => f.sums_with(r_m, axis_l, |z| t.lanes(z)),
             None => f.sums(r_m, axis_l),
         };
         sums.add_loads(&f, alpha_rad, beta_rad, k)
@@ -320,13 +314,6 @@ impl<R: Real> FieldLanes<R> {
         let z = R::select(z_m.lt(zero), zero, z_m);
         (-z).mul_add(self.inv_reversal_per_m, R::splat(1.0))
             / z.mul_add(self.inv_half_depth_per_m, R::splat(1.0))
-    }
-
-    /// g(z+) of the table, z+ = max(z, 0).
-    #[inline(always)]
-    fn table_shape(table: &ShapeRun, z_m: R) -> R {
-        let zero = R::splat(0.0);
-        table.lanes(R::select(z_m.lt(zero), zero, z_m))
     }
 
     /// (alpha_i, beta_i, eta) at the point `p_m` of L (the field does not vary with y), with

@@ -163,6 +163,15 @@ fn refuse(field: &str, reason: String) -> Refusal {
     (format!("flowfield.{field}"), reason)
 }
 
+/// `v` of `field`, which must be finite and above 0.
+fn positive(field: &str, v: f64) -> Result<(), Refusal> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(refuse(field, format!("= {v}: expected a finite value > 0")))
+    }
+}
+
 impl FlowfieldSpec {
     /// Checks the values for their range, and the rest of the scenario for what the field
     /// needs (docs/model.md section 3b): the six decay increments 0, the store's slopes
@@ -217,13 +226,6 @@ impl FlowfieldSpec {
                 Err(refuse(field, format!("= {v}: expected a finite value")))
             }
         };
-        let positive = |field: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(refuse(field, format!("= {v}: expected a finite value > 0")))
-            }
-        };
         finite("nose_x_m", self.nose_x_m)?;
         finite("tail_x_m", self.tail_x_m)?;
         if self.nose_x_m <= self.tail_x_m {
@@ -264,21 +266,9 @@ impl FlowfieldSpec {
     fn check_shape(&self) -> Result<(), Refusal> {
         match (&self.shape, self.half_depth_m) {
             (None, Some(l_z)) => {
-                if !(l_z.is_finite() && l_z > 0.0) {
-                    return Err(refuse(
-                        "half_depth_m",
-                        format!("= {l_z}: expected a finite value > 0"),
-                    ));
-                }
-                if let Some(z_r) = self.reversal_m
-                    && !(z_r.is_finite() && z_r > 0.0)
-                {
-                    return Err(refuse(
-                        "reversal_m",
-                        format!("= {z_r}: expected a finite value > 0"),
-                    ));
-                }
-                Ok(())
+                positive("half_depth_m", l_z)?;
+                self.reversal_m
+                    .map_or(Ok(()), |z_r| positive("reversal_m", z_r))
             }
             (None, None) => Err(refuse(
                 "half_depth_m",
