@@ -3,6 +3,7 @@
 //! tell apart, the predictions fold by fold, the corrections with their figure, and how they
 //! were chosen. The page is `templates/update.html` in sepval-report's layout.
 
+use sepval_common::correction::Target;
 use sepval_report::html::{HtmlError, PageTemplate, render_page};
 use serde::Serialize;
 
@@ -165,7 +166,7 @@ fn correction_rows(file: &UpdateFile) -> Vec<Correction> {
             name: c.name.clone(),
             field: c.field.clone(),
             // The flowfield's shape: one for every release, its value per metre of depth.
-            explored: if c.field.starts_with("flowfield.") {
+            explored: if matches!(Target::of_field(&c.field), Some(Target::Field(_))) {
                 "every release (per m)".to_string()
             } else {
                 format!("{} to {}", number(c.explored.0, 3), number(c.explored.1, 3))
