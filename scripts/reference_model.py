@@ -16,7 +16,10 @@ What it does:
    interference increments set to 0, the `[flowfield]` table of section 3b, truth factors,
    noise-free) and prints its table in section 8's format and the two stroke-end times;
 3. prints the flowfield's coefficient increments (dCX, dCY, dCZ, dCl, dCm, dCn) at one
-   documented state (`TEST_STATE` below), for a Rust unit test to compare against.
+   documented state (`TEST_STATE` below), for a Rust unit test to compare against;
+4. does the same for the field's shape as a table over depth (section 3b, "The shape as a
+   table") and for the field as tables over position (section 3b, "The field as a table over
+   position": examples/flowfield-store/grid.toml, reading its CSV file itself).
 
 Run:
 
@@ -70,6 +73,10 @@ FLOWFIELD_CASE = tomllib.loads(EXAMPLE.read_text())["flowfield"]
 SHAPE_TABLE = {"depth_m": [0.0, 0.3, 0.9, 1.6, 2.5], "g": [1.0, 0.62, 0.2, -0.07, 0.0]}
 SHAPE_TABLE_CASE = {k: v for k, v in FLOWFIELD_CASE.items()
                     if k not in ("half_depth_m", "reversal_m")} | {"shape": SHAPE_TABLE}
+# Section 3b, "The field as a table over position": the guide's surveyed field
+# (examples/flowfield-store/grid.toml), its four fields columns of field-grid.csv.
+GRID_EXAMPLE = EXAMPLE.parent / "grid.toml"
+GRID_CASE = tomllib.loads(GRID_EXAMPLE.read_text())["flowfield"]
 
 # Task item 5: the documented state at which the flowfield's increments are printed.
 _q = (0.99, 0.02, 0.08, -0.03)
@@ -120,18 +127,31 @@ class Flowfield:
         s_m = pg(mach) / pg(m_ref)                                    # s_M = Pg(M) / Pg(M_ref)
         d_alpha = math.radians(sc["flight"].get("alpha_deg", 0.0)) \
             - math.radians(ff.get("reference_alpha_deg", 0.0))        # alpha_a - alpha_ref [rad]
-        a0 = math.radians(ff["upwash_deg"])
+        const = lambda name, v: ff.get(name, v) if not isinstance(ff.get(name), dict) else v
+        a0 = math.radians(const("upwash_deg", 0.0))
         a_x = math.radians(ff.get("upwash_gradient_deg_per_m", 0.0))
-        b0 = math.radians(ff.get("sidewash_deg", 0.0))
+        b0 = math.radians(const("sidewash_deg", 0.0))
         b_x = math.radians(ff.get("sidewash_gradient_deg_per_m", 0.0))
         self.A = fac["czintfac"] * s_m * (a0 + ff.get("upwash_per_alpha", 0.0) * d_alpha)
         self.Ax = fac["cmintfac"] * s_m * a_x
         self.B = fac["cyintfac"] * s_m * (b0 + ff.get("sidewash_per_alpha", 0.0) * d_alpha)
         self.Bx = fac["cnintfac"] * s_m * b_x
-        self.E = fac["caintfac"] * s_m * (ff.get("dynamic_pressure_ratio", 1.0) - 1.0)
-        self.Lr = fac["clintfac"] * s_m * ff.get("roll_cl", 0.0)
+        self.E = fac["caintfac"] * s_m * (const("dynamic_pressure_ratio", 1.0) - 1.0)
+        self.Lr = fac["clintfac"] * s_m * const("roll_cl", 0.0)
         self.table = ff.get("shape")                                  # None: the analytic shape
-        if self.table is None:
+        self.grid = None
+        if isinstance(ff["upwash_deg"], dict):                        # tables over position
+            self.grid = Grid(ff)
+            c_a = 1.0
+            if "zero_lift_alpha_deg" in ff:                           # (alpha - a_0) / (ref - a_0)
+                a_0 = ff["zero_lift_alpha_deg"]
+                c_a = (sc["flight"].get("alpha_deg", 0.0) - a_0) \
+                    / (ff.get("reference_alpha_deg", 0.0) - a_0)
+            self.KA = fac["czintfac"] * s_m * c_a * math.pi / 180.0   # per deg of the table
+            self.KB = fac["cyintfac"] * s_m * c_a * math.pi / 180.0
+            self.KE = fac["caintfac"] * s_m
+            self.KL = fac["clintfac"] * s_m
+        elif self.table is None:
             self.Lz = ff["half_depth_m"]
             self.zr = ff.get("reversal_m")                            # None: never reverses
         # Stations at the middles of N equal segments of [tail, nose]; linear weights.
@@ -159,17 +179,22 @@ class Flowfield:
         e = 1.0 / (1.0 + zp / self.Lz)
         return e if self.zr is None else (1.0 - zp / self.zr) * e
 
+    def field(self, p):
+        """(alpha_i [rad], beta_i [rad], eta) at the point p of L (section 3b)."""
+        if self.grid is not None:
+            up, side, q = (self.grid.value(name, p) for name in ("upwash_deg", "sidewash_deg",
+                                                                  "dynamic_pressure_ratio"))
+            return self.KA * up, self.KB * side, 1.0 + self.KE * (q - 1.0)
+        gk = self.g(p[2])
+        return (self.A + self.Ax * p[0]) * gk, (self.B + self.Bx * p[0]) * gk, 1.0 + self.E * gk
+
     def increments(self, r, c, alpha, beta, cx):
         """(dCX, dCY, dCZ, dCl, dCm, dCn) given r (L), C_LB, the store's alpha, beta and CX."""
         N = len(self.xs)
         sz = sy = smz = smy = seta = 0.0
         for xk, wk, vk in zip(self.xs, self.w, self.v):
-            px = r[0] + c[0][0] * xk                                  # P_k = r + C_LB (x_k, 0, 0)
-            pz = r[2] + c[2][0] * xk
-            gk = self.g(pz)
-            alpha_k = (self.A + self.Ax * px) * gk
-            beta_k = (self.B + self.Bx * px) * gk
-            eta_k = 1.0 + self.E * gk
+            p = [r[j] + c[j][0] * xk for j in range(3)]               # P_k = r + C_LB (x_k, 0, 0)
+            alpha_k, beta_k, eta_k = self.field(p)
             n_k = eta_k * (alpha + alpha_k) - alpha
             m_k = eta_k * (beta + beta_k) - beta
             sz += wk * n_k
@@ -182,8 +207,63 @@ class Flowfield:
         d_cy = self.cy_b * sy
         d_cn = (self.cy_b / self.d) * smy
         d_cx = (seta / N - 1.0) * cx
-        d_cl = self.Lr * self.g(r[2])
+        if self.grid is not None:
+            d_cl = self.KL * self.grid.value("roll_cl", r)
+        else:
+            d_cl = self.Lr * self.g(r[2])
         return d_cx, d_cy, d_cz, d_cl, d_cm, d_cn
+
+
+class Grid:
+    """Section 3b's field as tables over position: the columns of the CSV files the fields name
+    (x, y, z [m] axes in nesting order, values in deg or -), interpolated one axis at a time
+    (section 1: linear, the last axis first), held at the edges; a field not given is neutral."""
+
+    def __init__(self, ff):
+        self.tables = {}
+        for name in ("upwash_deg", "sidewash_deg", "dynamic_pressure_ratio", "roll_cl"):
+            spec = ff.get(name)
+            if isinstance(spec, dict):
+                self.tables[name] = self.read(GRID_EXAMPLE.parent / spec["csv"], spec["column"])
+
+    @staticmethod
+    def read(path, column):
+        rows = [line for line in path.read_text().splitlines()
+                if line.strip() and not line.startswith("#")]
+        head = [h.strip() for h in rows[0].split(",")]
+        names = [h.split("[")[0].strip() for h in head]
+        units = [h.split("[")[1].rstrip("]").strip() for h in head]
+        axes = [k for k, n in enumerate(names) if n in ("x", "y", "z")]
+        assert all(units[k] == "m" for k in axes)
+        j = names.index(column)
+        assert units[j] in ("deg", "-")
+        data = [[float(f) for f in line.split(",")] for line in rows[1:]]
+        breakpoints = [sorted({row[k] for row in data}) for k in axes]
+        return {"components": [("x", "y", "z").index(names[k]) for k in axes],
+                "breakpoints": breakpoints, "values": [row[j] for row in data]}
+
+    def value(self, name, p):
+        if name not in self.tables:
+            return 1.0 if name == "dynamic_pressure_ratio" else 0.0
+        t = self.tables[name]
+        bs, comps = t["breakpoints"], t["components"]
+        cells = []
+        for b, comp in zip(bs, comps):
+            i = min(max(bisect.bisect_right(b, p[comp]) - 1, 0), len(b) - 2)
+            u = min(max((p[comp] - b[i]) / (b[i + 1] - b[i]), 0.0), 1.0)
+            cells.append((i, u))
+        strides = [1] * len(bs)
+        for k in range(len(bs) - 2, -1, -1):
+            strides[k] = strides[k + 1] * len(bs[k + 1])
+
+        def along(axis, at):                                          # the last axis first
+            if axis == len(bs):
+                return t["values"][at]
+            i, u = cells[axis]
+            lo = along(axis + 1, at + i * strides[axis])
+            hi = along(axis + 1, at + (i + 1) * strides[axis])
+            return lo + u * (hi - lo)
+        return along(0, 0)
 
 
 # ---- Sections 1-3: scenario, flow state, forces, moments, equations of motion -------------
@@ -428,6 +508,8 @@ def main(argv):
     incr = flowfield_increments(TEST_STATE, TEST_TIME)
     table_rows, _ = flowfield_model(case=SHAPE_TABLE_CASE).simulate(TIMES)
     table_incr = flowfield_increments(TEST_STATE, TEST_TIME, case=SHAPE_TABLE_CASE)
+    grid_rows, _ = flowfield_model(case=GRID_CASE).simulate(TIMES)
+    grid_incr = flowfield_increments(TEST_STATE, TEST_TIME, case=GRID_CASE)
     names = ["dCX", "dCY", "dCZ", "dCl", "dCm", "dCn"]
     columns = ["t_s", "x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"]
     if as_json:
@@ -439,7 +521,10 @@ def main(argv):
                            "increments": dict(zip(names, incr))},
             "shape_table_case": {"shape": SHAPE_TABLE,
                                  "rows": [dict(zip(columns, r)) for r in table_rows],
-                                 "increments": dict(zip(names, table_incr))}}, indent=2))
+                                 "increments": dict(zip(names, table_incr))},
+            "grid_case": {"scenario": "examples/flowfield-store/grid.toml",
+                          "rows": [dict(zip(columns, r)) for r in grid_rows],
+                          "increments": dict(zip(names, grid_incr))}}, indent=2))
     else:
         print("## Section 3b flowfield conformance case (truth factors, noise-free)\n")
         print(markdown_table(rows))
@@ -458,6 +543,12 @@ def main(argv):
         print(markdown_table(table_rows))
         print("\nincrements at the test state:")
         for n, val in zip(names, table_incr):
+            print(f"  {n} = {val:.15g}")
+        print("\n## Section 3b with the field as tables over position (truth factors, noise-free)\n")
+        print("examples/flowfield-store/grid.toml (field-grid.csv)\n")
+        print(markdown_table(grid_rows))
+        print("\nincrements at the test state:")
+        for n, val in zip(names, grid_incr):
             print(f"  {n} = {val:.15g}")
         print("\nsection 8:", "conforms" if ok else "DOES NOT CONFORM")
     return 0 if ok else 1

@@ -197,11 +197,19 @@ fn interference_table(i: &crate::scenario::Interference) -> String {
 }
 
 /// Writes the constant coefficients of `scenario` (without tables) as tables; the interference
-/// too when `interference` is set. Refuses a scenario that already has tables.
+/// too when `interference` is set. Refuses a scenario that already has tables, or a flowfield.
 pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, String> {
     if scenario.has_tables() {
         return Err(
             "the scenario already has tables: only a constant form is written as tables".into(),
+        );
+    }
+    if scenario.flowfield.is_some() {
+        return Err(
+            "the scenario has a [flowfield], which acts through the store's slopes CZ_alpha and \
+             CY_beta (docs/model.md section 3b): the table form writes them as static tables \
+             over alpha and beta, so it is written for a scenario without a field only"
+                .into(),
         );
     }
     let mach = mach_breakpoints(scenario.flight.mach);

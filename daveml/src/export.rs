@@ -241,6 +241,10 @@ fn input_description(v: Variable) -> String {
         Variable::Beta => "the store's local sideslip asin(v / V)".into(),
         Variable::Distance => "distance of the store's CG from its carriage position".into(),
         Variable::Lateral => "lateral (launch-frame y) offset of the CG from carriage".into(),
+        Variable::X | Variable::Y | Variable::Z => format!(
+            "launch-frame {} of a point from the CG's carriage position",
+            v.csv_name()
+        ),
     }
 }
 

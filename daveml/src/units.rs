@@ -47,7 +47,8 @@ pub fn input(v: Variable, units: &str) -> Result<Conversion, &'static str> {
             "rad" => Ok(Conversion::ToDegrees),
             _ => Err("deg or rad"),
         },
-        Variable::Distance | Variable::Lateral => match u {
+        Variable::Distance | Variable::Lateral | Variable::X | Variable::Y | Variable::Z => match u
+        {
             "m" => Ok(Conversion::Scale(1.0)),
             "ft" => Ok(Conversion::Scale(M_PER_FT)),
             "in" => Ok(Conversion::Scale(M_PER_IN)),
@@ -60,10 +61,17 @@ pub fn input(v: Variable, units: &str) -> Result<Conversion, &'static str> {
 pub fn output(kind: Kind, units: &str) -> Result<Conversion, &'static str> {
     let u = units.trim();
     match kind {
-        Kind::Static | Kind::Interference if NONDIMENSIONAL.contains(&u) => {
+        Kind::Static | Kind::Interference | Kind::FieldRatio if NONDIMENSIONAL.contains(&u) => {
             Ok(Conversion::Scale(1.0))
         }
-        Kind::Static | Kind::Interference => Err("nd (a coefficient is non-dimensional)"),
+        Kind::Static | Kind::Interference | Kind::FieldRatio => {
+            Err("nd (a coefficient is non-dimensional)")
+        }
+        Kind::FieldAngle => match u {
+            "deg" => Ok(Conversion::Scale(1.0)),
+            "rad" => Ok(Conversion::ToDegrees),
+            _ => Err("deg or rad (a flow angle)"),
+        },
         Kind::Derivative => match u {
             "1/rad" | "/rad" | "rad-1" => Ok(Conversion::Scale(1.0)),
             "1/deg" | "/deg" | "deg-1" => Ok(Conversion::ToDegrees),
@@ -77,15 +85,16 @@ pub fn written_input(v: Variable) -> &'static str {
     match v {
         Variable::Mach => "nd",
         Variable::Alpha | Variable::Beta => "deg",
-        Variable::Distance | Variable::Lateral => "m",
+        Variable::Distance | Variable::Lateral | Variable::X | Variable::Y | Variable::Z => "m",
     }
 }
 
 /// The unit sepval writes for a field of `kind`.
 pub fn written_output(kind: Kind) -> &'static str {
     match kind {
-        Kind::Static | Kind::Interference => "nd",
+        Kind::Static | Kind::Interference | Kind::FieldRatio => "nd",
         Kind::Derivative => "1/rad",
+        Kind::FieldAngle => "deg",
     }
 }
 

@@ -47,7 +47,8 @@ pub struct Explored {
     /// 3b), whose increments over distance are 0 by definition: no correction over distance
     /// is proposed then (it would bring back the model the field replaces).
     pub flowfield: bool,
-    /// Whether that field's shape is a table over depth (its shape is then not corrected).
+    /// Whether that field's shape is a table over depth, or the field tables over position (its
+    /// shape is then not corrected).
     pub field_shape_table: bool,
 }
 
@@ -86,7 +87,7 @@ impl Explored {
                 .scenario()
                 .flowfield
                 .as_ref()
-                .is_some_and(|f| f.shape.is_some()),
+                .is_some_and(|f| f.shape.is_some() || f.is_grid()),
         }
     }
 

@@ -30,11 +30,12 @@ pub(super) fn wind_lanes<R: Real>(parts: &[Parts], t_s: R) -> [R; 3] {
 /// Whether every lane has a field with the same number of stations, so that the fields are
 /// evaluated in the lanes together.
 pub(super) fn alike_fields(parts: &[Parts]) -> bool {
-    // A field whose shape is a table is evaluated one run at a time (its lookups are scalar).
+    // A field with a table is evaluated one run at a time (its lookups are scalar).
     let stations = |p: &Parts| {
         p.run
             .flowfield
-            .filter(|f| f.shape.is_none())
+            .as_ref()
+            .filter(|f| f.in_lanes())
             .map(|f| f.stations)
     };
     stations(&parts[0]).is_some() && parts.iter().all(|p| stations(p) == stations(&parts[0]))

@@ -17,11 +17,18 @@
 //! dCX = (eta_bar - 1) CX,        dCl = Lr g(r_z)
 //! ```
 //!
+//! A field given as tables over position ([`FieldGrid`]) takes the tables' values at P_k in
+//! place of (A + A_x p_x) g, (B + B_x p_x) g and E g, each times its factor and scaling, and
+//! the rolling-moment table's at the CG in place of Lr g(r_z).
+//!
 //! The loads are written once over [`Real`] (`FieldLanes`): for one run, and for four runs
 //! in the lanes of an `F64x4` with the same operations, so that a lane has its run's bits. A
 //! run without a field takes none of these operations.
 
+use std::sync::Arc;
+
 use super::aero::Coefficients;
+use super::flowfield_grid::FieldGrid;
 use super::tables::AeroAtMach;
 use crate::correction::interpolate;
 use crate::lanes::Real;
@@ -85,7 +92,7 @@ impl ShapeRun {
 }
 
 /// One run's field and stations, with the factors and the flight condition applied.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FlowfieldRun {
     /// Number of stations in use.
     pub stations: usize,
@@ -107,6 +114,13 @@ pub struct FlowfieldRun {
     /// The shape as a table over depth, in place of L_z and z_r (the effect
     /// `interference_decay` scales its depths).
     pub shape: Option<ShapeRun>,
+    /// The field as tables over position, in place of the analytic field: `upwash[0]` and
+    /// `sidewash[0]` are then the factors that turn its angles (degrees) into radians,
+    /// `dynamic_pressure` its eta - 1's, `roll_cl` its rolling moment's.
+    pub grid: Option<Arc<FieldGrid>>,
+    /// The depth scale k of a field of tables (the effect `interference_decay`: the field at
+    /// depth z is the tables' at z / k); 1 otherwise.
+    pub depth_scale: f64,
     /// 1 / z_r \[1/m\] (0: the field never changes sign), with any correction of it.
     pub inv_reversal_per_m: f64,
     /// A correction's change of 1 / L_z \[1/m\] (docs/update.md): 0 but in an update's
@@ -120,9 +134,11 @@ pub struct FlowfieldRun {
 
 impl FlowfieldRun {
     /// The run of `spec` for a store of diameter `diameter_m` with the derivatives `aero` at
-    /// the flight condition (`mach`, aircraft angle of attack `alpha_deg`), with `factors`.
+    /// the flight condition (`mach`, aircraft angle of attack `alpha_deg`), with `factors`;
+    /// `grid` is the field's tables over position ([`FieldGrid::of`] `spec`), if it has them.
     pub fn new(
         spec: &FlowfieldSpec,
+        grid: Option<&Arc<FieldGrid>>,
         aero: &AeroAtMach,
         diameter_m: f64,
         mach: f64,
@@ -152,31 +168,69 @@ impl FlowfieldRun {
             }
             w
         });
-        FlowfieldRun {
+        let [a0, b0, eta0, l0] = spec.carriage_values();
+        let run = FlowfieldRun {
             stations: n,
             station_x_m,
             weights,
             upwash: [
-                fx(Factor::Czintfac)
-                    * s_m
-                    * (spec.upwash_deg + spec.upwash_per_alpha * d_alpha).to_radians(),
+                fx(Factor::Czintfac) * s_m * (a0 + spec.upwash_per_alpha * d_alpha).to_radians(),
                 fx(Factor::Cmintfac) * s_m * spec.upwash_gradient_deg_per_m.to_radians(),
             ],
             sidewash: [
-                fx(Factor::Cyintfac)
-                    * s_m
-                    * (spec.sidewash_deg + spec.sidewash_per_alpha * d_alpha).to_radians(),
+                fx(Factor::Cyintfac) * s_m * (b0 + spec.sidewash_per_alpha * d_alpha).to_radians(),
                 fx(Factor::Cnintfac) * s_m * spec.sidewash_gradient_deg_per_m.to_radians(),
             ],
-            dynamic_pressure: fx(Factor::Caintfac) * s_m * (spec.dynamic_pressure_ratio - 1.0),
-            roll_cl: fx(Factor::Clintfac) * s_m * spec.roll_cl,
+            dynamic_pressure: fx(Factor::Caintfac) * s_m * (eta0 - 1.0),
+            roll_cl: fx(Factor::Clintfac) * s_m * l0,
             half_depth_m: spec.half_depth_m.unwrap_or(f64::INFINITY),
             shape: spec.shape.as_ref().map(|t| ShapeRun::new(&t.depth_m, &t.g)),
+            grid: None,
+            depth_scale: 1.0,
             inv_reversal_per_m: spec.reversal_m.map_or(0.0, |z_r| 1.0 / z_r),
             inv_half_depth_change_per_m: 0.0,
             slopes_per_rad: [aero.cz_alpha_per_rad, aero.cy_beta_per_rad],
             inv_diameter_per_m: 1.0 / diameter_m,
+        };
+        match grid {
+            Some(grid) => run.with_grid(grid, spec, factors, s_m, alpha_deg),
+            None => run,
         }
+    }
+
+    /// The run with the field of tables `grid` in place of the analytic field: its angles
+    /// scaled by the factor, s_M and (alpha_a - alpha_0) / (alpha_ref - alpha_0) (1 without
+    /// alpha_0), its eta - 1 and rolling moment by the factor and s_M (docs/model.md section
+    /// 3b, "The field as a table over position").
+    fn with_grid(
+        mut self,
+        grid: &Arc<FieldGrid>,
+        spec: &FlowfieldSpec,
+        factors: &Factors,
+        s_m: f64,
+        alpha_deg: f64,
+    ) -> Self {
+        let fx = |f: Factor| factors.get(f);
+        let c_alpha = spec.zero_lift_alpha_deg.map_or(1.0, |a_0| {
+            (alpha_deg - a_0) / (spec.reference_alpha_deg - a_0)
+        });
+        let has = |j: usize| spec.position_tables()[j].is_some();
+        self.upwash = [(fx(Factor::Czintfac) * s_m * c_alpha).to_radians(), 0.0];
+        self.sidewash = [(fx(Factor::Cyintfac) * s_m * c_alpha).to_radians(), 0.0];
+        self.dynamic_pressure = fx(Factor::Caintfac) * s_m;
+        self.roll_cl = if has(3) {
+            fx(Factor::Clintfac) * s_m
+        } else {
+            0.0
+        };
+        self.grid = Some(Arc::clone(grid));
+        self
+    }
+
+    /// Whether the field is evaluated in the lanes with others (an analytic field); a field
+    /// with a table goes one run at a time (its lookups are scalar).
+    pub fn in_lanes(&self) -> bool {
+        self.shape.is_none() && self.grid.is_none()
     }
 
     /// 1 / L_z \[1/m\], with any correction of it.
@@ -189,7 +243,7 @@ impl FlowfieldRun {
     /// the field's shape, docs/update.md); refused when 1 / L_z would not stay above 0 or
     /// 1 / z_r below 0 (the field would not decay, or would grow with depth).
     pub fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, String> {
-        if self.shape.is_some() {
+        if self.shape.is_some() || self.grid.is_some() {
             return Err(
                 "the flowfield's shape is a table: it has no half depth or reversal depth to correct"
                     .to_string(),
@@ -215,10 +269,29 @@ impl FlowfieldRun {
     /// The field at the point `p_m` of L: (alpha_i \[rad\], beta_i \[rad\], eta).
     pub fn at(&self, p_m: [f64; 3]) -> [f64; 3] {
         let f = FieldLanes::<f64>::gather(|_| self, 0.0);
-        match &self.shape {
-            Some(t) => f.at_with(p_m, |z| t.lanes(z)),
-            None => f.at_with(p_m, |z| f.analytic_shape(z)),
+        match (&self.grid, &self.shape) {
+            (Some(grid), _) => {
+                let [alpha_i, beta_i, _, eta] = self.grid_station(grid, p_m);
+                [alpha_i, beta_i, eta]
+            }
+            (None, Some(t)) => f.at_with(p_m, |z| t.lanes(z)),
+            (None, None) => f.at_with(p_m, |z| f.analytic_shape(z)),
         }
+    }
+
+    /// A field of tables at the point `p_m`: alpha_i \[rad\], beta_i \[rad\], e = eta - 1
+    /// and eta.
+    #[inline(always)]
+    fn grid_station(&self, grid: &FieldGrid, p_m: [f64; 3]) -> [f64; 4] {
+        let [up_deg, side_deg, eta_change] =
+            grid.angles_at([p_m[0], p_m[1], p_m[2] / self.depth_scale]);
+        let e = self.dynamic_pressure * eta_change;
+        [
+            self.upwash[0] * up_deg,
+            self.sidewash[0] * side_deg,
+            e,
+            1.0 + e,
+        ]
     }
 
     /// The coefficients `k` with the field's loads added (docs/model.md section 3b), for the
@@ -236,9 +309,20 @@ impl FlowfieldRun {
         k: Coefficients,
     ) -> Coefficients {
         let f = FieldLanes::<f64>::gather(|_| self, x_ref_m);
-        let sums = match &self.shape {
-            Some(t) => f.sums_with(r_m, axis_l, |z| t.lanes(z)),
-            None => f.sums(r_m, axis_l),
+        let sums = match (&self.grid, &self.shape) {
+            (Some(grid), _) => f.sums_by(
+                |arm| {
+                    let p = std::array::from_fn(|j| axis_l[j].mul_add(arm, r_m[j]));
+                    let [alpha_k, beta_k, e_k, eta_k] = self.grid_station(grid, p);
+                    [e_k, eta_k * alpha_k, eta_k * beta_k]
+                },
+                || {
+                    let r = [r_m[0], r_m[1], r_m[2] / self.depth_scale];
+                    self.roll_cl * grid.at(r)[3]
+                },
+            ),
+            (None, Some(t)) => f.sums_with(r_m, axis_l, |z| t.lanes(z)),
+            (None, None) => f.sums(r_m, axis_l),
         };
         sums.add_loads(&f, alpha_rad, beta_rad, k)
     }
@@ -344,7 +428,6 @@ impl<R: Real> FieldLanes<R> {
     /// evaluated one run at a time, through [`FlowfieldRun::add_loads`]).
     #[inline(always)]
     fn sums_with(&self, r_m: [R; 3], axis_l: [R; 3], shape: impl Fn(R) -> R) -> FieldSums<R> {
-        let zero = R::splat(0.0);
         // alpha_i / g = A + A_x p_x with p_x = r_x + C_LB[0][0] arm: at each station
         // (A + A_x r_x) + (A_x C_LB[0][0]) arm, one multiply-add (likewise beta_i).
         let upwash = [
@@ -355,17 +438,33 @@ impl<R: Real> FieldLanes<R> {
             self.sidewash[1].mul_add(r_m[0], self.sidewash[0]),
             self.sidewash[1] * axis_l[0],
         ];
+        self.sums_by(
+            |arm| {
+                let g = shape(axis_l[2].mul_add(arm, r_m[2]));
+                let e_k = self.dynamic_pressure * g;
+                let eta_g = e_k.mul_add(g, g);
+                [
+                    e_k,
+                    upwash[1].mul_add(arm, upwash[0]) * eta_g,
+                    sidewash[1].mul_add(arm, sidewash[0]) * eta_g,
+                ]
+            },
+            || self.roll_cl * shape(r_m[2]),
+        )
+    }
+
+    /// The sums over the stations of the field `station` gives at each station's arm
+    /// (e_k, eta_k alpha_k, eta_k beta_k), with the rolling moment `roll` (formed only when a
+    /// lane's field has one).
+    #[inline(always)]
+    fn sums_by(&self, station: impl Fn(R) -> [R; 3], roll: impl Fn() -> R) -> FieldSums<R> {
+        let zero = R::splat(0.0);
         // Each sum its own variable (an array indexed in a loop may be kept in memory).
         let [mut e_n, mut e_m, mut e_y, mut e_r] = [zero; 4];
         let [mut f_n, mut f_m, mut f_y, mut f_r] = [zero; 4];
         let mut e_sum = zero;
         for i in 0..self.stations {
-            let arm = self.arm_m[i];
-            let g = shape(axis_l[2].mul_add(arm, r_m[2]));
-            let e_k = self.dynamic_pressure * g;
-            let eta_g = e_k.mul_add(g, g);
-            let alpha_k = upwash[1].mul_add(arm, upwash[0]) * eta_g;
-            let beta_k = sidewash[1].mul_add(arm, sidewash[0]) * eta_g;
+            let [e_k, alpha_k, beta_k] = station(self.arm_m[i]);
             let (w, wx) = (self.weights[0][i], self.weighted_x_m[0][i]);
             let (v, vx) = (self.weights[1][i], self.weighted_x_m[1][i]);
             e_n = w.mul_add(e_k, e_n);
@@ -383,11 +482,7 @@ impl<R: Real> FieldLanes<R> {
             by_angle,
             field,
             e_sum,
-            roll_cl: if self.any_roll {
-                self.roll_cl * shape(r_m[2])
-            } else {
-                zero
-            },
+            roll_cl: if self.any_roll { roll() } else { zero },
         }
     }
 }

@@ -32,6 +32,7 @@ mod dcm;
 pub mod ejector;
 mod equations;
 pub mod flowfield;
+pub mod flowfield_grid;
 pub mod interference;
 pub mod tables;
 pub(crate) mod term_lanes;
@@ -55,6 +56,7 @@ use tables::AeroAtMach;
 pub use aero::{Coefficients, Flow};
 pub use ejector::EjectorCurve;
 pub use flowfield::FlowfieldRun;
+pub use flowfield_grid::FieldGrid;
 pub use interference::InterferenceDecay;
 
 /// Standard gravity [m/s^2] (docs/model.md section 1).
@@ -133,6 +135,9 @@ pub struct Model {
     pub interference_at_carriage: [f64; 6],
     /// The scenario's tables, ready for the force evaluation (docs/model.md section 3).
     pub tables: PreparedTables,
+    /// The aircraft's flowfield as tables over position (docs/model.md section 3b), when the
+    /// scenario gives it so.
+    pub field_grid: Option<std::sync::Arc<FieldGrid>>,
     /// The scenario's corrections (docs/update.md), whose values candidates carry.
     pub corrections: Vec<Correction>,
 }
@@ -172,6 +177,11 @@ impl Model {
             aero_at_mach,
             interference_at_carriage,
             tables,
+            field_grid: scenario
+                .flowfield
+                .as_ref()
+                .and_then(FieldGrid::of)
+                .map(std::sync::Arc::new),
             corrections: scenario.corrections(),
         }
     }
@@ -200,7 +210,7 @@ pub struct Foot {
 
 /// The constants of one run: the model with one factor set and one effect set applied.
 /// Built per evaluation (cheap, no allocation) and then used for every force evaluation.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub struct RunSetup {
     /// 1 / m [1/kg].
     pub inv_mass_per_kg: f64,
@@ -329,6 +339,7 @@ impl RunSetup {
             flowfield: sc.flowfield.as_ref().map(|f| {
                 FlowfieldRun::new(
                     f,
+                    model.field_grid.as_ref(),
                     &model.aero_at_mach,
                     model.diameter_m,
                     sc.flight.mach,

@@ -4,8 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use std::path::Path;
+
 use super::{Aero, Interference};
-use crate::table::Coefficient;
+use crate::table::{Coefficient, FieldAngle, FieldRatio, Table, TableError};
 
 /// The most stations along the store (docs/model.md section 3b).
 pub const MAX_STATIONS: usize = 16;
@@ -97,12 +99,20 @@ fn default_stations() -> usize {
     5
 }
 
-fn one() -> f64 {
-    1.0
+fn zero_angle() -> FieldAngle {
+    FieldAngle::constant(0.0)
 }
 
-/// The analytic flowfield of docs/model.md section 3b, as the scenario file gives it (angles
-/// in degrees).
+fn zero_ratio() -> FieldRatio {
+    FieldRatio::constant(0.0)
+}
+
+fn one_ratio() -> FieldRatio {
+    FieldRatio::constant(1.0)
+}
+
+/// The flowfield of docs/model.md section 3b, as the scenario file gives it (angles in
+/// degrees): analytic (its values at carriage, a shape over depth) or tables over position.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FlowfieldSpec {
@@ -113,29 +123,31 @@ pub struct FlowfieldSpec {
     pub nose_x_m: f64,
     /// Body x of the store's tail from the CG \[m\].
     pub tail_x_m: f64,
-    /// a0: induced angle of attack at carriage at the reference condition \[deg\].
-    pub upwash_deg: f64,
+    /// a0: induced angle of attack at carriage at the reference condition \[deg\]; or the
+    /// upwash as a table over position (x, y, z of L from the CG's carriage position).
+    pub upwash_deg: FieldAngle,
     /// a_alpha: its change per degree of aircraft angle of attack \[deg/deg\].
     #[serde(default)]
     pub upwash_per_alpha: f64,
     /// a_x: its change per metre along L's x \[deg/m\].
     #[serde(default)]
     pub upwash_gradient_deg_per_m: f64,
-    /// b0: induced sideslip at carriage \[deg\].
-    #[serde(default)]
-    pub sidewash_deg: f64,
+    /// b0: induced sideslip at carriage \[deg\]; or a table over position.
+    #[serde(default = "zero_angle")]
+    pub sidewash_deg: FieldAngle,
     /// b_alpha: its change per degree of aircraft angle of attack \[deg/deg\].
     #[serde(default)]
     pub sidewash_per_alpha: f64,
     /// b_x: its change per metre along L's x \[deg/m\].
     #[serde(default)]
     pub sidewash_gradient_deg_per_m: f64,
-    /// eta0: local over free-stream dynamic pressure at carriage.
-    #[serde(default = "one")]
-    pub dynamic_pressure_ratio: f64,
-    /// l0: rolling-moment coefficient the field induces at carriage.
-    #[serde(default)]
-    pub roll_cl: f64,
+    /// eta0: local over free-stream dynamic pressure at carriage; or a table over position.
+    #[serde(default = "one_ratio")]
+    pub dynamic_pressure_ratio: FieldRatio,
+    /// l0: rolling-moment coefficient the field induces at carriage; or a table over the CG's
+    /// position.
+    #[serde(default = "zero_ratio")]
+    pub roll_cl: FieldRatio,
     /// L_z: the depth below carriage at which the field has halved \[m\] (none: the shape
     /// is a table, [`FlowfieldSpec::shape`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -154,13 +166,37 @@ pub struct FlowfieldSpec {
     /// The shape g(z) as a table over depth, in place of `half_depth_m` and `reversal_m`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape: Option<ShapeTable>,
+    /// alpha_0: the aircraft's zero-lift angle of attack \[deg\], by which a field given as
+    /// tables scales with the aircraft's angle of attack (none: it does not).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zero_lift_alpha_deg: Option<f64>,
 }
+
+/// The fields of `[flowfield]` that may be tables over position, in the order of
+/// [`FlowfieldSpec::position_tables`].
+pub const POSITION_FIELDS: [&str; 4] = [
+    "upwash_deg",
+    "sidewash_deg",
+    "dynamic_pressure_ratio",
+    "roll_cl",
+];
+
+mod grid;
 
 /// A field of `[flowfield]` (its TOML path) and why its value is refused.
 pub(super) type Refusal = (String, String);
 
 fn refuse(field: &str, reason: String) -> Refusal {
     (format!("flowfield.{field}"), reason)
+}
+
+/// `v` of `field`, which must be finite.
+fn finite(field: &str, v: f64) -> Result<(), Refusal> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(refuse(field, format!("= {v}: expected a finite value")))
+    }
 }
 
 /// `v` of `field`, which must be finite and above 0.
@@ -219,13 +255,6 @@ impl FlowfieldSpec {
     }
 
     fn check_values(&self) -> Result<(), Refusal> {
-        let finite = |field: &str, v: f64| {
-            if v.is_finite() {
-                Ok(())
-            } else {
-                Err(refuse(field, format!("= {v}: expected a finite value")))
-            }
-        };
         finite("nose_x_m", self.nose_x_m)?;
         finite("tail_x_m", self.tail_x_m)?;
         if self.nose_x_m <= self.tail_x_m {
@@ -237,17 +266,6 @@ impl FlowfieldSpec {
                 ),
             ));
         }
-        for (field, v) in [
-            ("upwash_deg", self.upwash_deg),
-            ("sidewash_deg", self.sidewash_deg),
-        ] {
-            if !(v.is_finite() && v.abs() < 45.0) {
-                return Err(refuse(
-                    field,
-                    format!("= {v}: expected a finite angle within +-45 deg"),
-                ));
-            }
-        }
         finite("upwash_per_alpha", self.upwash_per_alpha)?;
         finite("upwash_gradient_deg_per_m", self.upwash_gradient_deg_per_m)?;
         finite("sidewash_per_alpha", self.sidewash_per_alpha)?;
@@ -255,11 +273,75 @@ impl FlowfieldSpec {
             "sidewash_gradient_deg_per_m",
             self.sidewash_gradient_deg_per_m,
         )?;
-        finite("roll_cl", self.roll_cl)?;
         finite("reference_alpha_deg", self.reference_alpha_deg)?;
-        positive("dynamic_pressure_ratio", self.dynamic_pressure_ratio)?;
         positive("reference_mach", self.reference_mach)?;
+        if self.is_grid() {
+            return self.check_grid();
+        }
+        let [a0, b0, eta0, l0] = self.carriage_values();
+        for (field, v) in [("upwash_deg", a0), ("sidewash_deg", b0)] {
+            if !(v.is_finite() && v.abs() < 45.0) {
+                return Err(refuse(
+                    field,
+                    format!("= {v}: expected a finite angle within +-45 deg"),
+                ));
+            }
+        }
+        finite("roll_cl", l0)?;
+        positive("dynamic_pressure_ratio", eta0)?;
+        if let Some(a) = self.zero_lift_alpha_deg {
+            return Err(refuse(
+                "zero_lift_alpha_deg",
+                format!(
+                    "= {a} is given for an analytic field: it scales a field given as tables over \
+                     position (the analytic field's change with alpha is upwash_per_alpha)"
+                ),
+            ));
+        }
         self.check_shape()
+    }
+
+    /// Whether the field is given as tables over position (any of [`POSITION_FIELDS`] a
+    /// table).
+    pub fn is_grid(&self) -> bool {
+        self.position_tables().iter().any(Option::is_some)
+    }
+
+    /// The tables over position of [`POSITION_FIELDS`], where given.
+    pub fn position_tables(&self) -> [Option<&Table>; 4] {
+        [
+            self.upwash_deg.as_table(),
+            self.sidewash_deg.as_table(),
+            self.dynamic_pressure_ratio.as_table(),
+            self.roll_cl.as_table(),
+        ]
+    }
+
+    /// The analytic field's values at carriage (a0 \[deg\], b0 \[deg\], eta0, l0); for a field
+    /// of tables, their neutral values (0, 0, 1, 0) where a field is not a constant.
+    pub fn carriage_values(&self) -> [f64; 4] {
+        [
+            self.upwash_deg.as_constant().unwrap_or(0.0),
+            self.sidewash_deg.as_constant().unwrap_or(0.0),
+            self.dynamic_pressure_ratio.as_constant().unwrap_or(1.0),
+            self.roll_cl.as_constant().unwrap_or(0.0),
+        ]
+    }
+
+    /// Reads the tables over position given as files (relative to `dir`) into inline tables,
+    /// naming the field of an error (its TOML path).
+    pub(super) fn resolve_tables(&mut self, dir: &Path) -> Result<(), (String, TableError)> {
+        let at = |field: &'static str| move |e| (format!("flowfield.{field}"), e);
+        self.upwash_deg
+            .resolve(dir)
+            .map_err(at(POSITION_FIELDS[0]))?;
+        self.sidewash_deg
+            .resolve(dir)
+            .map_err(at(POSITION_FIELDS[1]))?;
+        self.dynamic_pressure_ratio
+            .resolve(dir)
+            .map_err(at(POSITION_FIELDS[2]))?;
+        self.roll_cl.resolve(dir).map_err(at(POSITION_FIELDS[3]))
     }
 
     /// The shape: analytic (`half_depth_m`, and `reversal_m` if any) or a table, not both.

@@ -433,6 +433,10 @@ impl Scenario {
         for (field, c) in self.interference.increments_mut() {
             c.resolve(dir).map_err(|e| wrap(field, e))?;
         }
+        if let Some(f) = self.flowfield.as_mut() {
+            f.resolve_tables(dir)
+                .map_err(|(field, e)| wrap(&field, e))?;
+        }
         Ok(())
     }
 

@@ -37,6 +37,10 @@ impl Scenario {
                     "the [flowfield]'s shape is a table, with no half depth or reversal depth to \
                      correct",
                 ),
+                Some(f) if f.is_grid() => Some(
+                    "the [flowfield] is given as tables over position, with no half depth or \
+                     reversal depth to correct",
+                ),
                 Some(_) => None,
             };
             if let Some(why) = why {

@@ -64,7 +64,7 @@ pub fn read_csv(path: &Path, column: Option<&str>, kind: Kind) -> Result<Table, 
         return Err(TableError::Empty { file });
     };
     let header = Header::parse(file, header_line, header, kind)?;
-    let chosen = header.chosen(column)?;
+    let chosen = header.chosen(column, kind)?;
     let rows = header.rows(lines)?;
     header.table(&rows, chosen, kind)
 }
@@ -166,7 +166,11 @@ impl Header {
         if name.is_empty() {
             return Err(at("a column needs a name".into()));
         }
-        let conv = conversion(kind.value_units())?;
+        let conv = match conversion(kind.value_units()) {
+            Ok(c) => c,
+            Err(_) if kind.sibling_units().contains(&unit) => Conversion::Foreign,
+            Err(e) => return Err(e),
+        };
         if columns
             .iter()
             .any(|c| matches!(c, Column::Value(n, _) if n == name))
@@ -234,8 +238,27 @@ impl Header {
         Ok(())
     }
 
-    /// The index of the value column used: `want`, or the only one.
-    fn chosen(&self, want: Option<&str>) -> Result<usize, TableError> {
+    /// The index of the value column used: `want`, or the only one; in a unit of the kind.
+    fn chosen(&self, want: Option<&str>, kind: Kind) -> Result<usize, TableError> {
+        let k = self.chosen_column(want)?;
+        if let Column::Value(name, Conversion::Foreign) = &self.columns[k] {
+            return Err(TableError::UnknownUnit {
+                file: self.file.clone(),
+                line: self.line,
+                column: k + 1,
+                header: self.names[k].clone(),
+                expected: kind
+                    .value_units()
+                    .iter()
+                    .map(|(u, _)| format!("`{name} [{u}]`"))
+                    .collect::<Vec<_>>()
+                    .join(" or "),
+            });
+        }
+        Ok(k)
+    }
+
+    fn chosen_column(&self, want: Option<&str>) -> Result<usize, TableError> {
         let (n_axes, value_names) = (self.n_axes(), self.value_names());
         match want {
             Some(want) => self

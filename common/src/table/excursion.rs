@@ -12,7 +12,7 @@ pub struct TableState {
     pub(super) cursor: [[Cell<u32>; 3]; MAX_GROUPS],
     pub(super) evaluations: Cell<u64>,
     pub(super) count: [Cell<u64>; MAX_TABLES],
-    pub(super) worst: [[Cell<f64>; 5]; MAX_TABLES],
+    pub(super) worst: [[Cell<f64>; Variable::ALL.len()]; MAX_TABLES],
 }
 
 impl TableState {
@@ -62,7 +62,7 @@ pub struct TableExcursions {
     pub count: [u64; MAX_TABLES],
     /// Per table and variable ([`Variable::ALL`] order): the largest excursion, in the
     /// variable's unit.
-    pub worst: [[f64; 5]; MAX_TABLES],
+    pub worst: [[f64; Variable::ALL.len()]; MAX_TABLES],
 }
 
 impl Default for TableExcursions {
@@ -70,7 +70,7 @@ impl Default for TableExcursions {
         TableExcursions {
             evaluations: 0,
             count: [0; MAX_TABLES],
-            worst: [[0.0; 5]; MAX_TABLES],
+            worst: [[0.0; Variable::ALL.len()]; MAX_TABLES],
         }
     }
 }

@@ -57,16 +57,26 @@ pub enum Variable {
     Distance,
     /// Lateral offset of the CG from carriage: the launch-frame y (crossrange) \[m\].
     Lateral,
+    /// A point's launch-frame x from the CG's carriage position (forward) \[m\]: an axis of
+    /// the aircraft's flowfield (docs/model.md section 3b).
+    X,
+    /// A point's launch-frame y from the CG's carriage position (right) \[m\].
+    Y,
+    /// A point's launch-frame z from the CG's carriage position (down) \[m\].
+    Z,
 }
 
 impl Variable {
     /// Every variable (each [`Kind`] has its own nesting order, [`Kind::allowed`]).
-    pub const ALL: [Variable; 5] = [
+    pub const ALL: [Variable; 8] = [
         Variable::Mach,
         Variable::Alpha,
         Variable::Beta,
         Variable::Distance,
         Variable::Lateral,
+        Variable::X,
+        Variable::Y,
+        Variable::Z,
     ];
 
     /// Its key in an inline TOML table (with the unit of its breakpoints).
@@ -77,6 +87,9 @@ impl Variable {
             Variable::Beta => "beta_deg",
             Variable::Distance => "distance_m",
             Variable::Lateral => "lateral_m",
+            Variable::X => "x_m",
+            Variable::Y => "y_m",
+            Variable::Z => "z_m",
         }
     }
 
@@ -88,6 +101,9 @@ impl Variable {
             Variable::Beta => "beta",
             Variable::Distance => "distance",
             Variable::Lateral => "lateral",
+            Variable::X => "x",
+            Variable::Y => "y",
+            Variable::Z => "z",
         }
     }
 
@@ -96,7 +112,7 @@ impl Variable {
         match self {
             Variable::Mach => "-",
             Variable::Alpha | Variable::Beta => "deg",
-            Variable::Distance | Variable::Lateral => "m",
+            Variable::Distance | Variable::Lateral | Variable::X | Variable::Y | Variable::Z => "m",
         }
     }
 
@@ -108,7 +124,7 @@ impl Variable {
                 ("deg", Conversion::Scale(1.0)),
                 ("rad", Conversion::RadToDeg),
             ],
-            Variable::Distance | Variable::Lateral => &[
+            Variable::Distance | Variable::Lateral | Variable::X | Variable::Y | Variable::Z => &[
                 ("m", Conversion::Scale(1.0)),
                 ("ft", Conversion::Scale(M_PER_FT)),
                 ("in", Conversion::Scale(M_PER_IN)),
@@ -128,6 +144,9 @@ enum Conversion {
     Scale(f64),
     /// Radians to degrees (`f64::to_degrees`); for a value per degree, per radian.
     RadToDeg,
+    /// A value column in a unit of another quantity of the same file (a flowfield file holds
+    /// angles and ratios): read as is, and refused if it is the column chosen.
+    Foreign,
 }
 
 impl Conversion {
@@ -135,6 +154,7 @@ impl Conversion {
         match self {
             Conversion::Scale(s) => x * s,
             Conversion::RadToDeg => x.to_degrees(),
+            Conversion::Foreign => x,
         }
     }
 }
@@ -148,6 +168,12 @@ pub enum Kind {
     Derivative,
     /// An interference increment: over distance (required), alpha and lateral offset.
     Interference,
+    /// An angle of the aircraft's flowfield (upwash, sidewash; in degrees): over the point's
+    /// launch-frame x, y and z (docs/model.md section 3b).
+    FieldAngle,
+    /// A ratio or coefficient of the aircraft's flowfield (dynamic pressure ratio, rolling
+    /// moment): over x, y and z.
+    FieldRatio,
 }
 
 impl Kind {
@@ -157,6 +183,7 @@ impl Kind {
             Kind::Static => &[Variable::Mach, Variable::Alpha, Variable::Beta],
             Kind::Derivative => &[Variable::Mach],
             Kind::Interference => &[Variable::Distance, Variable::Alpha, Variable::Lateral],
+            Kind::FieldAngle | Kind::FieldRatio => &[Variable::X, Variable::Y, Variable::Z],
         }
     }
 
@@ -171,11 +198,28 @@ impl Kind {
     /// Units a CSV value column may give, and the conversion to the scenario's.
     fn value_units(self) -> &'static [(&'static str, Conversion)] {
         match self {
-            Kind::Static | Kind::Interference => &[("-", Conversion::Scale(1.0))],
+            Kind::Static | Kind::Interference | Kind::FieldRatio => {
+                &[("-", Conversion::Scale(1.0))]
+            }
             Kind::Derivative => &[
                 ("1/rad", Conversion::Scale(1.0)),
                 ("1/deg", Conversion::RadToDeg),
             ],
+            Kind::FieldAngle => &[
+                ("deg", Conversion::Scale(1.0)),
+                ("rad", Conversion::RadToDeg),
+            ],
+        }
+    }
+
+    /// Units of the other value columns a file of this kind may hold beside its own (a
+    /// flowfield's file holds its angles and its ratios): such a column is read, and refused
+    /// only if it is the one chosen.
+    fn sibling_units(self) -> &'static [&'static str] {
+        match self {
+            Kind::FieldAngle => &["-"],
+            Kind::FieldRatio => &["deg", "rad"],
+            _ => &[],
         }
     }
 
@@ -184,6 +228,8 @@ impl Kind {
             Kind::Static => "a static coefficient",
             Kind::Derivative => "a derivative",
             Kind::Interference => "an interference increment",
+            Kind::FieldAngle => "a flowfield angle",
+            Kind::FieldRatio => "a flowfield ratio",
         }
     }
 
@@ -393,6 +439,12 @@ pub struct DerivativeKind;
 /// Marker: an interference increment.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct InterferenceKind;
+/// Marker: an angle of the aircraft's flowfield.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FieldAngleKind;
+/// Marker: a ratio of the aircraft's flowfield.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FieldRatioKind;
 
 impl TableKind for StaticKind {
     const KIND: Kind = Kind::Static;
@@ -402,6 +454,12 @@ impl TableKind for DerivativeKind {
 }
 impl TableKind for InterferenceKind {
     const KIND: Kind = Kind::Interference;
+}
+impl TableKind for FieldAngleKind {
+    const KIND: Kind = Kind::FieldAngle;
+}
+impl TableKind for FieldRatioKind {
+    const KIND: Kind = Kind::FieldRatio;
 }
 
 /// A coefficient of a known kind: in TOML a number, an inline table
@@ -420,6 +478,11 @@ pub type StaticCoefficient = Tabulated<StaticKind>;
 pub type DerivativeCoefficient = Tabulated<DerivativeKind>;
 /// An interference increment.
 pub type InterferenceCoefficient = Tabulated<InterferenceKind>;
+/// An angle of the aircraft's flowfield \[deg\]: a constant (the analytic field's value at
+/// carriage) or a table over position.
+pub type FieldAngle = Tabulated<FieldAngleKind>;
+/// A ratio of the aircraft's flowfield: a constant or a table over position.
+pub type FieldRatio = Tabulated<FieldRatioKind>;
 
 impl<K: TableKind> Tabulated<K> {
     /// A constant.

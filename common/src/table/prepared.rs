@@ -288,8 +288,13 @@ impl PreparedTables {
                         Variable::Alpha => 0,
                         Variable::Beta => 1,
                         Variable::Distance => 2,
-                        // Mach never reaches the run time (sliced above).
-                        Variable::Lateral | Variable::Mach => 3,
+                        // Mach never reaches the run time (sliced above), nor a flowfield's
+                        // position (its tables are not the coefficients'; model::flowfield).
+                        Variable::Lateral
+                        | Variable::Mach
+                        | Variable::X
+                        | Variable::Y
+                        | Variable::Z => 3,
                     },
                     breakpoints,
                     report_scale,

@@ -56,6 +56,9 @@ struct RawTable {
     beta_deg: Option<Vec<f64>>,
     distance_m: Option<Vec<f64>>,
     lateral_m: Option<Vec<f64>>,
+    x_m: Option<Vec<f64>>,
+    y_m: Option<Vec<f64>>,
+    z_m: Option<Vec<f64>>,
     values: Option<Nested>,
 }
 
@@ -114,6 +117,9 @@ impl RawTable {
             (Variable::Beta, &self.beta_deg),
             (Variable::Distance, &self.distance_m),
             (Variable::Lateral, &self.lateral_m),
+            (Variable::X, &self.x_m),
+            (Variable::Y, &self.y_m),
+            (Variable::Z, &self.z_m),
         ]
         .into_iter()
         .filter_map(|(variable, b)| {

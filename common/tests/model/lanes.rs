@@ -81,7 +81,7 @@ fn mixed_runs(sim: &Simulator) -> Vec<RunSetup> {
     let n = runs.len();
     let stride = 7;
     assert!(n % stride != 0);
-    (0..n).map(|j| runs[(j * stride) % n]).collect()
+    (0..n).map(|j| runs[(j * stride) % n].clone()).collect()
 }
 
 pub(crate) fn check_lanes_against_scalar(sim: &Simulator, times: &[f64]) {

@@ -9,6 +9,7 @@ mod continuity;
 mod effects;
 mod elementary;
 mod flowfield;
+mod flowfield_grid;
 mod flowfield_shape;
 mod fuzz;
 mod input_files;

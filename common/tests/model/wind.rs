@@ -140,7 +140,9 @@ fn lanes_with_and_without_wind_keep_the_bits_of_their_scalar_runs() {
     );
     assert_eq!(scalar[0], scalar[4]);
     for start in 0..runs.len() {
-        let batch: Vec<RunSetup> = (0..LANES).map(|i| runs[(start + i) % runs.len()]).collect();
+        let batch: Vec<RunSetup> = (0..LANES)
+            .map(|i| runs[(start + i) % runs.len()].clone())
+            .collect();
         let mut sinks = vec![Samples::new(); batch.len()];
         for r in propagate_lanes(model, &batch, &times, &mut sinks) {
             r.unwrap();

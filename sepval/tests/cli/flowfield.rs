@@ -1,5 +1,6 @@
 //! The aircraft's flowfield through the binary (docs/model.md section 3b): the guide's example
-//! scenario simulates to its conformance values (and with its shape as a table, to that case's),
+//! scenario simulates to its conformance values (and with its shape as a table, or its field as
+//! tables over position, to those cases'),
 //! a scenario that keeps its decay increments
 //! beside a field or asks for the field as DAVE-ML is refused with nothing written, and (slow
 //! tier) a field fitted at two flight conditions predicts a third within 5 mm and 0.2 deg,
@@ -148,6 +149,68 @@ fn a_shape_table_simulates_as_written_and_a_bad_one_is_refused_with_nothing_writ
         "flowfield.shape.g",
     );
     assert!(!d.join("bad.csv").exists());
+}
+
+#[test]
+fn a_surveyed_field_simulates_as_written_and_a_bad_one_is_refused_with_nothing_written() {
+    // docs/model.md section 3b, "The field as a table over position": the guide's survey in its
+    // CSV file, read beside the scenario.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let examples = example().parent().unwrap().to_path_buf();
+    for f in ["grid.toml", "field-grid.csv"] {
+        std::fs::copy(examples.join(f), d.join(f)).unwrap();
+    }
+    ok(&sepval(
+        &["simulate", "--scenario", "grid.toml", "--out", "g.csv"],
+        d,
+    ));
+    // The conformance values at t = 1 s.
+    let expected = [
+        1.0,
+        -4.648363943,
+        0.310343763,
+        4.576442373,
+        34.9696657,
+        55.7528215,
+        20.7259505,
+    ];
+    let row = last_row(&d.join("g.csv"));
+    for (j, (got, want)) in row.iter().zip(expected).enumerate() {
+        assert!((got - want).abs() < 2e-6, "column {j}: {got} vs {want}");
+    }
+    // Written back by `sepval scenario` (the tables inline), the same release to the bit.
+    ok(&sepval(
+        &["scenario", "--scenario", "grid.toml", "--out", "w.toml"],
+        d,
+    ));
+    std::fs::remove_file(d.join("field-grid.csv")).unwrap();
+    ok(&sepval(
+        &["simulate", "--scenario", "w.toml", "--out", "w.csv"],
+        d,
+    ));
+    assert_eq!(
+        std::fs::read(d.join("g.csv")).unwrap(),
+        std::fs::read(d.join("w.csv")).unwrap()
+    );
+    // Its file gone: refused naming the field and the file, nothing written.
+    refused(
+        &sepval(
+            &["simulate", "--scenario", "grid.toml", "--out", "bad.csv"],
+            d,
+        ),
+        "field-grid.csv",
+    );
+    assert!(!d.join("bad.csv").exists());
+    // Not written as tables of the store's aerodynamics: the field needs the store's slopes.
+    refused(
+        &sepval(
+            &["scenario", "--scenario", "w.toml", "--tables", "--out", "t"],
+            d,
+        ),
+        "[flowfield]",
+    );
+    assert!(!d.join("t").exists());
 }
 
 /// The example's text at flight condition (`mach`, `alpha_deg`).

@@ -5,6 +5,7 @@
 use sepval_common::model::flowfield::*;
 use sepval_common::model::tables::AeroAtMach;
 use sepval_common::scenario::{FlowfieldSpec, MachScaling};
+use sepval_common::table::{FieldAngle, FieldRatio};
 use sepval_core::factors::Factors;
 
 fn spec() -> FlowfieldSpec {
@@ -12,20 +13,21 @@ fn spec() -> FlowfieldSpec {
         stations: 5,
         nose_x_m: 1.5,
         tail_x_m: -1.5,
-        upwash_deg: 3.0,
+        upwash_deg: FieldAngle::constant(3.0),
         upwash_per_alpha: 0.5,
         upwash_gradient_deg_per_m: 0.0,
-        sidewash_deg: -1.5,
+        sidewash_deg: FieldAngle::constant(-1.5),
         sidewash_per_alpha: 0.0,
         sidewash_gradient_deg_per_m: 0.0,
-        dynamic_pressure_ratio: 1.0,
-        roll_cl: 0.0,
+        dynamic_pressure_ratio: FieldRatio::constant(1.0),
+        roll_cl: FieldRatio::constant(0.0),
         half_depth_m: Some(0.8),
         reversal_m: Some(2.0),
         reference_mach: 0.85,
         reference_alpha_deg: 2.0,
         mach_scaling: MachScaling::PrandtlGlauert,
         shape: None,
+        zero_lift_alpha_deg: None,
     }
 }
 
@@ -44,7 +46,7 @@ fn aero() -> AeroAtMach {
 
 #[test]
 fn weights_sum_to_one_and_put_the_force_at_the_centre_of_pressure() {
-    let run = FlowfieldRun::new(&spec(), &aero(), 0.508, 0.95, 0.0, &Factors::NOMINAL);
+    let run = FlowfieldRun::new(&spec(), None, &aero(), 0.508, 0.95, 0.0, &Factors::NOMINAL);
     for (plane, x_cp) in [(0, -0.508 * 0.3 / -6.0), (1, 0.508 * -0.3 / -6.0)] {
         let w = &run.weights[plane][..run.stations];
         let sum: f64 = w.iter().sum();
@@ -59,7 +61,7 @@ fn weights_sum_to_one_and_put_the_force_at_the_centre_of_pressure() {
 
 #[test]
 fn the_field_scales_with_lift_and_mach_and_changes_sign_at_the_reversal() {
-    let run = FlowfieldRun::new(&spec(), &aero(), 0.508, 0.95, 0.0, &Factors::NOMINAL);
+    let run = FlowfieldRun::new(&spec(), None, &aero(), 0.508, 0.95, 0.0, &Factors::NOMINAL);
     let s_m = (1.0 / 0.1f64.sqrt()) / (1.0 / (1.0 - 0.85f64 * 0.85).sqrt());
     let a = s_m * (3.0f64 + 0.5 * (0.0 - 2.0)).to_radians();
     assert!((run.upwash[0] - a).abs() < 1e-15);
@@ -103,7 +105,7 @@ fn a_field_whose_shape_is_a_table_of_its_analytic_shape_has_its_loads() {
         depth_m,
     });
     let factors = Factors::NOMINAL;
-    let run = |s: &FlowfieldSpec| FlowfieldRun::new(s, &aero(), 0.5, 0.9, 3.0, &factors);
+    let run = |s: &FlowfieldSpec| FlowfieldRun::new(s, None, &aero(), 0.5, 0.9, 3.0, &factors);
     let (a, t) = (run(&analytic), run(&tabulated));
     for z in [-0.1, 0.0, 0.05, 0.3, 0.9, 1.7, 2.6] {
         let (fa, ft) = (a.at([0.2, 0.0, z]), t.at([0.2, 0.0, z]));
