@@ -7,7 +7,7 @@
 //! of each factor's range, goals accumulated against the nominal run, as the criterion bench
 //! `simulate` does) with the default model, then the same batch with the flowfield of
 //! docs/model.md section 3b's conformance case, one run at a time (scalar) and four at a time
-//! (lanes). The rounds interleave the two models, so that a machine whose speed drifts slows
+//! (lanes); then with the guide's surveyed field (tables over position). The rounds interleave the two models, so that a machine whose speed drifts slows
 //! both alike; the ratio of each round is printed, and their median, which is the figure to
 //! quote (criterion's separate timings of `simulate_default_event_flowfield` and
 //! `simulate_default_event` are taken minutes apart, and this machine's speed changes by more
@@ -25,6 +25,14 @@ use sepval_common::{EffectSet, Factors, Scenario, Simulator};
 fn flowfield() -> Scenario {
     let text = include_str!("../../examples/flowfield-store/scenario.toml");
     Scenario::from_toml_str(text, "flowfield").expect("a valid field")
+}
+
+/// The guide's surveyed field (`examples/flowfield-store/grid.toml`): the field as tables over
+/// position, 4 x 3 x 8 points, evaluated one run at a time in the lanes.
+fn survey() -> Scenario {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/flowfield-store/grid.toml");
+    Scenario::load(&path).expect("a valid field")
 }
 
 /// 100 runs around the truth (the criterion bench's spread).
@@ -81,25 +89,31 @@ fn main() {
         .and_then(|a| a.parse().ok())
         .unwrap_or(21);
     let default = Simulator::embedded_default();
-    let field = Simulator::new(&flowfield());
-    let (default_runs, field_runs) = (runs(&default), runs(&field));
-    for (name, lanes) in [("scalar", false), ("lanes", true)] {
-        let mut ratios = Vec::new();
-        let mut per_run = (Vec::new(), Vec::new());
-        for _ in 0..rounds {
-            let d = time_batch(&default, &default_runs, lanes);
-            let f = time_batch(&field, &field_runs, lanes);
-            ratios.push(f / d);
-            per_run.0.push(d / 100.0);
-            per_run.1.push(f / 100.0);
+    let default_runs = runs(&default);
+    for (field_name, scenario) in [
+        ("analytic field", flowfield()),
+        ("surveyed field", survey()),
+    ] {
+        let field = Simulator::new(&scenario);
+        let field_runs = runs(&field);
+        for (name, lanes) in [("scalar", false), ("lanes", true)] {
+            let mut ratios = Vec::new();
+            let mut per_run = (Vec::new(), Vec::new());
+            for _ in 0..rounds {
+                let d = time_batch(&default, &default_runs, lanes);
+                let f = time_batch(&field, &field_runs, lanes);
+                ratios.push(f / d);
+                per_run.0.push(d / 100.0);
+                per_run.1.push(f / 100.0);
+            }
+            println!(
+                "{field_name}, {name}: flowfield / default = {:.3} (median of {rounds} interleaved rounds; min {:.3}, max {:.3}); per run {:.0} us vs {:.0} us",
+                median(ratios.clone()),
+                ratios.iter().copied().fold(f64::INFINITY, f64::min),
+                ratios.iter().copied().fold(0.0, f64::max),
+                1e6 * median(per_run.1),
+                1e6 * median(per_run.0),
+            );
         }
-        println!(
-            "{name}: flowfield / default = {:.3} (median of {rounds} interleaved rounds; min {:.3}, max {:.3}); per run {:.0} us vs {:.0} us",
-            median(ratios.clone()),
-            ratios.iter().copied().fold(f64::INFINITY, f64::min),
-            ratios.iter().copied().fold(0.0, f64::max),
-            1e6 * median(per_run.1),
-            1e6 * median(per_run.0),
-        );
     }
 }

@@ -34,7 +34,7 @@ impl Effect for InterferenceDecayFactor {
             if let Some(t) = field.shape.as_mut() {
                 t.scale_depth(p[0]);
             }
-            field.depth_scale *= p[0];
+            field.inv_depth_scale /= p[0];
         }
         Ok(())
     }

@@ -118,9 +118,9 @@ pub struct FlowfieldRun {
     /// `sidewash[0]` are then the factors that turn its angles (degrees) into radians,
     /// `dynamic_pressure` its eta - 1's, `roll_cl` its rolling moment's.
     pub grid: Option<Arc<FieldGrid>>,
-    /// The depth scale k of a field of tables (the effect `interference_decay`: the field at
-    /// depth z is the tables' at z / k); 1 otherwise.
-    pub depth_scale: f64,
+    /// 1 / k, the inverse of the depth scale k of a field of tables (the effect
+    /// `interference_decay`: the field at depth z is the tables' at z / k); 1 otherwise.
+    pub inv_depth_scale: f64,
     /// 1 / z_r \[1/m\] (0: the field never changes sign), with any correction of it.
     pub inv_reversal_per_m: f64,
     /// A correction's change of 1 / L_z \[1/m\] (docs/update.md): 0 but in an update's
@@ -186,7 +186,7 @@ impl FlowfieldRun {
             half_depth_m: spec.half_depth_m.unwrap_or(f64::INFINITY),
             shape: spec.shape.as_ref().map(|t| ShapeRun::new(&t.depth_m, &t.g)),
             grid: None,
-            depth_scale: 1.0,
+            inv_depth_scale: 1.0,
             inv_reversal_per_m: spec.reversal_m.map_or(0.0, |z_r| 1.0 / z_r),
             inv_half_depth_change_per_m: 0.0,
             slopes_per_rad: [aero.cz_alpha_per_rad, aero.cy_beta_per_rad],
@@ -283,8 +283,8 @@ impl FlowfieldRun {
     /// and eta.
     #[inline(always)]
     fn grid_station(&self, grid: &FieldGrid, p_m: [f64; 3]) -> [f64; 4] {
-        let [up_deg, side_deg, eta_change] =
-            grid.angles_at([p_m[0], p_m[1], p_m[2] / self.depth_scale]);
+        let [up_deg, side_deg, eta_change, _] =
+            grid.at([p_m[0], p_m[1], p_m[2] * self.inv_depth_scale]);
         let e = self.dynamic_pressure * eta_change;
         [
             self.upwash[0] * up_deg,
@@ -317,7 +317,7 @@ impl FlowfieldRun {
                     [e_k, eta_k * alpha_k, eta_k * beta_k]
                 },
                 || {
-                    let r = [r_m[0], r_m[1], r_m[2] / self.depth_scale];
+                    let r = [r_m[0], r_m[1], r_m[2] * self.inv_depth_scale];
                     self.roll_cl * grid.at(r)[3]
                 },
             ),

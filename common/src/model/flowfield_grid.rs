@@ -12,35 +12,27 @@
 //! ```
 //!
 //! The four tables share one grid (checked with the scenario), so a point's cell and weights
-//! are found once for all of them.
+//! are found once for all of them, and their four values are kept together at each grid point
+//! and interpolated together. An axis the tables do not span is kept as one breakpoint whose
+//! weight is 0, so that every grid has three axes (x, y, z) and one code path.
 
 use crate::scenario::FlowfieldSpec;
-use crate::table::{Table, Variable};
+use crate::table::Variable;
 
-/// The most axes of a field's grid (x, y and z).
-const MAX_AXES: usize = 3;
-
-/// The field's tables over position on their one grid, values as the scenario gives them
-/// (angles in degrees).
+/// The field's tables over position on their one grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FieldGrid {
-    /// The component of the point (0: x, 1: y, 2: z) each axis reads, in nesting order.
-    components: Vec<usize>,
-    /// Each axis's breakpoints \[m\].
-    breakpoints: Vec<Vec<f64>>,
-    /// Each axis's stride in the row-major values.
-    strides: Vec<usize>,
-    /// Upwash and sidewash \[deg\], dynamic pressure ratio minus 1, rolling-moment coefficient,
-    /// at each grid point (row-major); none where the scenario has no table of it.
-    values: [Option<Vec<f64>>; 4],
-}
-
-/// A point's cell in the grid: the index of its lower corner and each axis's weight of the upper
-/// one.
-#[derive(Debug, Clone, Copy)]
-struct Cell {
-    base: usize,
-    t: [f64; MAX_AXES],
+    /// The breakpoints along x, y and z \[m\] (one, 0, for an axis not spanned).
+    breakpoints: [Vec<f64>; 3],
+    /// 1 / (b_i+1 - b_i) of each interval of each axis \[1/m\].
+    inv_widths: [Vec<f64>; 3],
+    /// Each axis's stride in `values` (0 for an axis not spanned: its upper corner is its
+    /// lower one).
+    strides: [usize; 3],
+    /// At each grid point (row-major, z fastest): upwash and sidewash \[deg\], the dynamic
+    /// pressure ratio minus 1 and the rolling-moment coefficient (0 where the scenario has no
+    /// table of it).
+    values: Vec<[f64; 4]>,
 }
 
 impl FieldGrid {
@@ -49,81 +41,63 @@ impl FieldGrid {
     pub fn of(spec: &FlowfieldSpec) -> Option<FieldGrid> {
         let tables = spec.position_tables();
         let first = tables.iter().flatten().next()?;
-        let axes = first.axes();
-        let mut strides = vec![1usize; axes.len()];
-        for k in (0..axes.len().saturating_sub(1)).rev() {
-            strides[k] = strides[k + 1] * axes[k + 1].breakpoints.len();
+        let mut breakpoints: [Vec<f64>; 3] = [vec![0.0], vec![0.0], vec![0.0]];
+        for a in first.axes() {
+            let j = match a.variable {
+                Variable::X => 0,
+                Variable::Y => 1,
+                _ => 2,
+            };
+            breakpoints[j] = a.breakpoints.clone();
         }
-        let component = |v: Variable| match v {
-            Variable::X => 0,
-            Variable::Y => 1,
-            _ => 2,
-        };
-        let values = std::array::from_fn(|j| {
-            tables[j].map(|t: &Table| {
-                let v = t.values();
+        let sizes = breakpoints.each_ref().map(Vec::len);
+        let row_major = [sizes[1] * sizes[2], sizes[2], 1];
+        let strides = std::array::from_fn(|j| if sizes[j] > 1 { row_major[j] } else { 0 });
+        let points = first.values().len();
+        let neutral = [0.0, 0.0, 1.0, 0.0];
+        let values = (0..points)
+            .map(|k| {
+                let mut v: [f64; 4] =
+                    std::array::from_fn(|j| tables[j].map_or(neutral[j], |t| t.values()[k]));
                 // The dynamic pressure ratio is kept as its change, eta - 1.
-                if j == 2 {
-                    v.iter().map(|eta| eta - 1.0).collect()
-                } else {
-                    v.to_vec()
-                }
+                v[2] -= 1.0;
+                v
             })
-        });
+            .collect();
+        let inv_widths = breakpoints
+            .each_ref()
+            .map(|b| b.windows(2).map(|w| 1.0 / (w[1] - w[0])).collect());
         Some(FieldGrid {
-            components: axes.iter().map(|a| component(a.variable)).collect(),
-            breakpoints: axes.iter().map(|a| a.breakpoints.clone()).collect(),
+            breakpoints,
+            inv_widths,
             strides,
             values,
         })
-    }
-
-    /// The cell of the point `p_m` (held at the edges; NaN gives NaN weights).
-    #[inline(always)]
-    fn cell(&self, p_m: [f64; 3]) -> Cell {
-        let mut cell = Cell {
-            base: 0,
-            t: [0.0; MAX_AXES],
-        };
-        for (j, (b, &c)) in self.breakpoints.iter().zip(&self.components).enumerate() {
-            let v = p_m[c];
-            let i = b.partition_point(|&x| x <= v).clamp(1, b.len() - 1) - 1;
-            cell.t[j] = ((v - b[i]) / (b[i + 1] - b[i])).clamp(0.0, 1.0);
-            cell.base += i * self.strides[j];
-        }
-        cell
-    }
-
-    /// `values` at `cell`, interpolated along the axes from `axis` on (the last axis first).
-    fn interpolate(&self, values: &[f64], cell: &Cell, axis: usize, at: usize) -> f64 {
-        if axis == self.components.len() {
-            return values[at];
-        }
-        let lo = self.interpolate(values, cell, axis + 1, at);
-        let hi = self.interpolate(values, cell, axis + 1, at + self.strides[axis]);
-        lo + cell.t[axis] * (hi - lo)
     }
 
     /// The tables at the point `p_m` of L: upwash \[deg\], sidewash \[deg\], eta - 1 and the
     /// rolling-moment coefficient (0 where a table is absent).
     #[inline(always)]
     pub fn at(&self, p_m: [f64; 3]) -> [f64; 4] {
-        let cell = self.cell(p_m);
-        self.values.each_ref().map(|v| {
-            v.as_deref()
-                .map_or(0.0, |v| self.interpolate(v, &cell, 0, cell.base))
-        })
-    }
-
-    /// The upwash, sidewash and eta - 1 at the point `p_m` (the rolling moment, read at the CG
-    /// only, is not interpolated).
-    #[inline(always)]
-    pub fn angles_at(&self, p_m: [f64; 3]) -> [f64; 3] {
-        let cell = self.cell(p_m);
-        std::array::from_fn(|j| {
-            self.values[j]
-                .as_deref()
-                .map_or(0.0, |v| self.interpolate(v, &cell, 0, cell.base))
-        })
+        let mut base = 0;
+        let mut t = [0.0; 3];
+        for j in 0..3 {
+            let b = &self.breakpoints[j];
+            if b.len() > 1 {
+                let v = p_m[j];
+                let i = b.partition_point(|&x| x <= v).clamp(1, b.len() - 1) - 1;
+                t[j] = ((v - b[i]) * self.inv_widths[j][i]).clamp(0.0, 1.0);
+                base += i * self.strides[j];
+            }
+        }
+        let [sx, sy, sz] = self.strides;
+        let v = |at: usize| self.values[at];
+        let lerp = |lo: [f64; 4], hi: [f64; 4], t: f64| {
+            std::array::from_fn(|k| lo[k] + t * (hi[k] - lo[k]))
+        };
+        // Along z on the four edges of the cell, then along y, then along x.
+        let along_z = |at: usize| lerp(v(at), v(at + sz), t[2]);
+        let along_y = |at: usize| lerp(along_z(at), along_z(at + sy), t[1]);
+        lerp(along_y(base), along_y(base + sx), t[0])
     }
 }
