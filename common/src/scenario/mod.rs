@@ -505,6 +505,8 @@ mod flowfield;
 mod same_store;
 mod validate;
 
-pub use flowfield::{FlowfieldSpec, MAX_SHAPE_POINTS, MAX_STATIONS, MachScaling, ShapeTable};
+pub use flowfield::{
+    FlowfieldSpec, MAX_SHAPE_POINTS, MAX_STATIONS, MachScaling, POSITION_FIELDS, ShapeTable,
+};
 
 pub use same_store::StoreDifference;
