@@ -29,6 +29,28 @@ pub(crate) fn refusal(text: &str) -> String {
         .to_string()
 }
 
+/// The largest difference in position \[m\] and attitude \[deg\] between the releases of
+/// `a` and `b` at `factors` (the default event's samples).
+pub(crate) fn largest_difference(a: &Scenario, b: &Scenario, factors: &Factors) -> (f64, f64) {
+    use sepval_common::propagator::{Observation, propagate};
+    let fly = |s: &Scenario| {
+        let sim = Simulator::new(s);
+        let run = sim.run_setup(factors, &EffectSet::NONE).unwrap();
+        let mut samples: Vec<Observation> = Vec::new();
+        propagate(sim.model(), &run, &sim.default_times(), &mut samples).unwrap();
+        samples
+    };
+    let (a, b) = (fly(a), fly(b));
+    let (mut pos_m, mut att_deg) = (0.0f64, 0.0f64);
+    for (a, b) in a.iter().zip(&b) {
+        for j in 0..3 {
+            pos_m = pos_m.max((a.pos_m[j] - b.pos_m[j]).abs());
+            att_deg = att_deg.max((a.att_deg[j] - b.att_deg[j]).abs());
+        }
+    }
+    (pos_m, att_deg)
+}
+
 #[test]
 fn a_uniform_field_is_a_change_of_flow_angle() {
     // No gradient, no change of dynamic pressure, the store level at carriage: every station

@@ -7,12 +7,12 @@
 
 use std::path::{Path, PathBuf};
 
-use sepval_common::propagator::{Observation, propagate};
 use sepval_common::scenario::Scenario;
 use sepval_common::{EffectSet, Factors, Simulator};
 
 use crate::flowfield::{
-    EXAMPLE, assert_flies, conformance_scenario, loads_at_the_reference_test_state,
+    EXAMPLE, assert_flies, conformance_scenario, largest_difference,
+    loads_at_the_reference_test_state,
 };
 
 fn example_dir() -> PathBuf {
@@ -166,21 +166,7 @@ fn survey_of_the_analytic_field() -> String {
 fn a_survey_of_the_analytic_field_flies_the_analytic_release() {
     let survey = Scenario::from_toml_str(&survey_of_the_analytic_field(), "survey").unwrap();
     assert!(survey.flowfield.as_ref().unwrap().is_grid());
-    let fly = |s: &Scenario| {
-        let sim = Simulator::new(s);
-        let run = sim.run_setup(&Factors::NOMINAL, &EffectSet::NONE).unwrap();
-        let mut samples: Vec<Observation> = Vec::new();
-        propagate(sim.model(), &run, &sim.default_times(), &mut samples).unwrap();
-        samples
-    };
-    let (a, t) = (fly(&conformance_scenario()), fly(&survey));
-    let (mut pos_m, mut att_deg) = (0.0f64, 0.0f64);
-    for (a, t) in a.iter().zip(&t) {
-        for j in 0..3 {
-            pos_m = pos_m.max((a.pos_m[j] - t.pos_m[j]).abs());
-            att_deg = att_deg.max((a.att_deg[j] - t.att_deg[j]).abs());
-        }
-    }
+    let (pos_m, att_deg) = largest_difference(&conformance_scenario(), &survey, &Factors::NOMINAL);
     // Linear in x (exact on two breakpoints), the interpolation's error in z.
     assert!(pos_m < 2e-3 && att_deg < 0.05, "{pos_m} m, {att_deg} deg");
     assert!(pos_m > 0.0, "the survey is a different path");

@@ -5,10 +5,11 @@
 //! is refused naming the field.
 
 use sepval_common::scenario::Scenario;
-use sepval_common::{EffectSet, Factors, Simulator};
+use sepval_common::{Factors, Simulator};
 
 use crate::flowfield::{
-    assert_flies, conformance_scenario, example_with, loads_at_the_reference_test_state, refusal,
+    assert_flies, conformance_scenario, example_with, largest_difference,
+    loads_at_the_reference_test_state, refusal,
 };
 
 /// [`EXAMPLE`] with its shape as a table over depth (the analytic g at the depths given) in
@@ -128,24 +129,9 @@ fn lanes_equal_scalar_runs_bit_for_bit_with_a_shape_table() {
 
 #[test]
 fn a_shape_table_of_the_analytic_shape_flies_the_analytic_release() {
-    use sepval_common::propagator::{Observation, propagate};
     let depths: Vec<f64> = (0..32).map(|k| 6.0 * (k as f64 / 31.0).powi(2)).collect();
     let table = Scenario::from_toml_str(&example_with_shape_table(&depths), "table").unwrap();
-    let fly = |s: &Scenario| {
-        let sim = Simulator::new(s);
-        let run = sim.run_setup(&Factors::TRUTH, &EffectSet::NONE).unwrap();
-        let mut samples: Vec<Observation> = Vec::new();
-        propagate(sim.model(), &run, &sim.default_times(), &mut samples).unwrap();
-        samples
-    };
-    let (a, t) = (fly(&conformance_scenario()), fly(&table));
-    let (mut pos_m, mut att_deg) = (0.0f64, 0.0f64);
-    for (a, t) in a.iter().zip(&t) {
-        for j in 0..3 {
-            pos_m = pos_m.max((a.pos_m[j] - t.pos_m[j]).abs());
-            att_deg = att_deg.max((a.att_deg[j] - t.att_deg[j]).abs());
-        }
-    }
+    let (pos_m, att_deg) = largest_difference(&conformance_scenario(), &table, &Factors::TRUTH);
     // The linear interpolation's error on the field, a fraction of a percent near the store.
     assert!(pos_m < 2e-3 && att_deg < 0.05, "{pos_m} m, {att_deg} deg");
     assert!(pos_m > 0.0, "the table is a different path");
