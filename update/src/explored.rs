@@ -87,7 +87,7 @@ impl Explored {
                 .scenario()
                 .flowfield
                 .as_ref()
-                .is_some_and(|f| f.shape.is_some() || f.is_grid()),
+                .is_some_and(|f| f.shape_is_tabulated()),
         }
     }
 

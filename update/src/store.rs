@@ -132,7 +132,7 @@ fn set_field_shape(s: &mut Scenario, part: FieldShape, change: f64) -> Result<()
             field.half_depth_m = Some(1.0 / inverse);
         }
         FieldShape::Reversal => {
-            if field.shape.is_some() {
+            if field.shape_is_tabulated() {
                 return Err(
                     "the flowfield's shape is a table: no reversal depth to correct".into(),
                 );

@@ -230,7 +230,13 @@ impl FlowfieldRun {
     /// Whether the field is evaluated in the lanes with others (an analytic field); a field
     /// with a table goes one run at a time (its lookups are scalar).
     pub fn in_lanes(&self) -> bool {
-        self.shape.is_none() && self.grid.is_none()
+        !self.shape_is_tabulated()
+    }
+
+    /// Whether the shape is a table over depth or the field tables over position (no half
+    /// depth or reversal depth to correct, and scalar lookups).
+    fn shape_is_tabulated(&self) -> bool {
+        self.shape.is_some() || self.grid.is_some()
     }
 
     /// 1 / L_z \[1/m\], with any correction of it.
@@ -243,7 +249,7 @@ impl FlowfieldRun {
     /// the field's shape, docs/update.md); refused when 1 / L_z would not stay above 0 or
     /// 1 / z_r below 0 (the field would not decay, or would grow with depth).
     pub fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, String> {
-        if self.shape.is_some() || self.grid.is_some() {
+        if self.shape_is_tabulated() {
             return Err(
                 "the flowfield's shape is a table: it has no half depth or reversal depth to correct"
                     .to_string(),
@@ -268,14 +274,14 @@ impl FlowfieldRun {
 
     /// The field at the point `p_m` of L: (alpha_i \[rad\], beta_i \[rad\], eta).
     pub fn at(&self, p_m: [f64; 3]) -> [f64; 3] {
+        if let Some(grid) = &self.grid {
+            let [alpha_i, beta_i, _, eta] = self.grid_station(grid, p_m);
+            return [alpha_i, beta_i, eta];
+        }
         let f = FieldLanes::<f64>::gather(|_| self, 0.0);
-        match (&self.grid, &self.shape) {
-            (Some(grid), _) => {
-                let [alpha_i, beta_i, _, eta] = self.grid_station(grid, p_m);
-                [alpha_i, beta_i, eta]
-            }
-            (None, Some(t)) => f.at_with(p_m, |z| t.lanes(z)),
-            (None, None) => f.at_with(p_m, |z| f.analytic_shape(z)),
+        match &self.shape {
+            Some(t) => f.at_with(p_m, |z| t.lanes(z)),
+            None => f.at_with(p_m, |z| f.analytic_shape(z)),
         }
     }
 

@@ -307,6 +307,12 @@ impl FlowfieldSpec {
         self.position_tables().iter().any(Option::is_some)
     }
 
+    /// Whether the field's shape is tabulated (a table over depth, or the field as tables over
+    /// position): it has no half depth or reversal depth for `update` to correct.
+    pub fn shape_is_tabulated(&self) -> bool {
+        self.shape.is_some() || self.is_grid()
+    }
+
     /// The tables over position of [`POSITION_FIELDS`], where given.
     pub fn position_tables(&self) -> [Option<&Table>; 4] {
         [

@@ -122,22 +122,11 @@ impl Header {
             }
         };
         let conversion = |accepted: &[(&str, Conversion)]| {
-            let unknown = || TableError::UnknownUnit {
-                file: file.clone(),
-                line,
-                column: k + 1,
-                header: h.clone(),
-                expected: accepted
-                    .iter()
-                    .map(|(u, _)| format!("`{name} [{u}]`"))
-                    .collect::<Vec<_>>()
-                    .join(" or "),
-            };
             accepted
                 .iter()
                 .find(|(u, _)| *u == unit)
                 .map(|(_, c)| *c)
-                .ok_or_else(unknown)
+                .ok_or_else(|| self.unknown_unit(k, name, accepted))
         };
         let columns = &self.columns;
         if let Some(v) = Variable::ALL.iter().find(|v| v.csv_name() == name) {
@@ -242,20 +231,24 @@ impl Header {
     fn chosen(&self, want: Option<&str>, kind: Kind) -> Result<usize, TableError> {
         let k = self.chosen_column(want)?;
         if let Column::Value(name, Conversion::Foreign) = &self.columns[k] {
-            return Err(TableError::UnknownUnit {
-                file: self.file.clone(),
-                line: self.line,
-                column: k + 1,
-                header: self.names[k].clone(),
-                expected: kind
-                    .value_units()
-                    .iter()
-                    .map(|(u, _)| format!("`{name} [{u}]`"))
-                    .collect::<Vec<_>>()
-                    .join(" or "),
-            });
+            return Err(self.unknown_unit(k, name, kind.value_units()));
         }
         Ok(k)
+    }
+
+    /// Column `k` (0-based), named `name`, is in none of the units `accepted`.
+    fn unknown_unit(&self, k: usize, name: &str, accepted: &[(&str, Conversion)]) -> TableError {
+        TableError::UnknownUnit {
+            file: self.file.clone(),
+            line: self.line,
+            column: k + 1,
+            header: self.names[k].clone(),
+            expected: accepted
+                .iter()
+                .map(|(u, _)| format!("`{name} [{u}]`"))
+                .collect::<Vec<_>>()
+                .join(" or "),
+        }
     }
 
     fn chosen_column(&self, want: Option<&str>) -> Result<usize, TableError> {
