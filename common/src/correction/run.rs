@@ -237,7 +237,8 @@ impl CorrectionRun {
 /// `d[slot] += v`, each slot by a constant index, so that `d` stays in registers: written at a
 /// computed index, it went through memory and was read back as vectors by the caller, a load
 /// the stores cannot forward to (a third of an update's correction time, `perf annotate`,
-/// 2026-11-28). The same sums in the same order.
+/// 2026-11-28). The same sums in the same order; a slot outside `d` is a defect, as the
+/// computed index's bounds check made it.
 #[inline(always)]
 fn add_at(d: &mut [f64; 12], slot: usize, v: f64) {
     match slot {
@@ -252,6 +253,7 @@ fn add_at(d: &mut [f64; 12], slot: usize, v: f64) {
         8 => d[8] += v,
         9 => d[9] += v,
         10 => d[10] += v,
-        _ => d[11] += v,
+        11 => d[11] += v,
+        _ => unreachable!("correction slot {slot}: a run has 12"),
     }
 }
