@@ -82,7 +82,9 @@ impl RunSetup {
         a.cm_q += d[5];
         a.cn_r += d[6];
         if let Some(field) = run.flowfield {
-            let changed = field.with_shape_change(folded.field_shape);
+            // The field acts through the store's slopes, corrected (model.md section 3b).
+            let field = field.with_slope_change([d[0], d[2], d[1], d[3]]);
+            let changed = field.with_change(folded.field);
             run.flowfield = Some(changed.map_err(CorrectionError::Values)?);
         }
         run.corrections = corrections;

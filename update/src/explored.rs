@@ -16,7 +16,7 @@
 //!   other counted once). A static coefficient over Mach needs two of them (one would be a
 //!   constant); a derivative may be corrected at one (a constant change of its slope).
 
-use sepval_common::correction::{Derivative, FieldShape, Target};
+use sepval_common::correction::{Derivative, FieldPart, Target};
 use sepval_common::evaluation::Job;
 use sepval_common::table::Variable;
 use sepval_diagnose::Sample;
@@ -29,6 +29,8 @@ pub const ANGLE_KNOTS: usize = 5;
 pub const MIN_ANGLE_RANGE_DEG: f64 = 1.0;
 /// Flight Mach numbers closer than this are one.
 pub const MACH_MERGE: f64 = 0.005;
+/// Aircraft angles of attack closer than this are one \[deg\].
+pub const ALPHA_MERGE_DEG: f64 = 0.05;
 
 /// The ranges the releases explored along their fitted trajectories.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -50,6 +52,14 @@ pub struct Explored {
     /// Whether that field's shape is a table over depth, or the field tables over position (its
     /// shape is then not corrected).
     pub field_shape_table: bool,
+    /// Whether that field is tables over position (they scale with alpha by their zero-lift
+    /// angle: no change with alpha is corrected).
+    #[serde(default)]
+    pub field_grid: bool,
+    /// The releases' aircraft angles of attack \[deg\], increasing, those within
+    /// [`ALPHA_MERGE_DEG`] of each other counted once.
+    #[serde(default)]
+    pub aircraft_alphas_deg: Vec<f64>,
 }
 
 impl Explored {
@@ -75,19 +85,24 @@ impl Explored {
             .collect();
         machs.sort_by(f64::total_cmp);
         machs.dedup_by(|a, b| (*a - *b).abs() < MACH_MERGE);
+        let mut alphas: Vec<f64> = job
+            .events()
+            .iter()
+            .map(|e| e.simulator.scenario().flight.alpha_deg)
+            .collect();
+        alphas.sort_by(f64::total_cmp);
+        alphas.dedup_by(|a, b| (*a - *b).abs() < ALPHA_MERGE_DEG);
+        let field = job.events()[0].simulator.scenario().flowfield.as_ref();
         Explored {
             distance_m: distance,
             alpha_deg: alpha,
             beta_deg: beta,
             machs,
             s_end_m: job.events()[0].simulator.scenario().interference.s_end_m,
-            flowfield: job.events()[0].simulator.scenario().flowfield.is_some(),
-            field_shape_table: job.events()[0]
-                .simulator
-                .scenario()
-                .flowfield
-                .as_ref()
-                .is_some_and(|f| f.shape_is_tabulated()),
+            flowfield: field.is_some(),
+            field_shape_table: field.is_some_and(|f| f.shape_is_tabulated()),
+            field_grid: field.is_some_and(|f| f.is_grid()),
+            aircraft_alphas_deg: alphas,
         }
     }
 
@@ -143,11 +158,17 @@ impl Proposal {
             Target::Static(k) => AXES[k].to_string(),
             Target::Interference(k) => format!("interference {}", INCREMENTS[k]),
             Target::Derivative(d) => derivative_name(d).to_string(),
-            Target::Field(FieldShape::HalfDepth) => {
+            Target::Field(FieldPart::HalfDepth) => {
                 return "the flowfield's half depth (1 / L_z)".to_string();
             }
-            Target::Field(FieldShape::Reversal) => {
+            Target::Field(FieldPart::Reversal) => {
                 return "the flowfield's reversal depth (1 / z_r)".to_string();
+            }
+            Target::Field(FieldPart::UpwashPerAlpha) => {
+                return "the flowfield's upwash per alpha".to_string();
+            }
+            Target::Field(FieldPart::SidewashPerAlpha) => {
+                return "the flowfield's sidewash per alpha".to_string();
             }
         };
         let over = match self.variable {
@@ -188,23 +209,37 @@ fn even(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The corrections of the flowfield's shape (docs/update.md section 15.3a), when the scenario
-/// has a field: its inverse half depth and inverse reversal depth, each one constant (a field
-/// is the aircraft's, one shape for every release), at the first release's Mach.
+/// The corrections of the flowfield (docs/update.md section 15.3a), when the scenario has a
+/// field, each one constant (a field is the aircraft's, one for every release) at the first
+/// release's Mach: its inverse half depth and inverse reversal depth, unless its shape is a
+/// table; its upwash's and sidewash's change per degree of the aircraft's angle of attack, when
+/// the releases were flown at two angles or more (at one, a change with alpha is a change of the
+/// field's strength, which its factors fit) and the field is not tables over position.
 pub fn field_proposals(explored: &Explored) -> Vec<Proposal> {
-    // A shape given as a table has no half depth or reversal depth to correct.
-    if !explored.flowfield || explored.field_shape_table {
+    if !explored.flowfield {
         return Vec::new();
     }
     let mach = explored.machs.first().copied().unwrap_or(0.0);
-    FieldShape::ALL
-        .map(|part| Proposal {
+    let shape: &[FieldPart] = if explored.field_shape_table {
+        &[]
+    } else {
+        &FieldPart::SHAPE
+    };
+    let per_alpha: &[FieldPart] = if explored.field_grid || explored.aircraft_alphas_deg.len() < 2 {
+        &[]
+    } else {
+        &FieldPart::PER_ALPHA
+    };
+    shape
+        .iter()
+        .chain(per_alpha)
+        .map(|&part| Proposal {
             target: Target::Field(part),
             variable: Variable::Mach,
             breakpoints: vec![mach],
             pinned: vec![false],
         })
-        .to_vec()
+        .collect()
 }
 
 /// Every correction of axis `axis` (0 CA, ..., 5 Cn) that the explored ranges allow.

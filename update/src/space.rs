@@ -3,7 +3,7 @@
 //! penalty on the values as rows appended to the residual vector.
 
 use nalgebra::DMatrix;
-use sepval_common::correction::{Correction, CorrectionValues, Derivative, FieldShape, Target};
+use sepval_common::correction::{Correction, CorrectionValues, Derivative, FieldPart, Target};
 use sepval_common::evaluation::Candidate;
 use sepval_common::model::Model;
 use sepval_core::factors::{Factor, FactorTable, Factors};
@@ -91,7 +91,8 @@ impl UpdateSpace {
                 if !pinned {
                     let unit = match p.target {
                         Target::Derivative(_) => "1/rad",
-                        Target::Field(_) => "1/m",
+                        Target::Field(f) if f.is_shape() => "1/m",
+                        Target::Field(_) => "deg/deg",
                         _ => "-",
                     };
                     params.push(format!("{}[{k}]@{b}", p.target.field()), unit, lo, hi);
@@ -326,16 +327,22 @@ fn bound(model: &Model, target: Target) -> (f64, f64) {
 /// any release: an inverse of 0.01 per m).
 pub const FIELD_DEPTH_M: (f64, f64) = (0.05, 100.0);
 
-/// The bounds of a correction of the flowfield's `part` (it adds to the inverse depth): the
-/// corrected half depth within [`FIELD_DEPTH_M`]; the corrected reversal depth beyond its
-/// shallowest, or none (an inverse of 0).
-fn field_bounds(model: &Model, part: FieldShape) -> (f64, f64) {
+/// The least bound of a correction of the field's upwash or sidewash per degree of the
+/// aircraft's angle of attack \[deg/deg\] (either sign): a field growing by twice the change
+/// of the aircraft's angle is beyond what a wing induces beneath it.
+pub const PER_ALPHA_BOUND: f64 = 2.0;
+
+/// The bounds of a correction of the flowfield's `part`: for the shape (it adds to the inverse
+/// depth), the corrected half depth within [`FIELD_DEPTH_M`] and the corrected reversal depth
+/// beyond its shallowest, or none (an inverse of 0); for the upwash's and sidewash's change
+/// with alpha, either sign of the larger of [`PER_ALPHA_BOUND`] and twice the scenario's.
+fn field_bounds(model: &Model, part: FieldPart) -> (f64, f64) {
     let Some(field) = model.scenario().flowfield.as_ref() else {
         return (0.0, 0.0);
     };
     let (shallowest, deepest) = FIELD_DEPTH_M;
     match part {
-        FieldShape::HalfDepth => {
+        FieldPart::HalfDepth => {
             // A table's shape is never corrected (no proposal is made for it): no room.
             let Some(l_z) = field.half_depth_m else {
                 return (0.0, 0.0);
@@ -343,9 +350,17 @@ fn field_bounds(model: &Model, part: FieldShape) -> (f64, f64) {
             let inverse = 1.0 / l_z;
             (1.0 / deepest - inverse, 1.0 / shallowest - inverse)
         }
-        FieldShape::Reversal => {
+        FieldPart::Reversal => {
             let inverse = field.reversal_m.map_or(0.0, |z_r| 1.0 / z_r);
             (-inverse, 1.0 / shallowest - inverse)
+        }
+        FieldPart::UpwashPerAlpha | FieldPart::SidewashPerAlpha => {
+            let given = match part {
+                FieldPart::UpwashPerAlpha => field.upwash_per_alpha,
+                _ => field.sidewash_per_alpha,
+            };
+            let b = PER_ALPHA_BOUND.max(2.0 * given.abs());
+            (-b, b)
         }
     }
 }

@@ -13,7 +13,7 @@
 
 use std::path::PathBuf;
 
-use sepval_common::correction::{Correction, Derivative, FieldShape, Target, interpolate};
+use sepval_common::correction::{Correction, Derivative, FieldPart, Target, interpolate};
 use sepval_common::model::InterferenceDecay;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{
@@ -41,7 +41,7 @@ fn kind(target: Target) -> Kind {
         Target::Derivative(_) => Kind::Derivative,
         Target::Interference(_) => Kind::Interference,
         Target::Field(_) => {
-            unreachable!("the flowfield's shape is not a table (Target::all lists the tables)")
+            unreachable!("the flowfield's parts are not tables (Target::all lists the tables)")
         }
     }
 }
@@ -60,7 +60,7 @@ fn current(s: &Scenario, target: Target) -> Coefficient {
         Target::Derivative(d) => value(derivative(a, d).map(|c| &c.value)),
         Target::Interference(k) => s.interference.increments()[k].1.value.clone(),
         Target::Field(_) => {
-            unreachable!("the flowfield's shape is not a table (Target::all lists the tables)")
+            unreachable!("the flowfield's parts are not tables (Target::all lists the tables)")
         }
     }
 }
@@ -108,20 +108,21 @@ fn set(s: &mut Scenario, target: Target, c: Coefficient) {
         }
         Target::Interference(k) => *s.interference.increments_mut()[k].1 = tabulated(c),
         Target::Field(_) => {
-            unreachable!("the flowfield's shape is not a table (Target::all lists the tables)")
+            unreachable!("the flowfield's parts are not tables (Target::all lists the tables)")
         }
     }
 }
 
-/// The flowfield's `part` of `s` corrected by `change` \[1/m\], added to its inverse (a
-/// constant: the one breakpoint's value): the half depth 1 / (1 / L_z + change); the reversal
-/// depth 1 / (1 / z_r + change), or none when that is 0.
-fn set_field_shape(s: &mut Scenario, part: FieldShape, change: f64) -> Result<(), String> {
+/// The flowfield's `part` of `s` corrected by `change` (a constant: the one breakpoint's
+/// value): the half depth 1 / (1 / L_z + change) and the reversal depth 1 / (1 / z_r +
+/// change), or none when that is 0 (`change` in 1/m, added to the inverse); the upwash's and
+/// sidewash's change with alpha plus `change` \[deg/deg\].
+fn set_field_part(s: &mut Scenario, part: FieldPart, change: f64) -> Result<(), String> {
     let Some(field) = s.flowfield.as_mut() else {
         return Err("the scenario has no [flowfield]".into());
     };
     match part {
-        FieldShape::HalfDepth => {
+        FieldPart::HalfDepth => {
             let Some(l_z) = field.half_depth_m else {
                 return Err("the flowfield's shape is a table: no half depth to correct".into());
             };
@@ -131,7 +132,7 @@ fn set_field_shape(s: &mut Scenario, part: FieldShape, change: f64) -> Result<()
             }
             field.half_depth_m = Some(1.0 / inverse);
         }
-        FieldShape::Reversal => {
+        FieldPart::Reversal => {
             if field.shape_is_tabulated() {
                 return Err(
                     "the flowfield's shape is a table: no reversal depth to correct".into(),
@@ -143,6 +144,8 @@ fn set_field_shape(s: &mut Scenario, part: FieldShape, change: f64) -> Result<()
             }
             field.reversal_m = (inverse > 0.0).then(|| 1.0 / inverse);
         }
+        FieldPart::UpwashPerAlpha => field.upwash_per_alpha += change,
+        FieldPart::SidewashPerAlpha => field.sidewash_per_alpha += change,
     }
     Ok(())
 }
@@ -254,7 +257,7 @@ pub fn updated_store(
     }
     for (c, v) in corrections {
         if let Target::Field(part) = c.target {
-            set_field_shape(&mut s, part, v[0]).map_err(|message| UpdateError::Merge {
+            set_field_part(&mut s, part, v[0]).map_err(|message| UpdateError::Merge {
                 field: c.target.field(),
                 message,
             })?;

@@ -24,8 +24,13 @@
 //! | `aero.cz_alpha_per_rad` ... `aero.cn_r_per_rad` | `mach` | the derivative += c |
 //! | `interference.dcx0` ... `interference.dcn0` | `distance_m` | the increment += c, times its multiplier |
 //! | `flowfield.half_depth_m`, `flowfield.reversal_m` | `mach` | 1 / L_z += c, 1 / z_r += c \[1/m\] |
+//! | `flowfield.upwash_per_alpha`, `flowfield.sidewash_per_alpha` | `mach` | a_alpha += c, b_alpha += c \[deg/deg\] |
 //!
-//! The last two change the shape of the aircraft's flowfield (docs/model.md section 3b), the
+//! The last two rows change the aircraft's flowfield (docs/model.md section 3b). The last
+//! changes how its upwash and sidewash grow with the aircraft's angle of attack, what releases
+//! at two or more angles of attack measure and one cannot (the thin-wing scaling of section 3b
+//! with its slope unknown: the field of a wing is linear in its angle of attack). The one before
+//! changes its shape, the
 //! depth below carriage at which it has halved and where it changes sign, through their
 //! inverses, so that a correction is a smooth change of g(z) = (1 - z / z_r) / (1 + z / L_z)
 //! whatever its size (an inverse of 0: no decay, no reversal); a scenario with such a correction
@@ -100,30 +105,53 @@ pub enum Target {
     Derivative(Derivative),
     /// An interference increment: 0 dCX, ..., 5 dCn.
     Interference(usize),
-    /// The shape of the aircraft's flowfield (docs/model.md section 3b).
-    Field(FieldShape),
+    /// A part of the aircraft's flowfield (docs/model.md section 3b): its shape or its change
+    /// with the aircraft's angle of attack.
+    Field(FieldPart),
 }
 
-/// A part of the flowfield's shape a correction may change, through its inverse.
+/// A part of the flowfield (docs/model.md section 3b) a correction may change: its shape,
+/// through the inverses of its depths, or its change with the aircraft's angle of attack.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FieldShape {
+pub enum FieldPart {
     /// The depth at which the field has halved, L_z: the correction adds to 1 / L_z \[1/m\].
     HalfDepth,
     /// The depth at which it changes sign, z_r: the correction adds to 1 / z_r \[1/m\] (0:
     /// none).
     Reversal,
+    /// The upwash's change per degree of aircraft angle of attack, a_alpha: the correction adds
+    /// to it \[deg/deg\].
+    UpwashPerAlpha,
+    /// The sidewash's, b_alpha \[deg/deg\].
+    SidewashPerAlpha,
 }
 
-impl FieldShape {
-    /// Both parts, in the scenario's order.
-    pub const ALL: [FieldShape; 2] = [FieldShape::HalfDepth, FieldShape::Reversal];
+impl FieldPart {
+    /// Every part, in the scenario's order.
+    pub const ALL: [FieldPart; 4] = [
+        FieldPart::HalfDepth,
+        FieldPart::Reversal,
+        FieldPart::UpwashPerAlpha,
+        FieldPart::SidewashPerAlpha,
+    ];
+    /// The parts of the field's shape over depth.
+    pub const SHAPE: [FieldPart; 2] = [FieldPart::HalfDepth, FieldPart::Reversal];
+    /// The parts of its change with the aircraft's angle of attack.
+    pub const PER_ALPHA: [FieldPart; 2] = [FieldPart::UpwashPerAlpha, FieldPart::SidewashPerAlpha];
 
     /// Its scenario field's name within `[flowfield]`.
     pub fn key(self) -> &'static str {
         match self {
-            FieldShape::HalfDepth => "half_depth_m",
-            FieldShape::Reversal => "reversal_m",
+            FieldPart::HalfDepth => "half_depth_m",
+            FieldPart::Reversal => "reversal_m",
+            FieldPart::UpwashPerAlpha => "upwash_per_alpha",
+            FieldPart::SidewashPerAlpha => "sidewash_per_alpha",
         }
+    }
+
+    /// Whether it is a part of the shape over depth (the others: the change with alpha).
+    pub fn is_shape(self) -> bool {
+        matches!(self, FieldPart::HalfDepth | FieldPart::Reversal)
     }
 }
 
@@ -143,10 +171,10 @@ impl Target {
             .collect()
     }
 
-    /// Every target, the flowfield's shape after the aerodynamic data.
+    /// Every target, the flowfield's parts after the aerodynamic data.
     pub fn every() -> Vec<Target> {
         let mut out = Target::all();
-        out.extend(FieldShape::ALL.map(Target::Field));
+        out.extend(FieldPart::ALL.map(Target::Field));
         out
     }
 
@@ -183,10 +211,12 @@ impl Target {
 
     /// The coefficient axis it acts on: 0 CA (or dCX), ..., 5 Cn; for a derivative, the axis of
     /// its coefficient (CZ for CZ_alpha, ...); for the flowfield's shape, which acts on every
-    /// axis, CZ's (that of its upwash, the field's largest part).
+    /// axis, CZ's (that of its upwash, the field's largest part); for the upwash's and the
+    /// sidewash's change with alpha, CZ's and CY's.
     pub fn axis(self) -> usize {
         match self {
             Target::Static(k) | Target::Interference(k) => k,
+            Target::Field(FieldPart::SidewashPerAlpha) => 1,
             Target::Field(_) => 2,
             Target::Derivative(d) => match d {
                 Derivative::CzAlpha => 2,

@@ -3,7 +3,7 @@
 //! a run is set up without allocation.
 
 use super::{
-    Correction, CorrectionError, Derivative, FieldShape, MAX_CORRECTION_VALUES, MAX_CORRECTIONS,
+    Correction, CorrectionError, Derivative, FieldPart, MAX_CORRECTION_VALUES, MAX_CORRECTIONS,
     Target, interpolate,
 };
 use crate::table::Variable;
@@ -88,15 +88,16 @@ const NO_RUNTIME: Runtime = Runtime {
 
 /// What the corrections over Mach give a run, folded into its constants: each static
 /// coefficient's offset (CA positive aft, as the field), each derivative's change, and the
-/// change of the flowfield's shape.
+/// change of the flowfield's parts.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Folded {
     /// Added to CA, CY, CZ, Cl, Cm, Cn.
     pub statics: [f64; 6],
     /// Added to each derivative, in [`Derivative::ALL`] order.
     pub derivatives: [f64; 7],
-    /// Added to the flowfield's 1 / L_z and 1 / z_r \[1/m\], in [`FieldShape::ALL`] order.
-    pub field_shape: [f64; 2],
+    /// Added to the flowfield's 1 / L_z and 1 / z_r \[1/m\], a_alpha and b_alpha
+    /// \[deg/deg\], in [`FieldPart::ALL`] order.
+    pub field: [f64; 4],
 }
 
 /// One run's corrections evaluated at each force evaluation (those over alpha, beta and
@@ -166,8 +167,8 @@ impl CorrectionRun {
                             folded.derivatives[i] += x;
                         }
                         Target::Field(f) => {
-                            let i = FieldShape::ALL.iter().position(|&e| e == f).unwrap_or(0);
-                            folded.field_shape[i] += x;
+                            let i = FieldPart::ALL.iter().position(|&e| e == f).unwrap_or(0);
+                            folded.field[i] += x;
                         }
                         Target::Interference(_) => {}
                     }

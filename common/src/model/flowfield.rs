@@ -43,6 +43,30 @@ pub fn mach_factor(scaling: MachScaling, mach: f64) -> f64 {
     }
 }
 
+/// The normal force's weights w_k and the side force's v_k at `station_x_m` (docs/model.md
+/// section 3b, "Stations"): 1/N plus a part linear in x_k - x_bar that puts their centre at
+/// the centre of pressure of the store's `slopes` \[CZ_alpha, Cm_alpha, CY_beta, Cn_beta\].
+fn station_weights(
+    station_x_m: &[f64],
+    x_bar: f64,
+    diameter_m: f64,
+    slopes: [f64; 4],
+) -> [[f64; MAX_STATIONS]; 2] {
+    let n = station_x_m.len();
+    let spread: f64 = station_x_m.iter().map(|x| (x - x_bar).powi(2)).sum();
+    let centres_of_pressure = [
+        -diameter_m * slopes[1] / slopes[0],
+        diameter_m * slopes[3] / slopes[2],
+    ];
+    centres_of_pressure.map(|x_cp| {
+        let mut w = [0.0; MAX_STATIONS];
+        for (w_k, x_k) in w.iter_mut().zip(station_x_m) {
+            *w_k = 1.0 / n as f64 + (x_cp - x_bar) * (x_k - x_bar) / spread;
+        }
+        w
+    })
+}
+
 /// The field's shape g(z) as a table over depth (docs/model.md section 3b, "The shape as a
 /// table"): linear between the depths, held at the last value below the last.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,6 +124,14 @@ pub struct FlowfieldRun {
     pub station_x_m: [f64; MAX_STATIONS],
     /// Weights of the normal force (w_k) and of the side force (v_k).
     pub weights: [[f64; MAX_STATIONS]; 2],
+    /// x_bar: the middle of the store between nose and tail \[m\].
+    pub centre_x_m: f64,
+    /// The store's CZ_alpha, Cm_alpha, CY_beta and Cn_beta \[1/rad\] the weights were made
+    /// with.
+    pub store_slopes_per_rad: [f64; 4],
+    /// What a change of 1 deg/deg of a_alpha and of b_alpha adds to A and B \[rad\]: their
+    /// factors times s_M times (alpha_a - alpha_ref) in radians.
+    pub per_alpha_rad: [f64; 2],
     /// A: upwash at the carriage point \[rad\], and A_x, its gradient along L's x \[rad/m\].
     pub upwash: [f64; 2],
     /// B and B_x: the sidewash's \[rad, rad/m\].
@@ -156,23 +188,23 @@ impl FlowfieldRun {
             *x = spec.tail_x_m + (k as f64 + 0.5) * length_m / n as f64;
         }
         let x_bar = 0.5 * (spec.nose_x_m + spec.tail_x_m);
-        let spread: f64 = station_x_m[..n].iter().map(|x| (x - x_bar).powi(2)).sum();
-        let centres_of_pressure = [
-            -diameter_m * aero.cm_alpha_per_rad / aero.cz_alpha_per_rad,
-            diameter_m * aero.cn_beta_per_rad / aero.cy_beta_per_rad,
+        let slopes = [
+            aero.cz_alpha_per_rad,
+            aero.cm_alpha_per_rad,
+            aero.cy_beta_per_rad,
+            aero.cn_beta_per_rad,
         ];
-        let weights = centres_of_pressure.map(|x_cp| {
-            let mut w = [0.0; MAX_STATIONS];
-            for (w_k, x_k) in w.iter_mut().zip(&station_x_m).take(n) {
-                *w_k = 1.0 / n as f64 + (x_cp - x_bar) * (x_k - x_bar) / spread;
-            }
-            w
-        });
         let [a0, b0, eta0, l0] = spec.carriage_values();
         let run = FlowfieldRun {
             stations: n,
             station_x_m,
-            weights,
+            weights: station_weights(&station_x_m[..n], x_bar, diameter_m, slopes),
+            centre_x_m: x_bar,
+            store_slopes_per_rad: slopes,
+            per_alpha_rad: [
+                fx(Factor::Czintfac) * s_m * d_alpha.to_radians(),
+                fx(Factor::Cyintfac) * s_m * d_alpha.to_radians(),
+            ],
             upwash: [
                 fx(Factor::Czintfac) * s_m * (a0 + spec.upwash_per_alpha * d_alpha).to_radians(),
                 fx(Factor::Cmintfac) * s_m * spec.upwash_gradient_deg_per_m.to_radians(),
@@ -245,10 +277,53 @@ impl FlowfieldRun {
         1.0 / self.half_depth_m + self.inv_half_depth_change_per_m
     }
 
-    /// The shape changed by `change` \[1/m\] (added to 1 / L_z and 1 / z_r: a correction of
-    /// the field's shape, docs/update.md); refused when 1 / L_z would not stay above 0 or
-    /// 1 / z_r below 0 (the field would not decay, or would grow with depth).
-    pub fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, String> {
+    /// The field changed by the corrections `change` (docs/update.md section 15.3a), in
+    /// [`FieldPart::ALL`](crate::correction::FieldPart::ALL) order: 1 / L_z and 1 / z_r
+    /// \[1/m\], a_alpha and b_alpha \[deg/deg\]. Refused when 1 / L_z would not stay above 0
+    /// or 1 / z_r below 0 (the field would not decay, or would grow with depth), and when a
+    /// part the field does not have is changed (a table's shape has no depths; tables over
+    /// position scale with alpha by their zero-lift angle, not a slope). A part not changed
+    /// (0) keeps the field's bits.
+    pub fn with_change(mut self, change: [f64; 4]) -> Result<Self, String> {
+        if change[..2].iter().any(|&c| c != 0.0) {
+            self = self.with_shape_change([change[0], change[1]])?;
+        }
+        if change[2..].iter().any(|&c| c != 0.0) {
+            if self.grid.is_some() {
+                return Err(
+                    "the flowfield is given as tables over position: it scales with alpha by its \
+                     zero-lift angle, with no upwash_per_alpha or sidewash_per_alpha to correct"
+                        .to_string(),
+                );
+            }
+            self.upwash[0] = self.per_alpha_rad[0].mul_add(change[2], self.upwash[0]);
+            self.sidewash[0] = self.per_alpha_rad[1].mul_add(change[3], self.sidewash[0]);
+        }
+        Ok(self)
+    }
+
+    /// The field acting through the store's slopes changed by `change` (CZ_alpha, Cm_alpha,
+    /// CY_beta, Cn_beta \[1/rad\]: corrections of the store's derivatives, which the field's
+    /// loads and weights take as the store's own, docs/model.md section 3b). A change of 0
+    /// keeps the field's bits.
+    pub fn with_slope_change(mut self, change: [f64; 4]) -> Self {
+        if change.iter().all(|&c| c == 0.0) {
+            return self;
+        }
+        let mut slopes = self.store_slopes_per_rad;
+        for (s, c) in slopes.iter_mut().zip(change) {
+            *s += c;
+        }
+        let n = self.stations;
+        let diameter_m = 1.0 / self.inv_diameter_per_m;
+        self.weights = station_weights(&self.station_x_m[..n], self.centre_x_m, diameter_m, slopes);
+        self.store_slopes_per_rad = slopes;
+        self.slopes_per_rad = [slopes[0], slopes[2]];
+        self
+    }
+
+    /// The shape changed by `change` \[1/m\] (added to 1 / L_z and 1 / z_r).
+    fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, String> {
         if self.shape_is_tabulated() {
             return Err(
                 "the flowfield's shape is a table: it has no half depth or reversal depth to correct"

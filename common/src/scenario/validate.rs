@@ -27,19 +27,24 @@ impl Scenario {
         c.extension(&self.extension)?;
         let corrections = crate::correction::check_all(&self.correction)
             .map_err(|(k, e)| c.bad(&format!("correction[{k}]"), e.to_string()))?;
-        let field_shape = |x: &crate::correction::Correction| {
-            matches!(x.target, crate::correction::Target::Field(_))
-        };
-        if let Some(k) = corrections.iter().position(field_shape) {
+        for (k, x) in corrections.iter().enumerate() {
+            let crate::correction::Target::Field(part) = x.target else {
+                continue;
+            };
             let why = match &self.flowfield {
                 None => Some("the scenario has no [flowfield] to correct"),
-                Some(f) if f.shape.is_some() => Some(
+                Some(f) if part.is_shape() && f.shape.is_some() => Some(
                     "the [flowfield]'s shape is a table, with no half depth or reversal depth to \
                      correct",
                 ),
-                Some(f) if f.is_grid() => Some(
+                Some(f) if part.is_shape() && f.is_grid() => Some(
                     "the [flowfield] is given as tables over position, with no half depth or \
                      reversal depth to correct",
+                ),
+                Some(f) if f.is_grid() => Some(
+                    "the [flowfield] is given as tables over position, which scale with alpha by \
+                     its zero-lift angle, with no upwash_per_alpha or sidewash_per_alpha to \
+                     correct",
                 ),
                 Some(_) => None,
             };

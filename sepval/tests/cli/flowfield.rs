@@ -378,24 +378,28 @@ fn simulated(d: &Path, scenario: &str, factors: &str, seed: Option<&str>, out: &
 }
 
 #[test]
-fn update_finds_the_fields_reversal_depth_from_three_conditions_and_predicts_a_fourth() {
+fn update_finds_the_fields_reversal_and_alpha_slope_and_predicts_a_fourth_condition() {
     if skip_slow_tests() {
         return;
     }
     // docs/update.md section 15.3a. The truth is the example's field (halving at 0.8 m,
-    // reversing at 2 m); the store given to the update says the field halves at 0.5 m and never
-    // reverses. Releases at three conditions with the default flight test's noise; Mach 0.85,
-    // alpha 1.5 deg, never flown, predicted by the updated store.
+    // reversing at 2 m, its upwash growing 0.5 deg per degree of the aircraft's angle of
+    // attack); the store given to the update says the field halves at 0.5 m, never reverses and
+    // does not change with alpha. Releases at three conditions with the default flight test's
+    // noise; Mach 0.85, alpha 1.5 deg, never flown, predicted by the updated store.
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let truth = std::fs::read_to_string(example()).unwrap();
     assert!(truth.contains("\nreversal_m = 2.0"));
+    assert!(truth.contains("\nupwash_per_alpha = 0.5 "));
     let given: String = at_condition(&truth, 0.95, 0.0)
         .lines()
         .filter(|l| !l.starts_with("reversal_m"))
         .map(|l| {
             if l.starts_with("half_depth_m") {
                 "half_depth_m = 0.5".to_string()
+            } else if l.starts_with("upwash_per_alpha") {
+                "upwash_per_alpha = 0.0".to_string()
             } else {
                 l.to_string()
             }
@@ -425,14 +429,21 @@ fn update_finds_the_fields_reversal_depth_from_three_conditions_and_predicts_a_f
         .map(|c| c["field"].as_str().unwrap())
         .collect();
     assert!(kept.contains(&"flowfield.reversal_m"), "{kept:?}");
-    // The store written has the reversal depth found, near the truth's 2 m.
+    assert!(kept.contains(&"flowfield.upwash_per_alpha"), "{kept:?}");
+    // The store written has the reversal depth found, near the truth's 2 m, and the upwash's
+    // change with alpha, near the truth's 0.5 deg/deg.
     let store = std::fs::read_to_string(d.join("up/scenario.toml")).unwrap();
-    let z_r: f64 = store
-        .lines()
-        .find_map(|l| l.strip_prefix("reversal_m = "))
-        .and_then(|v| v.split_whitespace().next()?.parse().ok())
-        .expect("the updated store has a reversal depth");
+    let value = |key: &str| -> f64 {
+        store
+            .lines()
+            .find_map(|l| l.strip_prefix(key))
+            .and_then(|v| v.split_whitespace().next()?.parse().ok())
+            .unwrap_or_else(|| panic!("the updated store has no {key}"))
+    };
+    let z_r = value("reversal_m = ");
     assert!((z_r - 2.0).abs() < 0.2, "reversal depth {z_r} m");
+    let a_alpha = value("upwash_per_alpha = ");
+    assert!((a_alpha - 0.5).abs() < 0.05, "upwash per alpha {a_alpha}");
     // The condition never flown, predicted by the updated store with its factors: within the
     // noise of the flight test where the store as given, its factors fitted, misses by more.
     std::fs::write(d.join("up/c4.toml"), at_condition(&store, 0.85, 1.5)).unwrap();
@@ -449,7 +460,7 @@ fn update_finds_the_fields_reversal_depth_from_three_conditions_and_predicts_a_f
     simulated(d, "g4.toml", "base.json", None, "g4.csv");
     let (pos_given, att_given) = goals(d, "c4.csv", "g4.csv");
     eprintln!(
-        "Mach 0.85, alpha 1.5 deg: updated (z_r {z_r:.3} m) {pos:.6} m, {att:.5} deg; the store as given, its factors fitted, {pos_given:.6} m, {att_given:.5} deg"
+        "Mach 0.85, alpha 1.5 deg: updated (z_r {z_r:.3} m, a_alpha {a_alpha:.3}) {pos:.6} m, {att:.5} deg; the store as given, its factors fitted, {pos_given:.6} m, {att_given:.5} deg"
     );
     assert!(
         pos_given > 2.0 * pos && att_given > 2.0 * att,

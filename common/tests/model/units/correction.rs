@@ -44,7 +44,7 @@ fn every_field_names_itself_and_back() {
     }
     assert_eq!(
         Target::of_field("flowfield.reversal_m"),
-        Some(Target::Field(FieldShape::Reversal))
+        Some(Target::Field(FieldPart::Reversal))
     );
     assert_eq!(Target::table_of_field("flowfield.half_depth_m"), None);
     assert_eq!(
@@ -201,6 +201,146 @@ fn a_correction_of_the_fields_shape_needs_a_field() {
         .unwrap_err();
     assert!(
         e.to_string().contains("may be corrected over mach only"),
+        "{e}"
+    );
+}
+
+/// The guide's example store under its field at an aircraft angle of attack of 5 deg (3 deg
+/// from the field's reference), with `extra` appended.
+fn field_store_at_alpha_5(extra: &str) -> sepval_common::scenario::Scenario {
+    let text = include_str!("../../../../examples/flowfield-store/scenario.toml")
+        .replace("alpha_deg = 0.0", "alpha_deg = 5.0")
+        + extra;
+    sepval_common::scenario::Scenario::from_toml_str(&text, "field").unwrap()
+}
+
+/// The run of `s` with the correction values `v` (none: the scenario's own run).
+fn corrected_run(
+    s: &sepval_common::scenario::Scenario,
+    v: &[f64],
+) -> Result<sepval_common::model::RunSetup, sepval_common::model::ModelError> {
+    use sepval_common::effects::EffectSet;
+    use sepval_common::extension::TermSet;
+    use sepval_common::model::RunSetup;
+    use sepval_common::simulation::Simulator;
+    use sepval_core::factors::Factors;
+    let sim = Simulator::new(s);
+    RunSetup::with_corrections(
+        sim.model(),
+        &Factors::TRUTH,
+        &EffectSet::NONE,
+        &TermSet::NONE,
+        &CorrectionValues::of(v).unwrap(),
+    )
+}
+
+#[test]
+fn the_fields_change_with_alpha_is_corrected_as_the_store_written_with_it() {
+    const PER_ALPHA: &str = "\n[[correction]]\nfield = \"flowfield.upwash_per_alpha\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n\
+         \n[[correction]]\nfield = \"flowfield.sidewash_per_alpha\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n";
+    let s = field_store_at_alpha_5(PER_ALPHA);
+    let corrected = corrected_run(&s, &[0.3, -0.2]).unwrap().flowfield.unwrap();
+    // The store with a_alpha 0.5 + 0.3 and b_alpha 0 - 0.2, as `update` writes it.
+    let mut merged = field_store_at_alpha_5("");
+    let f = merged.flowfield.as_mut().unwrap();
+    f.upwash_per_alpha += 0.3;
+    f.sidewash_per_alpha -= 0.2;
+    let written = corrected_run(&merged, &[]).unwrap().flowfield.unwrap();
+    for p in [[0.0, 0.0, 0.0], [1.0, 0.1, 0.6], [-1.5, 0.0, 2.5]] {
+        let (a, b) = (corrected.at(p), written.at(p));
+        for k in 0..3 {
+            assert!((a[k] - b[k]).abs() < 1e-15, "{p:?}: {a:?} against {b:?}");
+        }
+    }
+    // The correction changes the field: 3 deg of alpha times 0.3 deg/deg of upwash, times
+    // czintfac and s_M.
+    let plain = corrected_run(&s, &[]).unwrap().flowfield.unwrap();
+    let up = corrected.at([0.0; 3])[0] - plain.at([0.0; 3])[0];
+    let truth = sepval_core::factors::Factors::TRUTH.get(sepval_core::factors::Factor::Czintfac);
+    let s_m = (1.0f64 - 0.85 * 0.85).sqrt() / 0.1f64.sqrt();
+    assert!(
+        (up - truth * s_m * 0.9f64.to_radians()).abs() < 1e-15,
+        "{up}"
+    );
+    // Without values, the scenario's field to the bit.
+    assert_eq!(
+        plain,
+        corrected_run(&field_store_at_alpha_5(""), &[])
+            .unwrap()
+            .flowfield
+            .unwrap()
+    );
+}
+
+#[test]
+fn a_correction_of_the_stores_slopes_is_the_slopes_the_field_acts_through() {
+    const SLOPES: &str = "\n[[correction]]\nfield = \"aero.cn_beta_per_rad\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n\
+         \n[[correction]]\nfield = \"aero.cz_alpha_per_rad\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n";
+    let s = field_store_at_alpha_5(SLOPES);
+    let corrected = corrected_run(&s, &[0.2, 0.5]).unwrap().flowfield.unwrap();
+    let mut merged = field_store_at_alpha_5("");
+    let text = merged
+        .to_toml_string()
+        .replace(
+            "cn_beta_per_rad = -0.3",
+            "cn_beta_per_rad = -0.09999999999999998",
+        )
+        .replace("cz_alpha_per_rad = -6.0", "cz_alpha_per_rad = -5.5");
+    merged = sepval_common::scenario::Scenario::from_toml_str(&text, "merged").unwrap();
+    let written = corrected_run(&merged, &[]).unwrap().flowfield.unwrap();
+    assert_eq!(corrected.slopes_per_rad, written.slopes_per_rad);
+    for side in 0..2 {
+        for k in 0..corrected.stations {
+            let (a, b) = (corrected.weights[side][k], written.weights[side][k]);
+            assert!(
+                (a - b).abs() < 1e-14,
+                "side {side} station {k}: {a} against {b}"
+            );
+        }
+    }
+    // The weights moved: the side force's centre of pressure is another.
+    let plain = corrected_run(&s, &[]).unwrap().flowfield.unwrap();
+    assert!((plain.weights[1][0] - corrected.weights[1][0]).abs() > 1e-3);
+}
+
+#[test]
+fn a_field_with_a_shape_table_takes_corrections_of_the_stores_data_and_its_alpha_slope() {
+    let table = "shape = { depth_m = [0.0, 0.3, 0.9, 1.6, 2.5], g = [1.0, 0.62, 0.2, -0.07, 0.0] }";
+    let text = include_str!("../../../../examples/flowfield-store/scenario.toml")
+        .replace("alpha_deg = 0.0", "alpha_deg = 5.0")
+        .replace("half_depth_m = 0.8 ", &format!("{table} #"))
+        .replace("reversal_m = 2.0 ", "#")
+        + "\n[[correction]]\nfield = \"aero.cm\"\nvariable = \"alpha_deg\"\nbreakpoints = [0.0, 10.0]\n\
+           \n[[correction]]\nfield = \"flowfield.upwash_per_alpha\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n";
+    let s = sepval_common::scenario::Scenario::from_toml_str(&text, "table").unwrap();
+    let run = corrected_run(&s, &[0.01, 0.02, 0.3])
+        .unwrap()
+        .flowfield
+        .unwrap();
+    let plain = corrected_run(&s, &[]).unwrap().flowfield.unwrap();
+    let up = run.at([0.0; 3])[0] - plain.at([0.0; 3])[0];
+    assert!((up - plain.per_alpha_rad[0] * 0.3).abs() < 1e-15, "{up}");
+    assert!(up > 0.01, "{up}");
+    // Its shape is not corrected: a scenario asking it is refused, naming why.
+    let e = sepval_common::scenario::Scenario::from_toml_str(
+        &(text + "\n[[correction]]\nfield = \"flowfield.half_depth_m\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n"),
+        "table",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("shape is a table"), "{e}");
+}
+
+#[test]
+fn a_field_of_tables_over_position_has_no_alpha_slope_to_correct() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/flowfield-store");
+    let text = std::fs::read_to_string(dir.join("grid.toml")).unwrap()
+        + "\n[[correction]]\nfield = \"flowfield.sidewash_per_alpha\"\nvariable = \"mach\"\nbreakpoints = [0.95]\n";
+    let e = sepval_common::scenario::Scenario::from_toml_str_in(&text, "grid.toml", Some(&dir))
+        .unwrap_err();
+    assert!(e.to_string().contains("correction[0]"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("no upwash_per_alpha or sidewash_per_alpha"),
         "{e}"
     );
 }

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# The Eglin CFD releases at four conditions (Mach 0.85 and 0.95, alpha 0 and 4 deg), each left
+# out in turn: the distance-decay model and the aircraft's flowfield (docs/model.md section 3b)
+# fitted to the other three, then updated (`sepval update`), predict it (issue 37; the table is
+# in docs/eglin-cfd.md, "Four conditions").
+#
+#   scripts/eglin-conditions.sh REPO [OUT_DIR]      (default bench-out/eglin-conditions)
+#
+# REPO is a git clone of https://github.com/AbdullahElyas/GPR_StoreSeparation (no licence
+# stated: its files stay out of this repository; scripts/eglin_convert.py converts them).
+# Models (the embedded default store, t_end 0.5 s as the CFD):
+#   decay      the default model, its 17 factors (`fit --method ga+lm --seed 1`);
+#   field      the flowfield set to the default's interference at carriage (upwash 5.99 deg,
+#              its gradient -10.4 deg/m, sidewash -5.84 deg, 4.28 deg/m, eta 1.09, roll -0.03),
+#              halving 0.42 m below it (as exp(-s / 0.6)), its factors' bounds widened to
+#              [-1, 3];
+#   +update    either, then `sepval update --seed 1` on the same three releases.
+# Writes OUT_DIR/conditions.csv (RMS position and attitude error of the release left out, over
+# its 0.5 s) and prints it. About 10 minutes on 2 cores.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ $# -ge 1 ] || { echo "usage: $0 REPO [OUT_DIR]" >&2; exit 2; }
+REPO=$1
+OUT=${2:-bench-out/eglin-conditions}
+SEPVAL=target/release/sepval
+[ -x "$SEPVAL" ] || { echo "build first: cargo build --release --workspace" >&2; exit 2; }
+rm -rf "$OUT"
+mkdir -p "$OUT"
+python3 scripts/eglin_convert.py "$REPO" "$OUT"
+BASE=common/scenarios/eglin_default.toml
+sed -e 's/^t_end_s = .*/t_end_s = 0.5/' "$BASE" > "$OUT/decay.toml"
+sed -E -e 's/^t_end_s = .*/t_end_s = 0.5/' -e 's/^(dc[xyzlmn]0) = .*/\1 = 0.0/' \
+    -e 's/^(c[aymnlz]intfac) = .*/\1 = { min = -1.0, max = 3.0, bits = 8 }/' "$BASE" > "$OUT/field.toml"
+cat >> "$OUT/field.toml" <<'FIELD'
+
+[flowfield]
+stations = 5
+nose_x_m = 1.5
+tail_x_m = -1.5
+upwash_deg = 5.99
+upwash_gradient_deg_per_m = -10.4
+sidewash_deg = -5.84
+sidewash_gradient_deg_per_m = 4.28
+dynamic_pressure_ratio = 1.09
+roll_cl = -0.03
+half_depth_m = 0.42
+reference_mach = 0.95
+FIELD
+
+CASES=(M085_AOA0 M085_AOA4 M095_AOA0 M095_AOA4)
+# The error of the scenario `$2` with the factors `$3` at the condition of release `$1`.
+predicted() {
+    local mach alpha pos att
+    mach=$(awk -F' = ' '/^# mach/ {print $2}' "$OUT/$1.csv")
+    alpha=$(awk -F' = ' '/^# alpha_deg/ {print $2}' "$OUT/$1.csv")
+    sed -e "s/^mach = .*/mach = $mach/" -e "s/^alpha_deg = .*/alpha_deg = $alpha/" "$2" > "$4/held.toml"
+    "$SEPVAL" simulate --scenario "$4/held.toml" --factors "$3" --out "$4/held.csv" > /dev/null
+    read -r pos att < <("$SEPVAL" goals --data "$OUT/$1.csv" --sim "$4/held.csv" \
+        | awk '/J_pos/ {p = $3} /J_att/ {a = $3} END {print p, a}')
+    echo "$1,$5,$(awk "BEGIN {printf \"%.1f\", $pos * 1000}"),$(awk "BEGIN {printf \"%.2f\", $att}")" >> "$OUT/conditions.csv"
+}
+
+echo "left_out,model,rms_position_mm,rms_attitude_deg" > "$OUT/conditions.csv"
+for held in "${CASES[@]}"; do
+    data=()
+    for c in "${CASES[@]}"; do [ "$c" = "$held" ] || data+=(--data "$OUT/$c.csv"); done
+    for model in decay field; do
+        fit="$OUT/$held-$model"
+        "$SEPVAL" fit --scenario "$OUT/$model.toml" "${data[@]}" --method ga+lm --seed 1 \
+            --no-figures --out "$fit" > /dev/null 2>&1
+        python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print(json.dumps(r["methods"]["ga+lm"]["best"]["factors"]))' \
+            "$fit/result.json" > "$fit/factors.json"
+        predicted "$held" "$OUT/$model.toml" "$fit/factors.json" "$fit" "$model"
+        up="$OUT/$held-$model-update"
+        "$SEPVAL" update --scenario "$OUT/$model.toml" "${data[@]}" --seed 1 --out "$up" > /dev/null 2>&1
+        predicted "$held" "$up/scenario.toml" "$up/factors.json" "$up" "$model+update"
+    done
+done
+column -s, -t < "$OUT/conditions.csv"
