@@ -84,7 +84,9 @@ impl RunSetup {
         if let Some(field) = run.flowfield {
             // The field acts through the store's slopes, corrected (model.md section 3b).
             let field = field.with_slope_change([d[0], d[2], d[1], d[3]]);
-            let changed = field.with_change(folded.field);
+            let changed = field
+                .with_change(folded.field)
+                .and_then(|f| f.with_shape_table_change(&folded.shape));
             run.flowfield = Some(changed.map_err(CorrectionError::Values)?);
         }
         run.corrections = corrections;

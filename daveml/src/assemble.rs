@@ -46,7 +46,7 @@ pub fn field(s: &Scenario, t: Target) -> Option<&Coefficient> {
             Derivative::CnR => Some(&a.cn_r_per_rad.value),
         },
         Target::Interference(k) => Some(&s.interference.increments()[k].1.value),
-        Target::Field(_) => None,
+        Target::Field(_) | Target::ShapeTable => None,
     }
 }
 
@@ -89,7 +89,7 @@ pub fn set_field(s: &mut Scenario, t: Target, c: Option<Coefficient>) {
             }
         }
         // Not a table (the map and the bands name the tables' fields only).
-        Target::Field(_) => {}
+        Target::Field(_) | Target::ShapeTable => {}
     }
 }
 

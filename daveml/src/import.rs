@@ -57,8 +57,8 @@ pub fn kind_of(t: Target) -> Kind {
         Target::Static(_) => Kind::Static,
         Target::Derivative(_) => Kind::Derivative,
         Target::Interference(_) => Kind::Interference,
-        Target::Field(_) => unreachable!(
-            "the flowfield's shape is not a table: DAVE-ML carries the tables (Target::all)"
+        Target::Field(_) | Target::ShapeTable => unreachable!(
+            "the flowfield is not the store's data: DAVE-ML carries the store's tables (Target::all)"
         ),
     }
 }

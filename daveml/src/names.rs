@@ -26,8 +26,8 @@ pub fn output_id(t: Target) -> &'static str {
             DERIVATIVE[k]
         }
         Target::Interference(k) => INTERFERENCE[k],
-        Target::Field(_) => unreachable!(
-            "the flowfield's shape is not a table: DAVE-ML carries the tables (Target::all)"
+        Target::Field(_) | Target::ShapeTable => unreachable!(
+            "the flowfield is not the store's data: DAVE-ML carries the store's tables (Target::all)"
         ),
     }
 }

@@ -56,6 +56,9 @@ pub struct Explored {
     /// angle: no change with alpha is corrected).
     #[serde(default)]
     pub field_grid: bool,
+    /// The number of depths of that field's shape table (0: none).
+    #[serde(default)]
+    pub field_shape_points: usize,
     /// The releases' aircraft angles of attack \[deg\], increasing, those within
     /// [`ALPHA_MERGE_DEG`] of each other counted once.
     #[serde(default)]
@@ -102,6 +105,9 @@ impl Explored {
             flowfield: field.is_some(),
             field_shape_table: field.is_some_and(|f| f.shape_is_tabulated()),
             field_grid: field.is_some_and(|f| f.is_grid()),
+            field_shape_points: field
+                .and_then(|f| f.shape.as_ref())
+                .map_or(0, |t| t.depth_m.len()),
             aircraft_alphas_deg: alphas,
         }
     }
@@ -170,6 +176,7 @@ impl Proposal {
             Target::Field(FieldPart::SidewashPerAlpha) => {
                 return "the flowfield's sidewash per alpha".to_string();
             }
+            Target::ShapeTable => return "the flowfield's shape table over depth".to_string(),
         };
         let over = match self.variable {
             Variable::Distance => "distance",
@@ -214,7 +221,8 @@ fn even(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 /// release's Mach: its inverse half depth and inverse reversal depth, unless its shape is a
 /// table; its upwash's and sidewash's change per degree of the aircraft's angle of attack, when
 /// the releases were flown at two angles or more (at one, a change with alpha is a change of the
-/// field's strength, which its factors fit) and the field is not tables over position.
+/// field's strength, which its factors fit) and the field is not tables over position; and a
+/// shape given as a table, over depth ([`shape_table_proposal`]).
 pub fn field_proposals(explored: &Explored) -> Vec<Proposal> {
     if !explored.flowfield {
         return Vec::new();
@@ -239,7 +247,37 @@ pub fn field_proposals(explored: &Explored) -> Vec<Proposal> {
             breakpoints: vec![mach],
             pinned: vec![false],
         })
+        .chain(shape_table_proposal(explored))
         .collect()
+}
+
+/// The correction of a shape table over depth, when the field has one: [`DISTANCE_KNOTS`]
+/// depths from 0 to the largest distance from carriage reached (the CG's depth is at most that),
+/// spaced quadratically as a correction over distance is (dense near carriage, where the field
+/// changes fastest), fewer where the table and the correction would have more than
+/// `MAX_SHAPE_POINTS` depths together; its value at 0 held there (g stays 1 at carriage), the
+/// last held below the last depth as the table holds its own.
+pub fn shape_table_proposal(explored: &Explored) -> Option<Proposal> {
+    use sepval_common::scenario::MAX_SHAPE_POINTS;
+    if !explored.flowfield || explored.field_shape_points == 0 || explored.distance_m <= 0.0 {
+        return None;
+    }
+    // The union shares depth 0 at least.
+    let n = DISTANCE_KNOTS.min(MAX_SHAPE_POINTS + 1 - explored.field_shape_points);
+    if n < 3 {
+        return None;
+    }
+    let breakpoints: Vec<f64> = (0..n)
+        .map(|j| explored.distance_m * (j as f64 / (n - 1) as f64).powi(2))
+        .collect();
+    let mut pinned = vec![false; n];
+    pinned[0] = true;
+    Some(Proposal {
+        target: Target::ShapeTable,
+        variable: Variable::Z,
+        breakpoints,
+        pinned,
+    })
 }
 
 /// Every correction of axis `axis` (0 CA, ..., 5 Cn) that the explored ranges allow.

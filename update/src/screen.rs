@@ -249,8 +249,8 @@ fn regressors(p: &Proposal, s: &Sample, mach: f64, multiplier: f64) -> Vec<f64> 
             },
         ),
         (Target::Static(_), _) => (mach, 1.0),
-        // Not screened: the field's shape is refitted on its own stage (section 15.3a).
-        (Target::Field(_), _) => (mach, 0.0),
+        // Not screened: the field is refitted on its own stage (section 15.3a).
+        (Target::Field(_) | Target::ShapeTable, _) => (mach, 0.0),
     };
     weights(&p.breakpoints, x)
         .into_iter()

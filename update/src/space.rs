@@ -267,7 +267,10 @@ pub fn taken_over(corrections: &[Proposal]) -> Vec<usize> {
         .filter(|p| p.free_values() > 0)
         .filter_map(|p| match p.target {
             Target::Static(k) => Some(OFFSETS[k].index()),
-            Target::Interference(_) | Target::Derivative(_) | Target::Field(_) => None,
+            Target::Interference(_)
+            | Target::Derivative(_)
+            | Target::Field(_)
+            | Target::ShapeTable => None,
         })
         .collect()
 }
@@ -302,6 +305,7 @@ fn bound(model: &Model, target: Target) -> (f64, f64) {
     let a = &model.aero_at_mach;
     match target {
         Target::Field(part) => field_bounds(model, part),
+        Target::ShapeTable => symmetric(SHAPE_BOUND),
         Target::Static(_) => symmetric(STATIC_BOUND),
         Target::Derivative(d) => {
             let base = match d {
@@ -326,6 +330,10 @@ fn bound(model: &Model, target: Target) -> (f64, f64) {
 /// not resolved by stations along the store) to a hundred metres (no decay or reversal within
 /// any release: an inverse of 0.01 per m).
 pub const FIELD_DEPTH_M: (f64, f64) = (0.05, 100.0);
+
+/// The bound of a correction of the field's shape table over depth (either sign): g changed by
+/// at most twice its value at carriage.
+pub const SHAPE_BOUND: f64 = 2.0;
 
 /// The least bound of a correction of the field's upwash or sidewash per degree of the
 /// aircraft's angle of attack \[deg/deg\] (either sign): a field growing by twice the change

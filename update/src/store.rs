@@ -15,6 +15,7 @@ use std::path::PathBuf;
 
 use sepval_common::correction::{Correction, Derivative, FieldPart, Target, interpolate};
 use sepval_common::model::InterferenceDecay;
+use sepval_common::model::flowfield::corrected_shape;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{
     Axis, Coefficient, Kind, Table, TableFile, TableKind, Tabulated, Variable, write_csv,
@@ -40,7 +41,7 @@ fn kind(target: Target) -> Kind {
         Target::Static(_) => Kind::Static,
         Target::Derivative(_) => Kind::Derivative,
         Target::Interference(_) => Kind::Interference,
-        Target::Field(_) => {
+        Target::Field(_) | Target::ShapeTable => {
             unreachable!("the flowfield's parts are not tables (Target::all lists the tables)")
         }
     }
@@ -59,7 +60,7 @@ fn current(s: &Scenario, target: Target) -> Coefficient {
         ),
         Target::Derivative(d) => value(derivative(a, d).map(|c| &c.value)),
         Target::Interference(k) => s.interference.increments()[k].1.value.clone(),
-        Target::Field(_) => {
+        Target::Field(_) | Target::ShapeTable => {
             unreachable!("the flowfield's parts are not tables (Target::all lists the tables)")
         }
     }
@@ -107,7 +108,7 @@ fn set(s: &mut Scenario, target: Target, c: Coefficient) {
             }
         }
         Target::Interference(k) => *s.interference.increments_mut()[k].1 = tabulated(c),
-        Target::Field(_) => {
+        Target::Field(_) | Target::ShapeTable => {
             unreachable!("the flowfield's parts are not tables (Target::all lists the tables)")
         }
     }
@@ -147,6 +148,18 @@ fn set_field_part(s: &mut Scenario, part: FieldPart, change: f64) -> Result<(), 
         FieldPart::UpwashPerAlpha => field.upwash_per_alpha += change,
         FieldPart::SidewashPerAlpha => field.sidewash_per_alpha += change,
     }
+    Ok(())
+}
+
+/// The flowfield's shape table of `s` with the correction (`depth_m`, `change`) added: the
+/// table the runs fitted it with (`corrected_shape`, the same function to the bit).
+fn set_shape_table(s: &mut Scenario, depth_m: &[f64], change: &[f64]) -> Result<(), String> {
+    let Some(shape) = s.flowfield.as_mut().and_then(|f| f.shape.as_mut()) else {
+        return Err("the scenario has no [flowfield] shape table".into());
+    };
+    let (depth, g) = corrected_shape(&shape.depth_m, &shape.g, depth_m, change)?;
+    shape.depth_m = depth;
+    shape.g = g;
     Ok(())
 }
 
@@ -256,12 +269,15 @@ pub fn updated_store(
         set(&mut s, target, c);
     }
     for (c, v) in corrections {
-        if let Target::Field(part) = c.target {
-            set_field_part(&mut s, part, v[0]).map_err(|message| UpdateError::Merge {
-                field: c.target.field(),
-                message,
-            })?;
-        }
+        let merged = match c.target {
+            Target::Field(part) => set_field_part(&mut s, part, v[0]),
+            Target::ShapeTable => set_shape_table(&mut s, &c.breakpoints, v),
+            _ => Ok(()),
+        };
+        merged.map_err(|message| UpdateError::Merge {
+            field: c.target.field(),
+            message,
+        })?;
     }
     s.validate("the updated store")
         .map_err(UpdateError::Store)?;

@@ -25,6 +25,7 @@
 //! | `interference.dcx0` ... `interference.dcn0` | `distance_m` | the increment += c, times its multiplier |
 //! | `flowfield.half_depth_m`, `flowfield.reversal_m` | `mach` | 1 / L_z += c, 1 / z_r += c \[1/m\] |
 //! | `flowfield.upwash_per_alpha`, `flowfield.sidewash_per_alpha` | `mach` | a_alpha += c, b_alpha += c \[deg/deg\] |
+//! | `flowfield.shape` (a shape given as a table) | `z_m` | g(z) += c(z), from depth 0 where c = 0 |
 //!
 //! The last two rows change the aircraft's flowfield (docs/model.md section 3b). The last
 //! changes how its upwash and sidewash grow with the aircraft's angle of attack, what releases
@@ -35,6 +36,10 @@
 //! inverses, so that a correction is a smooth change of g(z) = (1 - z / z_r) / (1 + z / L_z)
 //! whatever its size (an inverse of 0: no decay, no reversal); a scenario with such a correction
 //! must have a `[flowfield]`.
+//!
+//! A correction of a shape table is folded into the table when a run is set up: the table on
+//! the union of the two grids ([`crate::model::flowfield::corrected_shape`]), the function the
+//! store written with it has.
 //!
 //! Mach is the flight condition's, fixed for a run, so a correction over Mach is folded into the
 //! run's constants when it is set up ([`CorrectionRun::new`] returns them as [`Folded`]); the
@@ -48,7 +53,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::table::Variable;
 
-pub use run::{CorrectionRun, CorrectionValues, Folded};
+pub use run::{CorrectionRun, CorrectionValues, Folded, ShapeChange};
 
 /// Most correction values one run carries (over all its corrections): a candidate holds them
 /// in a fixed array, so that it travels to the workers without allocation.
@@ -108,6 +113,9 @@ pub enum Target {
     /// A part of the aircraft's flowfield (docs/model.md section 3b): its shape or its change
     /// with the aircraft's angle of attack.
     Field(FieldPart),
+    /// The flowfield's shape given as a table over depth, g(z): the correction adds to it
+    /// over depth (`z_m`).
+    ShapeTable,
 }
 
 /// A part of the flowfield (docs/model.md section 3b) a correction may change: its shape,
@@ -175,6 +183,7 @@ impl Target {
     pub fn every() -> Vec<Target> {
         let mut out = Target::all();
         out.extend(FieldPart::ALL.map(Target::Field));
+        out.push(Target::ShapeTable);
         out
     }
 
@@ -185,6 +194,7 @@ impl Target {
             Target::Derivative(d) => format!("aero.{}", d.key()),
             Target::Interference(k) => format!("interference.{}", INTERFERENCE_KEYS[k]),
             Target::Field(f) => format!("flowfield.{}", f.key()),
+            Target::ShapeTable => "flowfield.shape".to_string(),
         }
     }
 
@@ -206,6 +216,7 @@ impl Target {
             Target::Derivative(_) => &[Variable::Mach],
             Target::Interference(_) => &[Variable::Distance],
             Target::Field(_) => &[Variable::Mach],
+            Target::ShapeTable => &[Variable::Z],
         }
     }
 
@@ -217,7 +228,7 @@ impl Target {
         match self {
             Target::Static(k) | Target::Interference(k) => k,
             Target::Field(FieldPart::SidewashPerAlpha) => 1,
-            Target::Field(_) => 2,
+            Target::Field(_) | Target::ShapeTable => 2,
             Target::Derivative(d) => match d {
                 Derivative::CzAlpha => 2,
                 Derivative::CyBeta => 1,

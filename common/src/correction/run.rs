@@ -6,6 +6,7 @@ use super::{
     Correction, CorrectionError, Derivative, FieldPart, MAX_CORRECTION_VALUES, MAX_CORRECTIONS,
     Target, interpolate,
 };
+use crate::scenario::MAX_SHAPE_POINTS;
 use crate::table::Variable;
 
 /// The values of a scenario's corrections carried by one candidate: every correction's
@@ -98,6 +99,20 @@ pub struct Folded {
     /// Added to the flowfield's 1 / L_z and 1 / z_r \[1/m\], a_alpha and b_alpha
     /// \[deg/deg\], in [`FieldPart::ALL`] order.
     pub field: [f64; 4],
+    /// Added to the flowfield's shape table over depth.
+    pub shape: ShapeChange,
+}
+
+/// A correction of the flowfield's shape table: c(z) at `len` depths (section 1's
+/// interpolation, held at the ends).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ShapeChange {
+    /// Number of depths (0: none).
+    pub len: usize,
+    /// The depths \[m\], increasing.
+    pub depth_m: [f64; MAX_SHAPE_POINTS],
+    /// The change of g at each.
+    pub value: [f64; MAX_SHAPE_POINTS],
 }
 
 /// One run's corrections evaluated at each force evaluation (those over alpha, beta and
@@ -157,6 +172,14 @@ impl CorrectionRun {
             let n = c.breakpoints.len();
             let own = &v[at..at + n];
             at += n;
+            if c.target == Target::ShapeTable {
+                // Checked with the scenario: at most MAX_SHAPE_POINTS depths.
+                let k = n.min(MAX_SHAPE_POINTS);
+                folded.shape.len = k;
+                folded.shape.depth_m[..k].copy_from_slice(&c.breakpoints[..k]);
+                folded.shape.value[..k].copy_from_slice(&own[..k]);
+                continue;
+            }
             let input = match c.variable {
                 Variable::Mach => {
                     let x = interpolate(&c.breakpoints, own, mach);
@@ -170,7 +193,7 @@ impl CorrectionRun {
                             let i = FieldPart::ALL.iter().position(|&e| e == f).unwrap_or(0);
                             folded.field[i] += x;
                         }
-                        Target::Interference(_) => {}
+                        Target::Interference(_) | Target::ShapeTable => {}
                     }
                     continue;
                 }
@@ -181,7 +204,7 @@ impl CorrectionRun {
             let slot = match c.target {
                 Target::Static(k) => k,
                 Target::Interference(k) => 6 + k,
-                Target::Derivative(_) | Target::Field(_) => continue,
+                Target::Derivative(_) | Target::Field(_) | Target::ShapeTable => continue,
             };
             let start = run.count_values();
             for (j, (&b, &x)) in c.breakpoints.iter().zip(own).enumerate() {

@@ -29,8 +29,9 @@ use std::sync::Arc;
 
 use super::aero::Coefficients;
 use super::flowfield_grid::FieldGrid;
-pub use super::flowfield_shape::ShapeRun;
+pub use super::flowfield_shape::{ShapeRun, corrected_shape};
 use super::tables::AeroAtMach;
+use crate::correction::ShapeChange;
 use crate::lanes::Real;
 use crate::scenario::{FlowfieldSpec, MAX_STATIONS, MachScaling};
 use sepval_core::factors::{Factor, Factors};
@@ -254,6 +255,24 @@ impl FlowfieldRun {
         Ok(self)
     }
 
+    /// The field with its shape table corrected by `change` (a correction `flowfield.shape`
+    /// over depth, [`corrected_shape`]); refused when the shape is not a table. No change
+    /// keeps the field's bits.
+    pub fn with_shape_table_change(mut self, change: &ShapeChange) -> Result<Self, String> {
+        if change.len == 0 {
+            return Ok(self);
+        }
+        let Some(shape) = &self.shape else {
+            return Err(
+                "the flowfield's shape is not a table over depth: it has no table to correct"
+                    .to_string(),
+            );
+        };
+        let n = change.len;
+        self.shape = Some(shape.corrected(&change.depth_m[..n], &change.value[..n])?);
+        Ok(self)
+    }
+
     /// The field acting through the store's slopes changed by `change` (CZ_alpha, Cm_alpha,
     /// CY_beta, Cn_beta \[1/rad\]: corrections of the store's derivatives, which the field's
     /// loads and weights take as the store's own, docs/model.md section 3b). A change of 0
@@ -330,7 +349,8 @@ impl FlowfieldRun {
     /// The coefficients `k` with the field's loads added (docs/model.md section 3b), for the
     /// CG at `r_m` (L), the store's axis `axis_l` (C_LB's first column), the moment reference
     /// point `x_ref_m` ahead of the CG, and the stage's flow angles.
-    /// Inlined, so that its fused multiply-adds are compiled with the caller's target features.
+    /// Inlined, so that its fused multiply-adds are compiled with the caller's target features;
+    /// a field with a table goes out of line ([`FlowfieldRun::add_tabulated_loads`]).
     #[inline(always)]
     pub fn add_loads(
         &self,
@@ -341,20 +361,91 @@ impl FlowfieldRun {
         beta_rad: f64,
         k: Coefficients,
     ) -> Coefficients {
+        if self.shape_is_tabulated() {
+            return self.add_tabulated_loads(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k);
+        }
+        let f = FieldLanes::<f64>::gather(|_| self, x_ref_m);
+        f.sums(r_m, axis_l).add_loads(&f, alpha_rad, beta_rad, k)
+    }
+
+    /// [`FlowfieldRun::add_loads`] for a field with a table (a shape over depth or tables over
+    /// position), out of line: inlined, its lookups made the lane propagators a tenth larger and
+    /// their analytic field 4 % slower (flowfield_cost, 2026-11-28); compiled for AVX2 and FMA
+    /// where the host has them, as [`super::wind_l_m_s`] (the same bits).
+    #[inline(never)]
+    pub(crate) fn add_tabulated_loads(
+        &self,
+        r_m: [f64; 3],
+        axis_l: [f64; 3],
+        x_ref_m: f64,
+        alpha_rad: f64,
+        beta_rad: f64,
+        k: Coefficients,
+    ) -> Coefficients {
+        #[cfg(target_arch = "x86_64")]
+        if super::host_has_fma() {
+            // SAFETY: the CPU supports the features `tabulated_loads_fma` is compiled for.
+            return unsafe {
+                self.tabulated_loads_fma(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k)
+            };
+        }
+        self.tabulated_loads(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k)
+    }
+
+    /// [`FlowfieldRun::tabulated_loads`] compiled for x86-64 hosts with AVX2 and FMA.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn tabulated_loads_fma(
+        &self,
+        r_m: [f64; 3],
+        axis_l: [f64; 3],
+        x_ref_m: f64,
+        alpha_rad: f64,
+        beta_rad: f64,
+        k: Coefficients,
+    ) -> Coefficients {
+        self.tabulated_loads(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k)
+    }
+
+    /// The loads of a field with a table.
+    #[inline(always)]
+    fn tabulated_loads(
+        &self,
+        r_m: [f64; 3],
+        axis_l: [f64; 3],
+        x_ref_m: f64,
+        alpha_rad: f64,
+        beta_rad: f64,
+        k: Coefficients,
+    ) -> Coefficients {
         let f = FieldLanes::<f64>::gather(|_| self, x_ref_m);
         let sums = match (&self.grid, &self.shape) {
-            (Some(grid), _) => f.sums_by(
-                |arm| {
-                    let p = std::array::from_fn(|j| axis_l[j].mul_add(arm, r_m[j]));
+            (Some(grid), _) => {
+                // Each station's field looked up in a loop of its own, so that the closures
+                // given to `sums_by` stay small enough to be inlined (out of line, a closure's
+                // fused multiply-adds are calls to the software `fma`; perf, 2026-11-28).
+                let mut at = [[0.0; 3]; MAX_STATIONS];
+                for (a, &arm) in at.iter_mut().zip(&f.arm_m).take(f.stations) {
+                    let p = [
+                        axis_l[0].mul_add(arm, r_m[0]),
+                        axis_l[1].mul_add(arm, r_m[1]),
+                        axis_l[2].mul_add(arm, r_m[2]),
+                    ];
                     let [alpha_k, beta_k, e_k, eta_k] = self.grid_station(grid, p);
-                    [e_k, eta_k * alpha_k, eta_k * beta_k]
-                },
-                || {
+                    *a = [e_k, eta_k * alpha_k, eta_k * beta_k];
+                }
+                let roll = if f.any_roll {
                     let r = [r_m[0], r_m[1], r_m[2] * self.inv_depth_scale];
                     self.roll_cl * grid.at(r)[3]
-                },
-            ),
-            (None, Some(t)) => f.sums_with(r_m, axis_l, |z| t.lanes(z)),
+                } else {
+                    0.0
+                };
+                f.sums_by(|i, _| at[i], || roll)
+            }
+            (None, Some(t)) => f.sums_table(r_m, axis_l, t),
             (None, None) => f.sums(r_m, axis_l),
         };
         sums.add_loads(&f, alpha_rad, beta_rad, k)
@@ -457,47 +548,84 @@ impl<R: Real> FieldLanes<R> {
         self.sums_with(r_m, axis_l, |z| self.analytic_shape(z))
     }
 
-    /// [`FieldLanes::sums`] with the shape `shape` (a field whose shape is a table is
-    /// evaluated one run at a time, through [`FlowfieldRun::add_loads`]).
+    /// [`FieldLanes::sums`] with the shape `shape` (g at each lane's depth).
     #[inline(always)]
     fn sums_with(&self, r_m: [R; 3], axis_l: [R; 3], shape: impl Fn(R) -> R) -> FieldSums<R> {
-        // alpha_i / g = A + A_x p_x with p_x = r_x + C_LB[0][0] arm: at each station
-        // (A + A_x r_x) + (A_x C_LB[0][0]) arm, one multiply-add (likewise beta_i).
-        let upwash = [
-            self.upwash[1].mul_add(r_m[0], self.upwash[0]),
-            self.upwash[1] * axis_l[0],
-        ];
-        let sidewash = [
-            self.sidewash[1].mul_add(r_m[0], self.sidewash[0]),
-            self.sidewash[1] * axis_l[0],
-        ];
+        let upwash = self.upwash_at(r_m, axis_l);
+        let sidewash = self.sidewash_at(r_m, axis_l);
         self.sums_by(
-            |arm| {
-                let g = shape(axis_l[2].mul_add(arm, r_m[2]));
-                let e_k = self.dynamic_pressure * g;
-                let eta_g = e_k.mul_add(g, g);
-                [
-                    e_k,
-                    upwash[1].mul_add(arm, upwash[0]) * eta_g,
-                    sidewash[1].mul_add(arm, sidewash[0]) * eta_g,
-                ]
-            },
+            |_, arm| self.station(upwash, sidewash, shape(axis_l[2].mul_add(arm, r_m[2])), arm),
             || self.roll_cl * shape(r_m[2]),
         )
+    }
+
+    /// [`FieldLanes::sums`] with the shape a table `t` (a field of one run: a field whose shape
+    /// is a table is evaluated one run at a time, through [`FlowfieldRun::add_loads`]). The
+    /// stations' g are looked up first, in a loop of their own, so that the closure given to
+    /// [`FieldLanes::sums_by`] stays small enough to be inlined: out of line, its fused
+    /// multiply-adds were calls to the software `fma` (perf, 2026-11-28).
+    #[inline(always)]
+    fn sums_table(&self, r_m: [R; 3], axis_l: [R; 3], t: &ShapeRun) -> FieldSums<R> {
+        let mut g = [R::splat(0.0); MAX_STATIONS];
+        for (g_k, &arm) in g.iter_mut().zip(&self.arm_m).take(self.stations) {
+            *g_k = t.lanes(axis_l[2].mul_add(arm, r_m[2]));
+        }
+        let roll_g = if self.any_roll {
+            t.lanes(r_m[2])
+        } else {
+            R::splat(0.0)
+        };
+        let upwash = self.upwash_at(r_m, axis_l);
+        let sidewash = self.sidewash_at(r_m, axis_l);
+        self.sums_by(
+            |i, arm| self.station(upwash, sidewash, g[i], arm),
+            || self.roll_cl * roll_g,
+        )
+    }
+
+    /// alpha_i / g = A + A_x p_x with p_x = r_x + C_LB[0][0] arm: at each station
+    /// (A + A_x r_x) + (A_x C_LB[0][0]) arm, one multiply-add.
+    #[inline(always)]
+    fn upwash_at(&self, r_m: [R; 3], axis_l: [R; 3]) -> [R; 2] {
+        [
+            self.upwash[1].mul_add(r_m[0], self.upwash[0]),
+            self.upwash[1] * axis_l[0],
+        ]
+    }
+
+    /// The same for beta_i / g.
+    #[inline(always)]
+    fn sidewash_at(&self, r_m: [R; 3], axis_l: [R; 3]) -> [R; 2] {
+        [
+            self.sidewash[1].mul_add(r_m[0], self.sidewash[0]),
+            self.sidewash[1] * axis_l[0],
+        ]
+    }
+
+    /// (e_k, eta_k alpha_k, eta_k beta_k) at a station's `arm` where the shape is `g`.
+    #[inline(always)]
+    fn station(&self, upwash: [R; 2], sidewash: [R; 2], g: R, arm: R) -> [R; 3] {
+        let e_k = self.dynamic_pressure * g;
+        let eta_g = e_k.mul_add(g, g);
+        [
+            e_k,
+            upwash[1].mul_add(arm, upwash[0]) * eta_g,
+            sidewash[1].mul_add(arm, sidewash[0]) * eta_g,
+        ]
     }
 
     /// The sums over the stations of the field `station` gives at each station's arm
     /// (e_k, eta_k alpha_k, eta_k beta_k), with the rolling moment `roll` (formed only when a
     /// lane's field has one).
     #[inline(always)]
-    fn sums_by(&self, station: impl Fn(R) -> [R; 3], roll: impl Fn() -> R) -> FieldSums<R> {
+    fn sums_by(&self, station: impl Fn(usize, R) -> [R; 3], roll: impl Fn() -> R) -> FieldSums<R> {
         let zero = R::splat(0.0);
         // Each sum its own variable (an array indexed in a loop may be kept in memory).
         let [mut e_n, mut e_m, mut e_y, mut e_r] = [zero; 4];
         let [mut f_n, mut f_m, mut f_y, mut f_r] = [zero; 4];
         let mut e_sum = zero;
         for i in 0..self.stations {
-            let [e_k, alpha_k, beta_k] = station(self.arm_m[i]);
+            let [e_k, alpha_k, beta_k] = station(i, self.arm_m[i]);
             let (w, wx) = (self.weights[0][i], self.weighted_x_m[0][i]);
             let (v, vx) = (self.weights[1][i], self.weighted_x_m[1][i]);
             e_n = w.mul_add(e_k, e_n);

@@ -85,19 +85,57 @@ impl FieldGrid {
             let b = &self.breakpoints[j];
             if b.len() > 1 {
                 let v = p_m[j];
-                let i = b.partition_point(|&x| x <= v).clamp(1, b.len() - 1) - 1;
+                let i = upper_index(b, v).clamp(1, b.len() - 1) - 1;
                 t[j] = ((v - b[i]) * self.inv_widths[j][i]).clamp(0.0, 1.0);
                 base += i * self.strides[j];
             }
         }
         let [sx, sy, sz] = self.strides;
-        let v = |at: usize| self.values[at];
-        let lerp = |lo: [f64; 4], hi: [f64; 4], t: f64| {
-            std::array::from_fn(|k| lo[k] + t * (hi[k] - lo[k]))
-        };
-        // Along z on the four edges of the cell, then along y, then along x.
-        let along_z = |at: usize| lerp(v(at), v(at + sz), t[2]);
-        let along_y = |at: usize| lerp(along_z(at), along_z(at + sy), t[1]);
-        lerp(along_y(base), along_y(base + sx), t[0])
+        // Along z on the four edges of the cell, then along y, then along x (plain functions,
+        // not closures: a closure may be left out of line).
+        lerp(
+            self.along_y(base, [sy, sz], [t[1], t[2]]),
+            self.along_y(base + sx, [sy, sz], [t[1], t[2]]),
+            t[0],
+        )
     }
+
+    /// The values on the cell's face at `at` (strides and fractions along y and z).
+    #[inline(always)]
+    fn along_y(&self, at: usize, [sy, sz]: [usize; 2], [ty, tz]: [f64; 2]) -> [f64; 4] {
+        lerp(self.along_z(at, sz, tz), self.along_z(at + sy, sz, tz), ty)
+    }
+
+    /// The values between grid points `at` and `at + sz`, at `t` of the way.
+    #[inline(always)]
+    fn along_z(&self, at: usize, sz: usize, t: f64) -> [f64; 4] {
+        lerp(self.values[at], self.values[at + sz], t)
+    }
+}
+
+/// The number of breakpoints at or below `v` (`partition_point(|x| x <= v)`, by bisection,
+/// without a closure that may be left out of line).
+#[inline(always)]
+fn upper_index(b: &[f64], v: f64) -> usize {
+    let (mut lo, mut hi) = (0, b.len());
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if b[mid] <= v {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// lo + t (hi - lo), value by value.
+#[inline(always)]
+fn lerp(lo: [f64; 4], hi: [f64; 4], t: f64) -> [f64; 4] {
+    [
+        lo[0] + t * (hi[0] - lo[0]),
+        lo[1] + t * (hi[1] - lo[1]),
+        lo[2] + t * (hi[2] - lo[2]),
+        lo[3] + t * (hi[3] - lo[3]),
+    ]
 }

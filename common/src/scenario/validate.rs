@@ -28,6 +28,15 @@ impl Scenario {
         let corrections = crate::correction::check_all(&self.correction)
             .map_err(|(k, e)| c.bad(&format!("correction[{k}]"), e.to_string()))?;
         for (k, x) in corrections.iter().enumerate() {
+            if x.target == crate::correction::Target::ShapeTable {
+                self.check_shape_table_correction(x).map_err(|why| {
+                    c.bad(
+                        &format!("correction[{k}]"),
+                        format!("`field` `{}`: {why}", self.correction[k].field),
+                    )
+                })?;
+                continue;
+            }
             let crate::correction::Target::Field(part) = x.target else {
                 continue;
             };
@@ -58,6 +67,26 @@ impl Scenario {
         self.factors
             .validate()
             .map_err(|e| c.bad("factors", e.to_string()))
+    }
+}
+
+impl Scenario {
+    /// A correction of the flowfield's shape table: the scenario has one, the correction starts
+    /// at depth 0, and the two have at most `MAX_SHAPE_POINTS` depths together (the table the
+    /// correction folds into, `corrected_shape`).
+    fn check_shape_table_correction(
+        &self,
+        x: &crate::correction::Correction,
+    ) -> Result<(), String> {
+        let Some(shape) = self.flowfield.as_ref().and_then(|f| f.shape.as_ref()) else {
+            return Err("the scenario has no [flowfield] shape table to correct".into());
+        };
+        if x.breakpoints.first() != Some(&0.0) {
+            return Err("a correction of the shape starts at depth 0 (where g stays 1)".into());
+        }
+        let zeros = vec![0.0; x.breakpoints.len()];
+        crate::model::flowfield::corrected_shape(&shape.depth_m, &shape.g, &x.breakpoints, &zeros)
+            .map(|_| ())
     }
 }
 
