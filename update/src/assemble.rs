@@ -54,6 +54,7 @@ pub fn variable_label(v: Variable) -> &'static str {
         Variable::Distance => "distance from carriage [m]",
         Variable::Alpha => "local angle of attack [deg]",
         Variable::Beta => "local sideslip [deg]",
+        Variable::Z => "depth below carriage [m]",
         _ => "flight Mach number [-]",
     }
 }
@@ -78,7 +79,8 @@ pub fn assemble(p: Parts) -> Update {
             explored,
             lambda: model.corrections.lambdas[k],
         });
-        // The flowfield's shape is one constant for every release: a value, not a curve.
+        // The flowfield's parts are one constant for every release: a value, not a curve (its
+        // shape table over depth is a curve).
         if !matches!(c.target, sepval_common::correction::Target::Field(_)) {
             panels.push(panel(&p, k, c, v, explored));
         }

@@ -112,10 +112,12 @@ impl Explored {
         }
     }
 
-    /// The explored range of `variable` (Mach: the first and last flight Mach).
+    /// The explored range of `variable` (Mach: the first and last flight Mach; depth: that of
+    /// distance).
     pub fn range(&self, variable: Variable) -> (f64, f64) {
         match variable {
-            Variable::Distance => (0.0, self.distance_m),
+            // A depth below carriage is at most the distance from it.
+            Variable::Distance | Variable::Z => (0.0, self.distance_m),
             Variable::Alpha => self.alpha_deg,
             Variable::Beta => self.beta_deg,
             _ => (

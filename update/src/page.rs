@@ -165,11 +165,12 @@ fn correction_rows(file: &UpdateFile) -> Vec<Correction> {
         .map(|c| Correction {
             name: c.name.clone(),
             field: c.field.clone(),
-            // The flowfield's shape: one for every release, its value per metre of depth.
-            explored: if matches!(Target::of_field(&c.field), Some(Target::Field(_))) {
-                "every release (per m)".to_string()
-            } else {
-                format!("{} to {}", number(c.explored.0, 3), number(c.explored.1, 3))
+            // The flowfield's parts: one for every release, its shape's values per metre of
+            // depth, its slopes with alpha in deg/deg.
+            explored: match Target::of_field(&c.field) {
+                Some(Target::Field(part)) if part.is_shape() => "every release (per m)".to_string(),
+                Some(Target::Field(_)) => "every release (deg/deg)".to_string(),
+                _ => format!("{} to {}", number(c.explored.0, 3), number(c.explored.1, 3)),
             },
             lambda: number(c.lambda, 2),
             values: c

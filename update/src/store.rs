@@ -13,9 +13,10 @@
 
 use std::path::PathBuf;
 
-use sepval_common::correction::{Correction, Derivative, FieldPart, Target, interpolate};
+use sepval_common::correction::{
+    Correction, Derivative, FieldPart, Target, corrected_shape, interpolate,
+};
 use sepval_common::model::InterferenceDecay;
-use sepval_common::model::flowfield::corrected_shape;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{
     Axis, Coefficient, Kind, Table, TableFile, TableKind, Tabulated, Variable, write_csv,

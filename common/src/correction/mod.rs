@@ -38,7 +38,7 @@
 //! must have a `[flowfield]`.
 //!
 //! A correction of a shape table is folded into the table when a run is set up: the table on
-//! the union of the two grids ([`crate::model::flowfield::corrected_shape`]), the function the
+//! the union of the two grids ([`corrected_shape`]), the function the
 //! store written with it has.
 //!
 //! Mach is the flight condition's, fixed for a run, so a correction over Mach is folded into the
@@ -61,6 +61,10 @@ pub const MAX_CORRECTION_VALUES: usize = 64;
 
 /// Most corrections one scenario holds.
 pub const MAX_CORRECTIONS: usize = 16;
+
+/// Most depths of the flowfield's shape as a table (docs/model.md section 3b), with any
+/// correction of it: a run carries the table in a fixed array.
+pub const MAX_SHAPE_POINTS: usize = 32;
 
 /// The derivatives a correction may change, in the scenario's order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -387,6 +391,44 @@ pub fn check_all(
         out.push(c);
     }
     Ok(out)
+}
+
+/// The shape table (`depth_m`, `g`) with the correction c(z) (`knots_m`, `change`: section 1's
+/// interpolation, held at the ends) added: the table on the union of the two grids, where the
+/// sum of the two piecewise-linear functions is linear on every cell, so that it is the same
+/// function (W. H. Press et al., *Numerical Recipes*, 3rd ed., 2007, section 3.6). The
+/// correction must keep g(0) = 1 and the union at most [`MAX_SHAPE_POINTS`] depths; `sepval
+/// update`'s correction `flowfield.shape` over `z_m` (docs/update.md section 15.3a), folded
+/// into a run's shape and merged into the store written by this one function.
+pub fn corrected_shape(
+    depth_m: &[f64],
+    g: &[f64],
+    knots_m: &[f64],
+    change: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let mut union: Vec<f64> = depth_m.iter().chain(knots_m).copied().collect();
+    union.sort_by(f64::total_cmp);
+    union.dedup();
+    if union.len() > MAX_SHAPE_POINTS {
+        return Err(format!(
+            "the flowfield's shape table and its correction have {} depths together: expected at most {MAX_SHAPE_POINTS}",
+            union.len()
+        ));
+    }
+    let sum: Vec<f64> = union
+        .iter()
+        .map(|&z| interpolate(depth_m, g, z) + interpolate(knots_m, change, z))
+        .collect();
+    // Exactly 1, as the scenario's check of a table (its g at carriage).
+    #[allow(clippy::float_cmp)]
+    let at_carriage_is_one = sum[0] == 1.0;
+    if union.first() != Some(&0.0) || !at_carriage_is_one {
+        return Err(format!(
+            "the flowfield's corrected shape is {} at carriage: expected 1 (a correction of the shape starts at depth 0 with the value 0)",
+            sum[0]
+        ));
+    }
+    Ok((union, sum))
 }
 
 /// The value at `x` of the piecewise-linear function through (`b_i`, `v_i`), held at the ends

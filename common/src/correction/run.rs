@@ -4,9 +4,8 @@
 
 use super::{
     Correction, CorrectionError, Derivative, FieldPart, MAX_CORRECTION_VALUES, MAX_CORRECTIONS,
-    Target, interpolate,
+    MAX_SHAPE_POINTS, Target, interpolate,
 };
-use crate::scenario::MAX_SHAPE_POINTS;
 use crate::table::Variable;
 
 /// The values of a scenario's corrections carried by one candidate: every correction's

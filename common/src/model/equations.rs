@@ -26,7 +26,7 @@ use crate::table::TableState;
 
 use super::aero::{AeroConstants, Flow};
 use super::by_lane::{Parts, alike_fields, flowfield_lanes, lane_by_lane_terms, wind_lanes};
-use super::flowfield::{FieldLanes, FieldSums};
+use super::flowfield_lanes::{FieldLanes, FieldSums};
 use super::interference::DecayLanes;
 use super::term_lanes::TermLanes;
 use super::{Dcm, EjectorCurve, Model, RunSetup, STATE_LEN, StateVector};

@@ -2,7 +2,7 @@
 //! table"): section 1's piecewise-linear interpolation (`correction::interpolate`), held at the
 //! ends, for one run and for the lanes of a batch.
 
-use crate::correction::interpolate;
+use crate::correction::{corrected_shape, interpolate};
 use crate::lanes::Real;
 use crate::scenario::MAX_SHAPE_POINTS;
 
@@ -52,41 +52,6 @@ impl ShapeRun {
         }
         R::from_array(a)
     }
-}
-
-/// The shape table (`depth_m`, `g`) with the correction c(z) (`knots_m`, `change`: section 1's
-/// interpolation, held at the ends) added: the table on the union of the two grids, where the
-/// sum of the two piecewise-linear functions is linear on every cell, so that it is the same
-/// function (W. H. Press et al., *Numerical Recipes*, 3rd ed., 2007, section 3.6). The
-/// correction must keep g(0) = 1 and the union at most [`MAX_SHAPE_POINTS`] depths; `sepval
-/// update`'s correction `flowfield.shape` over `z_m` (docs/update.md section 15.3a), folded
-/// into a run's shape and merged into the store written by this one function.
-pub fn corrected_shape(
-    depth_m: &[f64],
-    g: &[f64],
-    knots_m: &[f64],
-    change: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let mut union: Vec<f64> = depth_m.iter().chain(knots_m).copied().collect();
-    union.sort_by(f64::total_cmp);
-    union.dedup();
-    if union.len() > MAX_SHAPE_POINTS {
-        return Err(format!(
-            "the flowfield's shape table and its correction have {} depths together: expected at most {MAX_SHAPE_POINTS}",
-            union.len()
-        ));
-    }
-    let sum: Vec<f64> = union
-        .iter()
-        .map(|&z| interpolate(depth_m, g, z) + interpolate(knots_m, change, z))
-        .collect();
-    if union.first() != Some(&0.0) || sum[0] != 1.0 {
-        return Err(format!(
-            "the flowfield's corrected shape is {} at carriage: expected 1 (a correction of the shape starts at depth 0 with the value 0)",
-            sum[0]
-        ));
-    }
-    Ok((union, sum))
 }
 
 impl ShapeRun {

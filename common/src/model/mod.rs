@@ -33,6 +33,7 @@ pub mod ejector;
 mod equations;
 pub mod flowfield;
 pub mod flowfield_grid;
+mod flowfield_lanes;
 mod flowfield_shape;
 pub mod interference;
 pub mod tables;

@@ -12,8 +12,7 @@ use crate::table::{Coefficient, FieldAngle, FieldRatio, Table, TableError};
 /// The most stations along the store (docs/model.md section 3b).
 pub const MAX_STATIONS: usize = 16;
 
-/// The most points of a shape given as a table over depth (docs/model.md section 3b).
-pub const MAX_SHAPE_POINTS: usize = 32;
+pub use crate::correction::MAX_SHAPE_POINTS;
 
 /// The field's shape g(z) given as a table over the depth below carriage (docs/model.md
 /// section 3b, "The shape as a table"), in place of `half_depth_m` and `reversal_m`.

@@ -85,7 +85,7 @@ impl Scenario {
             return Err("a correction of the shape starts at depth 0 (where g stays 1)".into());
         }
         let zeros = vec![0.0; x.breakpoints.len()];
-        crate::model::flowfield::corrected_shape(&shape.depth_m, &shape.g, &x.breakpoints, &zeros)
+        crate::correction::corrected_shape(&shape.depth_m, &shape.g, &x.breakpoints, &zeros)
             .map(|_| ())
     }
 }

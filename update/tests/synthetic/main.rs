@@ -369,3 +369,54 @@ fn show(g: &sepval_update::record::GoalsRecord) -> String {
         g.j_att_deg.unwrap_or(f64::NAN)
     )
 }
+
+#[test]
+fn a_shape_table_is_proposed_over_depth_from_carriage_to_the_deepest_release() {
+    use sepval_update::explored::{DISTANCE_KNOTS, Explored, field_proposals};
+    let explored = |points: usize, alphas: &[f64]| Explored {
+        distance_m: 3.0,
+        alpha_deg: (-2.0, 10.0),
+        beta_deg: (-1.0, 4.0),
+        machs: vec![0.8, 0.95],
+        s_end_m: 9.144,
+        flowfield: true,
+        field_shape_table: points > 0,
+        field_grid: false,
+        field_shape_points: points,
+        aircraft_alphas_deg: alphas.to_vec(),
+    };
+    let proposals = field_proposals(&explored(5, &[0.0]));
+    let names: Vec<String> = proposals.iter().map(|p| p.target.field()).collect();
+    // One angle of attack: no slope with alpha; a table: no depths to correct, the table itself.
+    assert_eq!(names, ["flowfield.shape"]);
+    let p = &proposals[0];
+    assert_eq!(p.variable, Variable::Z);
+    assert_eq!(p.breakpoints.len(), DISTANCE_KNOTS);
+    assert_eq!(p.breakpoints[0], 0.0);
+    assert_eq!(*p.breakpoints.last().unwrap(), 3.0);
+    assert!(
+        p.breakpoints[1] < 3.0 / 6.0,
+        "dense near carriage: {:?}",
+        p.breakpoints
+    );
+    assert!(p.pinned[0]);
+    assert!(p.pinned[1..].iter().all(|&x| !x));
+    // A table of 28 depths leaves room for 5 more: fewer knots.
+    let p = field_proposals(&explored(28, &[0.0, 4.0]));
+    let names: Vec<String> = p.iter().map(|p| p.target.field()).collect();
+    assert_eq!(
+        names,
+        [
+            "flowfield.upwash_per_alpha",
+            "flowfield.sidewash_per_alpha",
+            "flowfield.shape"
+        ]
+    );
+    assert_eq!(p[2].breakpoints.len(), 5);
+    // An analytic shape: its depths, no table.
+    let names: Vec<String> = field_proposals(&explored(0, &[0.0]))
+        .iter()
+        .map(|p| p.target.field())
+        .collect();
+    assert_eq!(names, ["flowfield.half_depth_m", "flowfield.reversal_m"]);
+}

@@ -344,3 +344,96 @@ fn a_field_of_tables_over_position_has_no_alpha_slope_to_correct() {
         "{e}"
     );
 }
+
+/// The guide's example store at alpha 5 deg with the conformance case's shape table in place of
+/// its half depth and reversal depth (docs/model.md section 3b, "The shape as a table"), and
+/// `extra` appended.
+fn shape_table_store(extra: &str) -> Result<sepval_common::scenario::Scenario, String> {
+    let table = "shape = { depth_m = [0.0, 0.3, 0.9, 1.6, 2.5], g = [1.0, 0.62, 0.2, -0.07, 0.0] }";
+    let text = include_str!("../../../../examples/flowfield-store/scenario.toml")
+        .replace("alpha_deg = 0.0", "alpha_deg = 5.0")
+        .replace("half_depth_m = 0.8 ", &format!("{table} #"))
+        .replace("reversal_m = 2.0 ", "#")
+        + extra;
+    sepval_common::scenario::Scenario::from_toml_str(&text, "table").map_err(|e| e.to_string())
+}
+
+/// A correction of the shape table over depth with the breakpoints `b`.
+fn shape_correction(b: &str) -> String {
+    format!(
+        "\n[[correction]]\nfield = \"flowfield.shape\"\nvariable = \"z_m\"\nbreakpoints = {b}\n"
+    )
+}
+
+#[test]
+fn a_shape_table_is_corrected_over_depth_as_the_store_written_with_it() {
+    let s = shape_table_store(&shape_correction("[0.0, 0.5, 2.0]")).unwrap();
+    let change = [0.0, -0.1, 0.05];
+    let corrected = corrected_run(&s, &change).unwrap().flowfield.unwrap();
+    // The store written: the table on the union of the depths, the sum at each.
+    let (depth, g) = corrected_shape(
+        &[0.0, 0.3, 0.9, 1.6, 2.5],
+        &[1.0, 0.62, 0.2, -0.07, 0.0],
+        &[0.0, 0.5, 2.0],
+        &change,
+    )
+    .unwrap();
+    assert_eq!(depth, [0.0, 0.3, 0.5, 0.9, 1.6, 2.0, 2.5]);
+    let mut merged = shape_table_store("").unwrap();
+    let shape = merged.flowfield.as_mut().unwrap().shape.as_mut().unwrap();
+    (shape.depth_m, shape.g) = (depth, g);
+    let written = corrected_run(&merged, &[]).unwrap().flowfield.unwrap();
+    for z in [-0.2, 0.0, 0.2, 0.5, 0.7, 1.2, 1.8, 2.2, 3.0, 9.0] {
+        let (a, b) = (corrected.at([0.3, 0.0, z]), written.at([0.3, 0.0, z]));
+        assert_eq!(
+            a.map(f64::to_bits),
+            b.map(f64::to_bits),
+            "z {z}: {a:?} against {b:?}"
+        );
+    }
+    // The sum of the two piecewise-linear functions: at 0.7 m, g 0.62 + (0.2 - 0.62) 0.4/0.6
+    // and c -0.1 + 0.15 (0.2/1.5).
+    let g = corrected.shape.unwrap().at(0.7);
+    let want = 0.62 + (0.2 - 0.62) * (0.4 / 0.6) + (-0.1 + 0.15 * (0.2 / 1.5));
+    assert!((g - want).abs() < 1e-15, "{g} against {want}");
+    // Without values, the table as given, to the bit.
+    let plain = corrected_run(&s, &[]).unwrap().flowfield.unwrap();
+    assert_eq!(
+        plain,
+        corrected_run(&shape_table_store("").unwrap(), &[])
+            .unwrap()
+            .flowfield
+            .unwrap()
+    );
+}
+
+#[test]
+fn a_correction_of_the_shape_table_is_refused_where_it_cannot_be_one() {
+    // A change at carriage would make g(0) other than 1.
+    let s = shape_table_store(&shape_correction("[0.0, 1.0]")).unwrap();
+    let e = match corrected_run(&s, &[0.1, 0.0]) {
+        Ok(_) => panic!("a change at carriage was not refused"),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("at carriage: expected 1"), "{e}");
+    // Breakpoints not from depth 0.
+    let e = shape_table_store(&shape_correction("[0.2, 1.0]")).unwrap_err();
+    assert!(
+        e.contains("correction[0]") && e.contains("starts at depth 0"),
+        "{e}"
+    );
+    // More depths together than a table holds.
+    let many: Vec<String> = (0..30).map(|k| format!("{}.05", k)).collect();
+    let e =
+        shape_table_store(&shape_correction(&format!("[0.0, {}]", many.join(", ")))).unwrap_err();
+    assert!(e.contains("depths together: expected at most 32"), "{e}");
+    // A field whose shape is analytic has no table to correct.
+    let text = include_str!("../../../../examples/flowfield-store/scenario.toml").to_string()
+        + &shape_correction("[0.0, 1.0]");
+    let e = sepval_common::scenario::Scenario::from_toml_str(&text, "analytic").unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("no [flowfield] shape table to correct"),
+        "{e}"
+    );
+}
