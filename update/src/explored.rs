@@ -81,20 +81,18 @@ impl Explored {
         let distance = range(&|s| s.input.distance_m).1.max(0.0);
         let alpha = range(&|s| s.input.alpha_rad.to_degrees());
         let beta = range(&|s| s.input.beta_rad.to_degrees());
-        let mut machs: Vec<f64> = job
-            .events()
-            .iter()
-            .map(|e| e.simulator.scenario().flight.mach)
-            .collect();
-        machs.sort_by(f64::total_cmp);
-        machs.dedup_by(|a, b| (*a - *b).abs() < MACH_MERGE);
-        let mut alphas: Vec<f64> = job
-            .events()
-            .iter()
-            .map(|e| e.simulator.scenario().flight.alpha_deg)
-            .collect();
-        alphas.sort_by(f64::total_cmp);
-        alphas.dedup_by(|a, b| (*a - *b).abs() < ALPHA_MERGE_DEG);
+        let distinct = |of: &dyn Fn(&sepval_common::scenario::Flight) -> f64, merge: f64| {
+            let mut v: Vec<f64> = job
+                .events()
+                .iter()
+                .map(|e| of(&e.simulator.scenario().flight))
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v.dedup_by(|a, b| (*a - *b).abs() < merge);
+            v
+        };
+        let machs = distinct(&|f| f.mach, MACH_MERGE);
+        let alphas = distinct(&|f| f.alpha_deg, ALPHA_MERGE_DEG);
         let field = job.events()[0].simulator.scenario().flowfield.as_ref();
         Explored {
             distance_m: distance,

@@ -37,7 +37,14 @@ impl FlowfieldRun {
         k: Coefficients,
     ) -> Coefficients {
         if self.shape_is_tabulated() {
-            return self.add_tabulated_loads(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k);
+            let at = LoadsAt {
+                r_m,
+                axis_l,
+                x_ref_m,
+                alpha_rad,
+                beta_rad,
+            };
+            return self.add_tabulated_loads(&at, k);
         }
         let f = FieldLanes::<f64>::gather(|_| self, x_ref_m);
         f.sums(r_m, axis_l).add_loads(&f, alpha_rad, beta_rad, k)
@@ -48,23 +55,13 @@ impl FlowfieldRun {
     /// their analytic field 4 % slower (flowfield_cost, 2026-11-28); compiled for AVX2 and FMA
     /// where the host has them, as [`super::wind_l_m_s`] (the same bits).
     #[inline(never)]
-    pub(crate) fn add_tabulated_loads(
-        &self,
-        r_m: [f64; 3],
-        axis_l: [f64; 3],
-        x_ref_m: f64,
-        alpha_rad: f64,
-        beta_rad: f64,
-        k: Coefficients,
-    ) -> Coefficients {
+    fn add_tabulated_loads(&self, at: &LoadsAt, k: Coefficients) -> Coefficients {
         #[cfg(target_arch = "x86_64")]
         if super::host_has_fma() {
             // SAFETY: the CPU supports the features `tabulated_loads_fma` is compiled for.
-            return unsafe {
-                self.tabulated_loads_fma(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k)
-            };
+            return unsafe { self.tabulated_loads_fma(at, k) };
         }
-        self.tabulated_loads(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k)
+        self.tabulated_loads(at, k)
     }
 
     /// [`FlowfieldRun::tabulated_loads`] compiled for x86-64 hosts with AVX2 and FMA.
@@ -73,29 +70,20 @@ impl FlowfieldRun {
     /// The CPU must support AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn tabulated_loads_fma(
-        &self,
-        r_m: [f64; 3],
-        axis_l: [f64; 3],
-        x_ref_m: f64,
-        alpha_rad: f64,
-        beta_rad: f64,
-        k: Coefficients,
-    ) -> Coefficients {
-        self.tabulated_loads(r_m, axis_l, x_ref_m, alpha_rad, beta_rad, k)
+    unsafe fn tabulated_loads_fma(&self, at: &LoadsAt, k: Coefficients) -> Coefficients {
+        self.tabulated_loads(at, k)
     }
 
     /// The loads of a field with a table.
     #[inline(always)]
-    fn tabulated_loads(
-        &self,
-        r_m: [f64; 3],
-        axis_l: [f64; 3],
-        x_ref_m: f64,
-        alpha_rad: f64,
-        beta_rad: f64,
-        k: Coefficients,
-    ) -> Coefficients {
+    fn tabulated_loads(&self, at: &LoadsAt, k: Coefficients) -> Coefficients {
+        let LoadsAt {
+            r_m,
+            axis_l,
+            x_ref_m,
+            alpha_rad,
+            beta_rad,
+        } = *at;
         let f = FieldLanes::<f64>::gather(|_| self, x_ref_m);
         let sums = match (&self.grid, &self.shape) {
             (Some(grid), _) => {
@@ -125,6 +113,17 @@ impl FlowfieldRun {
         };
         sums.add_loads(&f, alpha_rad, beta_rad, k)
     }
+}
+
+/// Where and how the store meets the field at one force evaluation ([`FlowfieldRun::add_loads`]'s
+/// arguments but the coefficients).
+#[derive(Debug, Clone, Copy)]
+struct LoadsAt {
+    r_m: [f64; 3],
+    axis_l: [f64; 3],
+    x_ref_m: f64,
+    alpha_rad: f64,
+    beta_rad: f64,
 }
 
 /// The fields of one run per lane (see [`crate::lanes`]), all with the same number of stations:
