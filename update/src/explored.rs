@@ -209,6 +209,13 @@ fn derivatives_of(axis: usize) -> Vec<Derivative> {
         .collect()
 }
 
+/// `n` breakpoints from 0 to `max`, spaced quadratically (max (j / (n - 1))^2: dense near 0).
+fn quadratic(max: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|j| max * (j as f64 / (n - 1) as f64).powi(2))
+        .collect()
+}
+
 /// `n` breakpoints evenly from `lo` to `hi`.
 fn even(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     (0..n)
@@ -267,9 +274,7 @@ pub fn shape_table_proposal(explored: &Explored) -> Option<Proposal> {
     if n < 3 {
         return None;
     }
-    let breakpoints: Vec<f64> = (0..n)
-        .map(|j| explored.distance_m * (j as f64 / (n - 1) as f64).powi(2))
-        .collect();
+    let breakpoints = quadratic(explored.distance_m, n);
     let mut pinned = vec![false; n];
     pinned[0] = true;
     Some(Proposal {
@@ -289,9 +294,7 @@ pub fn proposals(axis: usize, explored: &Explored) -> Vec<Proposal> {
     };
     let s_max = explored.distance_m;
     if s_max > 0.0 && !explored.flowfield {
-        let mut b: Vec<f64> = (0..DISTANCE_KNOTS)
-            .map(|j| s_max * (j as f64 / (DISTANCE_KNOTS - 1) as f64).powi(2))
-            .collect();
+        let mut b = quadratic(s_max, DISTANCE_KNOTS);
         let mut pinned = vec![false; b.len()];
         if explored.s_end_m > s_max * 1.05 {
             b.push(explored.s_end_m);

@@ -78,8 +78,9 @@ pub struct FlowfieldRun {
     pub weights: [[f64; MAX_STATIONS]; 2],
     /// x_bar: the middle of the store between nose and tail \[m\].
     pub centre_x_m: f64,
-    /// The store's CZ_alpha, Cm_alpha, CY_beta and Cn_beta \[1/rad\] the weights were made
-    /// with.
+    /// The store's CZ_alpha, Cm_alpha, CY_beta and Cn_beta \[1/rad\]: the weights were made
+    /// with them, and the field acts through CZ_alpha and CY_beta
+    /// ([`FlowfieldRun::slopes_per_rad`]).
     pub store_slopes_per_rad: [f64; 4],
     /// What a change of 1 deg/deg of a_alpha and of b_alpha adds to A and B \[rad\]: their
     /// factors times s_M times (alpha_a - alpha_ref) in radians.
@@ -110,8 +111,8 @@ pub struct FlowfieldRun {
     /// A correction's change of 1 / L_z \[1/m\] (docs/update.md): 0 but in an update's
     /// refits.
     pub inv_half_depth_change_per_m: f64,
-    /// CZ_alpha and CY_beta \[1/rad\], the slopes the field acts through.
-    pub slopes_per_rad: [f64; 2],
+    /// d \[m\], the store's diameter (the weights' centres of pressure).
+    pub diameter_m: f64,
     /// 1 / d \[1/m\].
     pub inv_diameter_per_m: f64,
 }
@@ -173,7 +174,7 @@ impl FlowfieldRun {
             inv_depth_scale: 1.0,
             inv_reversal_per_m: spec.reversal_m.map_or(0.0, |z_r| 1.0 / z_r),
             inv_half_depth_change_per_m: 0.0,
-            slopes_per_rad: [aero.cz_alpha_per_rad, aero.cy_beta_per_rad],
+            diameter_m,
             inv_diameter_per_m: 1.0 / diameter_m,
         };
         match grid {
@@ -215,6 +216,12 @@ impl FlowfieldRun {
     /// with a table goes one run at a time (its lookups are scalar).
     pub fn in_lanes(&self) -> bool {
         !self.shape_is_tabulated()
+    }
+
+    /// CZ_alpha and CY_beta \[1/rad\], the slopes the field acts through.
+    #[inline(always)]
+    pub fn slopes_per_rad(&self) -> [f64; 2] {
+        [self.store_slopes_per_rad[0], self.store_slopes_per_rad[2]]
     }
 
     /// Whether the shape is a table over depth or the field tables over position (no half
@@ -285,10 +292,13 @@ impl FlowfieldRun {
             *s += c;
         }
         let n = self.stations;
-        let diameter_m = 1.0 / self.inv_diameter_per_m;
-        self.weights = station_weights(&self.station_x_m[..n], self.centre_x_m, diameter_m, slopes);
+        self.weights = station_weights(
+            &self.station_x_m[..n],
+            self.centre_x_m,
+            self.diameter_m,
+            slopes,
+        );
         self.store_slopes_per_rad = slopes;
-        self.slopes_per_rad = [slopes[0], slopes[2]];
         self
     }
 

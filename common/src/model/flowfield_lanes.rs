@@ -179,10 +179,10 @@ impl<R: Real> FieldLanes<R> {
             roll_cl: g(&|r| r.roll_cl),
             inv_half_depth_per_m: g(&|r| r.inv_half_depth_per_m()),
             inv_reversal_per_m: g(&|r| r.inv_reversal_per_m),
-            slopes_per_rad: [g(&|r| r.slopes_per_rad[0]), g(&|r| r.slopes_per_rad[1])],
+            slopes_per_rad: [g(&|r| r.slopes_per_rad()[0]), g(&|r| r.slopes_per_rad()[1])],
             slopes_per_rad_m: [
-                g(&|r| r.slopes_per_rad[0] * r.inv_diameter_per_m),
-                g(&|r| r.slopes_per_rad[1] * r.inv_diameter_per_m),
+                g(&|r| r.slopes_per_rad()[0] * r.inv_diameter_per_m),
+                g(&|r| r.slopes_per_rad()[1] * r.inv_diameter_per_m),
             ],
             inv_stations: g(&|r| 1.0 / r.stations as f64),
             any_roll: (0..R::LANES).any(|i| runs(i).roll_cl != 0.0),

@@ -52,9 +52,7 @@ impl ShapeRun {
         }
         R::from_array(a)
     }
-}
 
-impl ShapeRun {
     /// The table with the correction (`knots_m`, `change`) added ([`corrected_shape`]).
     pub fn corrected(&self, knots_m: &[f64], change: &[f64]) -> Result<ShapeRun, String> {
         let n = self.points;

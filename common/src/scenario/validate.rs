@@ -28,34 +28,12 @@ impl Scenario {
         let corrections = crate::correction::check_all(&self.correction)
             .map_err(|(k, e)| c.bad(&format!("correction[{k}]"), e.to_string()))?;
         for (k, x) in corrections.iter().enumerate() {
-            if x.target == crate::correction::Target::ShapeTable {
-                self.check_shape_table_correction(x).map_err(|why| {
-                    c.bad(
-                        &format!("correction[{k}]"),
-                        format!("`field` `{}`: {why}", self.correction[k].field),
-                    )
-                })?;
-                continue;
-            }
-            let crate::correction::Target::Field(part) = x.target else {
-                continue;
-            };
-            let why = match &self.flowfield {
-                None => Some("the scenario has no [flowfield] to correct"),
-                Some(f) if part.is_shape() && f.shape.is_some() => Some(
-                    "the [flowfield]'s shape is a table, with no half depth or reversal depth to \
-                     correct",
-                ),
-                Some(f) if part.is_shape() && f.is_grid() => Some(
-                    "the [flowfield] is given as tables over position, with no half depth or \
-                     reversal depth to correct",
-                ),
-                Some(f) if f.is_grid() => Some(
-                    "the [flowfield] is given as tables over position, which scale with alpha by \
-                     its zero-lift angle, with no upwash_per_alpha or sidewash_per_alpha to \
-                     correct",
-                ),
-                Some(_) => None,
+            let why = match x.target {
+                crate::correction::Target::ShapeTable => self.check_shape_table_correction(x).err(),
+                crate::correction::Target::Field(part) => {
+                    self.field_part_refusal(part).map(str::to_string)
+                }
+                _ => None,
             };
             if let Some(why) = why {
                 return Err(c.bad(
@@ -71,6 +49,29 @@ impl Scenario {
 }
 
 impl Scenario {
+    /// Why a correction of the flowfield's `part` cannot be one of this scenario, if it cannot:
+    /// no field; a shape's depth where the shape is a table or the field tables over position;
+    /// a slope with alpha where the field is tables over position.
+    fn field_part_refusal(&self, part: crate::correction::FieldPart) -> Option<&'static str> {
+        match &self.flowfield {
+            None => Some("the scenario has no [flowfield] to correct"),
+            Some(f) if part.is_shape() && f.shape.is_some() => Some(
+                "the [flowfield]'s shape is a table, with no half depth or reversal depth to \
+                 correct",
+            ),
+            Some(f) if part.is_shape() && f.is_grid() => Some(
+                "the [flowfield] is given as tables over position, with no half depth or \
+                 reversal depth to correct",
+            ),
+            Some(f) if f.is_grid() => Some(
+                "the [flowfield] is given as tables over position, which scale with alpha by \
+                 its zero-lift angle, with no upwash_per_alpha or sidewash_per_alpha to \
+                 correct",
+            ),
+            Some(_) => None,
+        }
+    }
+
     /// A correction of the flowfield's shape table: the scenario has one, the correction starts
     /// at depth 0, and the two have at most `MAX_SHAPE_POINTS` depths together (the table the
     /// correction folds into, `corrected_shape`).

@@ -288,7 +288,7 @@ fn a_correction_of_the_stores_slopes_is_the_slopes_the_field_acts_through() {
         .replace("cz_alpha_per_rad = -6.0", "cz_alpha_per_rad = -5.5");
     merged = sepval_common::scenario::Scenario::from_toml_str(&text, "merged").unwrap();
     let written = corrected_run(&merged, &[]).unwrap().flowfield.unwrap();
-    assert_eq!(corrected.slopes_per_rad, written.slopes_per_rad);
+    assert_eq!(corrected.slopes_per_rad(), written.slopes_per_rad());
     for side in 0..2 {
         for k in 0..corrected.stations {
             let (a, b) = (corrected.weights[side][k], written.weights[side][k]);
