@@ -31,7 +31,8 @@ pub struct Flow<R = f64> {
     pub r_hat: R,
     /// Air-relative speed V [m/s].
     pub speed_m_s: R,
-    /// Interference decay factor f(s) in [0, 1].
+    /// Interference decay factor f(s) in [0, 1] (0 with a flowfield, section 3b, which replaces
+    /// the decay increments).
     pub interference_factor: R,
     /// Time of the evaluation (the RK4 stage's) \[s\].
     pub t_s: R,

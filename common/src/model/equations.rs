@@ -70,6 +70,10 @@ pub(crate) struct Constants<R: Real> {
     field: Option<FieldLanes<R>>,
     /// Whether some lanes have a field but not all alike (each is then evaluated alone).
     field_by_lane: bool,
+    /// Whether any lane has the decay increments of section 3 (a run without a field): with a
+    /// field in every lane, f(s) is not formed (section 3b: the increments are 0, so the factor
+    /// they multiply is taken as 0, the same bits).
+    decay_used: bool,
 }
 
 impl<R: Real> Constants<R> {
@@ -115,6 +119,7 @@ impl<R: Real> Constants<R> {
                 )
             }),
             field_by_lane: !alike && parts.iter().any(|p| p.run.flowfield.is_some()),
+            decay_used: parts.iter().any(|p| p.run.flowfield.is_none()),
         }
     }
 }
@@ -231,8 +236,14 @@ fn flow_frame<R: Real>(
     let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
     // Section 1: interference decay with s = |r|. First: its input is ready long before
     // the stage's velocity and attitude, so the exponential overlaps the rest.
+    // A field in every lane: the increments are 0 (section 3b), so f(s) is not formed; 0 in its
+    // place leaves every coefficient's bits as they are (0 f = 0 for any f >= 0).
     let distance_m = dot([rx, ry, rz], [rx, ry, rz]).sqrt();
-    let f_s = c.decay.factor(distance_m);
+    let f_s = if c.decay_used {
+        c.decay.factor(distance_m)
+    } else {
+        R::splat(0.0)
+    };
     // Section 2: C_LB of the stage's quaternion scaled to unit length, kept as
     // |q|^2 C_LB and 1 / |q|^2 (the scale is applied where it is needed, off the chain
     // from the stage's state to the flow angles).
