@@ -467,6 +467,37 @@ impl Scenario {
         Scenario::from_toml_str_in(&text, &path.display().to_string(), Some(dir))
     }
 
+    /// The table files the scenario file at `path` names (each `csv = "..."` in it, relative
+    /// to its directory as [`Scenario::load`] reads them): what a run that loads it reads
+    /// besides the file itself, so that no output may be written over them. None when the file
+    /// cannot be read or parsed (loading it says why).
+    pub fn table_files(path: &Path) -> Vec<std::path::PathBuf> {
+        fn collect(v: &toml::Value, out: &mut Vec<String>) {
+            match v {
+                toml::Value::Table(t) => {
+                    if let Some(toml::Value::String(f)) = t.get("csv") {
+                        out.push(f.clone());
+                    }
+                    t.values().for_each(|x| collect(x, out));
+                }
+                toml::Value::Array(a) => a.iter().for_each(|x| collect(x, out)),
+                _ => {}
+            }
+        }
+        let Ok(text) = read_string(path, "scenario", MAX_SCENARIO_BYTES) else {
+            return Vec::new();
+        };
+        let Ok(value) = toml::from_str::<toml::Value>(&text) else {
+            return Vec::new();
+        };
+        let mut names = Vec::new();
+        collect(&value, &mut names);
+        let dir = path.parent().unwrap_or(Path::new(""));
+        names.sort();
+        names.dedup();
+        names.into_iter().map(|n| dir.join(n)).collect()
+    }
+
     /// The scenario as TOML (values round-trip exactly).
     pub fn to_toml_string(&self) -> String {
         toml::to_string(self).expect("a scenario always serialises")

@@ -55,6 +55,16 @@ pub enum OutDirError {
         /// The input, as the flag that gives it and its path.
         input: String,
     },
+    /// An output file that is one of the run's inputs.
+    #[error(
+        "{path} is {input}, an input of this run (writing it would destroy what the run reads): give another --out"
+    )]
+    FileIsInput {
+        /// The output file.
+        path: PathBuf,
+        /// The input, as the flag that gives it and its path.
+        input: String,
+    },
     /// A directory to clear holding entries sepval did not write.
     #[error("not clearing {path}: {why}")]
     NotOurs {

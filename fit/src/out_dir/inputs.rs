@@ -50,6 +50,16 @@ impl Input {
         }
     }
 
+    /// An input file that another input names (e.g. a table file a scenario reads): `whose`
+    /// names that input.
+    pub fn named_by(whose: &str, path: &Path) -> Input {
+        Input {
+            what: format!("the table {} that {whose} names", path.display()),
+            path: path.to_path_buf(),
+            directory: false,
+        }
+    }
+
     /// The input directory `path`, the run directory of the checkpoint `--resume` gives.
     pub fn resumed_run(checkpoint: &Path, path: &Path) -> Input {
         Input {
@@ -125,6 +135,39 @@ pub(super) fn check(out: &Path, inputs: &[Input], allowed: &[PathBuf]) -> Result
     Ok(())
 }
 
+/// Refuses an output file `out` that is one of `inputs`: the same path once resolved, or the
+/// same file by another name (a hard link).
+pub fn check_file(out: &Path, inputs: &[Input]) -> Result<(), OutDirError> {
+    let here = resolved(out);
+    let here_id = file_id(out);
+    for input in inputs {
+        let same_path = resolved(&input.path) == here;
+        let same_file = here_id.is_some() && file_id(&input.path) == here_id;
+        if same_path || same_file {
+            return Err(OutDirError::FileIsInput {
+                path: out.to_path_buf(),
+                input: input.what.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The device and inode of the file at `path`, when it exists (unix); none elsewhere, where
+/// the resolved paths alone are compared.
+fn file_id(path: &Path) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata(path).ok().map(|m| (m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,6 +207,14 @@ mod tests {
         let data = [Input::file("--data", &d.join("a.csv"))];
         assert!(refused(d, &data).unwrap().contains("holds --data"));
         assert_eq!(refused(&d.join("run"), &data), None);
+        // An output file: refused when it is an input, by any name.
+        std::fs::hard_link(d.join("a.csv"), d.join("b.csv")).unwrap();
+        for out in [d.join("a.csv"), d.join("dg/../a.csv"), d.join("b.csv")] {
+            let e = check_file(&out, &data).unwrap_err().to_string();
+            assert!(e.contains("is --data"), "{e}");
+        }
+        assert!(check_file(&d.join("c.csv"), &data).is_ok());
+        assert!(check_file(&d.join("link/a.csv"), &data).is_ok());
         // The run directory a resumed run goes on in.
         assert_eq!(
             check(&d.join("dg"), &from, &[resolved(&d.join("link"))]).ok(),

@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 pub use error::OutDirError;
-pub use inputs::Input;
+pub use inputs::{Input, check_file};
 pub use lock::{DirLock, LOCK_FILE};
 pub use marker::MARKER_FILE;
 

@@ -152,12 +152,30 @@ pub fn geometry_inputs(g: &crate::cli::GeometryArgs) -> Vec<Input> {
     out
 }
 
-/// The files of `--data`, `--scenario` and `--extension`, as inputs.
+/// The files of `--data`, `--scenario` (with the table files it names) and `--extension`, as
+/// inputs.
 pub fn model_inputs(i: &crate::cli::InputArgs) -> Vec<Input> {
     let mut out = input_files("--data", &i.data);
-    out.extend(input_files("--scenario", &i.model.scenario));
-    out.extend(input_files("--extension", &i.model.extension));
+    out.extend(scenario_inputs(&i.model));
     out
+}
+
+/// The files of `--scenario`, the table files it names, and `--extension`, as inputs.
+pub fn scenario_inputs(m: &crate::cli::ModelArgs) -> Vec<Input> {
+    let mut out = input_files("--scenario", &m.scenario);
+    if let Some(path) = &m.scenario {
+        let whose = format!("--scenario {}", path.display());
+        let tables = sepval_common::Scenario::table_files(path);
+        out.extend(tables.iter().map(|t| Input::named_by(&whose, t)));
+    }
+    out.extend(input_files("--extension", &m.extension));
+    out
+}
+
+/// Refuses a file `--out` that is one of the run's `inputs` (the same file by any name),
+/// before any work: a run that wrote it would destroy what it reads.
+pub fn out_file_apart(out: &Path, inputs: &[Input]) -> Result<()> {
+    sepval_fit::out_dir::check_file(out, inputs).with_context(|| format!("--out {}", out.display()))
 }
 
 /// Input files given by `flag` (none, one or several).

@@ -22,6 +22,14 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
     if let Some(model) = &args.from_daveml {
         return from_daveml(&args, model);
     }
+    if !args.tables {
+        // The file written may be neither the scenario read nor a table it names.
+        let model = crate::cli::ModelArgs {
+            scenario: args.scenario.clone(),
+            extension: None,
+        };
+        super::out_file_apart(&args.out, &super::scenario_inputs(&model))?;
+    }
     let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
     if args.to_daveml {
         let prov = sepval_daveml::Provenance::now(

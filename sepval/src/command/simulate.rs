@@ -1,5 +1,7 @@
 //! `sepval simulate`: one release, written as a trajectory file.
 
+use std::path::PathBuf;
+
 use anyhow::{Context, Result};
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test_logged;
@@ -15,6 +17,17 @@ use crate::cli::SimulateArgs;
 pub fn run(args: SimulateArgs) -> Result<()> {
     let t_end = args.t_end.map(|t| positive("--t-end", t)).transpose()?;
     let rate = args.rate.map(|r| positive("--rate", r)).transpose()?;
+    // Nothing the run reads may be written over: its scenario, the tables the scenario names,
+    // its extension, factors and geometry.
+    let mut read = super::scenario_inputs(&args.model);
+    if !matches!(args.factors.as_str(), "truth" | "nominal") {
+        read.extend(super::input_files(
+            "--factors",
+            [&PathBuf::from(&args.factors)],
+        ));
+    }
+    read.extend(super::geometry_inputs(&args.geometry));
+    super::out_file_apart(&args.out, &read)?;
     let effects = inputs::effects(&args.effects)?;
     let scenario = inputs::scenario(
         args.model.scenario.as_deref(),

@@ -305,3 +305,61 @@ fn a_lock_that_names_no_process_is_taken_over_and_said() {
         assert!(d.join(&out).join("result.json").is_file());
     }
 }
+
+/// A file `--out` (simulate's trajectory, scenario's TOML or DAVE-ML) that is the scenario
+/// read, a table file the scenario names, or one of them by another name (`..`, a hard link),
+/// is refused before any work, naming both, and every input is left as it was; a file that is
+/// none of them is written.
+#[test]
+fn simulate_and_scenario_never_write_over_what_they_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let example = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/flowfield-store");
+    for f in ["grid.toml", "field-grid.csv"] {
+        std::fs::copy(example.join(f), d.join(f)).unwrap();
+    }
+    std::fs::create_dir(d.join("sub")).unwrap();
+    std::fs::hard_link(d.join("field-grid.csv"), d.join("linked.csv")).unwrap();
+    let read = |f: &str| std::fs::read(d.join(f)).unwrap();
+    let before = [read("grid.toml"), read("field-grid.csv")];
+    let table = "the table field-grid.csv that --scenario grid.toml names";
+    for (out, input) in [
+        ("grid.toml", "--scenario grid.toml"),
+        ("sub/../grid.toml", "--scenario grid.toml"),
+        ("field-grid.csv", table),
+        ("linked.csv", table),
+    ] {
+        let expected = format!("--out {out}: {out} is {input}, an input of this run");
+        for args in [
+            vec!["simulate", "--scenario", "grid.toml", "--out", out],
+            vec!["scenario", "--scenario", "grid.toml", "--out", out],
+            vec![
+                "scenario",
+                "--scenario",
+                "grid.toml",
+                "--to-daveml",
+                "--out",
+                out,
+            ],
+        ] {
+            let stderr = refused(&sepval(&args, d), &expected);
+            assert!(stderr.contains("give another --out"), "{stderr}");
+            assert_eq!(
+                [read("grid.toml"), read("field-grid.csv")],
+                before,
+                "{args:?}"
+            );
+        }
+    }
+    let factors = "{}";
+    std::fs::write(d.join("f.json"), factors).unwrap();
+    refused(
+        &sepval(&["simulate", "--factors", "f.json", "--out", "f.json"], d),
+        "--out f.json: f.json is --factors f.json, an input of this run",
+    );
+    assert_eq!(std::fs::read_to_string(d.join("f.json")).unwrap(), factors);
+    ok(&sepval(
+        &["simulate", "--scenario", "grid.toml", "--out", "t.csv"],
+        d,
+    ));
+}
