@@ -3,8 +3,9 @@
 
 use crate::effects::EffectSet;
 use crate::goals::{GoalAccumulator, GoalSums, Goals};
-use crate::model::{Model, ModelError, RunSetup};
-use crate::propagator::{Diverged, Observation, RunLog, propagate};
+use crate::model::flowfield_grid::GridExcursions;
+use crate::model::{Model, ModelError, RunSetup, StateVector};
+use crate::propagator::{Diverged, Observation, RunLog, SampleSink, propagate};
 use crate::scenario::Scenario;
 use crate::telemetry::Trajectory;
 use sepval_core::factors::Factors;
@@ -94,8 +95,14 @@ impl Simulator {
             .into());
         }
         let run = self.run_setup(factors, effects)?;
-        let mut samples: Vec<Observation> = Vec::with_capacity(times_s.len());
-        let log = propagate(&self.model, &run, times_s, &mut samples)?;
+        let mut sink = Reported {
+            run: &run,
+            samples: Vec::with_capacity(times_s.len()),
+            field_grid: GridExcursions::default(),
+        };
+        let mut log = propagate(&self.model, &run, times_s, &mut sink)?;
+        log.field_grid = sink.field_grid;
+        let samples = sink.samples;
         let traj = Trajectory {
             times_s: times_s.to_vec(),
             pos_m: samples.iter().map(|o| o.pos_m).collect(),
@@ -107,8 +114,33 @@ impl Simulator {
 
     /// The tables a run left (docs/model.md section 3: held at the edge and recorded), named,
     /// from its log; empty for a scenario without tables or a run that stayed inside them.
+    /// The flowfield's tables over position count as one table, `flowfield` (section 3b),
+    /// counted at the samples.
     pub fn table_excursions(&self, log: &RunLog) -> Vec<crate::table::TableExcursion> {
-        self.model.tables.report(&log.tables)
+        let mut out = self.model.tables.report(&log.tables);
+        let ex = &log.field_grid;
+        if let (Some(grid), true) = (&self.model.field_grid, ex.outside > 0) {
+            let axes = ["x_m", "y_m", "z_m"]
+                .into_iter()
+                .enumerate()
+                .filter_map(|(j, variable)| {
+                    let range = grid.range(j)?;
+                    (ex.worst_m[j] > 0.0).then(|| crate::table::AxisExcursion {
+                        variable: variable.to_string(),
+                        range,
+                        worst_excursion: ex.worst_m[j],
+                    })
+                })
+                .collect();
+            out.push(crate::table::TableExcursion {
+                table: "flowfield".to_string(),
+                evaluations_outside: ex.outside,
+                evaluations: ex.samples,
+                axes,
+                at_samples: true,
+            });
+        }
+        out
     }
 
     /// Simulates at `times_s` (strictly increasing).
@@ -145,4 +177,23 @@ impl Simulator {
 pub fn sample_times(t_end_s: f64, rate_hz: f64) -> Vec<f64> {
     let n = (t_end_s * rate_hz + 1e-9).floor() as usize + 1;
     (0..n).map(|j| j as f64 / rate_hz).collect()
+}
+
+/// The sink of a reported run: the samples, and whether the flowfield's points were beyond its
+/// grid at them ([`RunLog::field_grid`]).
+struct Reported<'a> {
+    run: &'a RunSetup,
+    samples: Vec<Observation>,
+    field_grid: GridExcursions,
+}
+
+impl SampleSink for Reported<'_> {
+    fn record(&mut self, _index: usize, obs: &Observation, x: &StateVector) {
+        self.samples.push(*obs);
+        if let Some(f) = &self.run.flowfield
+            && let Some(beyond) = f.beyond_grid(x, self.run.aero_reference_x_m)
+        {
+            self.field_grid.note(beyond);
+        }
+    }
 }

@@ -212,6 +212,30 @@ impl FlowfieldRun {
         self
     }
 
+    /// How far the stations of the store in state `x` (and its CG, where the rolling moment is
+    /// a table) lie beyond the field's grid along each axis, in the tables' coordinates \[m\],
+    /// with the moment reference point `x_ref_m` ahead of the CG; none without tables over
+    /// position. The points are those [`FlowfieldRun::add_loads`] looks the tables up at.
+    pub fn beyond_grid(&self, x: &crate::model::StateVector, x_ref_m: f64) -> Option<[f64; 3]> {
+        let grid = self.grid.as_ref()?;
+        let c_lb = crate::frames::dcm_from_quaternion([x[6], x[7], x[8], x[9]]);
+        let r_m = [x[0], x[1], x[2]];
+        let scaled = |p: [f64; 3]| [p[0], p[1], p[2] * self.inv_depth_scale];
+        let mut worst = if self.roll_cl != 0.0 {
+            grid.beyond(scaled(r_m))
+        } else {
+            [0.0; 3]
+        };
+        for &x_k in &self.station_x_m[..self.stations] {
+            let arm = x_k + x_ref_m;
+            let p = std::array::from_fn(|j| c_lb[(j, 0)].mul_add(arm, r_m[j]));
+            for (w, b) in worst.iter_mut().zip(grid.beyond(scaled(p))) {
+                *w = w.max(b);
+            }
+        }
+        Some(worst)
+    }
+
     /// Whether the field is evaluated in the lanes with others (an analytic field); a field
     /// with a table goes one run at a time (its lookups are scalar).
     pub fn in_lanes(&self) -> bool {

@@ -100,6 +100,21 @@ impl FieldGrid {
         )
     }
 
+    /// How far the point `p_m` (in the tables' coordinates) lies beyond the grid along each
+    /// axis \[m\]: 0 inside, and along an axis the tables do not span.
+    pub fn beyond(&self, p_m: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|j| match self.range(j) {
+            Some([lo, hi]) => (lo - p_m[j]).max(p_m[j] - hi).max(0.0),
+            None => 0.0,
+        })
+    }
+
+    /// The first and last breakpoint along axis `j` (x, y, z), when the tables span it.
+    pub fn range(&self, j: usize) -> Option<[f64; 2]> {
+        let b = &self.breakpoints[j];
+        (b.len() > 1).then(|| [b[0], b[b.len() - 1]])
+    }
+
     /// The values on the cell's face at `at` (strides and fractions along y and z).
     #[inline(always)]
     fn along_y(&self, at: usize, [sy, sz]: [usize; 2], [ty, tz]: [f64; 2]) -> [f64; 4] {
@@ -138,4 +153,32 @@ fn lerp(lo: [f64; 4], hi: [f64; 4], t: f64) -> [f64; 4] {
         lo[2] + t * (hi[2] - lo[2]),
         lo[3] + t * (hi[3] - lo[3]),
     ]
+}
+
+/// How often a run's samples found the field beyond its grid, and how far (docs/model.md
+/// section 3b: the tables are held at the grid's edges, and a run that leaves them is reported
+/// as one that leaves a coefficient's table is). Counted at the telemetry samples, from the
+/// state: a station, or the CG where the rolling moment is a table, beyond an axis the tables
+/// span.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GridExcursions {
+    /// Samples looked at.
+    pub samples: u64,
+    /// Samples with a point beyond the grid.
+    pub outside: u64,
+    /// The largest distance beyond the grid along x, y and z \[m\] (the tables' coordinates).
+    pub worst_m: [f64; 3],
+}
+
+impl GridExcursions {
+    /// Counts one sample whose points lie `beyond` the grid (from [`FieldGrid::beyond`]).
+    pub fn note(&mut self, beyond: [f64; 3]) {
+        self.samples += 1;
+        if beyond.iter().any(|&b| b > 0.0) {
+            self.outside += 1;
+        }
+        for (w, b) in self.worst_m.iter_mut().zip(beyond) {
+            *w = w.max(b);
+        }
+    }
 }

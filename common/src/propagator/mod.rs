@@ -87,6 +87,9 @@ pub struct RunLog {
     pub steps: u64,
     /// How often the force evaluations left the scenario's tables (all zero without tables).
     pub tables: crate::table::TableExcursions,
+    /// How often the samples found the flowfield beyond its grid (all zero without tables over
+    /// position; filled by [`crate::Simulator::simulate_logged`], which reports runs).
+    pub field_grid: crate::model::flowfield_grid::GridExcursions,
 }
 
 /// The integrator state between grid points.

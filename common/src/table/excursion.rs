@@ -86,6 +86,10 @@ pub struct TableExcursion {
     pub evaluations: u64,
     /// Each axis left: its range and the largest excursion beyond it.
     pub axes: Vec<AxisExcursion>,
+    /// Whether the counts are of the run's samples rather than its force evaluations (the
+    /// flowfield's tables over position, docs/model.md section 3b).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub at_samples: bool,
 }
 
 /// The excursion beyond one axis of a table.
@@ -101,9 +105,14 @@ pub struct AxisExcursion {
 
 impl fmt::Display for TableExcursion {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        let counted = if self.at_samples {
+            "samples"
+        } else {
+            "force evaluations"
+        };
         write!(
             f,
-            "left table `{}` in {} of {} force evaluations (value held at the edge)",
+            "left table `{}` in {} of {} {counted} (value held at the edge)",
             self.table, self.evaluations_outside, self.evaluations
         )?;
         for a in &self.axes {

@@ -443,6 +443,7 @@ impl PreparedTables {
                 evaluations_outside: count,
                 evaluations: ex.evaluations,
                 axes,
+                at_samples: false,
             });
         }
         out

@@ -161,10 +161,35 @@ fn a_surveyed_field_simulates_as_written_and_a_bad_one_is_refused_with_nothing_w
     for f in ["grid.toml", "field-grid.csv"] {
         std::fs::copy(examples.join(f), d.join(f)).unwrap();
     }
-    ok(&sepval(
+    let run = sepval(
         &["simulate", "--scenario", "grid.toml", "--out", "g.csv"],
         d,
-    ));
+    );
+    ok(&run);
+    let told = String::from_utf8_lossy(&run.stderr);
+    // The store leaves the survey aft of its x = -3 m after about 0.76 s: held at the grid's
+    // edge and said, as a coefficient's table left is; refused with --strict-tables, nothing
+    // written; a release that stays inside (0.3 s) says nothing.
+    let left =
+        "left table `flowfield` in 49 of 201 samples (value held at the edge); x_m up to 2.27";
+    assert!(told.contains(&format!("warning: {left}")), "{told}");
+    let strict = ["simulate", "--scenario", "grid.toml", "--strict-tables"];
+    let stderr = refused(
+        &sepval(&[&strict[..], &["--out", "s.csv"]].concat(), d),
+        &format!("--strict-tables: the run {left}"),
+    );
+    assert!(
+        stderr.contains("beyond [-3, 3] (nothing written)"),
+        "{stderr}"
+    );
+    assert!(!d.join("s.csv").exists());
+    let short = sepval(
+        &[&strict[..], &["--t-end", "0.3", "--out", "s.csv"]].concat(),
+        d,
+    );
+    ok(&short);
+    let short = String::from_utf8_lossy(&short.stderr);
+    assert!(!short.contains("warning"), "{short}");
     // The conformance values at t = 1 s.
     let expected = [
         1.0,
