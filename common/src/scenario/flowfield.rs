@@ -14,6 +14,15 @@ pub const MAX_STATIONS: usize = 16;
 
 pub use crate::correction::MAX_SHAPE_POINTS;
 
+/// The shortest and longest store the field's stations are spread along, nose to tail \[m\]
+/// (sepval's choice: a millimetre to a kilometre).
+pub const MIN_STORE_LENGTH_M: f64 = 1e-3;
+/// See [`MIN_STORE_LENGTH_M`].
+pub const MAX_STORE_LENGTH_M: f64 = 1e3;
+/// The least difference between a field of tables' reference angle of attack and its
+/// zero-lift angle \[deg\] (sepval's choice).
+pub const MIN_LIFT_ALPHA_DEG: f64 = 0.5;
+
 /// The field's shape g(z) given as a table over the depth below carriage (docs/model.md
 /// section 3b, "The shape as a table"), in place of `half_depth_m` and `reversal_m`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -262,6 +271,20 @@ impl FlowfieldSpec {
                 format!(
                     "= {}: expected the nose ahead of the tail (tail_x_m = {})",
                     self.nose_x_m, self.tail_x_m
+                ),
+            ));
+        }
+        // The stations' spread sum (x_k - x_bar)^2 divides their weights (docs/model.md
+        // section 3b): a store 1e-300 m long made it 0 and the weights NaN, one 1e155 m long
+        // infinite.
+        let length_m = self.nose_x_m - self.tail_x_m;
+        if !(MIN_STORE_LENGTH_M..=MAX_STORE_LENGTH_M).contains(&length_m) {
+            return Err(refuse(
+                "nose_x_m",
+                format!(
+                    "- tail_x_m = {} m: expected a store from {MIN_STORE_LENGTH_M} to \
+                     {MAX_STORE_LENGTH_M} m long",
+                    sepval_core::number_text::Shown(length_m)
                 ),
             ));
         }

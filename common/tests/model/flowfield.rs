@@ -130,6 +130,11 @@ fn what_the_field_cannot_do_is_refused_naming_the_field() {
             "nose ahead of the tail",
         ),
         (
+            example_with("tail_x_m = -1.5", "tail_x_m = 1.4999999999999998"),
+            "flowfield.nose_x_m",
+            "- tail_x_m = 2.220446049250313e-16 m: expected a store from 0.001 to 1000 m long",
+        ),
+        (
             example_with("half_depth_m = 0.8", "half_depth_m = 0.0"),
             "flowfield.half_depth_m",
             "> 0",

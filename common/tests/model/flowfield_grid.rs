@@ -236,6 +236,14 @@ fn a_field_of_tables_that_is_not_one_is_refused_naming_the_field() {
         ),
         (
             grid_with(
+                "zero_lift_alpha_deg = -3.0",
+                "zero_lift_alpha_deg = 1.9999999999999998",
+            ),
+            "flowfield.zero_lift_alpha_deg",
+            "within 0.5 deg of the reference angle of attack 2",
+        ),
+        (
+            grid_with(
                 upwash,
                 "upwash_deg = { x_m = [-3.0, 3.0], z_m = [0.0, 6.0], values = [[2.0, 0.0], [2.0, 0.0]] }",
             ),

@@ -2,7 +2,7 @@
 //! field as a table over position"): the tables on one grid, their values in range, and none of
 //! the analytic field's parameters beside them.
 
-use super::{FlowfieldSpec, POSITION_FIELDS, Refusal, finite, refuse};
+use super::{FlowfieldSpec, MIN_LIFT_ALPHA_DEG, POSITION_FIELDS, Refusal, finite, refuse};
 
 /// The largest induced angle a table may hold \[deg\] (as the analytic field's a0 and b0).
 const MAX_ANGLE_DEG: f64 = 45.0;
@@ -54,12 +54,16 @@ impl FlowfieldSpec {
         self.check_grid_tables()?;
         if let Some(a) = self.zero_lift_alpha_deg {
             finite("zero_lift_alpha_deg", a)?;
-            if a == self.reference_alpha_deg {
+            // sepval's choice: the survey's condition at least MIN_LIFT_ALPHA_DEG from zero
+            // lift, so that a release at 10 deg scales it by at most 20.
+            if (self.reference_alpha_deg - a).abs() < MIN_LIFT_ALPHA_DEG {
                 return Err(refuse(
                     "zero_lift_alpha_deg",
                     format!(
-                        "= {a} is the reference angle of attack: the tables, measured at zero \
-                         lift, would scale without bound"
+                        "= {a} is within {MIN_LIFT_ALPHA_DEG} deg of the reference angle of \
+                         attack {}: the tables, measured at (nearly) zero lift, would scale \
+                         (nearly) without bound",
+                        self.reference_alpha_deg
                     ),
                 ));
             }
