@@ -398,6 +398,19 @@ fn check_breakpoints(v: Variable, b: &[f64]) -> Result<(), String> {
                 b[k - 1]
             ));
         }
+        // An interval is interpolated across by its width's inverse: a width below 1e-308 (or
+        // above 1e308) has none that is finite and non-zero, and the value there would be NaN.
+        if k > 0 {
+            let inv = 1.0 / (x - b[k - 1]);
+            if !(inv.is_finite() && inv > 0.0) {
+                return Err(format!(
+                    "axis {} breakpoints {} and {x} are too close together or too far apart to \
+                     interpolate between (their spacing's inverse is {inv})",
+                    v.csv_name(),
+                    b[k - 1]
+                ));
+            }
+        }
     }
     Ok(())
 }
