@@ -236,8 +236,9 @@ impl RunDir {
 
 impl Drop for RunDir {
     fn drop(&mut self) {
-        let untouched = entries(&self.path).is_ok_and(|e| e.is_empty());
-        if self.created && untouched {
+        // A directory this run made and wrote no file into (an empty `generations/` of a fit
+        // that failed at its start is no file) goes, with what the run made in it.
+        if self.created && holds_no_file(&self.path) && remove_empty(&self.path) {
             let _ = std::fs::remove_file(self.path.join(MARKER_FILE));
             let _ = std::fs::remove_file(&self.lock);
             let _ = std::fs::remove_dir(&self.path);
@@ -259,6 +260,27 @@ fn run_of(checkpoint: &Path) -> PathBuf {
         .and_then(Path::parent)
         .map(Path::to_path_buf)
         .unwrap_or_default()
+}
+
+/// Whether `path` holds nothing but directories without a file (and a run's lock and marker).
+fn holds_no_file(path: &Path) -> bool {
+    entries(path).is_ok_and(|names| {
+        names.iter().all(|n| {
+            let p = path.join(n);
+            std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_dir()) && holds_no_file(&p)
+        })
+    })
+}
+
+/// Removes the directories under `path` that [`holds_no_file`] found, deepest first
+/// (`remove_dir`: never a file); whether all went.
+fn remove_empty(path: &Path) -> bool {
+    entries(path).is_ok_and(|names| {
+        names.iter().all(|n| {
+            let p = path.join(n);
+            remove_empty(&p) && std::fs::remove_dir(&p).is_ok()
+        })
+    })
 }
 
 /// The directory's entries other than the lock and the marker, sorted.
@@ -349,6 +371,22 @@ mod tests {
         let d = tmp.path().join("run");
         drop(RunDir::claim(&d, request("predict", Claim::Fresh)).unwrap());
         assert!(!d.exists());
+        // A run that made directories but wrote no file in them (a fit that failed at its
+        // start, its `generations/` empty) leaves nothing either; one that wrote a file keeps
+        // it, and the directories that lead to it.
+        let run = RunDir::claim(&d, request("fit", Claim::Fresh)).unwrap();
+        run.prepare().unwrap();
+        std::fs::create_dir_all(d.join("generations/deeper")).unwrap();
+        drop(run);
+        assert!(!d.exists());
+        let run = RunDir::claim(&d, request("fit", Claim::Fresh)).unwrap();
+        run.prepare().unwrap();
+        std::fs::create_dir_all(d.join("generations/deeper")).unwrap();
+        std::fs::write(d.join("generations/gen-0000.json"), "{}").unwrap();
+        drop(run);
+        assert!(d.join("generations/gen-0000.json").exists());
+        assert!(d.join("generations/deeper").is_dir());
+        std::fs::remove_dir_all(&d).unwrap();
         let run = RunDir::claim(&d, request("predict", Claim::Fresh)).unwrap();
         run.prepare().unwrap();
         std::fs::write(d.join("prediction.json"), "{}").unwrap();
