@@ -123,12 +123,30 @@ impl FlowfieldSpec {
                 return Err(refuse(
                     field,
                     format!(
-                        "has {} at grid point {k}: expected {expected}",
-                        t.values()[k]
+                        "has {} at {}: expected {expected}",
+                        t.values()[k],
+                        point_words(t.axes(), k)
                     ),
                 ));
             }
         }
         Ok(())
     }
+}
+
+/// The grid point `k` of a table over `axes` (row-major, the last axis fastest) in words, by
+/// its coordinates: `x_m = -3, z_m = 1.5`, the row of its CSV file.
+fn point_words(axes: &[crate::table::Axis], mut k: usize) -> String {
+    let mut words: Vec<String> = axes
+        .iter()
+        .rev()
+        .map(|a| {
+            let n = a.breakpoints.len().max(1);
+            let i = k % n;
+            k /= n;
+            format!("{} = {}", a.variable.key(), a.breakpoints[i])
+        })
+        .collect();
+    words.reverse();
+    words.join(", ")
 }
