@@ -14,9 +14,13 @@
 #              its gradient -10.4 deg/m, sidewash -5.84 deg, 4.28 deg/m, eta 1.09, roll -0.03),
 #              halving 0.42 m below it (as exp(-s / 0.6)), its factors' bounds widened to
 #              [-1, 3];
-#   +update    either, then `sepval update --seed 1` on the same three releases.
+#   +update    either, then `sepval update --seed 1` on the same three releases;
+#   +CA        either with the store's CA over Mach from the CFD's own loads of the three
+#              releases fitted (scripts/eglin_loads.py --ca0-without the one left out), its
+#              17 factors fitted; only when PYTHON names a Python with numpy and scipy
+#              (e.g. PYTHON=venv/bin/python), which that script needs.
 # Writes OUT_DIR/conditions.csv (RMS position and attitude error of the release left out, over
-# its 0.5 s) and prints it. About 10 minutes on 2 cores.
+# its 0.5 s) and prints it. About 10 minutes on 2 cores (15 with +CA).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ $# -ge 1 ] || { echo "usage: $0 REPO [OUT_DIR]" >&2; exit 2; }
@@ -74,6 +78,16 @@ for held in "${CASES[@]}"; do
         up="$OUT/$held-$model-update"
         "$SEPVAL" update --scenario "$OUT/$model.toml" "${data[@]}" --seed 1 --out "$up" > /dev/null 2>&1
         predicted "$held" "$up/scenario.toml" "$up/factors.json" "$up" "$model+update"
+        [ -n "${PYTHON:-}" ] || continue
+        ca="$OUT/$held-$model-ca"
+        mkdir -p "$ca"
+        line=$("$PYTHON" scripts/eglin_loads.py "$REPO" --ca0-without "$held")
+        sed -e "s/^ca0 = .*/$line/" "$OUT/$model.toml" > "$ca/scenario.toml"
+        "$SEPVAL" fit --scenario "$ca/scenario.toml" "${data[@]}" --method ga+lm --seed 1 \
+            --no-figures --out "$ca/fit" > /dev/null 2>&1
+        python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print(json.dumps(r["methods"]["ga+lm"]["best"]["factors"]))' \
+            "$ca/fit/result.json" > "$ca/factors.json"
+        predicted "$held" "$ca/scenario.toml" "$ca/factors.json" "$ca" "$model+CA"
     done
 done
 column -s, -t < "$OUT/conditions.csv"

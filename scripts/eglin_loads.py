@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The Eglin CFD store's own loads at the four conditions of AbdullahElyas/GPR_StoreSeparation.
 
-    scripts/eglin_loads.py REPO
+    scripts/eglin_loads.py REPO                      (the table below)
+    scripts/eglin_loads.py REPO --ca0-without NAME   (a scenario's `ca0` line)
 
 REPO is a git clone of https://github.com/AbdullahElyas/GPR_StoreSeparation (read at the
 commit scripts/eglin_convert.py reads). Its simData.mat holds, per condition, the store's
@@ -12,7 +13,10 @@ data; this script takes the objects' property cells out of the file's function w
 each condition's block (Mach, alpha, sideslip, altitude, then the body-axis and inertial-axis
 loads, then the condition's name: SimData.m's property order) and prints the body-axis axial
 force as a coefficient, F_x / (qbar S), over 0.1 s windows, with qbar from the ISA at 26 000 ft
-and S of the 20 in store (docs/model.md section 1).
+and S of the 20 in store (docs/model.md section 1). With `--ca0-without NAME` (e.g.
+M095_AOA0) it prints instead the store's CA over Mach as a scenario's `ca0` table: at each
+Mach, the mean over 0 to 0.5 s of the releases at that Mach other than NAME (for a study that
+leaves NAME out, so that nothing of it is used).
 
 The sign and axes of SimData.m's body frame are the author's (its x along the store, positive
 aft as a drag); this script does not re-derive them. The repository states no licence: read
@@ -65,16 +69,36 @@ def conditions(cells):
     return out
 
 
+def ca0_line(found, without, rho, a):
+    """The scenario line `ca0 = { mach = [...], values = [...] }` from the releases but
+    `without`."""
+    by_mach = {}
+    for name, mach, _, force in found:
+        if name != without:
+            qs = 0.5 * rho * (mach * a) ** 2 * AREA_M2
+            by_mach.setdefault(mach, []).append(force[0].mean() / qs)
+    machs = sorted(by_mach)
+    values = [sum(by_mach[m]) / len(by_mach[m]) for m in machs]
+    return (f"ca0 = {{ mach = [{', '.join(repr(m) for m in machs)}], "
+            f"values = [{', '.join(f'{v:.4f}' for v in values)}] }}")
+
+
 def main():
-    if len(sys.argv) != 2:
+    args = sys.argv[1:]
+    if len(args) not in (1, 3) or (len(args) == 3 and args[1] != "--ca0-without"):
         sys.exit(__doc__)
-    repo = sys.argv[1]
+    repo = args[0]
     data = subprocess.run(["git", "-C", repo, "show", f"{COMMIT}:simData.mat"], check=True,
                           capture_output=True).stdout
     found = conditions(property_cells(io.BytesIO(data)))
     if len(found) != 4:
         sys.exit(f"expected the four conditions' loads in simData.mat, found {len(found)}")
     rho, a = isa(ALTITUDE_M)
+    if len(args) == 3:
+        if args[2] not in [f[0] for f in found]:
+            sys.exit(f"--ca0-without {args[2]}: no such condition in simData.mat")
+        print(ca0_line(found, args[2], rho, a))
+        return
     windows = [(0.0, 0.1), (0.1, 0.2), (0.2, 0.3), (0.3, 0.4), (0.4, 0.5)]
     print("| condition | qbar S [N] | " + " | ".join(f"CA {lo:.1f}-{hi:.1f} s" for lo, hi in windows)
           + " |")
