@@ -8,6 +8,7 @@ use std::path::Path;
 
 use super::{Aero, Interference};
 use crate::table::{Coefficient, FieldAngle, FieldRatio, Table, TableError};
+use sepval_core::number_text::Shown;
 
 /// The most stations along the store (docs/model.md section 3b).
 pub const MAX_STATIONS: usize = 16;
@@ -203,7 +204,10 @@ fn finite(field: &str, v: f64) -> Result<(), Refusal> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(refuse(field, format!("= {v}: expected a finite value")))
+        Err(refuse(
+            field,
+            format!("= {}: expected a finite value", Shown(v)),
+        ))
     }
 }
 
@@ -212,7 +216,10 @@ fn positive(field: &str, v: f64) -> Result<(), Refusal> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(refuse(field, format!("= {v}: expected a finite value > 0")))
+        Err(refuse(
+            field,
+            format!("= {}: expected a finite value > 0", Shown(v)),
+        ))
     }
 }
 
@@ -284,7 +291,7 @@ impl FlowfieldSpec {
                 format!(
                     "- tail_x_m = {} m: expected a store from {MIN_STORE_LENGTH_M} to \
                      {MAX_STORE_LENGTH_M} m long",
-                    sepval_core::number_text::Shown(length_m)
+                    Shown(length_m)
                 ),
             ));
         }
@@ -305,7 +312,7 @@ impl FlowfieldSpec {
             if !(v.is_finite() && v.abs() < 45.0) {
                 return Err(refuse(
                     field,
-                    format!("= {v}: expected a finite angle within +-45 deg"),
+                    format!("= {}: expected a finite angle within +-45 deg", Shown(v)),
                 ));
             }
         }

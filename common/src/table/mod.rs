@@ -533,6 +533,13 @@ impl<K: TableKind> Tabulated<K> {
     /// Reads a file reference (relative to `dir`) into its table; constants and tables stay.
     pub fn resolve(&mut self, dir: &Path) -> Result<(), TableError> {
         if let Coefficient::File(f) = &self.value {
+            if f.csv.as_os_str().is_empty() {
+                return Err(TableError::Io {
+                    file: "csv = \"\"".to_string(),
+                    message: "no file named: expected a CSV file's path, relative to the scenario"
+                        .to_string(),
+                });
+            }
             let path = dir.join(&f.csv);
             let table = read_csv(&path, f.column.as_deref(), K::KIND)?;
             self.value = Coefficient::Table(table);

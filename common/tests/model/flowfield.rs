@@ -125,6 +125,11 @@ fn what_the_field_cannot_do_is_refused_naming_the_field() {
             "expected 2 to 16",
         ),
         (
+            example_with("upwash_deg = 3.0", "upwash_deg = 1e300"),
+            "flowfield.upwash_deg",
+            "= 1e300: expected a finite angle within +-45 deg",
+        ),
+        (
             example_with("tail_x_m = -1.5", "tail_x_m = 2.0"),
             "flowfield.nose_x_m",
             "nose ahead of the tail",

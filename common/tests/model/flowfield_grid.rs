@@ -207,6 +207,11 @@ fn a_field_of_tables_that_is_not_one_is_refused_naming_the_field() {
     let sidewash = "sidewash_deg = { csv = \"field-grid.csv\", column = \"sidewash\" }";
     let cases = [
         (
+            grid_with(upwash, "upwash_deg = { csv = \"\", column = \"upwash\" }"),
+            "flowfield.upwash_deg",
+            "csv = \"\": cannot read table: no file named",
+        ),
+        (
             grid_with(
                 upwash,
                 "upwash_deg = { x_m = [-3.0, 3.0], z_m = [0.0, 6.0], values = [[2.0, 46.0], [2.0, 0.0]] }",

@@ -124,7 +124,7 @@ impl FlowfieldSpec {
                     field,
                     format!(
                         "has {} at {}: expected {expected}",
-                        t.values()[k],
+                        sepval_core::number_text::Shown(t.values()[k]),
                         point_words(t.axes(), k)
                     ),
                 ));
