@@ -51,24 +51,28 @@ pub fn scenario(path: Option<&Path>, extension: Option<&Path>) -> Result<Scenari
     Ok(s)
 }
 
+/// The file `--factors` names, if it names one rather than `truth` or `nominal`.
+pub fn factors_file(spec: &str) -> Option<&Path> {
+    (!matches!(spec, "truth" | "nominal")).then(|| Path::new(spec))
+}
+
 /// The factors of `--factors truth|nominal|FILE.json`, checked against `table`.
 pub fn factors(spec: &str, table: &FactorTable) -> Result<Factors, InputError> {
-    let factors = match spec {
-        "truth" => Factors::TRUTH,
-        "nominal" => Factors::NOMINAL,
-        path => {
-            let text = sepval_core::input_file::read_string(
-                Path::new(path),
-                "factors file",
-                sepval_core::limits::MAX_JSON_BYTES,
-            )?;
-            return Factors::from_json_str(&text, table).map_err(|source| {
-                InputError::FactorsFile {
-                    path: path.to_string(),
-                    source,
-                }
-            });
-        }
+    if let Some(path) = factors_file(spec) {
+        let text = sepval_core::input_file::read_string(
+            path,
+            "factors file",
+            sepval_core::limits::MAX_JSON_BYTES,
+        )?;
+        return Factors::from_json_str(&text, table).map_err(|source| InputError::FactorsFile {
+            path: spec.to_string(),
+            source,
+        });
+    }
+    let factors = if spec == "truth" {
+        Factors::TRUTH
+    } else {
+        Factors::NOMINAL
     };
     table
         .check(&factors)

@@ -156,19 +156,22 @@ pub fn geometry_inputs(g: &crate::cli::GeometryArgs) -> Vec<Input> {
 /// inputs.
 pub fn model_inputs(i: &crate::cli::InputArgs) -> Vec<Input> {
     let mut out = input_files("--data", &i.data);
-    out.extend(scenario_inputs(&i.model));
+    out.extend(scenario_inputs(
+        i.model.scenario.as_ref(),
+        i.model.extension.as_ref(),
+    ));
     out
 }
 
 /// The files of `--scenario`, the table files it names, and `--extension`, as inputs.
-pub fn scenario_inputs(m: &crate::cli::ModelArgs) -> Vec<Input> {
-    let mut out = input_files("--scenario", &m.scenario);
-    if let Some(path) = &m.scenario {
+pub fn scenario_inputs(scenario: Option<&PathBuf>, extension: Option<&PathBuf>) -> Vec<Input> {
+    let mut out = input_files("--scenario", scenario);
+    if let Some(path) = scenario {
         let whose = format!("--scenario {}", path.display());
         let tables = sepval_common::Scenario::table_files(path);
         out.extend(tables.iter().map(|t| Input::named_by(&whose, t)));
     }
-    out.extend(input_files("--extension", &m.extension));
+    out.extend(input_files("--extension", extension));
     out
 }
 

@@ -24,11 +24,8 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
     }
     if !args.tables {
         // The file written may be neither the scenario read nor a table it names.
-        let model = crate::cli::ModelArgs {
-            scenario: args.scenario.clone(),
-            extension: None,
-        };
-        super::out_file_apart(&args.out, &super::scenario_inputs(&model))?;
+        let read = super::scenario_inputs(args.scenario.as_ref(), None);
+        super::out_file_apart(&args.out, &read)?;
     }
     let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
     if args.to_daveml {

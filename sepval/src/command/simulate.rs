@@ -1,13 +1,12 @@
 //! `sepval simulate`: one release, written as a trajectory file.
 
-use std::path::PathBuf;
-
 use anyhow::{Context, Result};
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test_logged;
 use sepval_core::limits::{check_sampling, check_steps};
 use sepval_core::number_text::Shown;
 use sepval_fit::inputs;
+use sepval_fit::out_dir::Input;
 use sepval_predict::releases;
 
 use super::{clearance, positive};
@@ -19,12 +18,10 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     let rate = args.rate.map(|r| positive("--rate", r)).transpose()?;
     // Nothing the run reads may be written over: its scenario, the tables the scenario names,
     // its extension, factors and geometry.
-    let mut read = super::scenario_inputs(&args.model);
-    if !matches!(args.factors.as_str(), "truth" | "nominal") {
-        read.extend(super::input_files(
-            "--factors",
-            [&PathBuf::from(&args.factors)],
-        ));
+    let mut read =
+        super::scenario_inputs(args.model.scenario.as_ref(), args.model.extension.as_ref());
+    if let Some(path) = inputs::factors_file(&args.factors) {
+        read.push(Input::file("--factors", path));
     }
     read.extend(super::geometry_inputs(&args.geometry));
     super::out_file_apart(&args.out, &read)?;
