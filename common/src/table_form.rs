@@ -304,12 +304,9 @@ impl TableForm {
             let path = path.to_path_buf();
             move |source| TableDirError::Io { path, source }
         };
-        let mut builder = tempfile::Builder::new();
-        builder.prefix(".sepval-tmp-");
-        // The mode a plain create gives a directory (0o777 less the umask), not 0o700.
-        #[cfg(unix)]
-        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o777));
-        let stage = builder.tempdir_in(parent).map_err(io(dir))?;
+        let stage = sepval_core::atomic_file::staging(0o777)
+            .tempdir_in(parent)
+            .map_err(io(dir))?;
         for (p, text) in &self.files {
             let path = stage.path().join(p);
             if let Some(d) = path.parent() {

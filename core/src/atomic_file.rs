@@ -15,6 +15,20 @@ pub struct WriteError {
     pub source: std::io::Error,
 }
 
+/// A builder of sepval's staging files and directories (`.sepval-tmp-...`, renamed into place
+/// once complete): on unix created with `mode` less the umask, the mode a plain create gives
+/// (0o666 a file, 0o777 a directory), not the temporary file's owner-only one: what is staged
+/// is the user's output, not a secret.
+pub fn staging(mode: u32) -> tempfile::Builder<'static, 'static> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".sepval-tmp-");
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(mode));
+    #[cfg(not(unix))]
+    let _ = mode;
+    builder
+}
+
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
     let err = |source| WriteError {
@@ -25,13 +39,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".sepval-tmp-");
-    // The mode a plain create gives (0o666 less the umask), not the temporary file's 0o600:
-    // the file is the user's output, not a secret.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut tmp = builder.tempfile_in(dir).map_err(err)?;
+    let mut tmp = staging(0o666).tempfile_in(dir).map_err(err)?;
     tmp.write_all(bytes).map_err(err)?;
     tmp.as_file().sync_all().map_err(err)?;
     tmp.persist(path).map_err(|e| err(e.error))?;
