@@ -7,6 +7,7 @@ use crate::model::flowfield_grid::GridExcursions;
 use crate::model::{Model, ModelError, RunSetup, StateVector};
 use crate::propagator::{Diverged, Observation, RunLog, SampleSink, propagate};
 use crate::scenario::Scenario;
+use crate::table::Variable;
 use crate::telemetry::Trajectory;
 use sepval_core::factors::Factors;
 
@@ -120,13 +121,13 @@ impl Simulator {
         let mut out = self.model.tables.report(&log.tables);
         let ex = &log.field_grid;
         if let (Some(grid), true) = (&self.model.field_grid, ex.outside > 0) {
-            let axes = ["x_m", "y_m", "z_m"]
+            let axes = [Variable::X, Variable::Y, Variable::Z]
                 .into_iter()
                 .enumerate()
                 .filter_map(|(j, variable)| {
                     let range = grid.range(j)?;
                     (ex.worst_m[j] > 0.0).then(|| crate::table::AxisExcursion {
-                        variable: variable.to_string(),
+                        variable: variable.key().to_string(),
                         range,
                         worst_excursion: ex.worst_m[j],
                     })
