@@ -64,6 +64,12 @@ predicted() {
     echo "$1,$5,$(awk "BEGIN {printf \"%.1f\", $pos * 1000}"),$(awk "BEGIN {printf \"%.2f\", $att}")" >> "$OUT/conditions.csv"
 }
 
+# The best factors of the fit in `$1` (its ga+lm answer), written to `$1/factors.json`.
+best_factors() {
+    python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print(json.dumps(r["methods"]["ga+lm"]["best"]["factors"]))' \
+        "$1/result.json" > "$1/factors.json"
+}
+
 echo "left_out,model,rms_position_mm,rms_attitude_deg" > "$OUT/conditions.csv"
 for held in "${CASES[@]}"; do
     data=()
@@ -72,8 +78,7 @@ for held in "${CASES[@]}"; do
         fit="$OUT/$held-$model"
         "$SEPVAL" fit --scenario "$OUT/$model.toml" "${data[@]}" --method ga+lm --seed 1 \
             --no-figures --out "$fit" > /dev/null 2>&1
-        python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print(json.dumps(r["methods"]["ga+lm"]["best"]["factors"]))' \
-            "$fit/result.json" > "$fit/factors.json"
+        best_factors "$fit"
         predicted "$held" "$OUT/$model.toml" "$fit/factors.json" "$fit" "$model"
         up="$OUT/$held-$model-update"
         "$SEPVAL" update --scenario "$OUT/$model.toml" "${data[@]}" --seed 1 --out "$up" > /dev/null 2>&1
@@ -85,9 +90,8 @@ for held in "${CASES[@]}"; do
         sed -e "s/^ca0 = .*/$line/" "$OUT/$model.toml" > "$ca/scenario.toml"
         "$SEPVAL" fit --scenario "$ca/scenario.toml" "${data[@]}" --method ga+lm --seed 1 \
             --no-figures --out "$ca/fit" > /dev/null 2>&1
-        python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print(json.dumps(r["methods"]["ga+lm"]["best"]["factors"]))' \
-            "$ca/fit/result.json" > "$ca/factors.json"
-        predicted "$held" "$ca/scenario.toml" "$ca/factors.json" "$ca" "$model+CA"
+        best_factors "$ca/fit"
+        predicted "$held" "$ca/scenario.toml" "$ca/fit/factors.json" "$ca" "$model+CA"
     done
 done
 column -s, -t < "$OUT/conditions.csv"
