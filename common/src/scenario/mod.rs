@@ -409,7 +409,8 @@ impl Scenario {
     ) -> Result<Scenario, ScenarioError> {
         let mut scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             origin: origin.to_string(),
-            message: sepval_core::toml_error::one_line(text, &e),
+            message: sections::misformed(text)
+                .unwrap_or_else(|| sepval_core::toml_error::one_line(text, &e)),
         })?;
         if let Some(dir) = dir {
             scenario.resolve_tables(dir, origin)?;
@@ -534,6 +535,7 @@ pub fn hex_sha256(bytes: &[u8]) -> String {
 
 mod flowfield;
 mod same_store;
+mod sections;
 mod validate;
 
 pub use flowfield::{

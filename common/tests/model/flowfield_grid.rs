@@ -280,6 +280,11 @@ fn a_field_of_tables_that_is_not_one_is_refused_naming_the_field() {
             "no value column `upwash_deg`",
         ),
         (
+            grid_with("[flowfield]", "[[flowfield]]"),
+            "[[flowfield]]",
+            "`flowfield` is one table, written `[flowfield]`",
+        ),
+        (
             grid_with(upwash, "upwash_deg = { csv = \"no-such.csv\" }"),
             "flowfield.upwash_deg",
             "no-such.csv",
