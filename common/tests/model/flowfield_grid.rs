@@ -217,7 +217,7 @@ fn a_field_of_tables_that_is_not_one_is_refused_naming_the_field() {
                 "upwash_deg = { x_m = [-3.0, 3.0], z_m = [0.0, 6.0], values = [[2.0, 46.0], [2.0, 0.0]] }",
             ),
             "flowfield.upwash_deg",
-            "has 46 at x_m = -3, z_m = 6: expected an angle within +-45 deg",
+            "has 46 deg at x_m = -3, z_m = 6: expected an angle within +-45 deg",
         ),
         (
             grid_with(sidewash, "sidewash_deg = -1.5"),

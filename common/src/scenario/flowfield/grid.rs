@@ -120,10 +120,13 @@ impl FlowfieldSpec {
                 } else {
                     format!("an angle within +-{MAX_ANGLE_DEG} deg")
                 };
+                // An angle in degrees whatever its column's unit (a `[rad]` column is converted
+                // when read), so the unit is said.
+                let unit = if j == 2 { "" } else { " deg" };
                 return Err(refuse(
                     field,
                     format!(
-                        "has {} at {}: expected {expected}",
+                        "has {}{unit} at {}: expected {expected}",
                         sepval_core::number_text::Shown(t.values()[k]),
                         point_words(t.axes(), k)
                     ),
