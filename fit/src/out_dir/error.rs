@@ -65,13 +65,30 @@ pub enum OutDirError {
         /// The input, as the flag that gives it and its path.
         input: String,
     },
-    /// A directory to clear holding entries sepval did not write.
-    #[error("not clearing {path}: {why}")]
+    /// A directory to clear, or to resume a run in, holding entries sepval did not write.
+    #[error("not {doing} {path}: {why}{hint}")]
     NotOurs {
+        /// "clearing" or "resuming in".
+        doing: &'static str,
         /// The directory.
         path: PathBuf,
         /// What in it is not sepval's.
         why: String,
+        /// What to do (empty when clearing: the message says enough).
+        hint: &'static str,
+    },
+    /// A resumed run that would remove the checkpoint it resumes from: a checkpoint of an
+    /// earlier generation under a later generation's name in the run directory.
+    #[error(
+        "not resuming in {path}: --resume {checkpoint} holds generation {generation} but lies where the run keeps a later generation, which a resumed run removes (its continuation is replaced) or writes over; copy it to its own name (gen-{generation:04}.json) or resume into another --out"
+    )]
+    WouldRemoveCheckpoint {
+        /// The directory.
+        path: PathBuf,
+        /// The checkpoint.
+        checkpoint: PathBuf,
+        /// Its generation.
+        generation: usize,
     },
     /// A directory to clear whose marker lists no files (an older sepval's, or a killed run's).
     #[error(

@@ -104,12 +104,42 @@ fn write(dir: &Path, marker: &Marker) -> Result<(), OutDirError> {
 /// Whether `dir`, which holds `entries` besides its lock and marker, may be cleared: only when
 /// its marker's manifest lists every one of them, each file unchanged.
 pub(super) fn check_clearable(dir: &Path, entries: &[String]) -> Result<(), OutDirError> {
+    check_ours(dir, entries, Use::Clear)
+}
+
+/// Whether a run may be resumed in `dir`, which holds `entries` besides its lock and marker:
+/// only when it is a sepval run directory whose manifest lists every one of them, each file
+/// unchanged, so that the resumed run neither removes nor writes over, nor lists as its own, a
+/// file it did not write. A run killed before it ended (SIGKILL) left no manifest: its
+/// directory is taken as it is, the one case a resumed run cannot check.
+pub(super) fn check_resumable(dir: &Path, entries: &[String]) -> Result<(), OutDirError> {
+    check_ours(dir, entries, Use::Resume)
+}
+
+/// What is done to a directory that must hold only what a sepval run wrote.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Use {
+    Clear,
+    Resume,
+}
+
+fn check_ours(dir: &Path, entries: &[String], to: Use) -> Result<(), OutDirError> {
     if entries.is_empty() {
         return Ok(());
     }
     let not_ours = |why: String| OutDirError::NotOurs {
+        doing: match to {
+            Use::Clear => "clearing",
+            Use::Resume => "resuming in",
+        },
         path: dir.to_path_buf(),
         why,
+        hint: match to {
+            Use::Clear => "",
+            Use::Resume => {
+                "; move what its run did not write out of it, or resume into another (empty) --out"
+            }
+        },
     };
     let path = dir.join(MARKER_FILE);
     if std::fs::symlink_metadata(&path).is_err() {
@@ -131,6 +161,13 @@ pub(super) fn check_clearable(dir: &Path, entries: &[String]) -> Result<(), OutD
         why,
     };
     let (files, directories) = match (&marker.format, marker.files, marker.directories) {
+        // No manifest to check against (an older sepval's marker, a killed run's): a resumed
+        // run takes the directory as it is.
+        (None, _, _) | (Some(_), None, _) | (Some(_), _, None)
+            if to == Use::Resume && marker.format.as_deref().is_none_or(|f| f == FORMAT) =>
+        {
+            return Ok(());
+        }
         (None, _, _) => {
             return Err(unlisted(format!(
                 "its {MARKER_FILE} (of a run of `{}`) was written by an older sepval, which listed no files",

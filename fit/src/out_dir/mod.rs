@@ -154,13 +154,31 @@ impl RunDir {
                 }
             }
             Claim::Overwrite => marker::check_clearable(path, &others)?,
-            Claim::Resume { checkpoint, .. } => {
+            Claim::Resume {
+                checkpoint,
+                generation,
+            } => {
                 let expected = expected.unwrap_or_default();
-                if !others.is_empty() && inputs::resolved(path) != inputs::resolved(&expected) {
+                if others.is_empty() {
+                    return Ok(dir);
+                }
+                if inputs::resolved(path) != inputs::resolved(&expected) {
                     return Err(OutDirError::OtherRun {
                         path: path.to_path_buf(),
                         checkpoint: checkpoint.clone(),
                         expected,
+                    });
+                }
+                marker::check_resumable(path, &others)?;
+                let checkpoint_id = inputs::resolved(&checkpoint);
+                if later_generations(path, generation)?
+                    .iter()
+                    .any(|p| inputs::resolved(p) == checkpoint_id)
+                {
+                    return Err(OutDirError::WouldRemoveCheckpoint {
+                        path: path.to_path_buf(),
+                        checkpoint,
+                        generation,
                     });
                 }
             }
@@ -202,34 +220,18 @@ impl RunDir {
                 }
                 Vec::new()
             }
-            Claim::Resume { generation, .. } => self.discard_generations_after(*generation)?,
+            Claim::Resume { generation, .. } => {
+                // Checked again, as late as possible: nothing not its run's is removed.
+                marker::check_resumable(&self.path, &entries(&self.path)?)?;
+                let removed = later_generations(&self.path, *generation)?;
+                for p in &removed {
+                    std::fs::remove_file(p).map_err(io("cannot remove", p))?;
+                }
+                removed
+            }
         };
         marker::write_started(&self.path, &self.command)?;
         self.prepared.store(true, Ordering::Relaxed);
-        Ok(removed)
-    }
-
-    /// Removes the checkpoints of generations after `generation` (those of an abandoned
-    /// continuation, when a run is resumed from an earlier generation) and returns them.
-    fn discard_generations_after(&self, generation: usize) -> Result<Vec<PathBuf>, OutDirError> {
-        let dir = self.path.join("generations");
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            return Ok(Vec::new());
-        };
-        let mut removed = Vec::new();
-        for e in entries.filter_map(Result::ok) {
-            let name = e.file_name().to_string_lossy().into_owned();
-            let later = name
-                .strip_prefix("gen-")
-                .and_then(|n| n.strip_suffix(".json"))
-                .and_then(|n| n.parse::<usize>().ok())
-                .is_some_and(|g| g > generation);
-            if later {
-                std::fs::remove_file(e.path()).map_err(io("cannot remove", &e.path()))?;
-                removed.push(e.path());
-            }
-        }
-        removed.sort();
         Ok(removed)
     }
 }
@@ -251,6 +253,31 @@ impl Drop for RunDir {
         }
         let _ = std::fs::remove_file(&self.lock);
     }
+}
+
+/// The checkpoints in `dir` of generations after `generation` (those of an abandoned
+/// continuation, which a run resumed from an earlier generation replaces), sorted: files named
+/// exactly as a fit names them (`generations/gen-NNNN.json`), nothing else.
+fn later_generations(dir: &Path, generation: usize) -> Result<Vec<PathBuf>, OutDirError> {
+    let generations = dir.join("generations");
+    let Ok(entries) = std::fs::read_dir(&generations) else {
+        return Ok(Vec::new());
+    };
+    let mut later = Vec::new();
+    for e in entries.filter_map(Result::ok) {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let named = name
+            .strip_prefix("gen-")
+            .and_then(|n| n.strip_suffix(".json"))
+            .and_then(|n| n.parse::<usize>().ok())
+            .filter(|g| name == format!("gen-{g:04}.json"));
+        let is_file = e.file_type().is_ok_and(|t| t.is_file());
+        if is_file && named.is_some_and(|g| g > generation) {
+            later.push(e.path());
+        }
+    }
+    later.sort();
+    Ok(later)
 }
 
 /// The run directory of `checkpoint`: DIR/generations/gen-NNNN.json belongs to DIR.
@@ -411,6 +438,7 @@ mod tests {
         std::fs::create_dir_all(&generations).unwrap();
         let checkpoint = generations.join("gen-0005.json");
         std::fs::write(&checkpoint, "{}").unwrap();
+        marker::write_ended(&run, "fit").unwrap();
         let inputs = [
             Input::resumed_run(&checkpoint, &run),
             Input::file("--resume", &checkpoint),
@@ -460,8 +488,21 @@ mod tests {
             checkpoint: generations.join("gen-0002.json"),
             generation: 2,
         };
+        // Not a sepval run directory (no marker): nothing in it is taken for the run's.
+        let e = RunDir::claim(&d, request("fit", claim())).unwrap_err();
+        assert!(
+            e.to_string().starts_with(&format!(
+                "not resuming in {}: it is not a sepval output directory (it has no .sepval-run",
+                d.display()
+            )),
+            "{e}"
+        );
+        // A run killed before it ended (a marker without a manifest) is taken as it is; names
+        // a fit does not write are never removed.
+        marker::write_started(&d, "fit").unwrap();
+        std::fs::write(generations.join("gen-9.json"), "mine").unwrap();
         drop(RunDir::claim(&d, request("fit", claim())).unwrap());
-        assert!(generations.join("gen-0004.json").exists() && !d.join(MARKER_FILE).exists());
+        assert!(generations.join("gen-0004.json").exists());
         let resumed = RunDir::claim(&d, request("fit", claim())).unwrap();
         assert_eq!(
             resumed.prepare().unwrap(),
@@ -472,5 +513,47 @@ mod tests {
         );
         assert!(generations.join("gen-0002.json").exists());
         assert!(!generations.join("gen-0003.json").exists() && d.join(MARKER_FILE).exists());
+        assert!(generations.join("gen-9.json").exists());
+        drop(resumed);
+        // Its run has ended: its manifest lists gen-9.json (it was there, unchanged). A file
+        // added since, or a checkpoint changed, is not the run's: the resume is refused and
+        // nothing is removed.
+        std::fs::write(generations.join("gen-0007.json"), "mine").unwrap();
+        std::fs::write(d.join("notes.txt"), "mine").unwrap();
+        let e = RunDir::claim(&d, request("fit", claim())).unwrap_err();
+        assert!(
+            e.to_string().ends_with(
+                "it holds what its run of `fit` did not write: generations/gen-0007.json (not written by it), notes.txt (not written by it); move what its run did not write out of it, or resume into another (empty) --out"
+            ),
+            "{e}"
+        );
+        assert!(generations.join("gen-0007.json").exists());
+        std::fs::remove_file(generations.join("gen-0007.json")).unwrap();
+        std::fs::remove_file(d.join("notes.txt")).unwrap();
+        // The checkpoint resumed from, under a later generation's name, is never removed.
+        std::fs::rename(
+            generations.join("gen-0002.json"),
+            generations.join("gen-0005.json"),
+        )
+        .unwrap();
+        marker::write_ended(&d, "fit").unwrap();
+        let e = RunDir::claim(
+            &d,
+            request(
+                "fit",
+                Claim::Resume {
+                    checkpoint: generations.join("gen-0005.json"),
+                    generation: 2,
+                },
+            ),
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains(
+                "gen-0005.json holds generation 2 but lies where the run keeps a later generation"
+            ),
+            "{e}"
+        );
+        assert!(generations.join("gen-0005.json").exists());
     }
 }

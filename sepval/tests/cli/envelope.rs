@@ -101,6 +101,13 @@ fn an_envelope_maps_every_condition_and_a_resumed_sweep_is_the_same_bits() {
         "rows": [rows[0], rows[1]],
     });
     std::fs::write(sweep.join("progress.json"), progress.to_string()).unwrap();
+    // The marker a sweep killed mid-run leaves (no manifest): a directory without one is not
+    // a sepval run's, and no resume takes it.
+    std::fs::write(
+        p.join("env2/.sepval-run"),
+        "{\"format\": \"sepval-run/2\", \"command\": \"envelope\"}\n",
+    )
+    .unwrap();
     let again = envelope(p, "env2", &["--resume"]);
     assert_eq!(again["resumed"], 2);
     assert_eq!(csv(p, "env2"), text, "a resumed sweep is the same bits");
