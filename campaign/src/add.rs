@@ -27,6 +27,7 @@ use sepval_solve::run::ProgressObserver;
 
 use crate::CampaignError;
 use crate::assess::{AssessSettings, FormBand, Model, StartEvaluator};
+use crate::journal;
 use crate::program::{Campaign, NewRelease, STAGING, fitted_model};
 use crate::record::{CAMPAIGN_FORMAT, ReleaseRecord, read_json, record_error};
 
@@ -70,6 +71,11 @@ fn add_all(
 ) -> Result<Vec<Check>, CampaignError> {
     let flown = c.job()?;
     refuse_known(c, flown.as_ref(), &releases)?;
+    // Where the copies and the round will go, refused before any work if taken.
+    for i in 0..releases.len() {
+        journal::claim(&c.dir, &copy_name(c.file.releases.len() + i + 1))?;
+    }
+    journal::claim(&c.dir, &format!("rounds/{:02}", c.file.rounds.len()))?;
     let model = c.model_of(flown)?;
     let settings = c.assess_settings();
     // One band for every release checked: its held-out evidence (a refit per release flown)
@@ -84,8 +90,9 @@ fn add_all(
     let round = c.file.rounds.len();
     std::fs::create_dir_all(c.dir.join("releases")).map_err(|e| record_error(&c.dir, e))?;
     for (r, k) in releases.iter().zip(&checks) {
-        let file = format!("releases/{:02}.csv", c.file.releases.len() + 1);
+        let file = copy_name(c.file.releases.len() + 1);
         let path = c.dir.join(&file);
+        journal::record(&c.dir, &file)?;
         r.data.write(&path).map_err(|e| record_error(&path, e))?;
         c.file.releases.push(ReleaseRecord {
             file,
@@ -103,6 +110,11 @@ fn add_all(
     let model = fitted_model(&dir, job)?;
     c.round(&model, start, observer)?;
     Ok(checks)
+}
+
+/// The campaign's copy of its `n`-th release (from 1).
+fn copy_name(n: usize) -> String {
+    format!("releases/{n:02}.csv")
 }
 
 /// Refuses a release the campaign holds (`known`: its releases flown), or one given twice.

@@ -23,6 +23,7 @@
 
 pub mod add;
 pub mod assess;
+mod journal;
 pub mod next;
 pub mod page;
 pub mod prior;

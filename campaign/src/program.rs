@@ -7,7 +7,8 @@
 //! round under `CAMP/.staging/`, renames the round into `rounds/NN` and writes campaign.json
 //! last (the commit). A command interrupted before that commit leaves campaign.json as it was;
 //! whatever it left (a staging directory, a round or a release copy that campaign.json does not
-//! name) is removed by the next command that opens the campaign. The derived files
+//! name and that it recorded creating, [`crate::journal`]) is removed by the next command that
+//! opens the campaign, and nothing else is. The derived files
 //! (envelope.csv, status.json, report.html, figures/) are written after the commit from the
 //! records, and again by every command, so that they always follow campaign.json.
 
@@ -36,7 +37,7 @@ use crate::record::{
     read_json, write_json,
 };
 use crate::state::{Assessed, Counts};
-use crate::{CampaignError, page};
+use crate::{CampaignError, journal, page};
 
 /// The directory of staged changes.
 pub(crate) const STAGING: &str = ".staging";
@@ -245,43 +246,15 @@ impl Campaign {
         Ok(c)
     }
 
-    /// Removes what an interrupted command left: the staging directory, rounds and release
-    /// copies campaign.json does not name.
+    /// Removes what an interrupted command left: the staging directory, and the rounds and
+    /// release copies it recorded creating that campaign.json does not name ([`journal`]);
+    /// nothing else in the directory.
     pub(crate) fn tidy(&self) -> Result<(), CampaignError> {
-        let staging = self.dir.join(STAGING);
-        if staging.exists() {
-            std::fs::remove_dir_all(&staging).map_err(|e| record_error(&staging, e))?;
-        }
-        for (sub, named) in [
-            (
-                "rounds",
-                self.file
-                    .rounds
-                    .iter()
-                    .map(|r| r.dir.clone())
-                    .collect::<Vec<_>>(),
-            ),
-            (
-                "releases",
-                self.file.releases.iter().map(|r| r.file.clone()).collect(),
-            ),
-        ] {
-            let Ok(entries) = std::fs::read_dir(self.dir.join(sub)) else {
-                continue;
-            };
-            for e in entries.flatten() {
-                let rel = format!("{sub}/{}", e.file_name().to_string_lossy());
-                if !named.contains(&rel) {
-                    let p = e.path();
-                    let _ = if p.is_dir() {
-                        std::fs::remove_dir_all(&p)
-                    } else {
-                        std::fs::remove_file(&p)
-                    };
-                }
-            }
-        }
-        Ok(())
+        let named = |rel: &str| {
+            self.file.rounds.iter().any(|r| r.dir == rel)
+                || self.file.releases.iter().any(|r| r.file == rel)
+        };
+        journal::undo(&self.dir, &named)
     }
 
     /// What the derived files are made of.
@@ -435,6 +408,8 @@ impl Campaign {
     ) -> Result<(), CampaignError> {
         let t0 = Instant::now();
         let n = self.file.rounds.len();
+        let dir = format!("rounds/{n:02}");
+        journal::claim(&self.dir, &dir)?;
         let staged = self.dir.join(STAGING).join("round");
         std::fs::create_dir_all(&staged).map_err(|e| record_error(&staged, e))?;
         let assessed = assess(
@@ -454,9 +429,9 @@ impl Campaign {
                 .map_err(|e| record_error(&diagnosis, e))?;
         }
         sepval_core::cancel::check()?;
-        let dir = format!("rounds/{n:02}");
         let target = self.dir.join(&dir);
         std::fs::create_dir_all(self.dir.join("rounds")).map_err(|e| record_error(&target, e))?;
+        journal::record(&self.dir, &dir)?;
         std::fs::rename(&staged, &target).map_err(|e| record_error(&target, e))?;
         let counts = Counts::of(&assessed);
         self.file.rounds.push(RoundRecord {

@@ -252,6 +252,26 @@ fn add_records_a_round_the_same_on_threads_and_workers_and_refuses_a_copy_a_brok
         before,
         "a refusal changed the campaign"
     );
+    // What the user puts in the campaign directory is never the campaign's: `status` leaves
+    // it, and an add whose copy would go where a file is refuses, the file kept (before
+    // 2026-11-29 both removed it, the release given from there included).
+    std::fs::write(dir.join("c/releases/notes.txt"), "mine").unwrap();
+    std::fs::create_dir_all(dir.join("c/rounds/05")).unwrap();
+    std::fs::write(dir.join("c/rounds/05/notes.txt"), "mine").unwrap();
+    let r2 = release(dir, "r2.csv", "7");
+    std::fs::copy(dir.join(&r2), dir.join("c/releases/02.csv")).unwrap();
+    ok(&sepval(&["campaign", "status", "c"], dir));
+    refused(
+        &add("c/releases/02.csv"),
+        "c/releases/02.csv is there already, and the campaign's record (campaign.json) does not name it",
+    );
+    for f in [
+        "releases/notes.txt",
+        "rounds/05/notes.txt",
+        "releases/02.csv",
+    ] {
+        assert!(dir.join("c").join(f).is_file(), "{f} was removed");
+    }
     // The same release added over two iceoryx2 workers: the same round, bit for bit.
     init_with(
         dir,
