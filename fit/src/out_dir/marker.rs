@@ -18,6 +18,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use super::REPLACED;
 use super::error::{OutDirError, io};
 use super::lock::LOCK_FILE;
 
@@ -254,7 +255,7 @@ fn walk(dir: &Path, descend: &dyn Fn(&str) -> bool) -> Result<Vec<(String, Kind)
             .collect();
         names.sort_by(|a, b| a.0.cmp(&b.0));
         for (name, ty) in names {
-            if rel.is_empty() && (name == LOCK_FILE || name == MARKER_FILE) {
+            if rel.is_empty() && (name == LOCK_FILE || name == MARKER_FILE || name == REPLACED) {
                 continue;
             }
             let path = if rel.is_empty() {

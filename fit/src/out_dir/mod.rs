@@ -79,6 +79,11 @@ pub struct RunDir {
     /// Whether [`RunDir::prepare`] ran (the marker is then written again, with the manifest,
     /// when the run ends).
     prepared: AtomicBool,
+    /// Whether [`RunDir::prepare`] moved an earlier run aside ([`REPLACED`]), to be put back
+    /// if this run does not end by [`RunDir::commit`].
+    replaced: AtomicBool,
+    /// Whether the run ended by [`RunDir::commit`].
+    committed: bool,
     /// The notice of an ill-formed lock taken over.
     notice: Option<String>,
 }
@@ -139,6 +144,8 @@ impl RunDir {
             claim: claim.clone(),
             command: command.to_string(),
             prepared: AtomicBool::new(false),
+            replaced: AtomicBool::new(false),
+            committed: false,
             notice,
         };
         // From here on the lock is ours (released when `dir` drops, on error too).
@@ -209,14 +216,8 @@ impl RunDir {
             Claim::Overwrite => {
                 let others = entries(&self.path)?;
                 marker::check_clearable(&self.path, &others)?;
-                for e in others {
-                    let p = self.path.join(e);
-                    let is_dir = std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_dir());
-                    if is_dir {
-                        std::fs::remove_dir_all(&p).map_err(io("cannot clear", &p))?;
-                    } else {
-                        std::fs::remove_file(&p).map_err(io("cannot clear", &p))?;
-                    }
+                if !others.is_empty() {
+                    self.move_aside(&others)?;
                 }
                 Vec::new()
             }
@@ -236,8 +237,66 @@ impl RunDir {
     }
 }
 
+impl RunDir {
+    /// Moves the earlier run's `others` (and its marker) into [`REPLACED`], where they stay
+    /// until this run commits (then removed) or fails (then put back).
+    fn move_aside(&self, others: &[String]) -> Result<(), OutDirError> {
+        let aside = self.path.join(REPLACED);
+        std::fs::create_dir(&aside).map_err(io("cannot create", &aside))?;
+        self.replaced.store(true, Ordering::Relaxed);
+        for name in others.iter().map(String::as_str).chain([MARKER_FILE]) {
+            let p = self.path.join(name);
+            if std::fs::symlink_metadata(&p).is_ok() {
+                std::fs::rename(&p, aside.join(name)).map_err(io("cannot move aside", &p))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Ends the run as a success: the earlier run an `--overwrite` moved aside is removed, and
+    /// the directory keeps what this run wrote. A run dropped without it (an error, Ctrl-C)
+    /// puts the earlier run back as it was.
+    pub fn commit(mut self) {
+        self.committed = true;
+        if self.replaced.load(Ordering::Relaxed) {
+            let _ = std::fs::remove_dir_all(self.path.join(REPLACED));
+        }
+    }
+
+    /// Puts back the earlier run an `--overwrite` moved aside: what this run wrote goes, then
+    /// the earlier run's entries and marker return (best effort: what cannot return stays in
+    /// [`REPLACED`], never removed).
+    fn put_back(&self) {
+        let aside = self.path.join(REPLACED);
+        let Ok(names) = std::fs::read_dir(&aside).map(|d| {
+            d.filter_map(Result::ok)
+                .map(|e| e.file_name())
+                .collect::<Vec<_>>()
+        }) else {
+            return;
+        };
+        for name in entries(&self.path).unwrap_or_default() {
+            let p = self.path.join(name);
+            let _ = match std::fs::symlink_metadata(&p) {
+                Ok(m) if m.is_dir() => std::fs::remove_dir_all(&p),
+                _ => std::fs::remove_file(&p),
+            };
+        }
+        let _ = std::fs::remove_file(self.path.join(MARKER_FILE));
+        for name in names {
+            let _ = std::fs::rename(aside.join(&name), self.path.join(&name));
+        }
+        let _ = std::fs::remove_dir(&aside);
+    }
+}
+
 impl Drop for RunDir {
     fn drop(&mut self) {
+        if self.replaced.load(Ordering::Relaxed) && !self.committed {
+            self.put_back();
+            let _ = std::fs::remove_file(&self.lock);
+            return;
+        }
         // A directory this run made and wrote no file into (an empty `generations/` of a fit
         // that failed at its start is no file) goes, with what the run made in it.
         if self.created && holds_no_file(&self.path) && remove_empty(&self.path) {
@@ -310,13 +369,17 @@ fn remove_empty(path: &Path) -> bool {
     })
 }
 
-/// The directory's entries other than the lock and the marker, sorted.
+/// Where an `--overwrite` keeps the earlier run until it commits (`DIR/.sepval-replaced`).
+pub const REPLACED: &str = ".sepval-replaced";
+
+/// The directory's entries other than the lock, the marker and an earlier run moved aside,
+/// sorted.
 fn entries(path: &Path) -> Result<Vec<String>, OutDirError> {
     let mut out: Vec<String> = std::fs::read_dir(path)
         .map_err(io("cannot read", path))?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n != LOCK_FILE && n != MARKER_FILE)
+        .filter(|n| n != LOCK_FILE && n != MARKER_FILE && n != REPLACED)
         .collect();
     out.sort();
     Ok(out)
@@ -366,12 +429,13 @@ mod tests {
         assert_eq!(again.prepare().unwrap(), Vec::<PathBuf>::new());
         assert!(!d.join("result.json").exists() && d.join(MARKER_FILE).exists());
         std::fs::write(d.join("plan.json"), "{}").unwrap();
-        drop(again);
+        again.commit();
+        assert!(!d.join(REPLACED).exists() && !d.join("result.json").exists());
         // The manifest of the ended run makes a directory ours, whatever it holds.
         let marked = RunDir::claim(&d, request("plan", Claim::Overwrite)).unwrap();
         marked.prepare().unwrap();
         assert!(!d.join("plan.json").exists());
-        drop(marked);
+        marked.commit();
         // A directory sepval did not make is never cleared, nor one with a file of another
         // tool beside a sepval result.
         let other = tmp.path().join("mine");
@@ -428,6 +492,51 @@ mod tests {
             marker
         );
         assert!(d.join("prediction.json").exists());
+    }
+
+    #[test]
+    fn an_overwrite_that_fails_puts_the_earlier_run_back_as_it_was() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path().join("run");
+        let first = RunDir::claim(&d, request("fit", Claim::Fresh)).unwrap();
+        first.prepare().unwrap();
+        std::fs::create_dir_all(d.join("generations")).unwrap();
+        std::fs::write(d.join("generations/gen-0001.json"), "old checkpoint").unwrap();
+        std::fs::write(d.join("result.json"), "old result").unwrap();
+        first.commit();
+        let marker = std::fs::read_to_string(d.join(MARKER_FILE)).unwrap();
+        // Cleared, then a failure (an error, Ctrl-C) after it wrote: the earlier run returns.
+        let again = RunDir::claim(&d, request("fit", Claim::Overwrite)).unwrap();
+        again.prepare().unwrap();
+        assert!(!d.join("result.json").exists() && d.join(REPLACED).is_dir());
+        std::fs::create_dir_all(d.join("generations")).unwrap();
+        std::fs::write(d.join("generations/gen-0001.json"), "new checkpoint").unwrap();
+        std::fs::write(d.join("partial.json"), "new").unwrap();
+        drop(again);
+        assert_eq!(
+            std::fs::read_to_string(d.join("result.json")).unwrap(),
+            "old result"
+        );
+        assert_eq!(
+            std::fs::read_to_string(d.join("generations/gen-0001.json")).unwrap(),
+            "old checkpoint"
+        );
+        assert_eq!(
+            std::fs::read_to_string(d.join(MARKER_FILE)).unwrap(),
+            marker
+        );
+        assert!(!d.join("partial.json").exists() && !d.join(REPLACED).exists());
+        assert!(!d.join(LOCK_FILE).exists());
+        // So it may be cleared again, and a run that commits replaces it.
+        let last = RunDir::claim(&d, request("fit", Claim::Overwrite)).unwrap();
+        last.prepare().unwrap();
+        std::fs::write(d.join("result.json"), "new result").unwrap();
+        last.commit();
+        assert!(!d.join(REPLACED).exists() && !d.join("generations").exists());
+        assert_eq!(
+            std::fs::read_to_string(d.join("result.json")).unwrap(),
+            "new result"
+        );
     }
 
     #[test]

@@ -45,7 +45,7 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
         })?;
     }
     crate::front::out(&sepval_diagnose::summary(&d, &args.out));
-    drop(run_dir);
+    run_dir.commit();
     // Tables left by the fitted runs, as simulate and fit report them (--strict-tables refused
     // them after the baseline fit, before any other work).
     for l in &d.tables_left {

@@ -61,7 +61,7 @@ pub fn run(args: EnvelopeArgs) -> Result<()> {
     write_outputs(&sweep_inputs.grid, &file, &args.out)?;
     remove_progress(&args.out);
     crate::front::out(&file.terminal(&summary, &args.out));
-    drop(run_dir);
+    run_dir.commit();
     Ok(())
 }
 

@@ -58,7 +58,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         best_clearance(c, &args, evaluator.job(), &mut output)?;
     }
     render(&args, evaluator.job(), &output)?;
-    drop(run_dir);
+    run_dir.commit();
     // Tables left by the best fit: reported, or an error with --strict-tables.
     let left = output.result.tables_left();
     if args.tables.strict_tables && !left.is_empty() {

@@ -55,7 +55,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
     run_dir.prepare()?;
     write_outputs(&prepared, &found, &file, &args.out)?;
     crate::front::out(&sepval_plan::summary(&file, &args.out));
-    drop(run_dir);
+    run_dir.commit();
     Ok(())
 }
 

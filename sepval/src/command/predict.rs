@@ -87,6 +87,6 @@ pub fn run(args: PredictArgs) -> Result<()> {
     run_dir.prepare()?;
     write_outputs(&found, &file, &args.out)?;
     crate::front::out(&sepval_predict::summary(&file, &args.out));
-    drop(run_dir);
+    run_dir.commit();
     Ok(())
 }

@@ -43,7 +43,7 @@ pub fn run(args: UpdateArgs) -> Result<()> {
         let path = sepval_update::daveml::write_daveml(&u, &args.out, command, data.collect())?;
         say!("daveml:    {}", path.display());
     }
-    drop(run_dir);
+    run_dir.commit();
     crate::front::out(&u.summary(&args.out));
     Ok(())
 }
