@@ -13,8 +13,10 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::CampaignError;
-use crate::program::STAGING;
 use crate::record::record_error;
+
+/// The directory of staged changes.
+pub(crate) const STAGING: &str = ".staging";
 
 /// The journal in the staging directory.
 const JOURNAL: &str = "created";

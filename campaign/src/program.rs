@@ -39,8 +39,7 @@ use crate::record::{
 use crate::state::{Assessed, Counts};
 use crate::{CampaignError, journal, page};
 
-/// The directory of staged changes.
-pub(crate) const STAGING: &str = ".staging";
+pub(crate) use crate::journal::STAGING;
 
 /// What every command of a campaign works with: its record read and its inputs loaded.
 pub struct Campaign {

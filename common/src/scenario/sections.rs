@@ -57,28 +57,3 @@ pub(super) fn misformed(text: &str) -> Option<String> {
         if list { "any number of them" } else { "one" }
     ))
 }
-
-#[cfg(test)]
-mod tests {
-    use super::misformed;
-
-    #[test]
-    fn a_section_in_the_other_form_is_named_with_its_line() {
-        let text = "name = \"x\"\n\n[[flowfield]]\nstations = 5\n";
-        let m = misformed(text).expect("a list where one table belongs");
-        assert!(
-            m.starts_with(
-                "line 3: `[[flowfield]]`: `flowfield` is one table, written `[flowfield]`"
-            ),
-            "{m}"
-        );
-        let text = "[correction]\nfield = \"aero.cm\"\n";
-        let m = misformed(text).expect("one table where a list belongs");
-        assert!(
-            m.starts_with("line 1: `[correction]`: `correction` is a list"),
-            "{m}"
-        );
-        assert!(misformed("[flowfield]\nstations = 5\n[[correction]]\n").is_none());
-        assert!(misformed("not toml [").is_none());
-    }
-}

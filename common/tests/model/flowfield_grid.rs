@@ -285,6 +285,14 @@ fn a_field_of_tables_that_is_not_one_is_refused_naming_the_field() {
             "`flowfield` is one table, written `[flowfield]`",
         ),
         (
+            grid_with(
+                "[flowfield]",
+                "[correction]\nfield = \"aero.cm\"\n\n[flowfield]",
+            ),
+            "`[correction]`",
+            "`correction` is a list of tables, each written `[[correction]]`",
+        ),
+        (
             grid_with(upwash, "upwash_deg = { csv = \"no-such.csv\" }"),
             "flowfield.upwash_deg",
             "no-such.csv",
