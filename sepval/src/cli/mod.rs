@@ -301,6 +301,8 @@ pub struct BenchArgs {
     /// Output directory (bench.csv, bench.png).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub overwrite: OverwriteArgs,
 }
 
 /// The inputs' defaults are the checkpoint's record, each input on its own: the shared help

@@ -3,6 +3,7 @@
 use std::sync::Arc;
 
 use anyhow::{Result, bail};
+use sepval_fit::out_dir::Request;
 use sepval_report::figures::throughput_figure;
 use sepval_transport::bench::{BenchOptions, Transport, run_bench, series, table, write_csv};
 use sepval_transport::ipc::MAX_WORKERS;
@@ -46,6 +47,18 @@ pub fn run(args: BenchArgs) -> Result<()> {
         worker_executable: worker_executable()?,
         repeat: args.repeat,
     };
+    // A run directory as every command's: refused before anything runs when it holds what
+    // an earlier bench did not write (before 2026-11-29 bench.csv and bench.png were written
+    // into any directory, over a file of that name).
+    let run_dir = super::claim_out(
+        &args.out,
+        Request {
+            command: "bench",
+            claim: super::fresh_or_overwrite(&args.overwrite),
+            inputs: &[],
+            resume: None,
+        },
+    )?;
     let (job, _) = sepval_fit::inputs::job(&[], None, None, Default::default(), &mut tell())?;
     note!(
         "benchmarking {} simulations of the default event per measurement, median of {} \
@@ -64,6 +77,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         );
     })?;
     crate::front::out(&table(&rows));
+    run_dir.prepare()?;
     write_csv(&args.out, &rows)?;
     let data = series(&rows);
     let lines: Vec<(&str, &[(usize, f64)])> = data
@@ -76,5 +90,6 @@ pub fn run(args: BenchArgs) -> Result<()> {
         args.out.join("bench.csv").display(),
         args.out.join("bench.png").display()
     );
+    run_dir.commit();
     Ok(())
 }

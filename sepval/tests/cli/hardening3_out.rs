@@ -363,3 +363,81 @@ fn simulate_and_scenario_never_write_over_what_they_read() {
         d,
     ));
 }
+
+#[test]
+fn bench_and_a_failed_overwrite_leave_what_was_there() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // `bench --out` is a run directory: a directory of the user's files is refused, their
+    // bench.csv as it was (before 2026-11-29 it was written over).
+    std::fs::write(dir.join("bench.csv"), "my data").unwrap();
+    let bench = |out: &str, extra: &[&str]| {
+        let mut a = vec![
+            "bench",
+            "--workers",
+            "1",
+            "--evals",
+            "20",
+            "--repeat",
+            "1",
+            "--transports",
+            "single",
+            "--out",
+            out,
+        ];
+        a.extend(extra);
+        sepval(&a, dir)
+    };
+    refused(&bench(".", &[]), ". is not empty (it holds bench.csv)");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("bench.csv")).unwrap(),
+        "my data"
+    );
+    ok(&bench("b", &[]));
+    refused(&bench("b", &[]), "clear it (--overwrite)");
+    ok(&bench("b", &["--overwrite"]));
+    // A fit with --overwrite that fails once it has cleared (its hill climber's start diverges
+    // on this release) puts the earlier fit back as it was.
+    ok(&fit(dir, "2", "keep", &[]));
+    let before = snapshot(&dir.join("keep"));
+    ok(&sepval(
+        &[
+            "simulate",
+            "--t-end",
+            "60",
+            "--rate",
+            "5",
+            "--noise-seed",
+            "1",
+            "--out",
+            "long.csv",
+        ],
+        dir,
+    ));
+    let failed = sepval(
+        &[
+            "fit",
+            "--data",
+            "long.csv",
+            "--outliers",
+            "drop",
+            "--generations",
+            "2",
+            "--population",
+            "6",
+            "--evaluator",
+            "inproc",
+            "--no-figures",
+            "--overwrite",
+            "--out",
+            "keep",
+        ],
+        dir,
+    );
+    refused(&failed, "diverges");
+    assert_eq!(
+        snapshot(&dir.join("keep")),
+        before,
+        "the earlier fit is gone"
+    );
+}
