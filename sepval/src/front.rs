@@ -9,7 +9,7 @@
 //! transports' threads): [`install`] sets one until its guard drops, and with none installed it
 //! is the [`Terminal`].
 
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::sync::{Arc, RwLock};
 use std::time::Instant;
@@ -36,12 +36,15 @@ pub trait Front: Send + Sync {
 pub struct Terminal;
 
 impl Front for Terminal {
+    // A closed stream (`sepval effects | head -1`, stderr closed) is nobody listening, not a
+    // defect: the words are dropped and the command goes on to its end, its files complete
+    // (`print!` panicked on the broken pipe, reported as an internal error).
     fn out(&self, text: &str) {
-        print!("{text}");
+        let _ = std::io::stdout().lock().write_all(text.as_bytes());
     }
 
     fn err(&self, text: &str) {
-        eprint!("{text}");
+        let _ = std::io::stderr().lock().write_all(text.as_bytes());
     }
 
     fn progress(&self) -> Box<dyn ProgressObserver> {

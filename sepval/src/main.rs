@@ -16,7 +16,7 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => {
             if let Some(message) = sepval_cli::refusal(&e) {
-                eprintln!("sepval: error: {message}");
+                sepval_cli::front::err(&format!("sepval: error: {message}\n"));
                 return ExitCode::from(2);
             }
             e.exit()
@@ -32,11 +32,11 @@ fn main() -> ExitCode {
         Ok(Ok(())) => ExitCode::SUCCESS,
         // A panic has unwound: the lock, temporary files and workers are gone with it.
         Err(defect) => {
-            eprintln!("sepval: {defect}");
+            sepval_cli::front::err(&format!("sepval: {defect}\n"));
             ExitCode::from(2)
         }
         Ok(Err(e)) => {
-            eprintln!("sepval: error: {e:#}");
+            sepval_cli::front::err(&format!("sepval: error: {e:#}\n"));
             if sepval_core::cancel::requested() {
                 ExitCode::from(130)
             } else {

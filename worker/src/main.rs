@@ -79,7 +79,7 @@ fn main() -> ExitCode {
         Ok(result) => result,
         // A panic has unwound (the link and its shared memory dropped): a defect, said so.
         Err(defect) => {
-            eprintln!("sepval-worker: {defect}");
+            note(format_args!("sepval-worker: {defect}"));
             return ExitCode::from(2);
         }
     };
@@ -87,11 +87,11 @@ fn main() -> ExitCode {
         // The coordinator's own SIGTERM at the end of a run is not worth a word.
         Ok(Stopped::Signal) => ExitCode::SUCCESS,
         Ok(stopped) => {
-            eprintln!("sepval-worker: {stopped}");
+            note(format_args!("sepval-worker: {stopped}"));
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("sepval-worker: error: {e:#}");
+            note(format_args!("sepval-worker: error: {e:#}"));
             ExitCode::from(2)
         }
     }
@@ -127,10 +127,10 @@ fn serve_zenoh(cli: &Cli, run: &RunId, endpoint: &str, setup_timeout: Duration) 
         zenoh_config: cli.zenoh_config.clone(),
         announce_protocol: cli.announce_protocol,
     })?;
-    eprintln!(
+    note(format_args!(
         "sepval-worker: joined run {run} at {endpoint} as {}",
         link.worker_id()
-    );
+    ));
     let mut local = Local(Arc::clone(link.job()));
     Ok(serve(&mut link, &mut local)?)
 }
@@ -141,4 +141,11 @@ fn serve_zenoh(_: &Cli, _: &RunId, _: &str, _: Duration) -> Result<Stopped> {
         "--connect: this sepval-worker was built without the zenoh transport; rebuild with \
          `cargo build --release --features zenoh`"
     )
+}
+
+/// A line on standard error; a closed stderr drops it (never a panic: the worker's exit status
+/// is its answer).
+fn note(text: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{text}");
 }

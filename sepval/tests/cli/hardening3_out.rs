@@ -441,3 +441,47 @@ fn bench_and_a_failed_overwrite_leave_what_was_there() {
         "the earlier fit is gone"
     );
 }
+
+#[test]
+fn a_closed_output_stream_is_no_defect() {
+    use std::os::fd::FromRawFd;
+    use std::process::{Command, Stdio};
+    // `sepval effects | true`: the reader gone before the table is written. Before 2026-11-29
+    // the broken pipe was an "internal error" (exit 2), and 101 with stderr closed too.
+    let tmp = tempfile::tempdir().unwrap();
+    // A pipe whose read end is closed before sepval starts: its first write is refused.
+    let closed = || {
+        let mut fds = [0; 2];
+        // SAFETY: `fds` has room for the two descriptors `pipe` writes.
+        assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+        // SAFETY: the read end is ours and used nowhere else; the write end is owned by the
+        // File from here on.
+        unsafe {
+            libc::close(fds[0]);
+            Stdio::from(std::fs::File::from_raw_fd(fds[1]))
+        }
+    };
+    let run = |args: &[&str], stderr: Stdio| {
+        Command::new(sepval_tests::binary("sepval"))
+            .args(args)
+            .current_dir(tmp.path())
+            .stdout(closed())
+            .stderr(stderr)
+            .output()
+            .expect("run sepval")
+    };
+    let effects = run(&["effects"], Stdio::piped());
+    assert_eq!(effects.status.code(), Some(0), "{effects:?}");
+    assert!(effects.stderr.is_empty(), "{effects:?}");
+    std::fs::write(tmp.path().join("bad.json"), "{\"factors\": 1}").unwrap();
+    let refused = run(
+        &["simulate", "--factors", "bad.json", "--out", "o.csv"],
+        closed(),
+    );
+    assert_eq!(
+        refused.status.code(),
+        Some(2),
+        "a refusal's status, not a panic's"
+    );
+    assert!(!tmp.path().join("o.csv").exists());
+}
