@@ -109,6 +109,22 @@ pub struct Source {
     /// Releases the source held out of its fits (a diagnosis's `--validate`) whose files still
     /// open.
     pub held_out: Vec<PathBuf>,
+    /// The SHA-256 of the releases fitted, as the fit recorded it (a diagnosis's: its
+    /// baseline's), so that a release file changed since is refused, not fitted anew in
+    /// silence; `None` when the source records none.
+    pub data_sha256: Option<String>,
+}
+
+/// The `data_sha256` a fit's result.json at `path` records, when it reads.
+fn recorded_data_sha256(path: &Path) -> Option<String> {
+    let text = sepval_core::input_file::read_string(
+        path,
+        "fit result",
+        sepval_core::limits::MAX_JSON_BYTES,
+    )
+    .ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v.get("data_sha256")?.as_str().map(str::to_string)
 }
 
 /// Reads the source in `dir`: diagnosis.json when it holds one, else result.json.
@@ -199,6 +215,7 @@ impl Source {
             },
             inputs: d.inputs,
             held_out,
+            data_sha256: recorded_data_sha256(&dir.join("baseline/result.json")),
         })
     }
 }
@@ -245,6 +262,7 @@ fn fit_source(dir: &Path) -> Result<Source, SourceError> {
         },
         inputs,
         held_out: Vec::new(),
+        data_sha256: Some(r.data_sha256.clone()),
     })
 }
 
@@ -267,6 +285,21 @@ pub enum SourceInputsError {
     /// A release held out (given, or recorded by the source) that cannot be read.
     #[error(transparent)]
     HeldOut(Box<InputError>),
+    /// The releases it records as fitted read, but not as they were when it was fitted.
+    #[error(
+        "--from {}: the releases it was fitted to ({}) have changed since (their SHA-256 was {recorded}, now {now}): what it predicts would not be what was fitted; fit again, or restore them",
+        .from.display(), .files
+    )]
+    FittedChanged {
+        /// The source directory.
+        from: PathBuf,
+        /// The release files, comma-separated.
+        files: String,
+        /// The SHA-256 it records.
+        recorded: String,
+        /// The SHA-256 of the files now.
+        now: String,
+    },
 }
 
 /// A source with its releases: the releases it was fitted to, and those held out.
@@ -305,6 +338,27 @@ pub fn source_inputs(
         from: from.to_path_buf(),
         source: Box::new(source),
     })?;
+    let changed = source
+        .data_sha256
+        .as_deref()
+        .filter(|&r| r != fitted.data_sha256());
+    if let Some(recorded) = changed {
+        let files: Vec<String> = record
+            .data
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        return Err(SourceInputsError::FittedChanged {
+            from: from.to_path_buf(),
+            files: if files.is_empty() {
+                "the embedded flight test".into()
+            } else {
+                files.join(", ")
+            },
+            recorded: recorded.to_string(),
+            now: fitted.data_sha256().to_string(),
+        });
+    }
     let mut held = inputs::with_policy(validate, policy);
     let recorded = source
         .held_out

@@ -237,6 +237,7 @@ pub fn fitted_source(case: &Case, job: &Arc<Job>) -> Source {
             outliers: Default::default(),
         },
         held_out: Vec::new(),
+        data_sha256: None,
     }
 }
 

@@ -474,3 +474,71 @@ fn envelope_resume_refusals_say_what_differs_and_that_a_sweep_is_finished() {
         "it records a sweep of other inputs (--seed was 7, now 1): give the same inputs to --resume",
     );
 }
+
+#[test]
+fn a_prediction_from_a_fit_whose_releases_changed_is_refused() {
+    // Before 2026-11-29 predict re-read the releases a fit records and went on with whatever
+    // they held now, so its bands were of a fit that never was.
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path();
+    let release = |seed: &str| {
+        ok(&sepval(
+            &["simulate", "--noise-seed", seed, "--out", "d.csv"],
+            p,
+        ))
+    };
+    release("3");
+    ok(&sepval(
+        &[
+            "fit",
+            "--data",
+            "d.csv",
+            "--method",
+            "ga+lm",
+            "--generations",
+            "3",
+            "--population",
+            "10",
+            "--evaluator",
+            "inproc",
+            "--no-figures",
+            "--out",
+            "fit",
+        ],
+        p,
+    ));
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../common/scenarios/eglin_default.toml")
+        .display()
+        .to_string();
+    let predict = |out: &str| {
+        sepval(
+            &[
+                "predict",
+                "--from",
+                "fit",
+                "--scenario",
+                &scenario,
+                "--samples",
+                "400",
+                "--evaluator",
+                "inproc",
+                "--out",
+                out,
+            ],
+            p,
+        )
+    };
+    ok(&predict("before"));
+    release("4");
+    refused(
+        &predict("after"),
+        "--from fit: the releases it was fitted to (",
+    );
+    let e = String::from_utf8_lossy(&predict("after").stderr).into_owned();
+    assert!(
+        e.contains("d.csv) have changed since (their SHA-256 was "),
+        "{e}"
+    );
+    assert!(!p.join("after").exists());
+}
