@@ -161,10 +161,20 @@ impl Settings {
         }
         let least = min_samples(self.level);
         if self.samples < least {
+            // Only a level given by --level can need more than MAX_SAMPLES; the commands with a
+            // fixed level are told the samples alone.
+            let remedy = if least > MAX_SAMPLES {
+                format!(
+                    "more than the {MAX_SAMPLES} drawn at most: give a --level of at most {}",
+                    1.0 - 20.0 / MAX_SAMPLES as f64
+                )
+            } else {
+                format!("give --samples {least} or more")
+            };
             return Err(ConditionError::Samples {
                 samples: self.samples,
                 message: format!(
-                    "bands at level {} need at least {least} samples (20 / (1 - level), so that 20 samples fall outside the level); give --samples {least} or more, or a lower --level",
+                    "bands at level {} need at least {least} samples (20 / (1 - level), so that 20 samples fall outside the level); {remedy}",
                     self.level
                 ),
             });

@@ -367,7 +367,17 @@ fn a_prediction_far_from_every_release_says_so_first() {
 #[test]
 fn sample_counts_that_cannot_give_the_level_are_refused_with_the_rule() {
     let p = fitted();
-    for (samples, level, least) in [("1", "0.95", "400"), ("100", "0.9", "200")] {
+    for (samples, level, least, remedy) in [
+        ("1", "0.95", "400", "give --samples 400 or more"),
+        ("100", "0.9", "200", "give --samples 200 or more"),
+        // More than can be drawn: the level is what to change.
+        (
+            "1000",
+            "0.9999",
+            "200000",
+            "more than the 100000 drawn at most: give a --level of at most 0.9998",
+        ),
+    ] {
         refused(
             &sepval(
                 &[
@@ -386,7 +396,7 @@ fn sample_counts_that_cannot_give_the_level_are_refused_with_the_rule() {
                 p,
             ),
             &format!(
-                "--samples {samples}: bands at level {level} need at least {least} samples (20 / (1 - level), so that 20 samples fall outside the level)"
+                "--samples {samples}: bands at level {level} need at least {least} samples (20 / (1 - level), so that 20 samples fall outside the level); {remedy}"
             ),
         );
     }
