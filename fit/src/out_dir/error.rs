@@ -100,6 +100,12 @@ pub enum OutDirError {
         /// Why its marker lists no files.
         why: String,
     },
+    /// An output file that is a directory.
+    #[error("{path} is a directory: give the name of the file to write (in it, or anywhere)")]
+    FileIsDirectory {
+        /// The output.
+        path: PathBuf,
+    },
     /// A path that is not a directory.
     #[error("{path} exists and is not a directory")]
     NotADirectory {

@@ -138,6 +138,11 @@ pub(super) fn check(out: &Path, inputs: &[Input], allowed: &[PathBuf]) -> Result
 /// Refuses an output file `out` that is one of `inputs`: the same path once resolved, or the
 /// same file by another name (a hard link).
 pub fn check_file(out: &Path, inputs: &[Input]) -> Result<(), OutDirError> {
+    if out.is_dir() {
+        return Err(OutDirError::FileIsDirectory {
+            path: out.to_path_buf(),
+        });
+    }
     let here = resolved(out);
     let here_id = file_id(out);
     for input in inputs {

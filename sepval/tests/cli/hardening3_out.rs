@@ -358,6 +358,13 @@ fn simulate_and_scenario_never_write_over_what_they_read() {
         "--out f.json: f.json is --factors f.json, an input of this run",
     );
     assert_eq!(std::fs::read_to_string(d.join("f.json")).unwrap(), factors);
+    // A directory is no file name (`.` was "Device or resource busy").
+    for out in [".", "sub"] {
+        refused(
+            &sepval(&["simulate", "--out", out], d),
+            &format!("--out {out}: {out} is a directory: give the name of the file to write"),
+        );
+    }
     ok(&sepval(
         &["simulate", "--scenario", "grid.toml", "--out", "t.csv"],
         d,
