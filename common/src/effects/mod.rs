@@ -199,6 +199,12 @@ impl EffectSet {
             syntax("expected ID=V1,V2,... (for example roll_due_to_sideslip=-0.3)".into())
         })?;
         let id = id.trim();
+        if id.is_empty() {
+            return Err(syntax(
+                "no effect ID before `=` (expected ID=V1,V2,..., for example roll_due_to_sideslip=-0.3)"
+                    .into(),
+            ));
+        }
         let mut values = Vec::new();
         for (k, text) in list.split(',').enumerate() {
             let v: f64 = text.trim().parse().map_err(|_| {

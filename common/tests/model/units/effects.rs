@@ -62,6 +62,17 @@ fn spec_parsing_and_refusals() {
             .to_string(),
         "effect specification `cg_offset`: expected ID=V1,V2,... (for example roll_due_to_sideslip=-0.3)"
     );
+    for spec in ["=", "=1", " =0.3"] {
+        assert_eq!(
+            EffectSet::default()
+                .push_spec(spec)
+                .unwrap_err()
+                .to_string(),
+            format!(
+                "effect specification `{spec}`: no effect ID before `=` (expected ID=V1,V2,..., for example roll_due_to_sideslip=-0.3)"
+            )
+        );
+    }
     assert_eq!(
         EffectSet::default()
             .push_spec("cg_offset=abc")
