@@ -413,7 +413,16 @@ impl<'a, 'input> Reader<'a, 'input> {
         let value = self.required(n, "signalValue")?;
         let tol = self
             .child(n, "tol")
-            .map(|t| self.number(t, "tolerance", t.text().unwrap_or("")))
+            .map(|t| {
+                let v = self.number(t, "tolerance", t.text().unwrap_or(""))?;
+                if v < 0.0 {
+                    return Err(DavemlError::at(
+                        &self.place(t),
+                        format!("tolerance {v} is negative: a check's tolerance is 0 or more"),
+                    ));
+                }
+                Ok(v)
+            })
             .transpose()?;
         Ok(Signal {
             name,

@@ -104,6 +104,15 @@ fn a_check_case_the_tables_do_not_reproduce_is_refused() {
 }
 
 #[test]
+fn a_negative_tolerance_is_refused_at_its_element() {
+    let e = refused("<tol>1e-9</tol>", "<tol>-1</tol>");
+    assert!(
+        e.starts_with("t.dml line 111, <tol>: tolerance -1 is negative"),
+        "{e}"
+    );
+}
+
+#[test]
 fn a_file_that_is_not_xml_is_refused_with_its_position() {
     let e = import_model(
         "CN,alpha\n1,2\n",
