@@ -81,6 +81,18 @@ pub enum LimitError {
         /// Samples asked for.
         samples: f64,
     },
+    /// One sample: no trajectory.
+    #[error(
+        "one sample ({} s at {} Hz): a trajectory needs at least two (span x rate >= 1)",
+        Shown(*span_s),
+        Shown(*rate_hz)
+    )]
+    OneSample {
+        /// The span \[s\].
+        span_s: f64,
+        /// The rate \[Hz\].
+        rate_hz: f64,
+    },
 }
 
 /// Checks a run that integrates from 0 to `span_s` at step `dt_s` (both finite and > 0).
@@ -109,6 +121,9 @@ pub fn check_sampling(span_s: f64, rate_hz: f64) -> Result<(), LimitError> {
     if samples > MAX_SAMPLES as f64 {
         return Err(LimitError::Samples { samples });
     }
+    if samples < 2.0 {
+        return Err(LimitError::OneSample { span_s, rate_hz });
+    }
     Ok(())
 }
 
@@ -120,6 +135,11 @@ mod tests {
     fn limits_refuse_with_the_limit_in_the_message() {
         check_steps(1.0, 0.0005).unwrap();
         check_sampling(1.0, 200.0).unwrap();
+        check_sampling(1.0, 1.0).unwrap();
+        assert_eq!(
+            check_sampling(1e-300, 200.0).unwrap_err().to_string(),
+            "one sample (1e-300 s at 200 Hz): a trajectory needs at least two (span x rate >= 1)"
+        );
         assert_eq!(
             check_steps(1e5, 0.0005).unwrap_err().to_string(),
             "an event of 100000 s is longer than the limit of 3600 s"

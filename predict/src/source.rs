@@ -115,6 +115,24 @@ pub struct Source {
     pub data_sha256: Option<String>,
 }
 
+/// Refuses a covariance that determines no parameter's standard error (a fit of fewer
+/// residuals than parameters: every one not identifiable): draws from it would hold every
+/// parameter, and its bands would leave out the factors' uncertainty whole.
+fn some_determined(id: &Identifiability) -> Result<(), String> {
+    let determined = id
+        .parameters
+        .iter()
+        .any(|p| p.std_error_white.is_some_and(|s| s.is_finite() && s > 0.0));
+    if determined || id.parameters.is_empty() {
+        return Ok(());
+    }
+    Err(format!(
+        "determines the standard error of none of its {} parameters (not identifiable from its releases: {}): bands from it would leave out the factors' uncertainty; fit more of the release, or more releases",
+        id.parameters.len(),
+        id.not_identifiable.join(", ")
+    ))
+}
+
 /// The `data_sha256` a fit's result.json at `path` records, when it reads.
 fn recorded_data_sha256(path: &Path) -> Option<String> {
     let text = sepval_core::input_file::read_string(
@@ -190,6 +208,7 @@ impl Source {
         let identifiability = d.identifiability.clone().ok_or_else(|| {
             bad("records no covariance of the answer's parameters (`identifiability`, written by sepval since predict): diagnose again with this sepval".into())
         })?;
+        some_determined(&identifiability).map_err(bad)?;
         let mut models = vec![SourceModel {
             spec: d.model.clone(),
             delta_bic: 0.0,
@@ -241,6 +260,7 @@ fn fit_source(dir: &Path) -> Result<Source, SourceError> {
             methods: methods.join(", "),
         });
     };
+    some_determined(&identifiability).map_err(bad)?;
     let inputs = r.inputs.clone().ok_or_else(|| {
         bad("records no `inputs` (written by an older sepval): fit again with this sepval".into())
     })?;

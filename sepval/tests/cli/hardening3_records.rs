@@ -551,4 +551,38 @@ fn a_prediction_from_a_fit_whose_releases_changed_is_refused() {
         "{e}"
     );
     assert!(!p.join("after").exists());
+    // A fit of one sample determines no standard error: its bands would be of nothing.
+    let text = std::fs::read_to_string(p.join("d.csv")).unwrap();
+    let header = text.lines().position(|l| !l.starts_with('#')).unwrap();
+    let one: Vec<&str> = text.lines().take(header + 2).collect();
+    std::fs::write(p.join("d.csv"), one.join("\n") + "\n").unwrap();
+    ok(&sepval(
+        &[
+            "fit",
+            "--data",
+            "d.csv",
+            "--method",
+            "ga+lm",
+            "--generations",
+            "2",
+            "--population",
+            "10",
+            "--sigma-pos-m",
+            "0.003",
+            "--sigma-att-deg",
+            "0.1",
+            "--evaluator",
+            "inproc",
+            "--no-figures",
+            "--overwrite",
+            "--out",
+            "fit",
+        ],
+        p,
+    ));
+    refused(
+        &predict("after"),
+        "result.json: determines the standard error of none of its 17 parameters",
+    );
+    assert!(!p.join("after").exists());
 }
