@@ -205,6 +205,7 @@ fn tables_left_are_reported_and_refused_with_strict_tables() {
     );
     let d = diagnosis_in(dir.path());
     assert!(d["tables_left"].to_string().contains("mach up to"), "{d}");
+    let earlier = std::fs::read(dir.path().join("diag/diagnosis.json")).unwrap();
     let out = diagnose_in(
         dir.path(),
         "d.csv",
@@ -214,6 +215,10 @@ fn tables_left_are_reported_and_refused_with_strict_tables() {
         &out,
         "--strict-tables: the baseline fit d.csv: left table `aero.",
     );
-    assert!(!dir.path().join("diag/diagnosis.json").exists());
-    assert!(!dir.path().join("diag/report.html").exists());
+    // The refused run put back the diagnosis it was to replace (before 2026-11-29 it was gone).
+    assert_eq!(
+        std::fs::read(dir.path().join("diag/diagnosis.json")).unwrap(),
+        earlier
+    );
+    assert!(!dir.path().join("diag/.sepval-replaced").exists());
 }
