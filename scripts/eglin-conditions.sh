@@ -33,23 +33,8 @@ mkdir -p "$OUT"
 python3 scripts/eglin_convert.py "$REPO" "$OUT"
 BASE=common/scenarios/eglin_default.toml
 sed -e 's/^t_end_s = .*/t_end_s = 0.5/' "$BASE" > "$OUT/decay.toml"
-sed -E -e 's/^t_end_s = .*/t_end_s = 0.5/' -e 's/^(dc[xyzlmn]0) = .*/\1 = 0.0/' \
-    -e 's/^(c[aymnlz]intfac) = .*/\1 = { min = -1.0, max = 3.0, bits = 8 }/' "$BASE" > "$OUT/field.toml"
-cat >> "$OUT/field.toml" <<'FIELD'
-
-[flowfield]
-stations = 5
-nose_x_m = 1.5
-tail_x_m = -1.5
-upwash_deg = 5.99
-upwash_gradient_deg_per_m = -10.4
-sidewash_deg = -5.84
-sidewash_gradient_deg_per_m = 4.28
-dynamic_pressure_ratio = 1.09
-roll_cl = -0.03
-half_depth_m = 0.42
-reference_mach = 0.95
-FIELD
+. scripts/eglin-field.sh
+eglin_field "$BASE" "$OUT/field.toml"
 
 CASES=(M085_AOA0 M085_AOA4 M095_AOA0 M095_AOA4)
 # The error of the scenario `$2` with the factors `$3` at the condition of release `$1`.

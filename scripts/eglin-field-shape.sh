@@ -29,23 +29,8 @@ rm -rf "$OUT"
 mkdir -p "$OUT"
 python3 scripts/eglin_convert.py "$REPO" "$OUT" > /dev/null
 BASE=common/scenarios/eglin_default.toml
-sed -E -e 's/^t_end_s = .*/t_end_s = 0.5/' -e 's/^(dc[xyzlmn]0) = .*/\1 = 0.0/' \
-    -e 's/^(c[aymnlz]intfac) = .*/\1 = { min = -1.0, max = 3.0, bits = 8 }/' "$BASE" > "$OUT/field.toml"
-cat >> "$OUT/field.toml" <<'FIELD'
-
-[flowfield]
-stations = 5
-nose_x_m = 1.5
-tail_x_m = -1.5
-upwash_deg = 5.99
-upwash_gradient_deg_per_m = -10.4
-sidewash_deg = -5.84
-sidewash_gradient_deg_per_m = 4.28
-dynamic_pressure_ratio = 1.09
-roll_cl = -0.03
-half_depth_m = 0.42
-reference_mach = 0.95
-FIELD
+. scripts/eglin-field.sh
+eglin_field "$BASE" "$OUT/field.toml"
 
 DEPTHS=(0.25 0.42 0.7 1.0 1.5 3.0 5.0 10.0 30.0)
 REVERSALS=(none 0.75 1.5 3.0)

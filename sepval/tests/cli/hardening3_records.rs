@@ -497,9 +497,9 @@ fn a_prediction_from_a_fit_whose_releases_changed_is_refused() {
             p,
         ))
     };
-    release("3");
-    ok(&sepval(
-        &[
+    // The fit into `fit` (the earlier one cleared), with `extra` flags.
+    let fit = |extra: &[&str]| {
+        let mut a = vec![
             "fit",
             "--data",
             "d.csv",
@@ -512,11 +512,15 @@ fn a_prediction_from_a_fit_whose_releases_changed_is_refused() {
             "--evaluator",
             "inproc",
             "--no-figures",
+            "--overwrite",
             "--out",
             "fit",
-        ],
-        p,
-    ));
+        ];
+        a.extend(extra);
+        ok(&sepval(&a, p))
+    };
+    release("3");
+    fit(&[]);
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../common/scenarios/eglin_default.toml")
         .display()
@@ -556,30 +560,7 @@ fn a_prediction_from_a_fit_whose_releases_changed_is_refused() {
     let header = text.lines().position(|l| !l.starts_with('#')).unwrap();
     let one: Vec<&str> = text.lines().take(header + 2).collect();
     std::fs::write(p.join("d.csv"), one.join("\n") + "\n").unwrap();
-    ok(&sepval(
-        &[
-            "fit",
-            "--data",
-            "d.csv",
-            "--method",
-            "ga+lm",
-            "--generations",
-            "2",
-            "--population",
-            "10",
-            "--sigma-pos-m",
-            "0.003",
-            "--sigma-att-deg",
-            "0.1",
-            "--evaluator",
-            "inproc",
-            "--no-figures",
-            "--overwrite",
-            "--out",
-            "fit",
-        ],
-        p,
-    ));
+    fit(&["--sigma-pos-m", "0.003", "--sigma-att-deg", "0.1"]);
     refused(
         &predict("after"),
         "result.json: determines the standard error of none of its 17 parameters",
