@@ -7,7 +7,7 @@
 //! round under `CAMP/.staging/`, renames the round into `rounds/NN` and writes campaign.json
 //! last (the commit). A command interrupted before that commit leaves campaign.json as it was;
 //! whatever it left (a staging directory, a round or a release copy that campaign.json does not
-//! name and that it recorded creating, [`crate::journal`]) is removed by the next command that
+//! name and that it recorded creating, `journal.rs`) is removed by the next command that
 //! opens the campaign, and nothing else is. The derived files
 //! (envelope.csv, status.json, report.html, figures/) are written after the commit from the
 //! records, and again by every command, so that they always follow campaign.json.
