@@ -133,16 +133,15 @@ fn some_determined(id: &Identifiability) -> Result<(), String> {
     ))
 }
 
-/// The `data_sha256` a fit's result.json at `path` records, when it reads.
-fn recorded_data_sha256(path: &Path) -> Option<String> {
-    let text = sepval_core::input_file::read_string(
-        path,
-        "fit result",
-        sepval_core::limits::MAX_JSON_BYTES,
-    )
-    .ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    v.get("data_sha256")?.as_str().map(str::to_string)
+/// The `data_sha256` of the baseline fit a diagnosis in `dir` wrote (`baseline/result.json`,
+/// read and checked as every fit result is), none when it has none.
+fn baseline_data_sha256(dir: &Path) -> Result<Option<String>, SourceError> {
+    let baseline = dir.join("baseline");
+    if !baseline.join("result.json").exists() {
+        return Ok(None);
+    }
+    let r: FitResult = read(&baseline, "result.json", "baseline fit result")?;
+    Ok(Some(r.data_sha256))
 }
 
 /// Reads the source in `dir`: diagnosis.json when it holds one, else result.json.
@@ -234,7 +233,7 @@ impl Source {
             },
             inputs: d.inputs,
             held_out,
-            data_sha256: recorded_data_sha256(&dir.join("baseline/result.json")),
+            data_sha256: baseline_data_sha256(dir)?,
         })
     }
 }

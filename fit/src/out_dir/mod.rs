@@ -33,6 +33,8 @@ pub use marker::MARKER_FILE;
 
 use error::io;
 
+use crate::checkpoint::Checkpoint;
+
 /// How a run uses its directory.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Claim {
@@ -235,9 +237,7 @@ impl RunDir {
         self.prepared.store(true, Ordering::Relaxed);
         Ok(removed)
     }
-}
 
-impl RunDir {
     /// Moves the earlier run's `others` (and its marker) into [`REPLACED`], where they stay
     /// until this run commits (then removed) or fails (then put back).
     fn move_aside(&self, others: &[String]) -> Result<(), OutDirError> {
@@ -329,7 +329,7 @@ fn later_generations(dir: &Path, generation: usize) -> Result<Vec<PathBuf>, OutD
             .strip_prefix("gen-")
             .and_then(|n| n.strip_suffix(".json"))
             .and_then(|n| n.parse::<usize>().ok())
-            .filter(|g| name == format!("gen-{g:04}.json"));
+            .filter(|&g| e.path() == Checkpoint::path(dir, g));
         let is_file = e.file_type().is_ok_and(|t| t.is_file());
         if is_file && named.is_some_and(|g| g > generation) {
             later.push(e.path());
