@@ -4,8 +4,8 @@
 //! diagnosed again (`sepval diagnose`: the baseline fit, the effect catalogue, discovery beyond
 //! it; its answer and rivals), and the envelope is predicted again from that diagnosis (round
 //! N). A
-//! release already in the campaign (the same bytes, or the same samples at the same
-//! condition) is refused with nothing changed.
+//! release already in the campaign (the same bytes, or half or more of the same samples:
+//! [`crate::release::overlap`]) is refused with nothing changed.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -28,8 +28,10 @@ use sepval_solve::run::ProgressObserver;
 use crate::CampaignError;
 use crate::assess::{AssessSettings, FormBand, Model, StartEvaluator};
 use crate::journal;
-use crate::program::{Campaign, NewRelease, STAGING, fitted_model};
-use crate::record::{CAMPAIGN_FORMAT, ReleaseRecord, read_json, record_error};
+use crate::program::{Campaign, STAGING, fitted_model};
+use crate::record::{CAMPAIGN_FORMAT, ReleaseRecord, record_error};
+use crate::release::{NewRelease, overlap};
+use crate::seal::read_sealed;
 
 /// The noise of a prediction's bands before any release was fitted: the synthetic flight
 /// tests' (docs/model.md section 6).
@@ -55,7 +57,7 @@ pub fn add(
         // derived files, keeps the round); what it does not name is removed, best effort: the
         // next command that opens the campaign removes what is left.
         let path = c.dir.join("campaign.json");
-        if let Ok(on_disk) = read_json(&path, CAMPAIGN_FORMAT) {
+        if let Ok(on_disk) = read_sealed(&path, CAMPAIGN_FORMAT) {
             c.file = on_disk;
             let _ = c.tidy();
         }
@@ -94,14 +96,17 @@ fn add_all(
         let path = c.dir.join(&file);
         journal::record(&c.dir, &file)?;
         r.data.write(&path).map_err(|e| record_error(&path, e))?;
+        let copy = std::fs::read(&path).map_err(|e| record_error(&path, e))?;
         c.file.releases.push(ReleaseRecord {
             file,
             given: r.given.display().to_string(),
             sha256: r.sha256.clone(),
+            copy_sha256: sepval_common::scenario::hex_sha256(&copy),
             condition: ConditionRecord::of(&r.scenario.flight),
             round,
             inside: k.inside,
             check: k.verdict.clone(),
+            notes: r.notes.clone(),
         });
     }
     let job = c.job()?.expect("releases were added");
@@ -117,12 +122,19 @@ fn copy_name(n: usize) -> String {
     format!("releases/{n:02}.csv")
 }
 
-/// Refuses a release the campaign holds (`known`: its releases flown), or one given twice.
+/// Refuses a release the campaign holds (`known`: its releases flown), or one given twice: the
+/// same bytes, or half or more of the same samples ([`overlap`]: a copy, thinned or not).
 fn refuse_known(
     c: &Campaign,
     known: Option<&Job>,
     releases: &[NewRelease],
 ) -> Result<(), CampaignError> {
+    let same_flight = |name: &dyn std::fmt::Display, other: &str, shared: usize, d: &Trajectory| {
+        CampaignError::Refused(format!(
+            "{name} shares {shared} of its {} samples (time and value, bit for bit) with {other}: the same flight, wholly or in part, would count twice as evidence; each release is added once",
+            d.len()
+        ))
+    };
     for (i, r) in releases.iter().enumerate() {
         let name = r.given.display();
         if let Some(k) = c.file.releases.iter().find(|k| k.sha256 == r.sha256) {
@@ -131,41 +143,27 @@ fn refuse_known(
                 k.file, k.given
             )));
         }
-        if let Some(j) = known.and_then(|j| {
-            j.events()
-                .iter()
-                .position(|e| same(&e.data, &e.simulator.scenario().flight, r))
-        }) {
-            return Err(CampaignError::Refused(format!(
-                "{name} holds the same samples at the same condition as {}: each release is added once",
-                c.file.releases[j].file
-            )));
+        let flown = known.map_or(&[][..], |j| j.events());
+        for (k, e) in flown.iter().enumerate() {
+            if let Some(shared) = overlap(&e.data, &r.data) {
+                let other = format!("{}, flown already", c.file.releases[k].file);
+                return Err(same_flight(&name, &other, shared, &r.data));
+            }
         }
-        if let Some(o) = releases[..i]
-            .iter()
-            .find(|o| o.sha256 == r.sha256 || same(&o.data, &o.scenario.flight, r))
-        {
-            return Err(CampaignError::Refused(format!(
-                "{name} is the same release as {}: give each release once",
-                o.given.display()
-            )));
+        for o in &releases[..i] {
+            if o.sha256 == r.sha256 {
+                return Err(CampaignError::Refused(format!(
+                    "{name} is the same release as {}: give each release once",
+                    o.given.display()
+                )));
+            }
+            if let Some(shared) = overlap(&o.data, &r.data) {
+                let other = format!("{}, given beside it", o.given.display());
+                return Err(same_flight(&name, &other, shared, &r.data));
+            }
         }
     }
     Ok(())
-}
-
-/// Whether `r` holds `data`'s samples bit for bit at `flight`.
-fn same(data: &Trajectory, flight: &sepval_common::scenario::Flight, r: &NewRelease) -> bool {
-    let bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
-    let f = |f: &sepval_common::scenario::Flight| {
-        [f.mach, f.altitude_m, f.alpha_deg, f.beta_deg, f.gamma_deg]
-    };
-    let d = &r.data;
-    data.len() == d.len()
-        && bits(&f(flight), &f(&r.scenario.flight))
-        && bits(&data.times_s, &d.times_s)
-        && bits(data.pos_m.as_flattened(), d.pos_m.as_flattened())
-        && bits(data.att_deg.as_flattened(), d.att_deg.as_flattened())
 }
 
 /// The diagnosis of every release flown into `out` (DIR/diagnosis.json, its baseline fit in

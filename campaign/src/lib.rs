@@ -30,8 +30,10 @@ pub mod prior;
 pub mod program;
 pub mod record;
 pub mod rehearse;
+pub mod release;
 pub mod request;
 pub mod rivals;
+pub mod seal;
 pub mod state;
 
 pub use assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};
@@ -69,6 +71,38 @@ pub enum CampaignError {
         path: String,
         /// What is wrong.
         message: String,
+    },
+    /// A campaign record edited after sepval wrote it ([`seal`]).
+    #[error(
+        "{path}: {part} does not match its digest: edited after sepval wrote it? an edited campaign record is not used (put the file back as sepval wrote it)"
+    )]
+    Edited {
+        /// The record.
+        path: String,
+        /// The part that changed.
+        part: String,
+    },
+    /// A file the campaign wrote whose SHA-256 is not the one campaign.json records.
+    #[error(
+        "{path}: changed since the campaign wrote it (SHA-256 {recorded} recorded in campaign.json, {now} now): a campaign's releases and rounds are used as they were recorded (put the file back as the campaign wrote it)"
+    )]
+    Changed {
+        /// The file.
+        path: String,
+        /// The SHA-256 campaign.json records.
+        recorded: String,
+        /// Its SHA-256 now.
+        now: String,
+    },
+    /// A flag's value outside what a campaign can run.
+    #[error("{flag} {value}: {expected}")]
+    Setting {
+        /// The flag.
+        flag: &'static str,
+        /// Its value, as given.
+        value: String,
+        /// What it must be, and why.
+        expected: String,
     },
     /// A release or a flag refused.
     #[error("{0}")]

@@ -163,8 +163,11 @@ pub fn plan(
         let Some((mut c, mut e)) = by(&|x| x.1) else {
             break;
         };
+        // A gain is a difference of sums: what rounds to 0 is said as 0, never "-0.0".
+        let e_shown = |e: f64| if e > 0.0 { e } else { 0.0 };
         let mut why = format!(
-            "expected to settle {e:.1} of the {} undecided conditions",
+            "expected to settle {:.1} of the {} undecided conditions",
+            e_shown(e),
             undecided.len()
         );
         if e < SETTLES_NOTHING {
@@ -174,7 +177,8 @@ pub fn plan(
             // The batch's others: where the model's form is least known.
             (c, e) = by(&|x| effective(reaches[x.0])).expect("open is not empty");
             why = format!(
-                "adds {e:.1} to what the releases before it in the batch settle; chosen as the safe condition farthest from every release flown or planned (reach {:.1}), where the model's form is least known",
+                "adds {:.1} to what the releases before it in the batch settle; chosen as the safe condition farthest from every release flown or planned (reach {:.1}), where the model's form is least known",
+                e_shown(e),
                 reaches[c]
             );
         }
@@ -182,13 +186,20 @@ pub fn plan(
             "; P(fail) here {:.4}, within the fly risk {fly_risk}",
             risk(c)
         ));
-        chosen.push(planned(grid, assessed, c, e, why));
+        chosen.push(planned(grid, assessed, c, e_shown(e), why));
         // Taken as flown: the spreads it leaves, one release more.
         for u in 0..assessed.len() {
             (spreads[u], reaches[u]) = settle(&at(c, u), &spreads[u], reaches[u], n);
         }
     }
-    let words = words(undecided.len(), chosen.len());
+    let mut words = words(undecided.len(), chosen.len());
+    if !chosen.is_empty() && chosen.len() < count {
+        words.push_str(&format!(
+            "; {} of the {count} asked for: only {} of the grid's conditions are safe to fly (P(fail) within the fly risk), and each of them is planned",
+            chosen.len(),
+            safe.len()
+        ));
+    }
     Plan {
         settled: undecided.is_empty() || chosen.is_empty(),
         releases: chosen,

@@ -22,7 +22,7 @@ use sepval_report::{OutputError, Written};
 use sepval_envelope::Grid;
 
 use crate::CampaignError;
-use crate::record::{CampaignFile, STATUS_FORMAT, StatusFile, record_error};
+use crate::record::{CampaignFile, RoundRecord, STATUS_FORMAT, StatusFile, record_error};
 use crate::state::{Assessed, Counts, State};
 
 /// What the derived files are made of: the campaign's directory, its record and its grid.
@@ -85,11 +85,9 @@ pub struct RehearsalRelease {
 }
 
 impl View<'_> {
-    /// The envelope of round `dir` (`rounds/NN`).
-    pub fn round(&self, dir: &str) -> Result<Vec<Assessed>, CampaignError> {
-        let path = self.dir.join(dir).join("assessment.json");
-        let text = std::fs::read_to_string(&path).map_err(|e| record_error(&path, e))?;
-        serde_json::from_str(&text).map_err(|e| record_error(&path, e))
+    /// The envelope of round `r`.
+    pub fn round(&self, r: &RoundRecord) -> Result<Vec<Assessed>, CampaignError> {
+        crate::seal::read_round(self.dir, r)
     }
 
     /// The current round's envelope.
@@ -100,7 +98,7 @@ impl View<'_> {
                 "holds no round: the campaign's init did not finish",
             )
         })?;
-        self.round(&last.dir)
+        self.round(last)
     }
 }
 
@@ -163,7 +161,7 @@ pub fn render(c: &View<'_>) -> Result<(), CampaignError> {
     w.json("status.json", &status(c.file))?;
     let figures = w.figures()?;
     for r in &c.file.rounds {
-        let assessed = c.round(&r.dir)?;
+        let assessed = c.round(r)?;
         let path = figures.join(format!("state-{:02}.png", r.round));
         w.figure(path, |path| {
             state_map(c, &assessed, r.round, r.releases_flown, path)

@@ -74,7 +74,39 @@ pub struct Prior {
 #[serde(deny_unknown_fields)]
 struct PriorFile {
     format: String,
-    factors: BTreeMap<String, Belief>,
+    #[serde(deserialize_with = "in_file_order")]
+    factors: Vec<(String, Belief)>,
+}
+
+/// The entries of the `factors` object in file order, a name given twice refused (serde_json's
+/// maps keep the last of a repeated key, which would hide a mistake; before 2026-12-01 the last
+/// won here, as factors files already refused it).
+fn in_file_order<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Vec<(String, Belief)>, D::Error> {
+    struct V;
+    impl<'de> serde::de::Visitor<'de> for V {
+        type Value = Vec<(String, Belief)>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("an object of factors, each {\"mean\": M, \"sd\": S}")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut m: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out: Vec<(String, Belief)> = Vec::new();
+            while let Some((name, b)) = m.next_entry::<String, Belief>()? {
+                if out.iter().any(|(n, _)| *n == name) {
+                    return Err(serde::de::Error::custom(format!(
+                        "factor `{name}` is given twice"
+                    )));
+                }
+                out.push((name, b));
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(V)
 }
 
 impl Prior {
@@ -214,6 +246,10 @@ mod tests {
             (
                 r#"{"format":"sepval-prior/1","factors":{"fwdfac":{"mean":0.5,"sd":-1}}}"#,
                 "fwdfac.sd = -1",
+            ),
+            (
+                r#"{"format":"sepval-prior/1","factors":{"fwdfac":{"mean":0.5,"sd":0.1},"fwdfac":{"mean":0.6,"sd":0.1}}}"#,
+                "factor `fwdfac` is given twice at line 1",
             ),
         ] {
             std::fs::write(&p, text).unwrap();

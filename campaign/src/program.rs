@@ -19,7 +19,6 @@ use sepval_common::evaluation::{Event, Job};
 use sepval_common::scenario::{Scenario, hex_sha256};
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
-use sepval_common::telemetry::outliers::Policy;
 use sepval_envelope::grid::{Axis, Grid};
 use sepval_fit::conditions::Quantity;
 use sepval_fit::inputs;
@@ -33,9 +32,10 @@ use crate::assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};
 use crate::next::{Criteria, Plan, plan};
 use crate::record::record_error;
 use crate::record::{
-    CAMPAIGN_FORMAT, CampaignFile, InputRecord, NEXT_FORMAT, NextFile, RoundRecord, SettingsRecord,
-    read_json, write_json,
+    ASSESSMENT_FORMAT, AssessmentFile, CAMPAIGN_FORMAT, CampaignFile, InputRecord, NEXT_FORMAT,
+    NextFile, RoundRecord, SettingsRecord, check_recorded,
 };
+use crate::seal::{read_sealed, write_sealed};
 use crate::state::{Assessed, Counts};
 use crate::{CampaignError, journal, page};
 
@@ -76,46 +76,12 @@ pub struct Init {
     pub settings: SettingsRecord,
     /// The scenario.
     pub scenario: Scenario,
+    /// The grid of the settings' axes.
+    pub grid: Grid,
     /// The clearance.
     pub clearance: ClearanceSettings,
     /// Threads of this process.
     pub threads: usize,
-}
-
-/// A release to add, read and screened ([`NewRelease::read`]).
-pub struct NewRelease {
-    /// The file given.
-    pub given: PathBuf,
-    /// The SHA-256 of its bytes.
-    pub sha256: String,
-    /// Its samples (outliers dropped when asked).
-    pub data: Trajectory,
-    /// The campaign's scenario flown at its condition.
-    pub scenario: Scenario,
-}
-
-impl NewRelease {
-    /// The release in `path`, read with `policy` (what it leaves out told through `tell`) and
-    /// flown at its own condition with the campaign's `scenario`, whose store it must carry.
-    pub fn read(
-        path: &Path,
-        scenario: &Scenario,
-        policy: Policy,
-        tell: inputs::Tell,
-    ) -> Result<NewRelease, CampaignError> {
-        let name = path.display().to_string();
-        let input = |e: inputs::InputError| CampaignError::Inputs(Box::new(e));
-        let bytes = std::fs::read(path).map_err(|e| record_error(path, e))?;
-        let data = inputs::read(path, policy, tell).map_err(input)?;
-        let flown = inputs::event_scenario(scenario, &data, &name).map_err(input)?;
-        inputs::check_store(scenario, &data, &name, "the campaign's scenario").map_err(input)?;
-        Ok(NewRelease {
-            given: path.to_path_buf(),
-            sha256: hex_sha256(&bytes),
-            data,
-            scenario: flown,
-        })
-    }
 }
 
 /// The file of `path` as the campaign records it.
@@ -151,31 +117,97 @@ pub fn grid_of(settings: &SettingsRecord, scenario: &Scenario) -> Result<Grid, C
     Ok(Grid::of(scenario, &axes)?)
 }
 
-/// Starts a campaign in `dir` (absent or empty): round 0, the envelope under the prior.
+/// What `init` makes in the campaign's directory besides its lock: all that a failed `init`
+/// removes ([`Unmade`]).
+const INIT_MAKES: [&str; 8] = [
+    "campaign.json",
+    "status.json",
+    "envelope.csv",
+    "report.html",
+    "next.json",
+    "figures",
+    "rounds",
+    STAGING,
+];
+
+/// Removes what a failed (or interrupted, or panicking) `init` made, when dropped armed: the
+/// directory when `init` created it, else the entries of [`INIT_MAKES`] in it (it was empty).
+/// Before 2026-12-01 a disk filling during `init` left campaign.json, status.json, envelope.csv
+/// and rounds/ without the report, which `status` took for a campaign.
+struct Unmade {
+    dir: PathBuf,
+    created: bool,
+    armed: bool,
+}
+
+impl Drop for Unmade {
+    fn drop(&mut self) {
+        if !self.armed {
+            return;
+        }
+        if self.created {
+            let _ = std::fs::remove_dir_all(&self.dir);
+            return;
+        }
+        for name in INIT_MAKES {
+            let p = self.dir.join(name);
+            let _ = match std::fs::symlink_metadata(&p) {
+                Ok(m) if m.is_dir() => std::fs::remove_dir_all(&p),
+                Ok(_) => std::fs::remove_file(&p),
+                Err(_) => Ok(()),
+            };
+        }
+    }
+}
+
+/// Refuses `dir` unless it is absent or empty; says so when it holds what an interrupted
+/// `init` left (no campaign.json).
+fn refuse_taken(dir: &Path) -> Result<(), CampaignError> {
+    if !dir.exists() {
+        return Ok(());
+    }
+    let names: Vec<String> = std::fs::read_dir(dir)
+        .map_err(|e| record_error(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
+        .collect();
+    if names.is_empty() {
+        return Ok(());
+    }
+    let left = !names.iter().any(|n| n == "campaign.json")
+        && names
+            .iter()
+            .all(|n| INIT_MAKES.contains(&n.as_str()) || n == ".sepval-lock");
+    Err(record_error(
+        dir,
+        if left {
+            "holds what an interrupted `campaign init` left (no campaign.json): no campaign began there; remove the directory and begin again"
+        } else {
+            "not empty: a campaign begins in a new or empty directory (give another --out)"
+        },
+    ))
+}
+
+/// Starts a campaign in `dir` (absent or empty): round 0, the envelope under the prior. On an
+/// error, a signal or a panic, what it made is removed ([`Unmade`]).
 pub fn init(
     dir: &Path,
     init: Init,
     start: &mut StartEvaluator<'_>,
     observer: &mut dyn ProgressObserver,
 ) -> Result<Campaign, CampaignError> {
-    let grid = grid_of(&init.settings, &init.scenario)?;
-    if dir.exists() {
-        let empty = std::fs::read_dir(dir)
-            .map_err(|e| record_error(dir, e))?
-            .next()
-            .is_none();
-        if !empty {
-            return Err(record_error(
-                dir,
-                "not empty: a campaign begins in a new or empty directory (give another --out)",
-            ));
-        }
-    }
+    refuse_taken(dir)?;
+    let created = !dir.exists();
     std::fs::create_dir_all(dir).map_err(|e| record_error(dir, e))?;
+    let mut unmade = Unmade {
+        dir: dir.to_path_buf(),
+        created,
+        armed: true,
+    };
     let (lock, _) = DirLock::take(dir)?;
     let file = CampaignFile {
         format: CAMPAIGN_FORMAT.into(),
-        grid: grid
+        grid: init
+            .grid
             .conditions
             .list
             .iter()
@@ -192,13 +224,14 @@ pub fn init(
         dir: dir.to_path_buf(),
         file,
         scenario: init.scenario,
-        grid,
+        grid: init.grid,
         clearance: init.clearance,
         threads: init.threads,
         _lock: lock,
     };
     let model = c.model()?;
     c.round(&model, start, observer)?;
+    unmade.armed = false;
     Ok(c)
 }
 
@@ -215,7 +248,7 @@ impl Campaign {
             ));
         }
         let (lock, _) = DirLock::take(dir)?;
-        let file: CampaignFile = read_json(&path, CAMPAIGN_FORMAT)?;
+        let file: CampaignFile = read_sealed(&path, CAMPAIGN_FORMAT)?;
         let inputs = [
             Some(&file.settings.aircraft),
             file.settings.scenario.as_ref(),
@@ -296,7 +329,10 @@ impl Campaign {
         let mut events = Vec::new();
         for r in &self.file.releases {
             let path = self.dir.join(&r.file);
-            let data = Trajectory::read(&path).map_err(|e| record_error(&path, e))?;
+            let bytes = check_recorded(&path, &r.copy_sha256)?;
+            let text = String::from_utf8(bytes).map_err(|e| record_error(&path, e))?;
+            let data = Trajectory::parse(&text, &path.display().to_string())
+                .map_err(|e| record_error(&path, e))?;
             let mut s = self.scenario.clone();
             s.flight = r.condition.flight();
             events.push(Event {
@@ -340,9 +376,7 @@ impl Campaign {
                 "holds no round: the campaign's init did not finish",
             )
         })?;
-        let path = self.dir.join(&last.dir).join("assessment.json");
-        let text = std::fs::read_to_string(&path).map_err(|e| record_error(&path, e))?;
-        serde_json::from_str(&text).map_err(|e| record_error(&path, e))
+        crate::seal::read_round(&self.dir, last)
     }
 
     /// The plan of `count` releases from the current round.
@@ -368,7 +402,7 @@ impl Campaign {
         let mut s = format!("{}\n{}\n", page::headline(&self.file), self.file.words);
         let next = self.dir.join("next.json");
         if next.is_file() {
-            let n: NextFile = crate::record::read_json(&next, NEXT_FORMAT)?;
+            let n: NextFile = read_sealed(&next, NEXT_FORMAT)?;
             for r in &n.releases {
                 s.push_str(&format!(
                     "next:      Mach {}, altitude {} m, alpha {} deg: {}\n",
@@ -393,7 +427,7 @@ impl Campaign {
             settled: p.settled,
             words: p.words,
         };
-        write_json(&self.dir.join("next.json"), &next)?;
+        write_sealed(&self.dir.join("next.json"), &next)?;
         page::render(&self.view())?;
         Ok(next)
     }
@@ -419,7 +453,13 @@ impl Campaign {
             start,
             observer,
         )?;
-        write_json(&staged.join("assessment.json"), &assessed)?;
+        let file = AssessmentFile {
+            format: ASSESSMENT_FORMAT.into(),
+            conditions: assessed,
+        };
+        let assessment = staged.join("assessment.json");
+        let assessment_sha256 = write_sealed(&assessment, &file)?;
+        let assessed = file.conditions;
         page::write_envelope_csv(&staged.join("envelope.csv"), &assessed)?;
         // The diagnosis of an add's model was staged beside the round.
         let diagnosis = self.dir.join(STAGING).join("diagnosis");
@@ -439,6 +479,7 @@ impl Campaign {
             counts,
             settled: false,
             dir,
+            assessment_sha256,
             evaluations: (self.grid.len() * self.file.settings.samples) as u64,
             wall_s: t0.elapsed().as_secs_f64(),
         });
@@ -447,7 +488,9 @@ impl Campaign {
         last.settled = p.settled;
         self.file.settled = p.settled;
         self.file.words = p.words;
-        write_json(&self.dir.join("campaign.json"), &self.file)?;
+        write_sealed(&self.dir.join("campaign.json"), &self.file)?;
+        // A test's stand-in for a disk that fills after the commit.
+        sepval_core::defect::inject("campaign-committed");
         let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
         let _ = std::fs::remove_file(self.dir.join("next.json"));
         page::render(&self.view())

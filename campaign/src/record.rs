@@ -1,6 +1,10 @@
 //! The campaign's records (docs/campaign.md, "Files"): CAMP/campaign.json (the settings, the
 //! grid, the releases flown, the rounds: the program's record, written last by every command
-//! that changes it, so that it is the commit), CAMP/status.json and CAMP/next.json.
+//! that changes it, so that it is the commit), each round's CAMP/rounds/NN/assessment.json,
+//! CAMP/next.json (each sealed part by part, [`crate::seal`], and refused when edited) and
+//! CAMP/status.json (derived, never read back). campaign.json records the SHA-256 of each
+//! release's copy and of each round's assessment, so that a copy edited or an assessment
+//! replaced by another (itself sealed) is refused too.
 
 use std::path::Path;
 
@@ -12,7 +16,7 @@ use sepval_predict::record::ConditionRecord;
 use crate::CampaignError;
 use crate::next::Planned;
 use crate::prior::Prior;
-use crate::state::Counts;
+use crate::state::{Assessed, Counts};
 
 /// The format of campaign.json.
 pub const CAMPAIGN_FORMAT: &str = "sepval-campaign/1";
@@ -20,8 +24,8 @@ pub const CAMPAIGN_FORMAT: &str = "sepval-campaign/1";
 pub const NEXT_FORMAT: &str = "sepval-campaign-next/1";
 /// The format of status.json.
 pub const STATUS_FORMAT: &str = "sepval-campaign-status/1";
-/// The largest record read \[bytes\].
-const MAX_RECORD_BYTES: u64 = 64 << 20;
+/// The format of a round's assessment.json.
+pub const ASSESSMENT_FORMAT: &str = "sepval-campaign-assessment/1";
 
 /// A file the campaign reads each time, with its SHA-256 when the campaign began.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -69,6 +73,8 @@ pub struct ReleaseRecord {
     pub given: String,
     /// The SHA-256 of the file given.
     pub sha256: String,
+    /// The SHA-256 of its copy in the campaign (`file`), checked whenever it is read.
+    pub copy_sha256: String,
     /// Its condition.
     pub condition: ConditionRecord,
     /// The round that added it.
@@ -77,6 +83,9 @@ pub struct ReleaseRecord {
     pub inside: bool,
     /// The post-flight check in one sentence.
     pub check: String,
+    /// What `add` said of it first: a condition outside the grid, a release made with
+    /// another scenario (empty when nothing).
+    pub notes: Vec<String>,
 }
 
 /// One round: the envelope after a number of releases.
@@ -92,6 +101,8 @@ pub struct RoundRecord {
     pub settled: bool,
     /// Its directory in the campaign (`rounds/NN`).
     pub dir: String,
+    /// The SHA-256 of its `assessment.json`, checked whenever it is read.
+    pub assessment_sha256: String,
     /// Samples its envelope flew: conditions times samples (the diagnosis's, the discrepancy's
     /// calibration's and the post-flight check's simulations are not counted).
     pub evaluations: u64,
@@ -164,35 +175,32 @@ pub fn record_error(path: &Path, message: impl std::fmt::Display) -> CampaignErr
     }
 }
 
-/// Writes `value` as pretty JSON to `path`, atomically.
-pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CampaignError> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| CampaignError::Record {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })? + "\n";
-    write_atomically(path, text.as_bytes()).map_err(|e| CampaignError::Record {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })
+/// A round's CAMP/rounds/NN/assessment.json: every condition of the grid, in grid order.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AssessmentFile {
+    /// [`ASSESSMENT_FORMAT`].
+    pub format: String,
+    /// The conditions.
+    pub conditions: Vec<Assessed>,
 }
 
-/// Reads the JSON record `path` whose format must be `format` (its `format` field).
-pub fn read_json<T: for<'de> Deserialize<'de>>(
-    path: &Path,
-    format: &str,
-) -> Result<T, CampaignError> {
-    let bad = |message: String| CampaignError::Record {
-        path: path.display().to_string(),
-        message,
-    };
-    let text = sepval_core::input_file::read_string(path, "campaign record", MAX_RECORD_BYTES)
-        .map_err(|e| bad(e.to_string()))?;
-    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
-    let found = value.get("format").and_then(|f| f.as_str()).unwrap_or("");
-    if found != format {
-        return Err(bad(format!(
-            "format `{found}`, expected `{format}`: not a record of this sepval's campaigns"
-        )));
+/// Writes `value` as pretty JSON to `path`, atomically (an output no command reads back).
+pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), CampaignError> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| record_error(path, e))? + "\n";
+    write_atomically(path, text.as_bytes()).map_err(|e| record_error(path, e))
+}
+
+/// Refuses the file at `path` unless its SHA-256 is `recorded` (campaign.json's): a release's
+/// copy or a round's assessment changed or replaced since the campaign wrote it.
+pub fn check_recorded(path: &Path, recorded: &str) -> Result<Vec<u8>, CampaignError> {
+    let bytes = std::fs::read(path).map_err(|e| record_error(path, e))?;
+    let now = sepval_common::scenario::hex_sha256(&bytes);
+    if now != recorded {
+        return Err(CampaignError::Changed {
+            path: path.display().to_string(),
+            recorded: recorded.to_string(),
+            now,
+        });
     }
-    serde_json::from_value(value).map_err(|e| bad(e.to_string()))
+    Ok(bytes)
 }

@@ -19,6 +19,8 @@ use sepval_common::synthetic::synthetic_flight_test;
 use sepval_core::cancel;
 use sepval_core::factors::Factors;
 
+use sepval_envelope::Grid;
+use sepval_predict::ClearanceSettings;
 use sepval_predict::record::ConditionRecord;
 use sepval_predict::releases;
 use sepval_solve::run::ProgressObserver;
@@ -26,8 +28,9 @@ use sepval_solve::run::ProgressObserver;
 use crate::CampaignError;
 use crate::assess::StartEvaluator;
 use crate::page::{self, RehearsalRelease, RehearsalRound, RehearsalSection};
-use crate::program::{Campaign, NewRelease};
+use crate::program::Campaign;
 use crate::record::{record_error, write_json};
+use crate::release::NewRelease;
 use crate::state::{Counts, State};
 
 /// The format of CAMP/rehearsal.json.
@@ -165,26 +168,45 @@ impl Rehearsal {
     }
 }
 
-/// The truth at every condition of the campaign's grid.
-pub fn truth_envelope(c: &Campaign, truth: &Truth) -> Result<Vec<TruthCondition>, CampaignError> {
+/// The truth at every condition of `grid` with `clearance`, computed before the campaign
+/// begins: a truth that does not fly a condition of the grid (its simulation diverges, or its
+/// trajectory cannot be traced against the aircraft) is refused, naming the condition, before
+/// anything is written (before 2026-12-01 it was found after the whole `init`, when the
+/// rehearsal planned a release there, and left a round-0 campaign behind).
+pub fn truth_envelope(
+    grid: &Grid,
+    clearance: &ClearanceSettings,
+    truth: &Truth,
+) -> Result<Vec<TruthCondition>, CampaignError> {
     let base = &truth.scenario;
     let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
-    let criterion_m = c.clearance.criterion_m;
-    (0..c.grid.len())
+    let criterion_m = clearance.criterion_m;
+    (0..grid.len())
         .map(|k| {
             cancel::check()?;
-            let s = c.grid.scenario(base, k);
-            let min_m = synthetic_flight_test(
+            let s = grid.scenario(base, k);
+            let f = &s.flight;
+            let refused = |what: String| {
+                CampaignError::Refused(format!(
+                    "the truth at Mach {}, altitude {} m, alpha {} deg (condition {} of the grid) {what}: a rehearsal's truth must fly every condition of its grid (check --truth-factors, --truth-effect and the grid)",
+                    page::number(f.mach),
+                    page::number(f.altitude_m),
+                    page::number(f.alpha_deg),
+                    k + 1
+                ))
+            };
+            let flown = synthetic_flight_test(
                 &Simulator::new(&s),
                 &truth.factors,
                 &truth.effects,
                 &times,
                 None,
             )
-            .ok()
-            .and_then(|t| releases::trace(&c.clearance, &t).ok())
-            .map(|tr| tr.min.distance_m)
-            .unwrap_or(f64::NAN);
+            .map_err(|e| refused(format!("does not fly ({e})")))?;
+            let min_m = releases::trace(clearance, &flown)
+                .map_err(|e| refused(format!("cannot be traced against the aircraft ({e})")))?
+                .min
+                .distance_m;
             Ok(TruthCondition {
                 condition: ConditionRecord::of(&s.flight),
                 min_clearance_mm: 1e3 * min_m,
@@ -213,18 +235,20 @@ fn against(c: &Campaign, truth: &[TruthCondition]) -> Result<RoundAgainstTruth, 
     })
 }
 
-/// Runs the rehearsal on the campaign `c` (begun with `init`); writes CAMP/rehearsal.json after
-/// every round.
+/// Runs the rehearsal on the campaign `c` (begun with `init`) against `truth`, whose envelope
+/// over the campaign's grid is `truth_at` ([`truth_envelope`]); writes CAMP/rehearsal.json
+/// after every round.
 pub fn rehearse(
     c: &mut Campaign,
     truth: &Truth,
+    truth_at: Vec<TruthCondition>,
     max_releases: usize,
     start: &mut StartEvaluator<'_>,
     observer: &mut dyn ProgressObserver,
 ) -> Result<Rehearsal, CampaignError> {
     let mut r = Rehearsal {
         format: REHEARSAL_FORMAT.into(),
-        truth: truth_envelope(c, truth)?,
+        truth: truth_at,
         flown: Vec::new(),
         rounds: Vec::new(),
         settled: c.file.settled,
@@ -265,6 +289,7 @@ pub fn rehearse(
             sha256: hex_sha256(&bytes),
             data,
             scenario: c.grid.scenario(&c.scenario, p.index),
+            notes: Vec::new(),
         };
         crate::add::add(c, vec![release], start, observer)?;
         r.rounds.push(against(c, &r.truth)?);

@@ -1,16 +1,36 @@
 //! `sepval campaign init` and `rehearse` as asked: the flags' values checked and read into the
 //! campaign's settings record and what `init` starts from ([`Init`]), before anything is
-//! written.
+//! written or allocated for the work.
+//!
+//! The work's limits, each refused with exit status 2 before anything is made (before
+//! 2026-12-01 `--samples 10000000` on a 2 x 2 grid grew to 4.5 GB and aborted, leaving the
+//! directory locked):
+//! - `--samples` from [`MIN_SAMPLES`] to [`sepval_predict::condition::MAX_SAMPLES`] per
+//!   condition (a prediction's most), and their trajectories at the band's points within
+//!   [`sepval_predict::condition::MAX_VALUE_BYTES`] (one condition is held at a time);
+//! - samples x conditions at most [`MAX_ROUND_SIMULATIONS`] (a round's envelope);
+//! - `--generations` within the genetic search's limits ([`sepval_solve::ga`]:
+//!   `MAX_GENERATIONS`, and `MAX_EVALUATIONS` at the study's population of 100).
 
 use std::path::Path;
 
 use sepval_fit::inputs;
 use sepval_predict::ClearanceSettings;
 
+use sepval_common::simulation::sample_times;
+use sepval_predict::condition::{MAX_SAMPLES, MAX_VALUE_BYTES};
+
 use crate::CampaignError;
 use crate::prior::Prior;
-use crate::program::{Init, input_record};
+use crate::program::{Init, grid_of, input_record};
 use crate::record::SettingsRecord;
+
+/// The fewest samples per condition: a probability of failing estimated from fewer is one
+/// sample's (1 / 20 = 0.05, the default allowed probability).
+pub const MIN_SAMPLES: usize = 20;
+/// The most simulations of one round's envelope (samples x conditions): 1e7, about an hour on
+/// the 2-core development machine through the SIMD lanes.
+pub const MAX_ROUND_SIMULATIONS: u64 = 10_000_000;
 
 /// The flags of `init` (and of `rehearse`, which begins as `init` does), as given.
 #[derive(Debug, Clone)]
@@ -42,13 +62,61 @@ pub struct InitRequest<'a> {
 }
 
 /// A probability flag in (0, 0.5).
-fn probability(flag: &str, p: f64) -> Result<f64, CampaignError> {
+fn probability(flag: &'static str, p: f64) -> Result<f64, CampaignError> {
     if !(p > 0.0 && p < 0.5) {
-        return Err(CampaignError::Refused(format!(
-            "{flag} {p}: expected a probability above 0 and below 0.5"
-        )));
+        return Err(CampaignError::Setting {
+            flag,
+            value: p.to_string(),
+            expected: "expected a probability above 0 and below 0.5".into(),
+        });
     }
     Ok(p)
+}
+
+/// Checks the work the flags ask for (module docs) against the grid of `conditions` and the
+/// `points` of a condition's band.
+fn check_work(
+    samples: usize,
+    generations: usize,
+    conditions: usize,
+    points: usize,
+) -> Result<(), CampaignError> {
+    let refuse = |flag, value: usize, expected: String| {
+        Err(CampaignError::Setting {
+            flag,
+            value: value.to_string(),
+            expected,
+        })
+    };
+    if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&samples) {
+        let expected = format!("expected {MIN_SAMPLES} to {MAX_SAMPLES} samples per condition");
+        return refuse("--samples", samples, expected);
+    }
+    let bytes = samples.saturating_mul(points).saturating_mul(6 * 8);
+    if bytes > MAX_VALUE_BYTES {
+        let expected = format!(
+            "{samples} samples of {points} band points take {bytes} bytes, above the {MAX_VALUE_BYTES} a condition may hold: give fewer samples"
+        );
+        return refuse("--samples", samples, expected);
+    }
+    let simulations = samples as u64 * conditions as u64;
+    if simulations > MAX_ROUND_SIMULATIONS {
+        let expected = format!(
+            "{samples} samples at each of {conditions} conditions are {simulations} simulations a round, above the limit of {MAX_ROUND_SIMULATIONS}: give fewer samples or a coarser grid"
+        );
+        return refuse("--samples", samples, expected);
+    }
+    let ga = sepval_solve::ga::GaSettings {
+        generations,
+        ..Default::default()
+    };
+    match ga.validate() {
+        Err(sepval_solve::ga::GaError::Setting { expected, .. }) => {
+            refuse("--generations", generations, expected.to_string())
+        }
+        Err(e) => refuse("--generations", generations, e.to_string()),
+        Ok(()) => Ok(()),
+    }
 }
 
 impl InitRequest<'_> {
@@ -57,12 +125,6 @@ impl InitRequest<'_> {
     pub fn read(&self) -> Result<Init, CampaignError> {
         let allowed = probability("--allowed", self.allowed)?;
         let fly_risk = probability("--fly-risk", self.fly_risk)?;
-        if self.samples < 20 {
-            return Err(CampaignError::Refused(format!(
-                "--samples {}: at least 20 samples per condition",
-                self.samples
-            )));
-        }
         let Some(aircraft) = self.aircraft else {
             return Err(CampaignError::Refused(
                 "--aircraft FILE is required: the aircraft's geometry (e.g. examples/geometry/aircraft.toml)".into(),
@@ -95,9 +157,14 @@ impl InitRequest<'_> {
             generations: self.generations,
             prior,
         };
+        let grid = grid_of(&settings, &scenario)?;
+        let times = sample_times(scenario.integrator.t_end_s, scenario.integrator.rate_hz);
+        let points = sepval_predict::simulate::Grid::of(&times).len();
+        check_work(self.samples, self.generations, grid.len(), points)?;
         Ok(Init {
             settings,
             scenario,
+            grid,
             clearance,
             threads: self.threads,
         })

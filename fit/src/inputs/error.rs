@@ -67,9 +67,12 @@ pub enum InputError {
         #[source]
         source: FactorError,
     },
-    /// An `--effect ID=V1,...` that names no effect or gives wrong values.
-    #[error("--effect {spec}")]
+    /// An `--effect ID=V1,...` (or `--truth-effect`) that names no effect or gives wrong
+    /// values.
+    #[error("{flag} {spec}")]
     Effect {
+        /// The flag.
+        flag: &'static str,
         /// The flag's value.
         spec: String,
         /// Why.

@@ -85,9 +85,15 @@ pub fn factors(spec: &str, table: &FactorTable) -> Result<Factors, InputError> {
 
 /// The effects of repeated `--effect ID=V1,V2,...` flags.
 pub fn effects(specs: &[String]) -> Result<EffectSet, InputError> {
+    effects_of("--effect", specs)
+}
+
+/// [`effects`] given with `flag` (`--truth-effect`), which its errors name.
+pub fn effects_of(flag: &'static str, specs: &[String]) -> Result<EffectSet, InputError> {
     let mut set = EffectSet::NONE;
     for spec in specs {
         set.push_spec(spec).map_err(|source| InputError::Effect {
+            flag,
             spec: spec.clone(),
             source,
         })?;

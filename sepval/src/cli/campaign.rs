@@ -101,6 +101,10 @@ pub struct CampaignAddArgs {
     /// A release flown (CSV with its condition in its metadata; repeatable).
     #[arg(long, value_name = "FILE.csv", required = true)]
     pub data: Vec<PathBuf>,
+    /// Accept a release whose `# scenario_sha256` names another scenario than the campaign's
+    /// (another simulation, or a flight, of the same store); it is recorded with a note.
+    #[arg(long)]
+    pub other_scenario: bool,
     #[command(flatten)]
     pub outliers: OutlierArgs,
     #[command(flatten)]

@@ -5,7 +5,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use sepval_campaign::page;
-use sepval_campaign::program::{Campaign, NewRelease};
+use sepval_campaign::program::{Campaign, Init};
+use sepval_campaign::release::NewRelease;
 use sepval_campaign::request::InitRequest;
 use sepval_fit::inputs;
 
@@ -29,18 +30,16 @@ pub fn run(c: CampaignCommand) -> Result<()> {
 
 fn init(a: CampaignInitArgs) -> Result<()> {
     let spec = evaluator_spec(&a.eval)?;
+    let init = request(&a)?;
     let mut start = starter(&spec);
-    let c = begin(&a, &mut start)?;
+    let c = begin(&a, init, &mut start)?;
     say!("campaign:  {}", page::headline(&c.file));
     say!("report:    {}", a.out.join("report.html").display());
     Ok(())
 }
 
-/// Checks the init flags and begins the campaign in --out.
-fn begin(
-    a: &CampaignInitArgs,
-    start: &mut sepval_campaign::StartEvaluator<'_>,
-) -> Result<Campaign> {
+/// Checks the init flags and reads what they name: what `init` begins from.
+fn request(a: &CampaignInitArgs) -> Result<Init> {
     let request = InitRequest {
         scenario: a.scenario.as_deref(),
         aircraft: a.geometry.aircraft.as_deref(),
@@ -60,7 +59,15 @@ fn begin(
         prior: a.prior.as_deref(),
         threads: count("--threads", a.eval.threads)?,
     };
-    let init = request.read()?;
+    Ok(request.read()?)
+}
+
+/// Begins the campaign of `init` in --out.
+fn begin(
+    a: &CampaignInitArgs,
+    init: Init,
+    start: &mut sepval_campaign::StartEvaluator<'_>,
+) -> Result<Campaign> {
     let c = sepval_campaign::program::init(&a.out, init, start, &mut *crate::front::progress())?;
     Ok(c)
 }
@@ -71,19 +78,23 @@ fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
         .context("--truth-scenario")?;
     let factors =
         inputs::factors(&a.truth_factors, &scenario.factors).context("--truth-factors")?;
-    let effects = inputs::effects(&a.truth_effect)?;
+    let effects = inputs::effects_of("--truth-effect", &a.truth_effect)?;
     let truth = sepval_campaign::rehearse::Truth {
         scenario,
         factors,
         effects,
         noise_seed: a.noise_seed,
     };
+    let init = request(&a.init)?;
+    // The truth over the grid before anything is written: one that does not fly is refused.
+    let truth_at = sepval_campaign::rehearse::truth_envelope(&init.grid, &init.clearance, &truth)?;
     let mut start = starter(&spec);
-    let mut c = begin(&a.init, &mut start)?;
+    let mut c = begin(&a.init, init, &mut start)?;
     say!("round 0:   {}", page::headline(&c.file));
     let r = sepval_campaign::rehearse::rehearse(
         &mut c,
         &truth,
+        truth_at,
         a.releases,
         &mut start,
         &mut *crate::front::progress(),
@@ -118,8 +129,11 @@ fn add(a: CampaignAddArgs) -> Result<()> {
     let policy = a.outliers.policy();
     let mut new = Vec::new();
     for p in &a.data {
-        let release = NewRelease::read(p, &c.scenario, policy, &mut tell())
+        let release = NewRelease::read(p, &c, policy, a.other_scenario, &mut tell())
             .with_context(|| format!("--data {}", p.display()))?;
+        for n in &release.notes {
+            say!("note:      {n}");
+        }
         new.push(release);
     }
     let mut start = starter(&spec);

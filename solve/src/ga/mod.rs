@@ -27,6 +27,17 @@ use crate::pareto::{dominates, non_dominated_fronts, rank_and_crowding, select_b
 use crate::rng::{RngState, RngStateError, SearchRng, seeded};
 use crate::run::{Ask, Progress, RunError, SearchError, Solver};
 
+/// The largest population: 100 000 chromosomes (the study's is 100). Each is held with its
+/// decoded values and outcome, so a population is allocated whole: a bound keeps a mistyped
+/// `--population` from exhausting memory.
+pub const MAX_POPULATION: usize = 100_000;
+/// The most generations of one search: 100 000 (the study's is 500).
+pub const MAX_GENERATIONS: usize = 100_000;
+/// The most evaluations of one search (population x generations): 1e8, about a day of
+/// simulations on the 2-core development machine (a simulation of the default event takes
+/// about 0.25-0.5 ms per core, docs/performance.md).
+pub const MAX_EVALUATIONS: u128 = 100_000_000;
+
 /// Settings of the genetic algorithm; the defaults are the study's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -100,8 +111,29 @@ impl GaSettings {
                 "expected an even number >= 2",
             );
         }
+        if self.population > MAX_POPULATION {
+            return bad(
+                "population",
+                self.population.to_string(),
+                "expected at most 100000 (MAX_POPULATION)",
+            );
+        }
         if self.generations < 1 {
             return bad("generations", "0".into(), "expected at least 1");
+        }
+        if self.generations > MAX_GENERATIONS {
+            return bad(
+                "generations",
+                self.generations.to_string(),
+                "expected at most 100000 (MAX_GENERATIONS)",
+            );
+        }
+        if self.population as u128 * self.generations as u128 > MAX_EVALUATIONS {
+            return bad(
+                "generations",
+                self.generations.to_string(),
+                "population x generations expected at most 1e8 evaluations (MAX_EVALUATIONS)",
+            );
         }
         for (name, p) in [
             ("p_crossover", self.p_crossover),
