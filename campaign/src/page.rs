@@ -82,6 +82,10 @@ pub struct RehearsalRelease {
     pub p_fail_planned: String,
     /// `safe` or `UNSAFE`: what the truth does there.
     pub truth: &'static str,
+    /// The plan's forecast of the conditions it settles.
+    pub expected_settled: String,
+    /// The conditions it settled.
+    pub settled: usize,
 }
 
 impl View<'_> {

@@ -84,6 +84,13 @@ pub struct FlownRelease {
     pub p_fail_planned: f64,
     /// Whether the truth clears there.
     pub truly_safe: bool,
+    /// The plan's forecast: how many of the undecided conditions it would settle
+    /// (`expected_settled` of next.json).
+    pub expected_settled: f64,
+    /// How many it settled: undecided in the round before it, cleared or failing after.
+    pub settled: usize,
+    /// How many conditions decided before it were undecided after.
+    pub unsettled: usize,
 }
 
 /// CAMP/rehearsal.json.
@@ -103,6 +110,15 @@ pub struct Rehearsal {
     pub words: String,
 }
 
+/// The plan's forecasts held against what the releases then did: the sums over the releases
+/// flown of `expected_settled` and of the conditions settled (docs/campaign.md, "Forecasts").
+pub fn forecast_totals(flown: &[FlownRelease]) -> (f64, usize) {
+    (
+        flown.iter().map(|f| f.expected_settled).sum(),
+        flown.iter().map(|f| f.settled).sum(),
+    )
+}
+
 impl Rehearsal {
     /// What `sepval campaign rehearse` says of it on the terminal: each release flown, each
     /// round against the truth, and the verdict.
@@ -110,13 +126,15 @@ impl Rehearsal {
         let mut out = Vec::new();
         for (k, f) in self.flown.iter().enumerate() {
             out.push(format!(
-                "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {})",
+                "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {}; expected to settle {:.1}, settled {})",
                 k + 1,
                 crate::page::number(f.condition.mach),
                 crate::page::number(f.condition.altitude_m),
                 crate::page::number(f.condition.alpha_deg),
                 f.p_fail_planned,
-                if f.truly_safe { "safe" } else { "UNSAFE" }
+                if f.truly_safe { "safe" } else { "UNSAFE" },
+                f.expected_settled,
+                f.settled
             ));
         }
         for round in &self.rounds {
@@ -162,6 +180,8 @@ impl Rehearsal {
                     alpha_deg: crate::page::number(f.condition.alpha_deg),
                     p_fail_planned: format!("{:.3}", f.p_fail_planned),
                     truth: if f.truly_safe { "safe" } else { "UNSAFE" },
+                    expected_settled: format!("{:.1}", f.expected_settled),
+                    settled: f.settled,
                 })
                 .collect(),
         }
@@ -279,11 +299,7 @@ pub fn rehearse(
         let path: PathBuf = flown_dir.join(format!("flown-{:02}.csv", k + 1));
         data.write(&path).map_err(|e| record_error(&path, e))?;
         let bytes = std::fs::read(&path).map_err(|e| record_error(&path, e))?;
-        r.flown.push(FlownRelease {
-            condition: ConditionRecord::of(&s.flight),
-            p_fail_planned: p.p_fail,
-            truly_safe: !r.truth[p.index].fails,
-        });
+        let before = c.current()?;
         let release = NewRelease {
             given: path,
             sha256: hex_sha256(&bytes),
@@ -292,13 +308,32 @@ pub fn rehearse(
             notes: Vec::new(),
         };
         crate::add::add(c, vec![release], start, observer)?;
+        let after = c.current()?;
+        let moved = |from: &dyn Fn(State) -> bool, to: &dyn Fn(State) -> bool| {
+            before
+                .iter()
+                .zip(&after)
+                .filter(|(b, a)| from(b.state) && to(a.state))
+                .count()
+        };
+        let undecided = |s: State| s == State::Undecided;
+        let decided = |s: State| s != State::Undecided;
+        r.flown.push(FlownRelease {
+            condition: ConditionRecord::of(&s.flight),
+            p_fail_planned: p.p_fail,
+            truly_safe: !r.truth[p.index].fails,
+            expected_settled: p.expected_settled,
+            settled: moved(&undecided, &decided),
+            unsettled: moved(&decided, &undecided),
+        });
         r.rounds.push(against(c, &r.truth)?);
         r.settled = c.file.settled;
         write_json(&c.dir.join("rehearsal.json"), &r)?;
     }
     let last = r.rounds.last().expect("round 0 is there");
+    let (expected, settled) = forecast_totals(&r.flown);
     r.words = format!(
-        "{} after {} release(s): cleared {}, fails {}, undecided {}; against the truth {} false clear(s), {} false fail(s); {} of the {} releases flown truly safe",
+        "{} after {} release(s): cleared {}, fails {}, undecided {}; against the truth {} false clear(s), {} false fail(s); {} of the {} releases flown truly safe; the plan expected them to settle {expected:.1} condition(s), they settled {settled}",
         if r.settled { "settled" } else { "not settled" },
         last.releases_flown,
         last.counts.cleared,

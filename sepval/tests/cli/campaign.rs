@@ -370,6 +370,39 @@ fn a_rehearsal_of_a_null_truth_settles_with_no_false_clear_or_fail() {
         assert_eq!(round["false_clears"], 0, "{round}");
         assert_eq!(round["false_fails"], 0, "{round}");
     }
+    forecasts_account_for_the_rounds(&r, &html);
+}
+
+/// Each release flown carries the plan's forecast and what it settled, and these account for
+/// the rounds: the conditions settled less those unsettled, release by release, are the
+/// undecided conditions the round before less those after.
+fn forecasts_account_for_the_rounds(r: &Value, html: &str) {
+    let rounds = r["rounds"].as_array().unwrap();
+    let undecided = |k: usize| rounds[k]["counts"]["undecided"].as_i64().unwrap();
+    for (k, f) in r["flown"].as_array().unwrap().iter().enumerate() {
+        let expected = f["expected_settled"].as_f64().unwrap();
+        assert!(expected >= 0.0, "{f}");
+        let net = f["settled"].as_i64().unwrap() - f["unsettled"].as_i64().unwrap();
+        assert_eq!(
+            net,
+            undecided(k) - undecided(k + 1),
+            "release {}: {r}",
+            k + 1
+        );
+        let row = format!(
+            "<td>{:.1}</td><td>{}</td></tr>",
+            expected,
+            f["settled"].as_i64().unwrap()
+        );
+        assert!(html.contains(&row), "{row} not in the page");
+    }
+    assert!(
+        r["words"]
+            .as_str()
+            .unwrap()
+            .contains("the plan expected them to settle"),
+        "{r}"
+    );
 }
 
 #[test]
