@@ -23,6 +23,7 @@
 
 pub mod add;
 pub mod assess;
+pub mod begin;
 mod journal;
 pub mod next;
 pub mod page;

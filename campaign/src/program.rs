@@ -29,6 +29,7 @@ use sepval_predict::record::ConditionRecord;
 use sepval_solve::run::ProgressObserver;
 
 use crate::assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};
+use crate::begin::Narrowing;
 use crate::next::{Criteria, Plan, plan};
 use crate::record::record_error;
 use crate::record::{
@@ -379,21 +380,40 @@ impl Campaign {
         crate::seal::read_round(&self.dir, last)
     }
 
-    /// The plan of `count` releases from the current round.
-    pub fn plan(&self, count: usize) -> Result<Plan, CampaignError> {
+    /// The plan of `count` releases from the current round, and the round's narrowing when
+    /// nothing is safe to fly under the prior (its words in the plan's).
+    pub fn plan(&self, count: usize) -> Result<(Plan, Option<Narrowing>), CampaignError> {
         let flown: Vec<_> = self
             .file
             .releases
             .iter()
             .map(|r| r.condition.flight())
             .collect();
-        Ok(plan(
-            &self.grid,
-            &self.current()?,
-            &flown,
-            self.criteria(),
-            count,
-        ))
+        let last = self.file.rounds.last().ok_or_else(|| {
+            record_error(
+                &self.dir,
+                "holds no round: the campaign's init did not finish",
+            )
+        })?;
+        let file = crate::seal::read_round_file(&self.dir, last)?;
+        let mut p = plan(&self.grid, &file.conditions, &flown, self.criteria(), count);
+        let narrowing = file
+            .narrowing
+            .filter(|n| p.least_risky.as_ref().is_some_and(|l| l.index == n.index));
+        if let (Some(n), Some(l)) = (&narrowing, p.least_risky.as_mut()) {
+            let words = n.words();
+            l.why = format!("{}; {words}", l.why);
+            let f = self.grid.flight(l.index);
+            p.words = format!(
+                "{}; at the least risky (Mach {}, altitude {} m, alpha {} deg, P(fail) {:.3}) {words}",
+                p.words,
+                page::number(f.mach),
+                page::number(f.altitude_m),
+                page::number(f.alpha_deg),
+                l.p_fail
+            );
+        }
+        Ok((p, narrowing))
     }
 
     /// What `sepval campaign status` says: the answer, in words, and the releases next.json
@@ -418,7 +438,7 @@ impl Campaign {
 
     /// Plans `count` releases and writes next.json.
     pub fn next(&self, count: usize) -> Result<NextFile, CampaignError> {
-        let p = self.plan(count)?;
+        let (p, narrowing) = self.plan(count)?;
         let next = NextFile {
             format: NEXT_FORMAT.into(),
             round: self.file.rounds.len() - 1,
@@ -426,10 +446,33 @@ impl Campaign {
             least_risky: p.least_risky,
             settled: p.settled,
             words: p.words,
+            narrowing,
         };
         write_sealed(&self.dir.join("next.json"), &next)?;
         page::render(&self.view())?;
         Ok(next)
+    }
+
+    /// Under the prior (`model` unfitted) with no condition of `assessed` safe to fly: what
+    /// would make the least risky safe to fly ([`crate::begin`]).
+    fn narrowing(
+        &self,
+        model: &Model,
+        assessed: &[Assessed],
+        start: &mut StartEvaluator<'_>,
+    ) -> Result<Option<Narrowing>, CampaignError> {
+        let fly_risk = self.file.settings.fly_risk;
+        let least = (0..assessed.len())
+            .min_by(|&a, &b| assessed[a].row.p_fail.total_cmp(&assessed[b].row.p_fail));
+        let Some(k) =
+            least.filter(|&k| model.fitted.is_none() && assessed[k].row.p_fail > fly_risk)
+        else {
+            return Ok(None);
+        };
+        let p_fail = assessed[k].row.p_fail;
+        let at = (&self.grid, &self.scenario);
+        let settings = self.assess_settings();
+        crate::begin::narrowing(model, at, k, &settings, (p_fail, fly_risk), start).map(Some)
     }
 
     /// A new round from `model`: the envelope assessed and staged, then committed.
@@ -453,9 +496,11 @@ impl Campaign {
             start,
             observer,
         )?;
+        let narrowing = self.narrowing(model, &assessed, start)?;
         let file = AssessmentFile {
             format: ASSESSMENT_FORMAT.into(),
             conditions: assessed,
+            narrowing,
         };
         let assessment = staged.join("assessment.json");
         let assessment_sha256 = write_sealed(&assessment, &file)?;
@@ -483,7 +528,7 @@ impl Campaign {
             evaluations: (self.grid.len() * self.file.settings.samples) as u64,
             wall_s: t0.elapsed().as_secs_f64(),
         });
-        let p = self.plan(1)?;
+        let (p, _) = self.plan(1)?;
         let last = self.file.rounds.last_mut().expect("pushed above");
         last.settled = p.settled;
         self.file.settled = p.settled;

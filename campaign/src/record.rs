@@ -14,6 +14,7 @@ use sepval_core::atomic_file::write_atomically;
 use sepval_predict::record::ConditionRecord;
 
 use crate::CampaignError;
+use crate::begin::Narrowing;
 use crate::next::Planned;
 use crate::prior::Prior;
 use crate::state::{Assessed, Counts};
@@ -165,6 +166,9 @@ pub struct NextFile {
     pub settled: bool,
     /// In words.
     pub words: String,
+    /// When none is safe to fly under the prior: what would make the least risky safe to fly.
+    #[serde(default)]
+    pub narrowing: Option<Narrowing>,
 }
 
 /// The error of a file or directory of the campaign.
@@ -182,6 +186,10 @@ pub struct AssessmentFile {
     pub format: String,
     /// The conditions.
     pub conditions: Vec<Assessed>,
+    /// Under the prior with no condition safe to fly: what would make the least risky safe to
+    /// fly ([`crate::begin`]).
+    #[serde(default)]
+    pub narrowing: Option<Narrowing>,
 }
 
 /// Writes `value` as pretty JSON to `path`, atomically (an output no command reads back).

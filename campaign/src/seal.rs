@@ -144,6 +144,11 @@ pub fn read_sealed<T: DeserializeOwned>(path: &Path, format: &str) -> Result<T, 
 /// The envelope of round `r` of the campaign in `dir`: its assessment.json, sealed and the one
 /// campaign.json records.
 pub fn read_round(dir: &Path, r: &RoundRecord) -> Result<Vec<Assessed>, CampaignError> {
+    read_round_file(dir, r).map(|f| f.conditions)
+}
+
+/// [`read_round`], the whole file (with the narrowing the prior's round may hold).
+pub fn read_round_file(dir: &Path, r: &RoundRecord) -> Result<AssessmentFile, CampaignError> {
     let path = dir.join(&r.dir).join("assessment.json");
     // The seal first, which names the part edited; then the hash, which refuses a round's
     // assessment replaced whole by another (itself sealed).
@@ -160,7 +165,7 @@ pub fn read_round(dir: &Path, r: &RoundRecord) -> Result<Vec<Assessed>, Campaign
             ),
         ));
     }
-    Ok(file.conditions)
+    Ok(file)
 }
 
 #[cfg(test)]

@@ -537,3 +537,65 @@ fn an_add_interrupted_by_sigterm_leaves_the_campaign_as_it_was() {
         "the interrupted add changed the campaign"
     );
 }
+
+/// The 3 x 3 grid of the narrowing tests: Mach 0.6 to 1.0, alpha -4 to 8 deg.
+const GRID_3X3: [&str; 2] = ["0.6:1.0:3", "-4:8:3"];
+
+/// When nothing is safe to fly under the default prior, `next` names the factor whose spread
+/// makes the least risky condition risky and how narrow it must be known; a campaign begun
+/// from that narrower prior (other draws: another seed) then has a condition safe to fly. And
+/// when the prior's mean itself fails, it says that no narrowing helps.
+#[test]
+fn with_nothing_safe_to_fly_next_names_the_narrowing_that_makes_one_safe_and_it_does() {
+    // Three envelopes of 9 conditions at 1 000 samples: 25 s on 2 threads (2026-12-01).
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let threads = ["--evaluator", "inproc", "--threads", "2"];
+    init_on(dir, "wide", GRID_3X3, "112", "1000", &threads);
+    ok(&sepval(&["campaign", "next", "wide"], dir));
+    let next = json(&dir.join("wide/next.json"));
+    assert_eq!(next["releases"].as_array().unwrap().len(), 0, "{next}");
+    let n = &next["narrowing"];
+    assert_eq!(n["mean_clears"], true, "{next}");
+    let first = &n["factors"][0];
+    let sd = first["sd_needed"]
+        .as_f64()
+        .expect("a factor that suffices alone");
+    let factor = first["factor"].as_str().unwrap();
+    let words = next["words"].as_str().unwrap();
+    assert!(
+        words.contains(&format!("with {factor} known to sd")),
+        "{words}"
+    );
+    let camp = json(&dir.join("wide/campaign.json"));
+    let mean = camp["settings"]["prior"]["factors"][factor]["mean"].clone();
+    let prior = format!(
+        r#"{{"format":"sepval-prior/1","factors":{{"{factor}":{{"mean":{mean},"sd":{sd}}}}}}}"#
+    );
+    std::fs::write(dir.join("narrow.json"), prior).unwrap();
+    let narrow = [&threads[..], &["--prior", "narrow.json", "--seed", "2"]].concat();
+    init_on(dir, "narrow", GRID_3X3, "112", "1000", &narrow);
+    ok(&sepval(&["campaign", "next", "narrow"], dir));
+    let next = json(&dir.join("narrow/next.json"));
+    let releases = next["releases"].as_array().unwrap();
+    assert!(
+        !releases.is_empty(),
+        "the narrowing promised did not hold: {next}"
+    );
+    assert!(releases[0]["p_fail"].as_f64().unwrap() <= 0.01, "{next}");
+    // A criterion the prior's mean does not meet at any condition: no narrowing helps.
+    init_on(dir, "far", GRID_3X3, "125", "200", &threads);
+    ok(&sepval(&["campaign", "next", "far"], dir));
+    let next = json(&dir.join("far/next.json"));
+    assert_eq!(next["narrowing"]["mean_clears"], false, "{next}");
+    assert!(
+        next["words"]
+            .as_str()
+            .unwrap()
+            .contains("even the prior's mean fails to clear"),
+        "{next}"
+    );
+}
