@@ -6,7 +6,7 @@
 //! of order at their line, and a dangling or looping link given as `--out` is named as such.
 
 use super::hardening_on_disk::fit;
-use sepval_tests::refused;
+use sepval_tests::{refused, sepval};
 
 /// A telemetry file of 40 samples with `comments` above its header.
 fn telemetry(comments: &str) -> String {
@@ -33,4 +33,35 @@ fn metadata_given_twice_with_different_values_is_refused_naming_both_lines() {
     );
     assert!(!stderr.contains("defect"), "{stderr}");
     assert!(!d.join("F").exists());
+}
+
+#[test]
+fn a_grid_axis_of_one_point_with_lo_below_hi_is_refused_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Refused as the flags are parsed: no --from needs to exist.
+    let stderr = refused(
+        &sepval(
+            &[
+                "envelope",
+                "--mach",
+                "0.6:1.2:1",
+                "--from",
+                "nowhere",
+                "--aircraft",
+                "a.toml",
+                "--out",
+                "E",
+            ],
+            d,
+        ),
+        "--mach",
+    );
+    assert!(
+        stderr.contains(
+            "N = 1 holds the axis at one value, so HI 1.2 would be dropped: give 0.6:0.6:1 to hold it at 0.6, or N of 2 or more to sweep from 0.6 to 1.2"
+        ),
+        "{stderr}"
+    );
+    assert!(!d.join("E").exists());
 }
