@@ -5,8 +5,10 @@
 //! properly; a flowfield excursion is said with its unit, shuffled table rows are said to be out
 //! of order at their line, and a dangling or looping link given as `--out` is named as such.
 
-use super::hardening_on_disk::fit;
-use sepval_tests::{refused, sepval};
+use std::path::Path;
+
+use super::hardening_on_disk::{fit, snapshot};
+use sepval_tests::{ok, refused, sepval};
 
 /// A telemetry file of 40 samples with `comments` above its header.
 fn telemetry(comments: &str) -> String {
@@ -64,4 +66,97 @@ fn a_grid_axis_of_one_point_with_lo_below_hi_is_refused_naming_the_flag() {
         "{stderr}"
     );
     assert!(!d.join("E").exists());
+}
+
+/// Turns the ended run in `f` into what a `fit --overwrite` killed outright (SIGKILL) after it
+/// wrote its first checkpoint leaves: the earlier run moved whole into `f/.sepval-replaced`,
+/// the killed run's marker without a manifest, one checkpoint of its own and its lock naming
+/// a process that is gone.
+fn kill_mid_overwrite(f: &Path) {
+    let aside = f.join(".sepval-replaced");
+    std::fs::create_dir(&aside).unwrap();
+    for e in std::fs::read_dir(f).unwrap() {
+        let name = e.unwrap().file_name();
+        if name != ".sepval-replaced" {
+            std::fs::rename(f.join(&name), aside.join(&name)).unwrap();
+        }
+    }
+    std::fs::create_dir(f.join("generations")).unwrap();
+    std::fs::copy(
+        aside.join("generations/gen-0001.json"),
+        f.join("generations/gen-0001.json"),
+    )
+    .unwrap();
+    std::fs::write(
+        f.join(".sepval-run"),
+        "{\n  \"format\": \"sepval-run/2\",\n  \"command\": \"fit\"\n}\n",
+    )
+    .unwrap();
+    std::fs::write(f.join(".sepval-lock"), "999999999\n").unwrap();
+}
+
+#[test]
+fn after_a_killed_overwrite_every_message_names_the_earlier_run_and_overwrite_replaces_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    ok(&fit(d, "2", &["--out", "F"]));
+    let earlier = snapshot(&d.join("F"));
+    kill_mid_overwrite(&d.join("F"));
+    let killed = snapshot(&d.join("F"));
+    let put_back = "to put it back, remove everything in F but .sepval-replaced, then move what \
+                    F/.sepval-replaced holds (its .sepval-run too) into F and remove it";
+    // A fresh run, a resume of the killed run and the advice of each: where the earlier run is
+    // and how to put it back, never `rm -r F`.
+    for (extra, expected) in [
+        (
+            &[][..],
+            "F is not empty: an --overwrite run of `fit` into it was killed before it ended, and the earlier run it was replacing is whole in F/.sepval-replaced; give --overwrite to discard the killed run and replace the earlier one",
+        ),
+        (
+            &["--resume", "F/generations/gen-0001.json"][..],
+            "not resuming in F: an --overwrite run of `fit` into it was killed before it ended, and the earlier run it was replacing is whole in F/.sepval-replaced; to resume the killed run, remove the earlier one first (rm -r F/.sepval-replaced)",
+        ),
+    ] {
+        let stderr = refused(&fit(d, "2", &[&["--out", "F"], extra].concat()), expected);
+        assert!(stderr.contains(put_back), "{stderr}");
+        assert!(!stderr.contains("rm -r F "), "{stderr}");
+        assert!(snapshot(&d.join("F")) == killed, "{extra:?}: F changed");
+    }
+    // A second --overwrite discards the killed run and replaces the earlier one.
+    ok(&fit(d, "2", &["--out", "F", "--overwrite"]));
+    let after = snapshot(&d.join("F"));
+    assert!(!d.join("F/.sepval-replaced").exists());
+    assert!(after.contains_key("result.json"), "{:?}", after.keys());
+    let marker = String::from_utf8_lossy(&after[".sepval-run"]).into_owned();
+    assert!(marker.contains("\"result.json\": \""), "{marker}");
+    assert_eq!(
+        after.keys().collect::<Vec<_>>(),
+        earlier.keys().collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn a_dangling_or_looping_link_as_out_is_named_and_not_written_through() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::os::unix::fs::symlink("nowhere", d.join("dangling")).unwrap();
+    std::os::unix::fs::symlink("loop", d.join("loop")).unwrap();
+    for (out, what) in [
+        (
+            "dangling",
+            "dangling is a symbolic link to nowhere, which does not exist (a dangling link)",
+        ),
+        (
+            "loop",
+            "loop is a symbolic link that never resolves (a link loop)",
+        ),
+    ] {
+        let stderr = refused(&fit(d, "1", &["--out", out]), what);
+        assert!(
+            stderr.contains("sepval will not write through it"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("File exists"), "{stderr}");
+    }
+    assert!(!d.join("nowhere").exists());
 }
