@@ -136,6 +136,41 @@ fn after_a_killed_overwrite_every_message_names_the_earlier_run_and_overwrite_re
 }
 
 #[test]
+fn a_flowfield_excursion_is_said_with_its_unit_and_shuffled_rows_by_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/flowfield-store");
+    std::fs::copy(examples.join("grid.toml"), d.join("grid.toml")).unwrap();
+    let grid = std::fs::read_to_string(examples.join("field-grid.csv")).unwrap();
+    std::fs::write(d.join("field-grid.csv"), &grid).unwrap();
+    let args = ["simulate", "--scenario", "grid.toml", "--strict-tables"];
+    let stderr = refused(
+        &sepval(&[&args[..], &["--out", "s.csv"]].concat(), d),
+        "x_m by up to 2.27",
+    );
+    assert!(
+        stderr.contains(" m beyond [-3, 3] m (nothing written)"),
+        "{stderr}"
+    );
+    // Line 10 (the second row, z = 0.5) swapped with line 20 (y = 0): z seems to have one
+    // breakpoint, but the rows are out of order, and that is what is said.
+    let mut lines: Vec<&str> = grid.lines().collect();
+    assert!(lines[9].starts_with("-3.0,-1.0,0.5,"), "{}", lines[9]);
+    lines.swap(9, 19);
+    std::fs::write(d.join("field-grid.csv"), lines.join("\n") + "\n").unwrap();
+    let stderr = refused(
+        &sepval(
+            &["simulate", "--scenario", "grid.toml", "--out", "s.csv"],
+            d,
+        ),
+        "field-grid.csv: line 10, column",
+    );
+    assert!(stderr.contains("the rows are out of order"), "{stderr}");
+    assert!(!stderr.contains("has 1 breakpoint"), "{stderr}");
+    assert!(!d.join("s.csv").exists());
+}
+
+#[test]
 fn a_dangling_or_looping_link_as_out_is_named_and_not_written_through() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
