@@ -1,5 +1,5 @@
 //! The envelope's grid: each axis given as `LO:HI:N` (N values from LO to HI, evenly spaced;
-//! N = 1 holds the axis at LO), the conditions their product around the condition of the
+//! N = 1 holds the axis at LO, and so is refused unless LO = HI: `0.6:1.2:1` would drop HI), the conditions their product around the condition of the
 //! source's first release (an axis not given stays there), each range checked as a plan's is
 //! (`sepval_fit::conditions`: finite, ordered, a condition the scenario can fly, within the
 //! model's domain and its tables' breakpoints, `sepval_fit::domain`). At most [`MAX_CONDITIONS`] conditions and [`MAX_POINTS`]
@@ -81,6 +81,14 @@ impl Axis {
         }
         if points > 1 && lo >= hi {
             return Err(bad("with N > 1, LO must be below HI"));
+        }
+        if points == 1 && lo.to_bits() != hi.to_bits() {
+            let (lo_text, hi_text) = (parts[0], parts[1]);
+            return Err(bad(&format!(
+                "N = 1 holds the axis at one value, so HI {hi_text} would be dropped: give \
+                 {lo_text}:{lo_text}:1 to hold it at {lo_text}, or N of 2 or more to sweep from \
+                 {lo_text} to {hi_text}"
+            )));
         }
         Ok(Axis {
             range: Range { quantity, lo, hi },
@@ -181,11 +189,21 @@ mod tests {
             "x:0.9:3",
             "0.6:0.9:2.5",
             "0.6:nan:3",
+            "0.6:1.2:1",
+            "1.2:0.6:1",
         ] {
             let e = Axis::parse(Quantity::Mach, bad).unwrap_err().to_string();
             assert!(e.starts_with(&format!("--mach {bad}")), "{e}");
         }
         assert!(Axis::parse(Quantity::AltitudeM, "3000:3000:1").is_ok());
+        let e = Axis::parse(Quantity::Mach, "0.6:1.2:1")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "--mach 0.6:1.2:1: N = 1 holds the axis at one value, so HI 1.2 would be dropped: give \
+             0.6:0.6:1 to hold it at 0.6, or N of 2 or more to sweep from 0.6 to 1.2"
+        );
     }
 
     #[test]

@@ -203,6 +203,17 @@ impl Conditions {
                 });
             }
             check_range(base, &r)?;
+            if n == 1 && r.hi > r.lo {
+                return Err(ConditionError::Points {
+                    points: n,
+                    message: format!(
+                        "{} {}:{} with 1 point would be held at LO and drop HI: give 2 or more points to sweep it, or LO:LO to hold it",
+                        q.flag(),
+                        Shown(r.lo),
+                        Shown(r.hi)
+                    ),
+                });
+            }
             let n = if r.hi > r.lo { n } else { 1 };
             points = points.max(n);
             let values = (0..n)
@@ -338,6 +349,13 @@ mod tests {
         assert!(e(range(Quantity::Mach, -0.5, 0.6)).starts_with("--mach -0.5:0.6"));
         assert!(e(range(Quantity::AltitudeM, 0.0, f64::NAN)).contains("finite"));
         assert!(e(range(Quantity::AlphaDeg, 0.0, 95.0)).starts_with("--alpha-deg"));
+        let one = Conditions::grid(&s, &[range(Quantity::Mach, 0.5, 0.9)], 1).unwrap_err();
+        assert_eq!(
+            one.to_string(),
+            "--points 1: --mach 0.5:0.9 with 1 point would be held at LO and drop HI: give 2 or more points to sweep it, or LO:LO to hold it"
+        );
+        let held = Conditions::grid(&s, &[range(Quantity::Mach, 0.7, 0.7)], 1).unwrap();
+        assert_eq!(held.list.len(), 1);
         let points = Conditions::grid(&s, &[range(Quantity::Mach, 0.5, 0.9)], 0).unwrap_err();
         assert!(points.to_string().starts_with("--points 0"), "{points}");
         let five: Vec<Range> = Quantity::ALL.iter().map(|&q| range(q, 0.5, 0.6)).collect();

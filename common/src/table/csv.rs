@@ -368,6 +368,9 @@ impl Header {
                 r += stride;
             }
             if breakpoints[j].len() < 2 {
+                if let Some(e) = self.out_of_order(rows, j, r) {
+                    return Err(e);
+                }
                 return Err(self.grid_error(
                     rows,
                     0,
@@ -381,6 +384,29 @@ impl Header {
             stride *= breakpoints[j].len();
         }
         Ok(breakpoints)
+    }
+
+    /// Rows out of row-major order, when axis `j` seemed to have one breakpoint but takes
+    /// another value in a later row: the row `r` where a slower axis changed too early (or the
+    /// first row with another value of axis `j`) named, rather than "1 breakpoint".
+    fn out_of_order(&self, rows: &Rows, j: usize, r: usize) -> Option<TableError> {
+        let first = rows[0].1[j].to_bits();
+        let other = rows.iter().position(|(_, v)| v[j].to_bits() != first)?;
+        let (at, i) = match (0..j)
+            .find(|&i| r < rows.len() && rows[r].1[i].to_bits() != rows[0].1[i].to_bits())
+        {
+            Some(i) => (r, i),
+            None => (other, j),
+        };
+        Some(self.grid_error(
+            rows,
+            at,
+            i,
+            format!(
+                "the rows are out of order: {} changes here before {} has gone through its breakpoints (rows list every grid point in row-major order, the first axis slowest, the last fastest): sort them so",
+                self.names[i], self.names[j]
+            ),
+        ))
     }
 
     /// The table: the grid complete and in row-major order, the chosen column's values.

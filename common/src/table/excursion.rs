@@ -116,12 +116,23 @@ impl fmt::Display for TableExcursion {
             self.table, self.evaluations_outside, self.evaluations
         )?;
         for a in &self.axes {
+            let unit = a.unit().map(|u| format!(" {u}")).unwrap_or_default();
             write!(
                 f,
-                "; {} up to {} beyond [{}, {}]",
+                "; {} by up to {}{unit} beyond [{}, {}]{unit}",
                 a.variable, a.worst_excursion, a.range[0], a.range[1]
             )?;
         }
         Ok(())
+    }
+}
+
+impl AxisExcursion {
+    /// The unit of the variable, from its name (`x_m`: m, `alpha_deg`: deg; `mach`: none).
+    pub fn unit(&self) -> Option<&str> {
+        let (_, unit) = self.variable.rsplit_once('_')?;
+        ["m", "deg", "rad", "s", "ft"]
+            .contains(&unit)
+            .then_some(unit)
     }
 }

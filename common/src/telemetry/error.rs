@@ -187,6 +187,24 @@ pub enum TelemetryError {
         /// Which bound.
         kind: Bound,
     },
+    /// A metadata key given twice with different values (which one was meant cannot be told).
+    #[error(
+        "{file}: line {line}: metadata `{key}` is given twice with different values: `{value}` here, `{first_value}` at line {first_line}; give it once"
+    )]
+    MetadataTwice {
+        /// The file.
+        file: String,
+        /// The line of the second value.
+        line: usize,
+        /// The key.
+        key: String,
+        /// The second value.
+        value: String,
+        /// The line of the first value.
+        first_line: usize,
+        /// The first value.
+        first_value: String,
+    },
     /// Time not strictly increasing.
     #[error(
         "{file}: line {line}, column {column} (`t_s`): time {t_s} s is not after the previous sample's {previous_s} s (times must increase strictly)"

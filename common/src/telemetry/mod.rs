@@ -4,7 +4,9 @@
 //! z_m, roll_deg, pitch_deg, yaw_deg` (any order; positions may be `x_ft, y_ft, z_ft`), then one
 //! row per sample, time strictly increasing. Lines starting with `#` are comments; a comment of
 //! the form `# key = value` or `# key: value` is also kept as metadata (for example the event
-//! name or its flight condition).
+//! name or its flight condition). A key given twice must have the same value both times: `#
+//! mach = 1.2` then `# mach = 0.6` is refused, naming both lines (which one was meant cannot be
+//! told); the same value given again is accepted.
 //!
 //! Choices made here:
 //! - Columns for other quantities (a header whose quantity is not t, x, y, z, roll, pitch or
@@ -114,7 +116,8 @@ impl Trajectory {
         self.times_s.is_empty()
     }
 
-    /// The value of metadata `key`, if present (the last one wins).
+    /// The value of metadata `key`, if present (a key read from a file has one value, however
+    /// often it is given; of entries pushed with different values, the last one wins).
     pub fn meta(&self, key: &str) -> Option<&str> {
         self.metadata
             .iter()
@@ -167,6 +170,7 @@ impl Trajectory {
         let file = file.to_string();
         let mut out = Trajectory::default();
         let mut sample_lines = Vec::new();
+        let mut metadata_lines = Vec::new();
         let mut header: Option<Header> = None;
         for (i, raw) in lines.enumerate() {
             let line = i + 1;
@@ -188,7 +192,9 @@ impl Trajectory {
                 let comment = comment.trim();
                 out.comments.push(comment.to_string());
                 if let Some((k, v)) = split_metadata(comment) {
+                    check_repeated(&out.metadata, &metadata_lines, (&k, &v), line, &file)?;
                     out.metadata.push((k, v));
+                    metadata_lines.push(line);
                 }
                 continue;
             }
@@ -439,6 +445,31 @@ fn split_fields<'a>(
             Ok(inner.trim())
         })
         .collect()
+}
+
+/// Refuses metadata `key = value` on `line` when an earlier entry (`metadata`, read on
+/// `lines`) gives the key another value.
+fn check_repeated(
+    metadata: &[(String, String)],
+    lines: &[usize],
+    (key, value): (&str, &str),
+    line: usize,
+    file: &str,
+) -> Result<(), TelemetryError> {
+    let earlier = metadata.iter().zip(lines).find(|((k, _), _)| k == key);
+    match earlier {
+        Some(((_, first_value), &first_line)) if first_value != value => {
+            Err(TelemetryError::MetadataTwice {
+                file: file.to_string(),
+                line,
+                key: key.to_string(),
+                value: value.to_string(),
+                first_line,
+                first_value: first_value.clone(),
+            })
+        }
+        _ => Ok(()),
+    }
 }
 
 fn split_metadata(comment: &str) -> Option<(String, String)> {

@@ -257,6 +257,14 @@ fn bad_table_files_are_refused_with_file_line_and_column() {
         ),
         "t.csv: line 4, column 2 (`alpha [deg]`): breakpoints are not strictly increasing: 3 after 5 (rows are in row-major order, the first axis slowest)"
     );
+    // Rows out of order (the first axis fastest): said so at the row, not "1 breakpoint".
+    assert_eq!(
+        refused(
+            "mach [-],alpha [deg],cz [-]\n0.5,0,0\n0.9,0,0\n0.5,5,1\n0.9,5,1\n",
+            Kind::Static
+        ),
+        "t.csv: line 3, column 1 (`mach [-]`): the rows are out of order: mach [-] changes here before alpha [deg] has gone through its breakpoints (rows list every grid point in row-major order, the first axis slowest, the last fastest): sort them so"
+    );
     assert_eq!(
         refused("mach [-],cz [-]\n0.5,0\n0.9,NaN\n", Kind::Static),
         "t.csv: line 3, column 2 (`cz [-]`): expected a finite number, found `NaN`"

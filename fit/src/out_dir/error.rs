@@ -100,6 +100,33 @@ pub enum OutDirError {
         /// Why its marker lists no files.
         why: String,
     },
+    /// A directory an `--overwrite` run was killed in (`replaced`): where the earlier run is,
+    /// and how to go on or put it back.
+    #[error("{message}")]
+    Interrupted {
+        /// The directory.
+        path: PathBuf,
+        /// What happened, what to do, and how to put the earlier run back.
+        message: String,
+    },
+    /// An `--out` that is a symbolic link to nothing.
+    #[error(
+        "{path} is a symbolic link to {target}, which does not exist (a dangling link): sepval will not write through it; remove the link, or give another --out"
+    )]
+    DanglingLink {
+        /// The link.
+        path: PathBuf,
+        /// What it points to.
+        target: PathBuf,
+    },
+    /// An `--out` that is a symbolic link that never resolves.
+    #[error(
+        "{path} is a symbolic link that never resolves (a link loop): sepval will not write through it; remove the link, or give another --out"
+    )]
+    LinkLoop {
+        /// The link.
+        path: PathBuf,
+    },
     /// An output file that is a directory.
     #[error("{path} is a directory: give the name of the file to write (in it, or anywhere)")]
     FileIsDirectory {

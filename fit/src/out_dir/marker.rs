@@ -102,6 +102,20 @@ fn write(dir: &Path, marker: &Marker) -> Result<(), OutDirError> {
     })
 }
 
+/// The command of `dir`'s marker and whether it has a manifest (its run ended), when it is a
+/// marker this sepval reads.
+pub(super) fn command_of(dir: &Path) -> Option<(String, bool)> {
+    let text = sepval_core::input_file::read_string(
+        &dir.join(MARKER_FILE),
+        "run marker",
+        sepval_core::limits::MAX_JSON_BYTES,
+    )
+    .ok()?;
+    let m: Marker = serde_json::from_str(&text).ok()?;
+    let ended = m.files.is_some() && m.directories.is_some();
+    Some((m.command, ended))
+}
+
 /// Whether `dir`, which holds `entries` besides its lock and marker, may be cleared: only when
 /// its marker's manifest lists every one of them, each file unchanged.
 pub(super) fn check_clearable(dir: &Path, entries: &[String]) -> Result<(), OutDirError> {

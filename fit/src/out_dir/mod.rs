@@ -14,6 +14,15 @@
 //! continuation of a resumed run, and writes the marker. When the run ends (the [`RunDir`]
 //! dropped, on success or error), the marker gets the manifest of what the directory holds.
 //!
+//! An `--overwrite` moves the earlier run into `DIR/.sepval-replaced` ([`REPLACED`]), removed
+//! when the new run commits and put back when it fails. A run killed outright leaves it there:
+//! a second `--overwrite` discards the killed run's files and replaces the earlier run, and
+//! every other use of the directory is refused saying where the earlier run is and how to put
+//! it back (`replaced`).
+//!
+//! An `--out` that is a dangling symbolic link or a link loop is refused as such: nothing is
+//! written through it.
+//!
 //! Files: `DIR/.sepval-lock` (the holder's process id; removed when the run ends, left behind
 //! only by a killed process, and then taken over once that process is gone) and
 //! `DIR/.sepval-run` (the marker: which command made the directory, and its manifest).
@@ -22,6 +31,7 @@ mod error;
 mod inputs;
 mod lock;
 mod marker;
+mod replaced;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -116,19 +126,7 @@ impl RunDir {
             _ => Vec::new(),
         };
         inputs::check(path, inputs, &allowed)?;
-        let mut created = false;
-        match std::fs::metadata(path) {
-            Ok(m) if !m.is_dir() => {
-                return Err(OutDirError::NotADirectory {
-                    path: path.to_path_buf(),
-                });
-            }
-            Ok(_) => {}
-            Err(_) => {
-                std::fs::create_dir_all(path).map_err(io("cannot create", path))?;
-                created = true;
-            }
-        }
+        let created = make_dir(path)?;
         let lock = path.join(LOCK_FILE);
         let notice = match lock::take_lock(path, &lock) {
             Ok(notice) => notice,
@@ -152,6 +150,10 @@ impl RunDir {
         };
         // From here on the lock is ours (released when `dir` drops, on error too).
         let others = entries(path)?;
+        if let Some(killed) = replaced::killed(path, command) {
+            replaced::check(path, &claim, &killed)?;
+            return Ok(dir);
+        }
         match claim {
             Claim::Fresh => {
                 if let Some(first) = others.first() {
@@ -216,10 +218,18 @@ impl RunDir {
         let removed = match &self.claim {
             Claim::Fresh => Vec::new(),
             Claim::Overwrite => {
-                let others = entries(&self.path)?;
-                marker::check_clearable(&self.path, &others)?;
-                if !others.is_empty() {
-                    self.move_aside(&others)?;
+                if let Some(killed) = replaced::killed(&self.path, &self.command) {
+                    // Checked again, as late as possible; the earlier run, already aside, is
+                    // the one this run replaces (put back if it fails).
+                    replaced::check(&self.path, &self.claim, &killed)?;
+                    self.replaced.store(true, Ordering::Relaxed);
+                    replaced::discard_killed(&self.path)?;
+                } else {
+                    let others = entries(&self.path)?;
+                    marker::check_clearable(&self.path, &others)?;
+                    if !others.is_empty() {
+                        self.move_aside(&others)?;
+                    }
                 }
                 Vec::new()
             }
@@ -311,6 +321,43 @@ impl Drop for RunDir {
             let _ = marker::write_ended(&self.path, &self.command);
         }
         let _ = std::fs::remove_file(&self.lock);
+    }
+}
+
+/// Makes the directory `path` unless it is one; whether it was made. A path that is not a
+/// directory, or a link that does not resolve, is refused.
+fn make_dir(path: &Path) -> Result<bool, OutDirError> {
+    check_link(path)?;
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_dir() => Err(OutDirError::NotADirectory {
+            path: path.to_path_buf(),
+        }),
+        Ok(_) => Ok(false),
+        Err(_) => {
+            std::fs::create_dir_all(path).map_err(io("cannot create", path))?;
+            Ok(true)
+        }
+    }
+}
+
+/// Refuses an `--out` that is a symbolic link which does not resolve (to nothing, or in a
+/// loop): creating the directory would fail or write where the link points.
+fn check_link(path: &Path) -> Result<(), OutDirError> {
+    let is_link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link {
+        return Ok(());
+    }
+    match std::fs::metadata(path) {
+        Ok(_) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(OutDirError::DanglingLink {
+            path: path.to_path_buf(),
+            target: std::fs::read_link(path).unwrap_or_default(),
+        }),
+        // ELOOP: too many levels of symbolic links.
+        Err(e) if e.raw_os_error() == Some(40) => Err(OutDirError::LinkLoop {
+            path: path.to_path_buf(),
+        }),
+        Err(e) => Err(io("cannot resolve the link", path)(e)),
     }
 }
 
@@ -537,6 +584,99 @@ mod tests {
             std::fs::read_to_string(d.join("result.json")).unwrap(),
             "new result"
         );
+    }
+
+    /// A run that holds `d` killed outright (SIGKILL) after writing `partial.json`: nothing of
+    /// its drop runs, and its lock names a process that is gone.
+    fn killed(d: &Path, run: RunDir) {
+        std::fs::write(d.join("partial.json"), "killed").unwrap();
+        std::mem::forget(run);
+        std::fs::write(d.join(LOCK_FILE), "999999999\n").unwrap();
+    }
+
+    #[test]
+    fn after_an_overwrite_killed_outright_a_second_one_replaces_the_earlier_run() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path().join("run");
+        let claim = |c: Claim| RunDir::claim(&d, request("fit", c));
+        let first = claim(Claim::Fresh).unwrap();
+        first.prepare().unwrap();
+        std::fs::write(d.join("result.json"), "old result").unwrap();
+        first.commit();
+        let marker = std::fs::read_to_string(d.join(MARKER_FILE)).unwrap();
+        let run = claim(Claim::Overwrite).unwrap();
+        run.prepare().unwrap();
+        killed(&d, run);
+        // A fresh run and a resume are refused, saying where the earlier run is.
+        let resume = Claim::Resume {
+            checkpoint: d.join("generations/gen-0001.json"),
+            generation: 1,
+        };
+        for c in [Claim::Fresh, resume] {
+            let e = claim(c).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!(
+                    "the earlier run it was replacing is whole in {}",
+                    d.join(REPLACED).display()
+                )) && e.contains("; to put it back, remove everything in"),
+                "{e}"
+            );
+            assert!(d.join("partial.json").exists());
+        }
+        // A second overwrite that fails: the earlier run returns as it was, the killed run's
+        // file gone.
+        let again = claim(Claim::Overwrite).unwrap();
+        again.prepare().unwrap();
+        assert!(!d.join("partial.json").exists() && d.join(REPLACED).is_dir());
+        std::fs::write(d.join("mine.json"), "new").unwrap();
+        drop(again);
+        assert_eq!(
+            std::fs::read_to_string(d.join("result.json")).unwrap(),
+            "old result"
+        );
+        assert_eq!(
+            std::fs::read_to_string(d.join(MARKER_FILE)).unwrap(),
+            marker
+        );
+        assert!(!d.join("mine.json").exists() && !d.join(REPLACED).exists());
+        // Killed again, then one that commits: the new run alone.
+        let run = claim(Claim::Overwrite).unwrap();
+        run.prepare().unwrap();
+        killed(&d, run);
+        let last = claim(Claim::Overwrite).unwrap();
+        last.prepare().unwrap();
+        std::fs::write(d.join("result.json"), "new result").unwrap();
+        last.commit();
+        assert!(!d.join(REPLACED).exists() && !d.join("partial.json").exists());
+        assert_eq!(
+            std::fs::read_to_string(d.join("result.json")).unwrap(),
+            "new result"
+        );
+        // Killed while moving the earlier run aside (its marker not yet moved): refused,
+        // nothing removed.
+        std::fs::create_dir(d.join(REPLACED)).unwrap();
+        std::fs::rename(d.join("result.json"), d.join(REPLACED).join("result.json")).unwrap();
+        let e = claim(Claim::Overwrite).unwrap_err().to_string();
+        assert!(e.contains("partly in") && e.contains("move what"), "{e}");
+        assert!(d.join(REPLACED).join("result.json").exists());
+    }
+
+    #[test]
+    fn a_dangling_or_looping_link_is_refused_as_such() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dangling = tmp.path().join("dangling");
+        std::os::unix::fs::symlink(tmp.path().join("nowhere"), &dangling).unwrap();
+        let e = RunDir::claim(&dangling, request("fit", Claim::Fresh)).unwrap_err();
+        assert!(
+            matches!(e, OutDirError::DanglingLink { .. })
+                && e.to_string().contains("sepval will not write through it"),
+            "{e}"
+        );
+        let looping = tmp.path().join("loop");
+        std::os::unix::fs::symlink(&looping, &looping).unwrap();
+        let e = RunDir::claim(&looping, request("fit", Claim::Overwrite)).unwrap_err();
+        assert!(matches!(e, OutDirError::LinkLoop { .. }), "{e}");
+        assert!(!tmp.path().join("nowhere").exists());
     }
 
     #[test]

@@ -204,7 +204,10 @@ fn tables_left_are_reported_and_refused_with_strict_tables() {
         "{stderr}"
     );
     let d = diagnosis_in(dir.path());
-    assert!(d["tables_left"].to_string().contains("mach up to"), "{d}");
+    assert!(
+        d["tables_left"].to_string().contains("mach by up to"),
+        "{d}"
+    );
     let earlier = std::fs::read(dir.path().join("diag/diagnosis.json")).unwrap();
     let out = diagnose_in(
         dir.path(),

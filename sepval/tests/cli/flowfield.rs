@@ -171,7 +171,7 @@ fn a_surveyed_field_simulates_as_written_and_a_bad_one_is_refused_with_nothing_w
     // edge and said, as a coefficient's table left is; refused with --strict-tables, nothing
     // written; a release that stays inside (0.3 s) says nothing.
     let left =
-        "left table `flowfield` in 49 of 201 samples (value held at the edge); x_m up to 2.27";
+        "left table `flowfield` in 49 of 201 samples (value held at the edge); x_m by up to 2.27";
     assert!(told.contains(&format!("warning: {left}")), "{told}");
     let strict = ["simulate", "--scenario", "grid.toml", "--strict-tables"];
     let stderr = refused(
@@ -179,7 +179,7 @@ fn a_surveyed_field_simulates_as_written_and_a_bad_one_is_refused_with_nothing_w
         &format!("--strict-tables: the run {left}"),
     );
     assert!(
-        stderr.contains("beyond [-3, 3] (nothing written)"),
+        stderr.contains(" m beyond [-3, 3] m (nothing written)"),
         "{stderr}"
     );
     assert!(!d.join("s.csv").exists());

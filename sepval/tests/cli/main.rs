@@ -27,6 +27,7 @@ mod hardening3_out;
 mod hardening3_records;
 mod hardening3_releases;
 mod hardening5_campaign;
+mod hardening5_inputs;
 mod hardening_on_disk;
 mod jobs;
 mod plan;

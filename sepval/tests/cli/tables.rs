@@ -198,7 +198,8 @@ fn leaving_a_table_is_reported_or_refused() {
     ok(&out);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("warning: left table `aero.cz` in ") && stderr.contains("alpha_deg up to "),
+        stderr.contains("warning: left table `aero.cz` in ")
+            && stderr.contains("alpha_deg by up to "),
         "{stderr}"
     );
     std::fs::remove_file(d.join("o.csv")).unwrap();

@@ -117,3 +117,31 @@ fn tables_are_checked() {
         "has no distance axis: an interference increment is tabulated over distance at least"
     );
 }
+
+#[test]
+fn an_excursion_is_said_as_an_excess_with_its_unit() {
+    let axis = |variable: &str, range: [f64; 2], worst_excursion: f64| {
+        sepval_common::table::AxisExcursion {
+            variable: variable.into(),
+            range,
+            worst_excursion,
+        }
+    };
+    let e = sepval_common::table::TableExcursion {
+        table: "flowfield".into(),
+        evaluations_outside: 49,
+        evaluations: 201,
+        axes: vec![
+            axis("x_m", [-3.0, 3.0], 2.28),
+            axis("alpha_deg", [-10.0, 10.0], 1.5),
+            axis("mach", [0.4, 1.6], 0.1),
+        ],
+        at_samples: true,
+    };
+    assert_eq!(
+        e.to_string(),
+        "left table `flowfield` in 49 of 201 samples (value held at the edge); x_m by up to \
+         2.28 m beyond [-3, 3] m; alpha_deg by up to 1.5 deg beyond [-10, 10] deg; mach by up \
+         to 0.1 beyond [0.4, 1.6]"
+    );
+}

@@ -26,6 +26,21 @@ fn reads_metadata_and_samples() {
 }
 
 #[test]
+fn a_metadata_key_given_twice_must_keep_its_value() {
+    // Another value: refused, naming both lines (`#` and `:` forms alike).
+    let twice = format!("# mach = 1.2\n# free: text\n# mach: 0.6\n{}", &GOOD[42..]);
+    assert_eq!(
+        err(&twice),
+        "f.csv: line 3: metadata `mach` is given twice with different values: `0.6` here, `1.2` at line 1; give it once"
+    );
+    // The same value again: accepted, one value.
+    let same = format!("# mach = 0.95\n{GOOD}");
+    let t = Trajectory::parse(&same, "f.csv").unwrap();
+    assert_eq!(t.meta("mach"), Some("0.95"));
+    assert_eq!(t.metadata.len(), 3);
+}
+
+#[test]
 fn feet_are_converted_and_columns_may_be_reordered() {
     let text = "yaw_deg,t_s,x_ft,y_ft,z_ft,roll_deg,pitch_deg,mach\n3,0.5,1,2,10,1,2,0.9\n";
     let t = Trajectory::parse(text, "f.csv").unwrap();
