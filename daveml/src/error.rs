@@ -57,6 +57,21 @@ pub enum DavemlError {
         /// The XML parser's message, with its line and column.
         message: String,
     },
+    /// The file's DOCTYPE declares an entity (internal or external, general or parameter):
+    /// refused before the XML parser sees the text (docs/daveml.md section 1).
+    #[error(
+        "{file} line {line}: the DOCTYPE declares the {kind} `{name}`: sepval reads DAVE-ML without entity declarations (the standard needs none; an entity expanded many times would take gigabytes to parse); expand or remove it"
+    )]
+    Entity {
+        /// The file.
+        file: String,
+        /// The line of the `<!ENTITY` (from 1).
+        line: u32,
+        /// `entity` or `parameter entity`.
+        kind: &'static str,
+        /// The entity's name.
+        name: String,
+    },
     /// An element of the file that sepval cannot read or represent.
     #[error("{place}: {message}")]
     At {

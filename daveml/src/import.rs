@@ -12,7 +12,8 @@
 use std::collections::BTreeMap;
 
 use sepval_common::correction::Target;
-use sepval_common::table::{Axis, Kind, Table, Variable};
+use sepval_common::table::{Axis, Kind, Table, Variable, unit_suffix};
+use sepval_core::number_text::Shown;
 
 use crate::error::{DavemlError, Place};
 use crate::map::{Map, Output, Role};
@@ -432,6 +433,8 @@ fn axis(
             ),
         ));
     }
+    let breakpoints: Vec<f64> = b.iter().map(|&x| c.apply(x)).collect();
+    in_domain(&bp.place, bp_id, &i.var_id, variable, b, &breakpoints)?;
     let (lo, hi) = (b.first().copied(), b.last().copied());
     let inside = |(min, max): (Option<f64>, Option<f64>)| {
         min.zip(lo).is_some_and(|(x, e)| x > e) || max.zip(hi).is_some_and(|(x, e)| x < e)
@@ -456,8 +459,44 @@ fn axis(
     }
     Ok(AxisIn {
         variable,
-        breakpoints: b.iter().map(|&x| c.apply(x)).collect(),
+        breakpoints,
     })
+}
+
+/// Refuses a breakpoint set (`file` as the file gives it, `converted` to sepval's unit) with a
+/// breakpoint outside its variable's domain: the same range as the TOML and CSV forms'
+/// ([`Variable::domain`]).
+fn in_domain(
+    at: &Place,
+    bp_id: &str,
+    var_id: &str,
+    v: Variable,
+    file: &[f64],
+    converted: &[f64],
+) -> Result<(), DavemlError> {
+    let (lo, hi, why) = v.domain();
+    let Some((x, y)) = file
+        .iter()
+        .zip(converted)
+        .find(|&(_, y)| !(lo..=hi).contains(y))
+    else {
+        return Ok(());
+    };
+    let unit = unit_suffix(v);
+    let shown = if x.to_bits() == y.to_bits() {
+        format!("{x:?}")
+    } else {
+        format!("{x:?} ({y:?}{unit})")
+    };
+    Err(DavemlError::at(
+        at,
+        format!(
+            "breakpoint set `{bp_id}` of `{var_id}` (sepval's {0}): breakpoint {shown} is outside {0}'s domain, {1} to {2}{unit} ({why})",
+            v.csv_name(),
+            Shown(lo),
+            Shown(hi),
+        ),
+    ))
 }
 
 /// The axes put in sepval's nesting order for `kind`, the values permuted with them.

@@ -27,6 +27,7 @@
 pub mod assemble;
 pub mod bands;
 pub mod check;
+pub mod doctype;
 pub mod error;
 pub mod export;
 pub mod import;

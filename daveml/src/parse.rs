@@ -164,8 +164,10 @@ pub struct Parsed {
 /// elements.
 const NODES_LIMIT: u32 = 4_000_000;
 
-/// Parses DAVE-ML `text` (from `file`, for messages).
+/// Parses DAVE-ML `text` (from `file`, for messages), after refusing any entity declaration
+/// ([`crate::doctype`]).
 pub fn parse(text: &str, file: &str) -> Result<Parsed, DavemlError> {
+    crate::doctype::refuse_entities(text, file)?;
     let options = ParsingOptions {
         allow_dtd: true,
         nodes_limit: NODES_LIMIT,

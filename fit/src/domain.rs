@@ -18,8 +18,8 @@ use sepval_common::atmosphere::isa_troposphere;
 use sepval_common::scenario::{Flight, Scenario};
 use sepval_common::table::{Coefficient, Variable};
 
-/// The largest Mach number of the model's domain.
-pub const MAX_MACH: f64 = 3.0;
+/// The largest Mach number of the model's domain (one constant with the tables' Mach domain).
+pub use sepval_core::limits::MAX_MACH;
 /// The largest aircraft alpha and beta of the model's domain, either sign \[deg\].
 pub const MAX_ANGLE_DEG: f64 = 30.0;
 /// "Far" in Mach: beyond the releases' Mach span by more than this.

@@ -40,6 +40,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use sepval_core::limits::{MAX_MACH, MAX_POSITION_M};
+use sepval_core::number_text::Shown;
 use sepval_core::units::{M_PER_FT, M_PER_IN};
 
 pub use sepval_core::limits::MAX_TABLE_VALUES;
@@ -129,6 +131,23 @@ impl Variable {
                 ("ft", Conversion::Scale(M_PER_FT)),
                 ("in", Conversion::Scale(M_PER_IN)),
             ],
+        }
+    }
+
+    /// The values its breakpoints may take, in [`Variable::unit`], and where the range comes
+    /// from (docs/model.md section 1, "Tables"): a table's breakpoints outside it are refused,
+    /// whichever form (inline TOML, CSV, DAVE-ML) gives them.
+    pub fn domain(self) -> (f64, f64, &'static str) {
+        let position = "a position within +-MAX_POSITION_M of carriage, core/src/limits.rs";
+        let mach = "the model's domain, docs/model.md section 1; 0 is a table's edge";
+        match self {
+            Variable::Mach => (0.0, MAX_MACH, mach),
+            Variable::Alpha => (-180.0, 180.0, "alpha = atan2(w, u)"),
+            Variable::Beta => (-90.0, 90.0, "beta = asin(v / V)"),
+            Variable::Distance => (0.0, MAX_POSITION_M, "|r| >= 0, within MAX_POSITION_M"),
+            Variable::Lateral | Variable::X | Variable::Y | Variable::Z => {
+                (-MAX_POSITION_M, MAX_POSITION_M, position)
+            }
         }
     }
 
@@ -391,6 +410,17 @@ fn check_breakpoints(v: Variable, b: &[f64]) -> Result<(), String> {
                 v.csv_name()
             ));
         }
+        let (lo, hi, why) = v.domain();
+        if !(lo..=hi).contains(x) {
+            return Err(format!(
+                "axis {0} breakpoint {1} is outside {0}'s domain, {2} to {3}{4} ({why})",
+                v.csv_name(),
+                Shown(*x),
+                Shown(lo),
+                Shown(hi),
+                unit_suffix(v)
+            ));
+        }
         if k > 0 && *x <= b[k - 1] {
             return Err(format!(
                 "axis {} breakpoints are not strictly increasing: {x} after {}",
@@ -413,6 +443,15 @@ fn check_breakpoints(v: Variable, b: &[f64]) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// ` deg`, ` m`, or nothing for Mach: the unit after a number in a message.
+pub fn unit_suffix(v: Variable) -> &'static str {
+    match v.unit() {
+        "-" => "",
+        "deg" => " deg",
+        _ => " m",
+    }
 }
 
 /// A reference to a CSV table file, relative to the scenario file.

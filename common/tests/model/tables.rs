@@ -222,6 +222,39 @@ fn interpolation_in_mach_alpha_and_lateral_offset() {
         ),
         "{e}"
     );
+    // Breakpoints outside the variable's domain (docs/model.md section 1, "Tables"): the same
+    // limits as a DAVE-ML file's (docs/daveml.md).
+    for (bad, said) in [
+        (
+            "cm_q_per_rad = { mach = [-5.0, 1.5], values = [-80.0, -80.0] }",
+            "axis mach breakpoint -5 is outside mach's domain, 0 to 3",
+        ),
+        (
+            "cm_q_per_rad = { mach = [0.5, 1e200], values = [-80.0, -80.0] }",
+            "axis mach breakpoint 1e200 is outside mach's domain, 0 to 3",
+        ),
+        (
+            "dcm0 = { distance_m = [0.0, 5.0], lateral_m = [-1e6, 1.0], values = [[-1.5, -1.5], [0.0, 0.0]] }",
+            "axis lateral breakpoint -1000000 is outside lateral's domain, -100000 to 100000 m",
+        ),
+    ] {
+        let field = bad.split_once(' ').unwrap().0;
+        let old = if field == "dcm0" {
+            "dcm0 = -1.50"
+        } else {
+            "cm_q_per_rad = -80.0"
+        };
+        let text = sepval_common::scenario::DEFAULT_SCENARIO_TOML.replace(old, bad);
+        assert_ne!(text, sepval_common::scenario::DEFAULT_SCENARIO_TOML);
+        let e = Scenario::from_toml_str(&text, "x.toml").unwrap_err();
+        let chain = format!(
+            "{e} {}",
+            std::error::Error::source(&e)
+                .map(|s| s.to_string())
+                .unwrap_or_default()
+        );
+        assert!(chain.contains(said), "{chain}");
+    }
     // Ragged inline rows.
     let bad = "cz = { mach = [0.5, 1.0], alpha_deg = [-10.0, 0.0, 10.0], values = [[1.0, 0.0, -1.0], [1.0, -1.0]] }";
     let e = Scenario::from_toml_str(

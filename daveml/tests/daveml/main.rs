@@ -5,6 +5,7 @@
 
 #![allow(clippy::float_cmp)] // the round trip compares bits on purpose
 
+mod entities;
 mod import;
 mod refusals;
 mod round_trip;

@@ -190,3 +190,51 @@ fn limits_sepval_cannot_honour_are_refused_at_their_variable() {
     let map = load_map(Some(&fixture("other_tool.toml"))).unwrap();
     import_model(&text, "t.dml", &map, &Scenario::embedded_default()).unwrap();
 }
+
+/// The error of the fixture without its `checkData` and its one `min`/`max` (so nothing but
+/// the domain can refuse it), with `from` replaced by `to`.
+fn unchecked(from: &str, to: &str) -> Result<sepval_daveml::ImportedModel, DavemlError> {
+    let text = fixture_text("other_tool.dml");
+    let (head, rest) = text.split_once("  <checkData>").unwrap();
+    let (_, tail) = rest.split_once("</checkData>").unwrap();
+    let text = format!("{head}{tail}").replacen(" min=\"0.6\" max=\"1.2\"", "", 1);
+    assert!(!text.contains("min=") && text.contains(from), "{from}");
+    let map = load_map(Some(&fixture("other_tool.toml"))).unwrap();
+    import_model(
+        &text.replacen(from, to, 1),
+        "t.dml",
+        &map,
+        &Scenario::embedded_default(),
+    )
+}
+
+fn refused_unchecked(from: &str, to: &str) -> String {
+    unchecked(from, to).unwrap_err().to_string()
+}
+
+#[test]
+fn breakpoints_outside_the_models_domain_are_refused_at_their_set() {
+    let e = refused_unchecked("0.6, 0.9, 1.2", "-5, 0.9, 1.2");
+    assert!(
+        e.starts_with("t.dml line 26, <breakpointDef>: breakpoint set `MACH_bp` of `MACH` (sepval's mach): breakpoint -5.0 is outside mach's domain, 0 to 3 ("),
+        "{e}"
+    );
+    let e = refused_unchecked("0.6, 0.9, 1.2", "0.6, 0.9, 1e200");
+    assert!(
+        e.contains("breakpoint 1e200 is outside mach's domain, 0 to 3"),
+        "{e}"
+    );
+    // In the file's unit, and in sepval's: 4 rad is 229 deg, beyond atan2's range.
+    let e = refused_unchecked("-0.2 0.0 0.2", "-0.2 0.0 4.0");
+    assert!(
+        e.starts_with("t.dml line 30, <breakpointDef>: breakpoint set `ALPHA_bp` of `alprad` (sepval's alpha): breakpoint 4.0 (229.1831180523293 deg) is outside alpha's domain, -180 to 180 deg ("),
+        "{e}"
+    );
+    let e = refused_unchecked("0, 5, 10, 30", "-1, 5, 10, 30");
+    assert!(
+        e.contains("breakpoint -1.0 (-0.3048 m) is outside distance's domain, 0 to 100000 m"),
+        "{e}"
+    );
+    // The domain's edges are inside.
+    unchecked("0.6, 0.9, 1.2", "0, 0.9, 3").unwrap();
+}

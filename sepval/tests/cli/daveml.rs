@@ -180,3 +180,42 @@ fn daveml_bad_files_are_refused_and_nothing_is_written() {
         ["big.dml", "not.dml", "t.dml", "wrong.dml", "x"]
     );
 }
+
+#[test]
+fn daveml_entity_declarations_are_refused_before_parsing() {
+    // An entity of 10 kB used 2000 times (20 MB once expanded; the review's 1 MB file expanded
+    // to 4 GB and aborted): refused at its declaration with exit 2, nothing written.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = std::fs::read_to_string(fixture("other_tool.dml"))
+        .unwrap()
+        .replacen(
+            "<DAVEfunc",
+            &format!(
+                "<!DOCTYPE DAVEfunc [<!ENTITY big \"{}\">]>\n<DAVEfunc",
+                "x".repeat(10_000)
+            ),
+            1,
+        )
+        .replacen(
+            "<fileVersion>Rev A",
+            &format!("<fileVersion>{}", "&big;".repeat(2_000)),
+            1,
+        );
+    std::fs::write(d.join("amp.dml"), text).unwrap();
+    let map = fixture("other_tool.toml");
+    let args = [
+        "scenario",
+        "--from-daveml",
+        "amp.dml",
+        "--map",
+        map.to_str().unwrap(),
+        "--out",
+        "x",
+    ];
+    refused(
+        &sepval(&args, d),
+        "amp.dml line 7: the DOCTYPE declares the entity `big`: sepval reads DAVE-ML without entity declarations",
+    );
+    assert_eq!(entries(d), ["amp.dml"], "nothing written");
+}
