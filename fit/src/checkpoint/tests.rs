@@ -493,18 +493,22 @@ fn counts_that_overflow_are_refused_not_wrapped() {
         ),
         "{err}"
     );
-    // A generation whose count of simulations wraps to the one recorded.
+    // Generations beyond the search's limit (sepval_solve::ga::MAX_GENERATIONS) are refused
+    // as a setting, before any count is made of them.
     let mut c = checkpoint(&job, 3, true);
     c.settings.generations = usize::MAX;
+    c.save(&path).unwrap();
+    let err = refusal(&path, &job).unwrap();
+    assert!(err.contains("expected at most 100000 (MAX_GENERATIONS)"), "{err}");
+    // A generation whose count of simulations would wrap is past the settings' generations,
+    // which the limit above keeps at most 100 000: refused as such.
+    let mut c = checkpoint(&job, 3, true);
     c.state.generation = 1 << 63;
     c.state.evaluations = 0;
     c.save(&path).unwrap();
     let err = refusal(&path, &job).unwrap();
     assert!(
-        err.contains(
-            "0 simulations recorded, but 9223372036854775808 generations of 6 make \
-             55340232221128654848"
-        ),
+        err.contains("generation 9223372036854775808: expected 1 to the settings' 3 generations"),
         "{err}"
     );
 }
