@@ -499,7 +499,10 @@ fn counts_that_overflow_are_refused_not_wrapped() {
     c.settings.generations = usize::MAX;
     c.save(&path).unwrap();
     let err = refusal(&path, &job).unwrap();
-    assert!(err.contains("expected at most 100000 (MAX_GENERATIONS)"), "{err}");
+    assert!(
+        err.contains("expected at most 100000 (MAX_GENERATIONS)"),
+        "{err}"
+    );
     // A generation whose count of simulations would wrap is past the settings' generations,
     // which the limit above keeps at most 100 000: refused as such.
     let mut c = checkpoint(&job, 3, true);
