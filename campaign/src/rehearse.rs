@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use sepval_common::effects::EffectSet;
 use sepval_common::scenario::{Scenario, hex_sha256};
-use sepval_common::simulation::{Simulator, sample_times};
+use sepval_common::simulation::{SimError, Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
 use sepval_core::cancel;
 use sepval_core::factors::Factors;
@@ -53,7 +53,7 @@ pub struct Truth {
 pub struct TruthCondition {
     /// The condition.
     pub condition: ConditionRecord,
-    /// Its smallest clearance without noise \[mm\] (null: it diverged).
+    /// Its smallest clearance without noise \[mm\] (`"nan"`: it diverged, the store tumbles).
     #[serde(with = "sepval_core::nonfinite")]
     pub min_clearance_mm: f64,
     /// Whether it fails to clear (below the criterion, or diverged).
@@ -189,10 +189,11 @@ impl Rehearsal {
 }
 
 /// The truth at every condition of `grid` with `clearance`, computed before the campaign
-/// begins: a truth that does not fly a condition of the grid (its simulation diverges, or its
-/// trajectory cannot be traced against the aircraft) is refused, naming the condition, before
-/// anything is written (before 2026-12-01 it was found after the whole `init`, when the
-/// rehearsal planned a release there, and left a round-0 campaign behind).
+/// begins. Where the truth's simulation diverges the store tumbles: that condition fails
+/// (its smallest clearance null), as a store that tumbles off its rack fails in flight. A
+/// truth that flies none of the grid's conditions, or whose trajectory cannot be traced
+/// against the aircraft, is refused before anything is written, naming the condition (before
+/// 2026-12-01 it was found after the whole `init` and left a round-0 campaign behind).
 pub fn truth_envelope(
     grid: &Grid,
     clearance: &ClearanceSettings,
@@ -201,39 +202,60 @@ pub fn truth_envelope(
     let base = &truth.scenario;
     let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
     let criterion_m = clearance.criterion_m;
-    (0..grid.len())
+    let mut first_tumble: Option<String> = None;
+    let envelope = (0..grid.len())
         .map(|k| {
             cancel::check()?;
             let s = grid.scenario(base, k);
             let f = &s.flight;
+            let at = format!(
+                "the truth at Mach {}, altitude {} m, alpha {} deg (condition {} of the grid)",
+                page::number(f.mach),
+                page::number(f.altitude_m),
+                page::number(f.alpha_deg),
+                k + 1
+            );
             let refused = |what: String| {
                 CampaignError::Refused(format!(
-                    "the truth at Mach {}, altitude {} m, alpha {} deg (condition {} of the grid) {what}: a rehearsal's truth must fly every condition of its grid (check --truth-factors, --truth-effect and the grid)",
-                    page::number(f.mach),
-                    page::number(f.altitude_m),
-                    page::number(f.alpha_deg),
-                    k + 1
+                    "{at} {what}: a rehearsal's truth must be traced at every condition of its grid (check --truth-factors, --truth-effect and the grid)"
                 ))
             };
-            let flown = synthetic_flight_test(
+            let min_m = match synthetic_flight_test(
                 &Simulator::new(&s),
                 &truth.factors,
                 &truth.effects,
                 &times,
                 None,
-            )
-            .map_err(|e| refused(format!("does not fly ({e})")))?;
-            let min_m = releases::trace(clearance, &flown)
-                .map_err(|e| refused(format!("cannot be traced against the aircraft ({e})")))?
-                .min
-                .distance_m;
+            ) {
+                Ok(flown) => {
+                    releases::trace(clearance, &flown)
+                        .map_err(|e| {
+                            refused(format!("cannot be traced against the aircraft ({e})"))
+                        })?
+                        .min
+                        .distance_m
+                }
+                Err(SimError::Diverged(d)) => {
+                    first_tumble.get_or_insert(format!("{at} does not fly ({d})"));
+                    f64::NAN
+                }
+                Err(e) => return Err(refused(format!("cannot be simulated ({e})"))),
+            };
             Ok(TruthCondition {
                 condition: ConditionRecord::of(&s.flight),
                 min_clearance_mm: 1e3 * min_m,
                 fails: min_m.is_nan() || min_m < criterion_m,
             })
         })
-        .collect()
+        .collect::<Result<Vec<_>, CampaignError>>()?;
+    if envelope.iter().all(|t| t.min_clearance_mm.is_nan()) {
+        return Err(CampaignError::Refused(format!(
+            "{}, nor at any other of the grid's {} conditions: a rehearsal's truth must fly somewhere in its grid (check --truth-factors, --truth-effect and the grid)",
+            first_tumble.unwrap_or_default(),
+            envelope.len()
+        )));
+    }
+    Ok(envelope)
 }
 
 /// The current round against the truth.
@@ -279,6 +301,7 @@ pub fn rehearse(
     std::fs::create_dir_all(&flown_dir).map_err(|e| record_error(&flown_dir, e))?;
     let base = &truth.scenario;
     let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
+    let mut tumbled: Option<String> = None;
     for k in 0..max_releases {
         if c.file.settled {
             break;
@@ -288,14 +311,37 @@ pub fn rehearse(
             break;
         };
         let s = c.grid.scenario(base, p.index);
-        let data = synthetic_flight_test(
+        let data = match synthetic_flight_test(
             &Simulator::new(&s),
             &truth.factors,
             &truth.effects,
             &times,
             Some(truth.noise_seed.wrapping_add(k as u64)),
-        )
-        .map_err(|e| CampaignError::Refused(format!("the truth at release {}: {e}", k + 1)))?;
+        ) {
+            Ok(data) => data,
+            Err(SimError::Diverged(d)) => {
+                // The campaign flew where the store tumbles: an unsafe release, and the last.
+                r.flown.push(FlownRelease {
+                    condition: ConditionRecord::of(&s.flight),
+                    p_fail_planned: p.p_fail,
+                    truly_safe: false,
+                    expected_settled: p.expected_settled,
+                    settled: 0,
+                    unsettled: 0,
+                });
+                tumbled = Some(format!(
+                    "release {} tumbled ({d}); the rehearsal stopped there",
+                    k + 1
+                ));
+                break;
+            }
+            Err(e) => {
+                return Err(CampaignError::Refused(format!(
+                    "the truth at release {}: {e}",
+                    k + 1
+                )));
+            }
+        };
         let path: PathBuf = flown_dir.join(format!("flown-{:02}.csv", k + 1));
         data.write(&path).map_err(|e| record_error(&path, e))?;
         let bytes = std::fs::read(&path).map_err(|e| record_error(&path, e))?;
@@ -344,6 +390,21 @@ pub fn rehearse(
         r.flown.iter().filter(|f| f.truly_safe).count(),
         r.flown.len()
     );
+    if let Some(t) = tumbled {
+        r.words = format!("{}; {t}", r.words);
+    }
+    let tumbles = r
+        .truth
+        .iter()
+        .filter(|t| t.min_clearance_mm.is_nan())
+        .count();
+    if tumbles > 0 {
+        r.words = format!(
+            "{}; the truth tumbles (its simulation diverges) at {tumbles} of the grid's {} conditions, counted as failing",
+            r.words,
+            r.truth.len()
+        );
+    }
     write_json(&c.dir.join("rehearsal.json"), &r)?;
     // The page again, now with the comparison with the truth first.
     let section = r.section();

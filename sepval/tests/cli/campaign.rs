@@ -466,6 +466,18 @@ fn a_rehearsal_with_a_hidden_cause_outside_the_catalogue_settles_conservatively_
         !fails.is_empty() && fails.len() < truth.len(),
         "the truth's boundary must lie inside the grid: {r}"
     );
+    // Where the truth tumbles (diverges) the condition fails; it is not a refusal.
+    let tumbles = truth
+        .iter()
+        .filter(|t| t["min_clearance_mm"] == "nan")
+        .count();
+    assert!(tumbles > 0, "{r}");
+    assert!(
+        r["words"].as_str().unwrap().contains(&format!(
+            "the truth tumbles (its simulation diverges) at {tumbles} of the grid's"
+        )),
+        "{r}"
+    );
     assert_eq!(r["settled"], true, "{r}");
     let flown = r["flown"].as_array().unwrap();
     assert!(!flown.is_empty() && flown.len() <= 4, "{r}");
