@@ -8,7 +8,7 @@
 //! truth fails is a false clear, one it fails where the truth clears a false fail, and every
 //! release planned is checked to have been truly safe.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -27,6 +27,7 @@ use sepval_solve::run::ProgressObserver;
 
 use crate::CampaignError;
 use crate::assess::StartEvaluator;
+use crate::next::Planned;
 use crate::page::{self, RehearsalRelease, RehearsalRound, RehearsalSection};
 use crate::program::Campaign;
 use crate::record::{record_error, write_json};
@@ -299,8 +300,6 @@ pub fn rehearse(
     r.rounds.push(against(c, &r.truth)?);
     let flown_dir = c.dir.join("rehearsal");
     std::fs::create_dir_all(&flown_dir).map_err(|e| record_error(&flown_dir, e))?;
-    let base = &truth.scenario;
-    let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
     let mut tumbled: Option<String> = None;
     for k in 0..max_releases {
         if c.file.settled {
@@ -310,75 +309,130 @@ pub fn rehearse(
         let Some(p) = next.releases.first() else {
             break;
         };
-        let s = c.grid.scenario(base, p.index);
-        let data = match synthetic_flight_test(
-            &Simulator::new(&s),
-            &truth.factors,
-            &truth.effects,
-            &times,
-            Some(truth.noise_seed.wrapping_add(k as u64)),
-        ) {
-            Ok(data) => data,
-            Err(SimError::Diverged(d)) => {
+        let release = Release {
+            truth,
+            planned: p,
+            number: k + 1,
+            dir: &flown_dir,
+        };
+        match fly(c, &release, r.truth[p.index].fails, start, observer)? {
+            Flew::Added(f) => r.flown.push(f),
+            Flew::Tumbled(f, why) => {
                 // The campaign flew where the store tumbles: an unsafe release, and the last.
-                r.flown.push(FlownRelease {
-                    condition: ConditionRecord::of(&s.flight),
-                    p_fail_planned: p.p_fail,
-                    truly_safe: false,
-                    expected_settled: p.expected_settled,
-                    settled: 0,
-                    unsettled: 0,
-                });
-                tumbled = Some(format!(
-                    "release {} tumbled ({d}); the rehearsal stopped there",
-                    k + 1
-                ));
+                r.flown.push(f);
+                tumbled = Some(why);
                 break;
             }
-            Err(e) => {
-                return Err(CampaignError::Refused(format!(
-                    "the truth at release {}: {e}",
-                    k + 1
-                )));
-            }
-        };
-        let path: PathBuf = flown_dir.join(format!("flown-{:02}.csv", k + 1));
-        data.write(&path).map_err(|e| record_error(&path, e))?;
-        let bytes = std::fs::read(&path).map_err(|e| record_error(&path, e))?;
-        let before = c.current()?;
-        let release = NewRelease {
-            given: path,
-            sha256: hex_sha256(&bytes),
-            data,
-            scenario: c.grid.scenario(&c.scenario, p.index),
-            notes: Vec::new(),
-        };
-        crate::add::add(c, vec![release], start, observer)?;
-        let after = c.current()?;
-        let moved = |from: &dyn Fn(State) -> bool, to: &dyn Fn(State) -> bool| {
-            before
-                .iter()
-                .zip(&after)
-                .filter(|(b, a)| from(b.state) && to(a.state))
-                .count()
-        };
-        let undecided = |s: State| s == State::Undecided;
-        let decided = |s: State| s != State::Undecided;
-        r.flown.push(FlownRelease {
-            condition: ConditionRecord::of(&s.flight),
-            p_fail_planned: p.p_fail,
-            truly_safe: !r.truth[p.index].fails,
-            expected_settled: p.expected_settled,
-            settled: moved(&undecided, &decided),
-            unsettled: moved(&decided, &undecided),
-        });
+        }
         r.rounds.push(against(c, &r.truth)?);
         r.settled = c.file.settled;
         write_json(&c.dir.join("rehearsal.json"), &r)?;
     }
+    r.words = verdict(&r, tumbled);
+    write_json(&c.dir.join("rehearsal.json"), &r)?;
+    // The page again, now with the comparison with the truth first.
+    let section = r.section();
+    let view = page::View {
+        rehearsal: Some(&section),
+        ..c.view()
+    };
+    page::render(&view)?;
+    Ok(r)
+}
+
+/// One release of a rehearsal: the truth flown at the planned condition, the release's
+/// number (1 for the first), and where its file goes.
+struct Release<'a> {
+    truth: &'a Truth,
+    planned: &'a Planned,
+    number: usize,
+    dir: &'a Path,
+}
+
+/// What flying a planned release did.
+enum Flew {
+    /// The release was added to the campaign.
+    Added(FlownRelease),
+    /// The truth diverged there (the store tumbles): nothing to add, and why.
+    Tumbled(FlownRelease, String),
+}
+
+/// Flies `release` in the truth (`truly_fails` there or not) and adds it to `c`.
+fn fly(
+    c: &mut Campaign,
+    release: &Release<'_>,
+    truly_fails: bool,
+    start: &mut StartEvaluator<'_>,
+    observer: &mut dyn ProgressObserver,
+) -> Result<Flew, CampaignError> {
+    let Release {
+        truth,
+        planned: p,
+        number,
+        dir,
+    } = *release;
+    let base = &truth.scenario;
+    let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
+    let s = c.grid.scenario(base, p.index);
+    let mut flown = FlownRelease {
+        condition: ConditionRecord::of(&s.flight),
+        p_fail_planned: p.p_fail,
+        truly_safe: !truly_fails,
+        expected_settled: p.expected_settled,
+        settled: 0,
+        unsettled: 0,
+    };
+    let data = match synthetic_flight_test(
+        &Simulator::new(&s),
+        &truth.factors,
+        &truth.effects,
+        &times,
+        Some(truth.noise_seed.wrapping_add(number as u64 - 1)),
+    ) {
+        Ok(data) => data,
+        Err(SimError::Diverged(d)) => {
+            flown.truly_safe = false;
+            let why = format!("release {number} tumbled ({d}); the rehearsal stopped there");
+            return Ok(Flew::Tumbled(flown, why));
+        }
+        Err(e) => {
+            return Err(CampaignError::Refused(format!(
+                "the truth at release {number}: {e}"
+            )));
+        }
+    };
+    let path: PathBuf = dir.join(format!("flown-{number:02}.csv"));
+    data.write(&path).map_err(|e| record_error(&path, e))?;
+    let bytes = std::fs::read(&path).map_err(|e| record_error(&path, e))?;
+    let before = c.current()?;
+    let release = NewRelease {
+        given: path,
+        sha256: hex_sha256(&bytes),
+        data,
+        scenario: c.grid.scenario(&c.scenario, p.index),
+        notes: Vec::new(),
+    };
+    crate::add::add(c, vec![release], start, observer)?;
+    let after = c.current()?;
+    let moved = |from: &dyn Fn(State) -> bool, to: &dyn Fn(State) -> bool| {
+        before
+            .iter()
+            .zip(&after)
+            .filter(|(b, a)| from(b.state) && to(a.state))
+            .count()
+    };
+    let undecided = |s: State| s == State::Undecided;
+    let decided = |s: State| s != State::Undecided;
+    flown.settled = moved(&undecided, &decided);
+    flown.unsettled = moved(&decided, &undecided);
+    Ok(Flew::Added(flown))
+}
+
+/// The rehearsal's verdict in words.
+fn verdict(r: &Rehearsal, tumbled: Option<String>) -> String {
     let last = r.rounds.last().expect("round 0 is there");
     let (expected, settled) = forecast_totals(&r.flown);
-    r.words = format!(
+    let mut words = format!(
         "{} after {} release(s): cleared {}, fails {}, undecided {}; against the truth {} false clear(s), {} false fail(s); {} of the {} releases flown truly safe; the plan expected them to settle {expected:.1} condition(s), they settled {settled}",
         if r.settled { "settled" } else { "not settled" },
         last.releases_flown,
@@ -391,7 +445,7 @@ pub fn rehearse(
         r.flown.len()
     );
     if let Some(t) = tumbled {
-        r.words = format!("{}; {t}", r.words);
+        words = format!("{words}; {t}");
     }
     let tumbles = r
         .truth
@@ -399,19 +453,10 @@ pub fn rehearse(
         .filter(|t| t.min_clearance_mm.is_nan())
         .count();
     if tumbles > 0 {
-        r.words = format!(
-            "{}; the truth tumbles (its simulation diverges) at {tumbles} of the grid's {} conditions, counted as failing",
-            r.words,
+        words = format!(
+            "{words}; the truth tumbles (its simulation diverges) at {tumbles} of the grid's {} conditions, counted as failing",
             r.truth.len()
         );
     }
-    write_json(&c.dir.join("rehearsal.json"), &r)?;
-    // The page again, now with the comparison with the truth first.
-    let section = r.section();
-    let view = page::View {
-        rehearsal: Some(&section),
-        ..c.view()
-    };
-    page::render(&view)?;
-    Ok(r)
+    words
 }
