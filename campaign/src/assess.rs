@@ -31,6 +31,7 @@ use sepval_predict::{ClearanceSettings, PredictError, Sampler, Source, clearance
 use sepval_solve::run::{NoProgress, Progress as Step, ProgressObserver};
 
 use crate::CampaignError;
+use crate::joint;
 use crate::rivals;
 use crate::state::{Assessed, State, spread};
 
@@ -132,6 +133,7 @@ pub fn assess(
             factor_spread_mm: spread(factors.min_clearance_mm.p5, factors.min_clearance_mm.p95),
             rival_spread_mm: rivals::clearance_spread(&models, &each),
             rival_separation: noise.map_or(0.0, |n| rivals::separation(&models, &trajectories, n)),
+            joint: joint::samples(&trajectories, &each, noise.unwrap_or(joint::PRIOR_NOISE)),
             row,
         });
         observer.progress(&Step {

@@ -24,9 +24,11 @@
 pub mod add;
 pub mod assess;
 pub mod begin;
+pub mod joint;
 mod journal;
 pub mod next;
 pub mod page;
+pub mod preposterior;
 pub mod prior;
 pub mod program;
 pub mod record;

@@ -1,62 +1,58 @@
 //! The next release(s) to fly (docs/campaign.md, "The next release"). Only conditions whose
 //! probability of failing to clear is at most the fly risk are candidates: a program never
-//! flies where the prediction says the store may hit the aircraft. Among them, a release at c
-//! is ranked by the expected number of undecided conditions it settles, a preposterior
-//! analysis under a normal approximation of each condition's smallest clearance:
+//! flies where the prediction says the store may hit the aircraft. Among them a release at c is
+//! weighed two ways, both from the preposterior ([`crate::preposterior`]: what a release at c
+//! is expected to leave of each condition's spread of the smallest clearance):
 //!
-//! - at undecided condition u, m_u the median smallest clearance less the criterion, s_u the
-//!   spread of the normal about m_u that fails as often as its samples did (s_u = m_u /
-//!   Phi^-1(1 - p_fail): the tail, divergences included, decides a state, not the body), split
-//!   as the samples' spread is between the factors (s_f,u, the spread without the model-form
-//!   band) and the model form (s_m,u = sqrt(max(0, s_u^2 - s_f,u^2)));
-//! - a release at c brings u's reach down to r'_u = min(r_u, reach(c, u)): the model form's
-//!   part scales with the reach ([`sepval_predict::reach`]), s'_m,u = s_m,u e(r'_u) / e(r_u),
-//!   e the reach the band uses;
-//! - the factors' part is split again into the rivals' disagreement s_r,u (the spread of their
-//!   median clearances, [`crate::rivals`]) and the spread within a model s_w,u =
-//!   sqrt(max(0, s_f,u^2 - s_r,u^2));
-//! - it tells the rivals apart as well as their trajectories differ at c against the noise and
-//!   their own spread there (the separation S_c, [`crate::rivals::separation`]); the same model
-//!   holds everywhere, so s'_r,u = s_r,u sqrt(1 / (1 + S_c^2)) at every u: a release where the
-//!   rivals disagree settles the conditions whose decision hangs on them;
-//! - it informs the factors within a model, which are the same at every condition (the model's
-//!   form is what differs from one condition to another, and the reach carries it): with n
-//!   releases flown, s'_w,u = s_w,u sqrt(n / (n + 1)); with none, s'_w,u =
-//!   [`FIRST_RELEASE_SHARE`] s_w,u, the share of the prior's spread a first release leaves;
-//! - the median moves by what is learnt, a normal of variance tau^2 = s_u^2 - s'_u^2, and u is
-//!   settled when it ends more than z s'_u from the criterion (z the normal quantile of 1 -
-//!   allowed): P(settled) = Phi((m_u - z s'_u) / tau) + Phi((-m_u - z s'_u) / tau).
+//! - `expected_settled(c)`: the expected number of undecided conditions it settles, the sum of
+//!   their P(settled) less what they would be without the release (the batch's releases
+//!   before it). With nothing flown that is nothing: the prior clears nothing
+//!   ([`crate::state::State::before_release`]), so a condition the prior would clear is settled
+//!   by the first release when it stays more than z s' above the criterion afterwards;
+//! - `narrows(c)`: how much it narrows the undecided band, the sum over the undecided
+//!   conditions of 1 - s'_u / s_u: the build-up's measure, since the undecided conditions are
+//!   the band about the boundary.
 //!
-//! `expected_settled(c)` sums P(settled) over the undecided conditions, less what they would be
-//! without the release (the batch's releases before it). With nothing flown that is nothing:
-//! the prior clears nothing ([`crate::state::State::before_release`]), so a condition the
-//! prior would clear is settled by the first release when it stays more than z s'_u above the
-//! criterion afterwards. A batch of K is chosen
-//! greedily: each release chosen is taken as flown (the spreads it leaves, one more release)
-//! before the next is ranked, so that the batch's releases complement each other rather than
-//! settle the same conditions; once the releases chosen are expected to settle all that can be
-//! settled, the batch's others go where the model's form is least known (the safe condition of
-//! the largest reach from every release flown or planned). Ties go to the lower risk, then to
-//! grid order.
+//! The rule, one release at a time:
+//!
+//! 1. the release expected to settle most, when that is at least [`SETTLES_NOTHING`]; among
+//!    the candidates within [`FLAT`] of it (a flat ranking: the forecast cannot tell them
+//!    apart), the one that narrows the undecided band most, the build-up step toward the
+//!    boundary;
+//! 2. when none is expected to settle that many (an uncertain ranking), the build-up step: the
+//!    candidate that narrows the undecided band most, when it narrows it by at least
+//!    [`NARROWS_NOTHING`];
+//! 3. only when neither holds is the envelope settled with conditions undecided: no safe
+//!    release is expected to settle or narrow any of them.
+//!
+//! A batch of K is chosen greedily: each release chosen is taken as flown (the spreads it
+//! leaves, its reach) before the next is weighed, so the batch's releases complement each
+//! other; the batch's others, once nothing is expected to be settled or narrowed, go where the
+//! model's form is least known (the safe condition of the largest reach from every release
+//! flown or planned). Ties go to the lower risk, then to grid order.
 
 use serde::{Deserialize, Serialize};
-use statrs::distribution::{ContinuousCDF, Normal};
+use statrs::distribution::ContinuousCDF;
 
 use sepval_common::scenario::Flight;
 use sepval_envelope::Grid;
-use sepval_fit::domain::reach;
-use sepval_predict::reach::effective;
+use sepval_fit::domain::{covered_reach, reach};
+use sepval_predict::reach::{effective, uncovered};
 
+use crate::joint;
+use crate::preposterior::{
+    Pair, Spread, gain, narrowing, normal, settle, settled_before, tail_spreads,
+};
 use crate::rivals;
 use crate::state::{Assessed, State};
 
-/// The share of the prior's spread of the factors that a first release at the condition
-/// leaves: a release of 1 s determines the factors that act there to a few per cent of their
-/// prior range (docs/performance.md, the study's comparison: standard errors of 0.02 to 0.16
-/// against ranges of 0.2 to 1.75), so a quarter is a cautious reading.
-pub const FIRST_RELEASE_SHARE: f64 = 0.25;
 /// A release expected to settle fewer conditions than this settles nothing.
 pub const SETTLES_NOTHING: f64 = 0.5;
+/// Candidates expected to settle within this share of the best are ranked alike (rule 1).
+pub const FLAT: f64 = 0.9;
+/// A release that narrows the undecided band by less than this (a sum of shares of the
+/// undecided conditions' spreads) narrows nothing (rule 2).
+pub const NARROWS_NOTHING: f64 = 0.25;
 
 /// One release planned.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -115,84 +111,43 @@ pub fn plan(
     criteria: Criteria,
     count: usize,
 ) -> Plan {
-    let Criteria {
-        criterion_mm,
-        allowed,
-        fly_risk,
-    } = criteria;
     let undecided: Vec<usize> = (0..assessed.len())
         .filter(|&u| assessed[u].state == State::Undecided)
         .collect();
     let safe: Vec<usize> = (0..assessed.len())
-        .filter(|&c| assessed[c].row.p_fail <= fly_risk)
+        .filter(|&c| assessed[c].row.p_fail <= criteria.fly_risk)
         .collect();
     if safe.is_empty() {
-        return no_safe(grid, assessed, fly_risk, undecided.is_empty());
+        return no_safe(grid, assessed, criteria.fly_risk, undecided.is_empty());
     }
-    let z = normal().inverse_cdf(1.0 - allowed);
-    let mut spreads = tail_spreads(assessed, criterion_mm);
-    // Each condition's spread before any release of the batch: what is learnt is measured
-    // from it.
-    let start: Vec<f64> = spreads.iter().map(Spread::total).collect();
-    let mut reaches: Vec<f64> = assessed.iter().map(|a| a.reach).collect();
-    let at = |c: usize, u: usize| Pair {
-        reach: reach(&[grid.flight(c)], grid.flight(u)),
-        margin_mm: assessed[u].row.clearance_p50_mm - criterion_mm,
-        rivals_left: rivals::left_after(assessed[c].rival_separation),
-        z,
+    let planner = Planner {
+        grid,
+        assessed,
+        flown,
+        criteria,
+        z: normal().inverse_cdf(1.0 - criteria.allowed),
+        every: (0..assessed.len()).collect(),
+        undecided,
+        joint: assessed.iter().map(|a| a.joint.as_slice()).collect(),
     };
+    let mut outlook = planner.outlook_now();
     let mut chosen: Vec<Planned> = Vec::new();
     for n in flown.len()..flown.len() + count.max(1) {
-        let open: Vec<(usize, f64)> = safe
+        let options: Vec<Weighed> = safe
             .iter()
             .filter(|c| !chosen.iter().any(|p| p.index == **c))
-            .map(|&c| {
-                let gain = |u: usize| gain(&at(c, u), spreads[u], reaches[u], start[u], n);
-                (c, undecided.iter().map(|&u| gain(u)).sum())
-            })
+            .map(|&c| planner.weigh(&outlook, c, n))
             .collect();
-        let risk = |c: usize| assessed[c].row.p_fail;
-        let by = |key: &dyn Fn(&(usize, f64)) -> f64| {
-            open.iter().copied().max_by(|a, b| {
-                key(a)
-                    .total_cmp(&key(b))
-                    .then(risk(b.0).total_cmp(&risk(a.0)))
-                    .then(b.0.cmp(&a.0))
-            })
-        };
-        let Some((mut c, mut e)) = by(&|x| x.1) else {
+        let Some((pick, why)) = planner.pick(&options, &outlook, !chosen.is_empty()) else {
             break;
         };
-        // A gain is a difference of sums: what rounds to 0 is said as 0, never "-0.0".
-        let e_shown = |e: f64| if e > 0.0 { e } else { 0.0 };
-        let mut why = format!(
-            "expected to settle {:.1} of the {} undecided conditions",
-            e_shown(e),
-            undecided.len()
-        );
-        if e < SETTLES_NOTHING {
-            if chosen.is_empty() {
-                break;
-            }
-            // The batch's others: where the model's form is least known.
-            (c, e) = by(&|x| effective(reaches[x.0])).expect("open is not empty");
-            why = format!(
-                "adds {:.1} to what the releases before it in the batch settle; chosen as the safe condition farthest from every release flown or planned (reach {:.1}), where the model's form is least known",
-                e_shown(e),
-                reaches[c]
-            );
-        }
-        why.push_str(&format!(
-            "; P(fail) here {:.4}, within the fly risk {fly_risk}",
-            risk(c)
-        ));
-        chosen.push(planned(grid, assessed, c, e_shown(e), why));
+        let w = options.into_iter().find(|w| w.c == pick).expect("picked");
+        chosen.push(planned(grid, assessed, w.c, w.settles.max(0.0), why));
         // Taken as flown: the spreads it leaves, one release more.
-        for u in 0..assessed.len() {
-            (spreads[u], reaches[u]) = settle(&at(c, u), &spreads[u], reaches[u], n);
-        }
+        outlook = w.after;
     }
-    let mut words = words(undecided.len(), chosen.len());
+    let undecided = planner.undecided.len();
+    let mut words = words(undecided, chosen.len());
     if !chosen.is_empty() && chosen.len() < count {
         words.push_str(&format!(
             "; {} of the {count} asked for: only {} of the grid's conditions are safe to fly (P(fail) within the fly risk), and each of them is planned",
@@ -201,10 +156,176 @@ pub fn plan(
         ));
     }
     Plan {
-        settled: undecided.is_empty() || chosen.is_empty(),
+        settled: undecided == 0 || chosen.is_empty(),
         releases: chosen,
         least_risky: None,
         words,
+    }
+}
+
+/// What the planning reads the envelope from.
+struct Planner<'a> {
+    grid: &'a Grid,
+    assessed: &'a [Assessed],
+    flown: &'a [Flight],
+    criteria: Criteria,
+    /// The normal quantile of 1 - allowed.
+    z: f64,
+    /// Every condition's index.
+    every: Vec<usize>,
+    /// The undecided conditions.
+    undecided: Vec<usize>,
+    /// Each condition's joint samples ([`Assessed::joint`]).
+    joint: Vec<&'a [Option<joint::Sample>]>,
+}
+
+/// The envelope as the planning expects it once the batch chosen so far is flown.
+struct Outlook {
+    /// The batch's conditions.
+    batch: Vec<usize>,
+    /// Each condition's spread, in its parts.
+    spreads: Vec<Spread>,
+    /// Each condition's total spread before the batch: what is learnt is measured from it.
+    start: Vec<f64>,
+    /// Each condition's reach.
+    reaches: Vec<f64>,
+    /// The share of each condition's factors' variance the batch leaves
+    /// ([`joint::left_after`]; `None`: the rules without the joint samples).
+    left: Option<Vec<f64>>,
+}
+
+/// A candidate weighed against an outlook.
+struct Weighed {
+    c: usize,
+    /// Its expected number of undecided conditions settled.
+    settles: f64,
+    /// How much it narrows the undecided band.
+    narrows: f64,
+    /// The outlook once it is flown.
+    after: Outlook,
+}
+
+impl Planner<'_> {
+    /// The envelope before any release of the batch.
+    fn outlook_now(&self) -> Outlook {
+        let spreads = tail_spreads(self.assessed, self.criteria.criterion_mm);
+        Outlook {
+            batch: Vec::new(),
+            start: spreads.iter().map(Spread::total).collect(),
+            spreads,
+            reaches: self.assessed.iter().map(|a| a.reach).collect(),
+            left: joint::left_after(&self.joint, &[], &self.every),
+        }
+    }
+
+    /// A release at `c` flown after the outlook `o`'s batch, with `n` releases flown or
+    /// chosen before it.
+    fn weigh(&self, o: &Outlook, c: usize, n: usize) -> Weighed {
+        let mut batch = o.batch.clone();
+        batch.push(c);
+        let left = o
+            .left
+            .as_ref()
+            .and(joint::left_after(&self.joint, &batch, &self.every));
+        // Each condition's reach once c is flown: from the nearest release, beyond what the
+        // releases held out in turn then cover (as the next round's band reads it).
+        let mut all: Vec<&Flight> = self.flown.iter().collect();
+        all.extend(batch.iter().map(|&k| self.grid.flight(k)));
+        let covered = covered_reach(&all, &[]);
+        let mut after = Outlook {
+            batch,
+            spreads: o.spreads.clone(),
+            start: o.start.clone(),
+            reaches: o.reaches.clone(),
+            left: None,
+        };
+        let (mut settles, mut narrows) = (0.0, 0.0);
+        for &u in &self.every {
+            let pair = Pair {
+                reach: uncovered(reach(&all, self.grid.flight(u)), covered),
+                margin_mm: self.assessed[u].row.clearance_p50_mm - self.criteria.criterion_mm,
+                rivals_left: rivals::left_after(self.assessed[c].rival_separation),
+                factors_left: left.as_ref().zip(o.left.as_ref()).map(|(l, now)| {
+                    if now[u] > 0.0 {
+                        (l[u] / now[u]).min(1.0)
+                    } else {
+                        1.0
+                    }
+                }),
+                z: self.z,
+            };
+            let (spread, r) = settle(&pair, &o.spreads[u], o.reaches[u], n);
+            if self.undecided.contains(&u) {
+                settles += gain(&pair, o.spreads[u], o.reaches[u], o.start[u], n);
+                // What the batch is expected to settle already needs no narrowing.
+                let open = 1.0 - settled_before(&pair, o.spreads[u], o.start[u], n);
+                narrows += open.clamp(0.0, 1.0) * narrowing(&o.spreads[u], &spread);
+            }
+            (after.spreads[u], after.reaches[u]) = (spread, r);
+        }
+        after.left = left;
+        Weighed {
+            c,
+            settles,
+            narrows,
+            after,
+        }
+    }
+
+    /// The release to take among `options` (module docs' rule) and why; `None` when none
+    /// settles or narrows anything and `batch_begun` is false.
+    fn pick(&self, options: &[Weighed], o: &Outlook, batch_begun: bool) -> Option<(usize, String)> {
+        let risk = |c: usize| self.assessed[c].row.p_fail;
+        let best = |key: &dyn Fn(&Weighed) -> f64, among: &dyn Fn(&Weighed) -> bool| {
+            options.iter().filter(|w| among(w)).max_by(|a, b| {
+                key(a)
+                    .total_cmp(&key(b))
+                    .then(risk(b.c).total_cmp(&risk(a.c)))
+                    .then(b.c.cmp(&a.c))
+            })
+        };
+        let top = best(&|w| w.settles, &|_| true)?;
+        let undecided = self.undecided.len();
+        let (w, mut why) = if top.settles >= SETTLES_NOTHING {
+            let floor = FLAT * top.settles;
+            let w = best(&|w| w.narrows, &|w| w.settles >= floor).expect("top is among them");
+            let mut why = format!(
+                "expected to settle {:.1} of the {undecided} undecided conditions",
+                w.settles
+            );
+            if w.c != top.c {
+                why.push_str(&format!(
+                    "; as many as the best (within {:.0} %), and of those the build-up step: it narrows the undecided band most ({:.2} of their spreads)",
+                    100.0 * (1.0 - FLAT),
+                    w.narrows
+                ));
+            }
+            (w, why)
+        } else if let Some(w) = best(&|w| w.narrows, &|w| w.narrows >= NARROWS_NOTHING) {
+            let why = format!(
+                "the build-up step: no release is expected to settle a condition (the most, {:.1}), and this one narrows the band of the {undecided} undecided conditions most ({:.2} of their spreads), a step toward the boundary",
+                top.settles.max(0.0),
+                w.narrows
+            );
+            (w, why)
+        } else if batch_begun {
+            // The batch's others: where the model's form is least known.
+            let w = best(&|w| effective(o.reaches[w.c]), &|_| true).expect("options");
+            let why = format!(
+                "adds {:.1} to what the releases before it in the batch settle; chosen as the safe condition farthest from every release flown or planned (reach {:.1}), where the model's form is least known",
+                w.settles.max(0.0),
+                o.reaches[w.c]
+            );
+            (w, why)
+        } else {
+            return None;
+        };
+        why.push_str(&format!(
+            "; P(fail) here {:.4}, within the fly risk {}",
+            risk(w.c),
+            self.criteria.fly_risk
+        ));
+        Some((w.c, why))
     }
 }
 
@@ -214,50 +335,11 @@ fn words(undecided: usize, chosen: usize) -> String {
         "settled: no condition is undecided".to_string()
     } else if chosen == 0 {
         format!(
-            "settled: {undecided} condition(s) stay undecided, and no release safe to fly is expected to settle any of them"
+            "settled: {undecided} condition(s) stay undecided, and no release safe to fly is expected to settle or narrow any of them"
         )
     } else {
         format!("{chosen} release(s) planned for the {undecided} undecided condition(s)")
     }
-}
-
-/// A condition's spread of the smallest clearance in its three parts \[mm\] (module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Spread {
-    /// The rivals' disagreement.
-    rivals: f64,
-    /// The factors' within a model.
-    within: f64,
-    /// The model form's.
-    form: f64,
-}
-
-impl Spread {
-    fn total(&self) -> f64 {
-        self.rivals.hypot(self.within).hypot(self.form)
-    }
-}
-
-/// Each condition's spread: the spread of the normal that fails as often as its samples did
-/// (their tail, divergences included, decides the state, not their body), shared as the
-/// samples' spread is between the rivals, the factors within a model and the model form.
-fn tail_spreads(assessed: &[Assessed], criterion_mm: f64) -> Vec<Spread> {
-    assessed
-        .iter()
-        .map(|a| {
-            let s = finite_or_zero(a.spread_mm);
-            let f = finite_or_zero(a.factor_spread_mm).min(s);
-            let r = finite_or_zero(a.rival_spread_mm).min(f);
-            let part = |of: f64, less: f64| (of * of - less * less).max(0.0).sqrt();
-            let k = effective_spread(a.row.clearance_p50_mm - criterion_mm, a.row.p_fail)
-                .map_or(1.0, |e| if s > 0.0 { e / s } else { 1.0 });
-            Spread {
-                rivals: k * r,
-                within: k * part(f, r),
-                form: k * part(s, f),
-            }
-        })
-        .collect()
 }
 
 /// The plan when no condition is safe to fly: none, and the least risky named.
@@ -279,92 +361,6 @@ fn no_safe(grid: &Grid, assessed: &[Assessed], fly_risk: f64, settled: bool) -> 
             "no condition is safe to fly: every one has a probability of failing to clear above {fly_risk}"
         ),
     }
-}
-
-/// The standard deviation of a normal about a median `margin` above the criterion that
-/// falls below it with probability `p_fail`; `None` when that says nothing (no margin, or a
-/// probability of 0, 1 or not finite).
-fn effective_spread(margin: f64, p_fail: f64) -> Option<f64> {
-    if !(margin.is_finite() && margin.abs() > 0.0 && p_fail > 0.0 && p_fail < 1.0) {
-        return None;
-    }
-    let z = normal().inverse_cdf(1.0 - p_fail);
-    let s = margin / z;
-    (s.is_finite() && s > 0.0).then_some(s)
-}
-
-fn normal() -> Normal {
-    Normal::new(0.0, 1.0).expect("the standard normal")
-}
-
-fn finite_or_zero(v: f64) -> f64 {
-    if v.is_finite() { v.max(0.0) } else { 0.0 }
-}
-
-/// A release at c as condition u sees it.
-struct Pair {
-    /// reach(c, u).
-    reach: f64,
-    /// u's median smallest clearance less the criterion \[mm\].
-    margin_mm: f64,
-    /// The share of the rivals' variance a release at c leaves ([`rivals::left_after`]).
-    rivals_left: f64,
-    /// The normal quantile of 1 - allowed.
-    z: f64,
-}
-
-/// What a release does to a condition (`pair`) of spread `spread` and reach `r`, with `n`
-/// releases flown: its spread and reach afterwards.
-fn settle(pair: &Pair, spread: &Spread, r: f64, n: usize) -> (Spread, f64) {
-    let r_after = r.min(pair.reach);
-    let (e0, e1) = (effective(r), effective(r_after));
-    let form = if e0 > 0.0 {
-        spread.form * e1 / e0
-    } else {
-        spread.form
-    };
-    let within = if n == 0 {
-        spread.within * FIRST_RELEASE_SHARE
-    } else {
-        spread.within * (n as f64 / (n as f64 + 1.0)).sqrt()
-    };
-    let rivals = spread.rivals * pair.rivals_left.clamp(0.0, 1.0).sqrt();
-    (
-        Spread {
-            rivals,
-            within,
-            form,
-        },
-        r_after,
-    )
-}
-
-/// What a release (`pair`) adds to the probability that a condition ends settled, its spread
-/// `spread` and reach `r` now, its spread `start` before the batch, with `n` releases flown or
-/// chosen.
-fn gain(pair: &Pair, spread: Spread, r: f64, start: f64, n: usize) -> f64 {
-    let (after, _) = settle(pair, &spread, r, n);
-    // Before the first release nothing is cleared (`State::before_release`): whatever the
-    // prior would settle, the first release settles.
-    let before = if n == 0 {
-        0.0
-    } else {
-        p_settle(pair, start, spread.total())
-    };
-    p_settle(pair, start, after.total()) - before
-}
-
-/// The probability that a condition whose spread goes from `s` to `s_after` ends settled: its
-/// median moves by a normal of variance s^2 - s_after^2 and must end more than z s_after from
-/// the criterion (module docs). 0 when nothing is learnt or the median is unknown.
-fn p_settle(pair: &Pair, s: f64, s_after: f64) -> f64 {
-    let (margin, z) = (pair.margin_mm, pair.z);
-    if !margin.is_finite() {
-        return 0.0;
-    }
-    let tau = (s * s - s_after * s_after).max(1e-12).sqrt();
-    let nd = normal();
-    (nd.cdf((margin - z * s_after) / tau) + nd.cdf((-margin - z * s_after) / tau)).min(1.0)
 }
 
 /// The planned release at condition `c`.
@@ -407,6 +403,7 @@ mod tests {
                     factor_spread_mm: 8.0,
                     rival_spread_mm: 0.0,
                     rival_separation: 0.0,
+                    joint: Vec::new(),
                     row,
                 }
             })
@@ -482,5 +479,33 @@ mod tests {
         assert_eq!(p.releases.len(), 1, "{p:?}");
         assert_eq!(p.releases[0].index, 0, "{p:?}");
         assert!(p.releases[0].expected_settled > 1.0, "{p:?}");
+    }
+
+    #[test]
+    fn with_nothing_expected_settled_the_build_up_step_goes_toward_the_boundary() {
+        // Flown at Mach 0.6; safe at 0.6 and 0.7; undecided at 0.8 to 1.0, their medians on the
+        // criterion, so that no release is expected to settle them: the build-up step is the
+        // release nearer them (it narrows their model form's share too), and the envelope is
+        // not called settled.
+        let (grid, mut a) = envelope([0.0, 0.0, 0.45, 0.45, 0.45], [60.0, 60.0, 25.5, 25.5, 25.5]);
+        let flown = [grid.flight(0).clone()];
+        for (k, c) in a.iter_mut().enumerate() {
+            c.reach = k as f64;
+            (c.spread_mm, c.factor_spread_mm) = (10.0, 9.5);
+        }
+        let p = plan(&grid, &a, &flown, CRITERIA, 1);
+        assert!(!p.settled, "{p:?}");
+        assert_eq!(p.releases[0].index, 1, "{p:?}");
+        assert!(p.releases[0].why.starts_with("the build-up step"), "{p:?}");
+        // With the undecided conditions' spread all the factors' within a model (nothing a
+        // release nearer them narrows more than one at Mach 0.6), neither settles nor narrows
+        // enough after many releases: settled, saying so.
+        let many: Vec<Flight> = (0..50).map(|_| grid.flight(0).clone()).collect();
+        for c in &mut a {
+            (c.reach, c.factor_spread_mm) = (0.0, 10.0);
+        }
+        let p = plan(&grid, &a, &many, CRITERIA, 1);
+        assert!(p.settled && p.releases.is_empty(), "{p:?}");
+        assert!(p.words.contains("settle or narrow"), "{p:?}");
     }
 }

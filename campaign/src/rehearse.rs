@@ -115,7 +115,8 @@ pub struct Rehearsal {
 /// flown of `expected_settled` and of the conditions settled (docs/campaign.md, "Forecasts").
 pub fn forecast_totals(flown: &[FlownRelease]) -> (f64, usize) {
     (
-        flown.iter().map(|f| f.expected_settled).sum(),
+        // Summed from +0.0 (an empty f64 sum is -0.0, said "-0.0").
+        flown.iter().fold(0.0, |t, f| t + f.expected_settled),
         flown.iter().map(|f| f.settled).sum(),
     )
 }

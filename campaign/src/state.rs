@@ -86,6 +86,12 @@ pub struct Assessed {
     /// rival).
     #[serde(default)]
     pub rival_separation: f64,
+    /// Per sample, what the planning reads a release's lesson from ([`crate::joint`]): its
+    /// smallest clearance on the factors' draws and its trajectory's features (null: it did
+    /// not run). Empty in assessments written before 2026-12-02 (the planning then uses the
+    /// rules of [`crate::next`] without it).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint: Vec<Option<crate::joint::Sample>>,
 }
 
 /// The counts of an envelope's states.
