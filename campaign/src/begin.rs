@@ -4,7 +4,7 @@
 //! within the fly risk: the pre-flight test to ask for.
 //!
 //! The least risky condition's samples are flown again (the same draws as its assessment: the
-//! same seed and generators, [`crate::assess::draws`]), each with its smallest clearance and
+//! same seed and generators, `assess::draws`), each with its smallest clearance and
 //! whether it fails (below the criterion, or diverged). For factor j, a prior whose standard
 //! deviation is k sd_j (k in (0, 1]) is weighed by importance sampling on those samples: the
 //! prior draws every factor independently from a normal truncated to the factor's range, so

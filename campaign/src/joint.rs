@@ -88,8 +88,9 @@ pub const MIN_SAMPLES_BEYOND_FEATURES: usize = 20;
 
 /// Releases at the conditions `at` measured; the share of each condition `u`'s factors'
 /// variance of its smallest clearance they leave, from each condition's joint samples `joint`
-/// (an assessment's [`crate::state::Assessed::joint`]; module docs). `None` when a condition holds no joint samples (a record written before they were
-/// kept) or too few samples ran at every condition of `at`.
+/// (an assessment's [`crate::state::Assessed::joint`]; module docs). `None` when a condition
+/// holds no joint samples (a record written before they were kept) or too few samples ran at
+/// every condition of `at`.
 pub fn left_after(joint: &[&[Option<Sample>]], at: &[usize], u: &[usize]) -> Option<Vec<f64>> {
     if at.is_empty() {
         return Some(vec![1.0; u.len()]);

@@ -189,7 +189,7 @@ fn refuse_taken(dir: &Path) -> Result<(), CampaignError> {
 }
 
 /// Starts a campaign in `dir` (absent or empty): round 0, the envelope under the prior. On an
-/// error, a signal or a panic, what it made is removed ([`Unmade`]).
+/// error, a signal or a panic, what it made is removed (`Unmade`).
 pub fn init(
     dir: &Path,
     init: Init,
