@@ -40,9 +40,7 @@ use sepval_fit::domain::{covered_reach, reach};
 use sepval_predict::reach::{effective, uncovered};
 
 use crate::joint;
-use crate::preposterior::{
-    Pair, Spread, gain, narrowing, normal, settle, settled_before, tail_spreads,
-};
+use crate::preposterior::{Pair, Spread, normal, outcome, tail_spreads};
 use crate::rivals;
 use crate::state::{Assessed, State};
 
@@ -111,15 +109,17 @@ pub fn plan(
     criteria: Criteria,
     count: usize,
 ) -> Plan {
-    let undecided: Vec<usize> = (0..assessed.len())
-        .filter(|&u| assessed[u].state == State::Undecided)
-        .collect();
+    let undecided = assessed
+        .iter()
+        .filter(|a| a.state == State::Undecided)
+        .count();
     let safe: Vec<usize> = (0..assessed.len())
         .filter(|&c| assessed[c].row.p_fail <= criteria.fly_risk)
         .collect();
     if safe.is_empty() {
-        return no_safe(grid, assessed, criteria.fly_risk, undecided.is_empty());
+        return no_safe(grid, assessed, criteria.fly_risk, undecided == 0);
     }
+    let spreads = tail_spreads(assessed, criteria.criterion_mm);
     let planner = Planner {
         grid,
         assessed,
@@ -129,8 +129,9 @@ pub fn plan(
         every: (0..assessed.len()).collect(),
         undecided,
         joint: assessed.iter().map(|a| a.joint.as_slice()).collect(),
+        start: spreads.iter().map(Spread::total).collect(),
     };
-    let mut outlook = planner.outlook_now();
+    let mut outlook = planner.outlook_now(spreads);
     let mut chosen: Vec<Planned> = Vec::new();
     for n in flown.len()..flown.len() + count.max(1) {
         let options: Vec<Weighed> = safe
@@ -146,7 +147,7 @@ pub fn plan(
         // Taken as flown: the spreads it leaves, one release more.
         outlook = w.after;
     }
-    let undecided = planner.undecided.len();
+    let undecided = planner.undecided;
     let mut words = words(undecided, chosen.len());
     if !chosen.is_empty() && chosen.len() < count {
         words.push_str(&format!(
@@ -173,10 +174,12 @@ struct Planner<'a> {
     z: f64,
     /// Every condition's index.
     every: Vec<usize>,
-    /// The undecided conditions.
-    undecided: Vec<usize>,
+    /// How many conditions are undecided.
+    undecided: usize,
     /// Each condition's joint samples ([`Assessed::joint`]).
     joint: Vec<&'a [Option<joint::Sample>]>,
+    /// Each condition's total spread before the batch: what is learnt is measured from it.
+    start: Vec<f64>,
 }
 
 /// The envelope as the planning expects it once the batch chosen so far is flown.
@@ -185,8 +188,6 @@ struct Outlook {
     batch: Vec<usize>,
     /// Each condition's spread, in its parts.
     spreads: Vec<Spread>,
-    /// Each condition's total spread before the batch: what is learnt is measured from it.
-    start: Vec<f64>,
     /// Each condition's reach.
     reaches: Vec<f64>,
     /// The share of each condition's factors' variance the batch leaves
@@ -206,12 +207,10 @@ struct Weighed {
 }
 
 impl Planner<'_> {
-    /// The envelope before any release of the batch.
-    fn outlook_now(&self) -> Outlook {
-        let spreads = tail_spreads(self.assessed, self.criteria.criterion_mm);
+    /// The envelope before any release of the batch, each condition's spread `spreads`.
+    fn outlook_now(&self, spreads: Vec<Spread>) -> Outlook {
         Outlook {
             batch: Vec::new(),
-            start: spreads.iter().map(Spread::total).collect(),
             spreads,
             reaches: self.assessed.iter().map(|a| a.reach).collect(),
             left: joint::left_after(&self.joint, &[], &self.every),
@@ -226,16 +225,16 @@ impl Planner<'_> {
         let left = o
             .left
             .as_ref()
-            .and(joint::left_after(&self.joint, &batch, &self.every));
+            .and_then(|_| joint::left_after(&self.joint, &batch, &self.every));
         // Each condition's reach once c is flown: from the nearest release, beyond what the
         // releases held out in turn then cover (as the next round's band reads it).
         let mut all: Vec<&Flight> = self.flown.iter().collect();
         all.extend(batch.iter().map(|&k| self.grid.flight(k)));
         let covered = covered_reach(&all, &[]);
+        let rivals_left = rivals::left_after(self.assessed[c].rival_separation);
         let mut after = Outlook {
             batch,
             spreads: o.spreads.clone(),
-            start: o.start.clone(),
             reaches: o.reaches.clone(),
             left: None,
         };
@@ -244,7 +243,7 @@ impl Planner<'_> {
             let pair = Pair {
                 reach: uncovered(reach(&all, self.grid.flight(u)), covered),
                 margin_mm: self.assessed[u].row.clearance_p50_mm - self.criteria.criterion_mm,
-                rivals_left: rivals::left_after(self.assessed[c].rival_separation),
+                rivals_left,
                 factors_left: left.as_ref().zip(o.left.as_ref()).map(|(l, now)| {
                     if now[u] > 0.0 {
                         (l[u] / now[u]).min(1.0)
@@ -254,14 +253,12 @@ impl Planner<'_> {
                 }),
                 z: self.z,
             };
-            let (spread, r) = settle(&pair, &o.spreads[u], o.reaches[u], n);
-            if self.undecided.contains(&u) {
-                settles += gain(&pair, o.spreads[u], o.reaches[u], o.start[u], n);
-                // What the batch is expected to settle already needs no narrowing.
-                let open = 1.0 - settled_before(&pair, o.spreads[u], o.start[u], n);
-                narrows += open.clamp(0.0, 1.0) * narrowing(&o.spreads[u], &spread);
+            let out = outcome(&pair, &o.spreads[u], o.reaches[u], self.start[u], n);
+            if self.assessed[u].state == State::Undecided {
+                settles += out.gain;
+                narrows += out.narrows;
             }
-            (after.spreads[u], after.reaches[u]) = (spread, r);
+            (after.spreads[u], after.reaches[u]) = (out.after, pair.reach);
         }
         after.left = left;
         Weighed {
@@ -285,7 +282,7 @@ impl Planner<'_> {
             })
         };
         let top = best(&|w| w.settles, &|_| true)?;
-        let undecided = self.undecided.len();
+        let undecided = self.undecided;
         let (w, mut why) = if top.settles >= SETTLES_NOTHING {
             let floor = FLAT * top.settles;
             let w = best(&|w| w.narrows, &|w| w.settles >= floor).expect("top is among them");

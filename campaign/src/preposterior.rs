@@ -119,10 +119,9 @@ pub(crate) struct Pair {
 }
 
 /// What a release does to a condition (`pair`) of spread `spread` and reach `r`, with `n`
-/// releases flown: its spread and reach afterwards.
-pub(crate) fn settle(pair: &Pair, spread: &Spread, r: f64, n: usize) -> (Spread, f64) {
-    let r_after = pair.reach;
-    let (e0, e1) = (effective(r), effective(r_after));
+/// releases flown: its spread afterwards (its reach afterwards is `pair.reach`).
+pub(crate) fn settle(pair: &Pair, spread: &Spread, r: f64, n: usize) -> Spread {
+    let (e0, e1) = (effective(r), effective(pair.reach));
     // A reach may grow (the first release far from a condition, beyond the prior's
     // `UNFLOWN_REACH`, or the releases' cover shrinking): the band grows with it, as the next
     // round's will, and the condition's median is then not expected to move.
@@ -145,29 +144,41 @@ pub(crate) fn settle(pair: &Pair, spread: &Spread, r: f64, n: usize) -> (Spread,
             spread.rivals * pair.rivals_left.clamp(0.0, 1.0).sqrt(),
         ),
     };
-    (
-        Spread {
-            rivals,
-            within,
-            form,
-        },
-        r_after,
-    )
+    Spread {
+        rivals,
+        within,
+        form,
+    }
 }
 
-/// What a release (`pair`) adds to the probability that a condition ends settled, its spread
-/// `spread` and reach `r` now, its spread `start` before the batch, with `n` releases flown or
-/// chosen.
-pub(crate) fn gain(pair: &Pair, spread: Spread, r: f64, start: f64, n: usize) -> f64 {
-    let (after, _) = settle(pair, &spread, r, n);
-    p_settle(pair, start, after.total()) - settled_before(pair, spread, start, n)
+/// What a release does to one condition.
+pub(crate) struct Outcome {
+    /// The condition's spread afterwards.
+    pub(crate) after: Spread,
+    /// What the release adds to the probability that the condition ends settled.
+    pub(crate) gain: f64,
+    /// How much it narrows the condition's spread ([`narrowing`]), counted only as far as the
+    /// batch before it has not settled the condition already.
+    pub(crate) narrows: f64,
+}
+
+/// What a release (`pair`) does to a condition of spread `spread` and reach `r` now, its
+/// total spread `start` before the batch, with `n` releases flown or chosen.
+pub(crate) fn outcome(pair: &Pair, spread: &Spread, r: f64, start: f64, n: usize) -> Outcome {
+    let after = settle(pair, spread, r, n);
+    let before = settled_before(pair, spread, start, n);
+    Outcome {
+        gain: p_settle(pair, start, after.total()) - before,
+        narrows: (1.0 - before).clamp(0.0, 1.0) * narrowing(spread, &after),
+        after,
+    }
 }
 
 /// The probability that a condition of spread `spread` now (`start` before the batch) is
 /// settled by the batch chosen so far, with `n` releases flown or chosen. Before the first
 /// release nothing is cleared (`State::before_release`): whatever the prior would settle, the
 /// first release settles.
-pub(crate) fn settled_before(pair: &Pair, spread: Spread, start: f64, n: usize) -> f64 {
+fn settled_before(pair: &Pair, spread: &Spread, start: f64, n: usize) -> f64 {
     if n == 0 {
         0.0
     } else {
@@ -190,7 +201,7 @@ fn p_settle(pair: &Pair, s: f64, s_after: f64) -> f64 {
 
 /// How much a release narrows a condition's spread: 1 - s' / s (negative where it widens it,
 /// at least -1), 0 when it had none.
-pub(crate) fn narrowing(before: &Spread, after: &Spread) -> f64 {
+fn narrowing(before: &Spread, after: &Spread) -> f64 {
     let (s0, s1) = (before.total(), after.total());
     if s0 > 0.0 {
         (1.0 - s1 / s0).clamp(-1.0, 1.0)
