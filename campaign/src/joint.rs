@@ -12,7 +12,8 @@
 //!   c at [`TIMES`] points (a third, two thirds and the end of the band's points), x, y, z over
 //!   the position noise and roll, pitch, yaw over the attitude noise (the diagnosis's noise, or
 //!   the synthetic flight test's before any release): [`FEATURES`] numbers in units of the
-//!   noise, so the measurement's noise covariance is the identity;
+//!   noise, so the measurement's noise covariance is the identity (the first [`MAX_KEPT`]
+//!   samples of a round are kept, so that a large round's record stays small);
 //! - releases at the conditions S measure f = (f_c, c in S) with that noise: u's clearance
 //!   variance left is Var(y) - Cov(y, f) (Cov(f) + I)^-1 Cov(f, y), over the samples that ran
 //!   at every c of S;
@@ -54,8 +55,15 @@ pub const PRIOR_NOISE: Noise = Noise {
     att_deg: SIGMA_ATT_DEG,
 };
 
-/// Each sample's [`Sample`] at a condition: `trajectories[s]` at the band's points (`None`:
-/// it did not run), `closest_mm[s]` its smallest clearance on the factors' draws.
+/// The most samples kept per condition: the first of the round's draws (independent and
+/// seeded, so the first are as fair a sample as any), enough for a batch of up to 100 releases'
+/// features ([`MIN_SAMPLES_BEYOND_FEATURES`] beyond them) while an assessment of 100 000
+/// samples a condition does not grow by gigabytes.
+pub const MAX_KEPT: usize = 2_000;
+
+/// Each sample's [`Sample`] at a condition, the first [`MAX_KEPT`]: `trajectories[s]` at the
+/// band's points (`None`: it did not run), `closest_mm[s]` its smallest clearance on the
+/// factors' draws.
 pub fn samples(
     trajectories: &[Option<&GridTrajectory>],
     closest_mm: &[Option<f64>],
@@ -64,6 +72,7 @@ pub fn samples(
     trajectories
         .iter()
         .zip(closest_mm)
+        .take(MAX_KEPT)
         .map(|(t, c)| {
             let t = (*t)?;
             if t.is_empty() {
@@ -211,5 +220,9 @@ mod tests {
         assert_eq!(&first[7..8], &[10.0]); // point 5
         assert_eq!(&first[13..14], &[16.0]); // point 8, the end
         assert_eq!(s[1], None);
+        // A large round keeps its first MAX_KEPT samples.
+        let many = vec![Some(&t); MAX_KEPT + 500];
+        let closest = vec![Some(1.0); MAX_KEPT + 500];
+        assert_eq!(samples(&many, &closest, noise).len(), MAX_KEPT);
     }
 }
