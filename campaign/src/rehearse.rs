@@ -192,7 +192,7 @@ impl Rehearsal {
 
 /// The truth at every condition of `grid` with `clearance`, computed before the campaign
 /// begins. Where the truth's simulation diverges the store tumbles: that condition fails
-/// (its smallest clearance null), as a store that tumbles off its rack fails in flight. A
+/// (its smallest clearance `"nan"`), as a store that tumbles off its rack fails in flight. A
 /// truth that flies none of the grid's conditions, or whose trajectory cannot be traced
 /// against the aircraft, is refused before anything is written, naming the condition (before
 /// 2026-12-01 it was found after the whole `init` and left a round-0 campaign behind).
