@@ -60,8 +60,16 @@ def test_ctrl_c_while_the_command_runs(tmp_path):
             senders.append(sender)
             sender.start()
 
-    with pytest.raises(KeyboardInterrupt):
-        sepval.fit(generations=500, population=40, workers=2, out=tmp_path / "run", progress=send_sigint)
+    # Python's own Ctrl-C handler, whatever the runner left: a test runner started in the
+    # background by a non-interactive shell inherits SIGINT ignored, and Python then installs
+    # no handler, so the signal never reaches the fit (seen 2026-12-02, a cold .ci/run begun
+    # with `&`).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sepval.fit(generations=500, population=40, workers=2, out=tmp_path / "run", progress=send_sigint)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     senders[0].join(timeout=60)
     assert not senders[0].is_alive()
     assert not (tmp_path / "run" / "result.json").exists()
