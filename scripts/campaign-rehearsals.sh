@@ -18,10 +18,13 @@
 # all conditions decided right at the end (cleared and truly safe, or failing and truly
 # failing; target >= 90 %); each release's forecast (`expected_settled`) against what it
 # settled (target: realized / expected within 0.7-1.3 over all releases); then the averages
-# (target <= 4 releases).
+# (target <= 4 releases). With --check-settled, a rehearsal that settles with conditions
+# undecided has the claim checked: each condition then safe to fly is flown in turn on a copy
+# of the campaign (`campaign rehearse --check-settled`), and the table says how many candidates
+# there were and how many would have settled a condition (target 0).
 #
 #   scripts/campaign-rehearsals.sh OUT [--samples N] [--releases MAX] [--generations G]
-#       [--seed S] [--threads T] [--only NAME[,NAME...]]
+#       [--seed S] [--threads T] [--only NAME[,NAME...]] [--check-settled]
 #   scripts/campaign-rehearsals.sh OUT --truths    (only the truths' envelopes: --releases 0,
 #                                                   --samples 20, a few seconds each)
 #   scripts/campaign-rehearsals.sh OUT --table     (print the table of a finished OUT again)
@@ -48,6 +51,7 @@ seed=1
 threads=2
 only="null,catalogue,extension"
 table_only=0
+check=()
 while [ $# -gt 0 ]; do
     case "$1" in
         --samples) samples="$2"; shift 2 ;;
@@ -56,6 +60,7 @@ while [ $# -gt 0 ]; do
         --seed) seed="$2"; shift 2 ;;
         --threads) threads="$2"; shift 2 ;;
         --only) only="$2"; shift 2 ;;
+        --check-settled) check=(--check-settled); shift ;;
         --truths) releases=0; samples=20; shift ;;
         --table) table_only=1; shift ;;
         *) echo "unknown option: $1" >&2; usage ;;
@@ -82,7 +87,7 @@ if [ "$table_only" = 0 ]; then
         echo "started_utc=$(date -u +%Y-%m-%dT%H:%M:%SZ)"
         echo "commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
         echo "binary_sha256=$(sha256sum "$bin" | cut -d' ' -f1)"
-        echo "samples=$samples releases=$releases generations=$generations seed=$seed threads=$threads"
+        echo "samples=$samples releases=$releases generations=$generations seed=$seed threads=$threads check_settled=${#check[@]}"
     } >"$out/settings.txt"
     IFS=, read -r -a names <<<"$only"
     for name in "${names[@]}"; do
@@ -93,7 +98,7 @@ if [ "$table_only" = 0 ]; then
             --prior "$ex/prior.json" --fly-risk 0.05
             --samples "$samples" --generations "$generations" --seed "$seed"
             --releases "$releases" --evaluator inproc --threads "$threads"
-            "${truth[@]}")
+            "${check[@]}" "${truth[@]}")
         echo "rehearsal $name: ${cmd[*]#"$root/"}" >&2
         start=$(date +%s.%N)
         status=0
@@ -176,6 +181,9 @@ for name, status, wall in runs:
         "final": last["counts"], "final_false_fails": last["false_fails"],
         "expected_settled": expected, "settled": settled, "unsettled": unsettled,
         "ratio": settled / expected if expected > 0 else float("nan"),
+        "check_candidates": len(r.get("settled_check", [])),
+        "check_settling": sum(1 for f in r.get("settled_check", []) if f["settled"] > 0),
+        "check_most": max([f["settled"] for f in r.get("settled_check", [])], default=0),
     }
     row["truth_map"] = {f"{m:g},{h:g}": t["min_clearance_mm"] for t in r["truth"]
                         for m, h in [(t["condition"]["mach"], t["condition"]["altitude_m"])]}
@@ -188,15 +196,21 @@ for name, status, wall in runs:
         releases.append((name, i, c["mach"], c["altitude_m"], f["p_fail_planned"], f["truly_safe"],
                          f["expected_settled"], f["settled"], f["unsettled"]))
 
+def check_cell(r):
+    if not r["check_candidates"]:
+        return "-"
+    return f"{r['check_candidates']}, {r['check_settling']} (most {r['check_most']})"
+
+
 lines = []
 p = lines.append
 p("settings: " + " ".join(settings))
 p("")
-p("| rehearsal | truth fails | releases | settled | final cleared / fail / undecided | false clears, any round | releases truly unsafe | truly safe cleared | decided right | settled / expected | wall |")
-p("|---|---|---|---|---|---|---|---|---|---|---|")
+p("| rehearsal | truth fails | releases | settled | final cleared / fail / undecided | false clears, any round | releases truly unsafe | truly safe cleared | decided right | settled / expected | settled check: candidates, settling | wall |")
+p("|---|---|---|---|---|---|---|---|---|---|---|---|")
 for r in rows:
     if "error" in r:
-        p(f"| {r['name']} | {r['error']} | | | | | | | | | {r['wall_s']} s |")
+        p(f"| {r['name']} | {r['error']} | | | | | | | | | | {r['wall_s']} s |")
         continue
     fc = r["final"]
     p(f"| {r['name']} | {r['truth_fails']} of {r['conditions']} ({pct(r['truth_fails'], r['conditions']):.0f} %) "
@@ -205,7 +219,8 @@ for r in rows:
       f"| {r['false_clears_any_round']} | {r['unsafe_releases']} "
       f"| {r['safe_cleared']} of {r['safe']} ({r['safe_cleared_pct']:.0f} %) "
       f"| {r['decided_right']} of {r['conditions']} ({r['decided_right_pct']:.0f} %) "
-      f"| {r['settled']} / {r['expected_settled']:.1f} = {r['ratio']:.2f} | {r['wall_s']} s |")
+      f"| {r['settled']} / {r['expected_settled']:.1f} = {r['ratio']:.2f} "
+      f"| {check_cell(r)} | {r['wall_s']} s |")
 ok = [r for r in rows if "error" not in r]
 if ok:
     k = len(ok)
@@ -225,8 +240,8 @@ if ok:
     summary["average"] = avg
     p(f"| **average of {k}** | | {avg['releases']:.1f} | | | {avg['false_clears_any_round']} (total) "
       f"| {avg['unsafe_releases']} (total) | {avg['safe_cleared_pct']:.0f} % | {avg['decided_right_pct']:.0f} % "
-      f"| {set_all} / {exp_all:.1f} = {avg['ratio']:.2f} | {avg['wall_s']:.0f} s |")
-    p("| **target** | 40-60 % | <= 4 | | | 0 | 0 | >= 95 % | >= 90 % | 0.7-1.3 | |")
+      f"| {set_all} / {exp_all:.1f} = {avg['ratio']:.2f} | | {avg['wall_s']:.0f} s |")
+    p("| **target** | 40-60 % | <= 4 | | | 0 | 0 | >= 95 % | >= 90 % | 0.7-1.3 | 0 settling | |")
 p("")
 p("| rehearsal | release | Mach | altitude [m] | P(fail) planned | truly safe | expected to settle | settled | unsettled |")
 p("|---|---|---|---|---|---|---|---|---|")

@@ -44,6 +44,11 @@ pub struct CampaignRehearseArgs {
     /// The most releases to fly.
     #[arg(long, default_value_t = 6, value_name = "MAX")]
     pub releases: usize,
+    /// When the campaign settles with conditions undecided, check the claim: fly each
+    /// condition then safe to fly in turn, each on a copy of the campaign, and count what it
+    /// settles (one `add` a candidate).
+    #[arg(long)]
+    pub check_settled: bool,
 }
 
 #[derive(clap::Args)]

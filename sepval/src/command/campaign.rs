@@ -95,7 +95,10 @@ fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
         &mut c,
         &truth,
         truth_at,
-        a.releases,
+        sepval_campaign::rehearse::Schedule {
+            max_releases: a.releases,
+            check_settled: a.check_settled,
+        },
         &mut start,
         &mut *crate::front::progress(),
     )?;

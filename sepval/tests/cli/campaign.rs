@@ -416,7 +416,11 @@ fn a_rehearsal_with_a_hidden_cause_flies_only_truly_safe_releases_and_stays_cons
         tmp.path(),
         "hidden",
         "100",
-        &["--truth-effect", "pitch_stiffness_cubic=-1000"],
+        &[
+            "--truth-effect",
+            "pitch_stiffness_cubic=-1000",
+            "--check-settled",
+        ],
     );
     let truth_fails = r["truth"]
         .as_array()
@@ -442,6 +446,24 @@ fn a_rehearsal_with_a_hidden_cause_flies_only_truly_safe_releases_and_stays_cons
     // Settled within the 4 releases (measured 2026-11-27: after 2, 6 cleared, 1 fails,
     // 2 undecided that no safe release is expected to settle).
     assert_eq!(r["settled"], true, "{r}");
+    settled_holds(&r);
+}
+
+/// A rehearsal that settled with conditions undecided had the claim checked
+/// (`--check-settled`): every condition then safe to fly was flown in turn, and none settled
+/// a condition.
+fn settled_holds(r: &Value) {
+    let last = r["rounds"].as_array().unwrap().last().unwrap();
+    if last["counts"]["undecided"] == 0 {
+        return;
+    }
+    let check = r["settled_check"].as_array().expect("the settled check");
+    assert!(!check.is_empty(), "{r}");
+    for c in check {
+        assert_eq!(c["settled"], 0, "\"settled\" was wrong: {c}");
+    }
+    let words = r["words"].as_str().unwrap();
+    assert!(words.contains(&format!("\"settled\" checked by flying each of the {} condition(s) then safe to fly in turn: none settles", check.len())), "{words}");
 }
 
 #[test]

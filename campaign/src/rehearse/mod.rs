@@ -8,12 +8,13 @@
 //! truth fails is a false clear, one it fails where the truth clears a false fail, and every
 //! release planned is checked to have been truly safe.
 
-use std::path::{Path, PathBuf};
+mod check;
+mod fly;
 
 use serde::{Deserialize, Serialize};
 
 use sepval_common::effects::EffectSet;
-use sepval_common::scenario::{Scenario, hex_sha256};
+use sepval_common::scenario::Scenario;
 use sepval_common::simulation::{SimError, Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
 use sepval_core::cancel;
@@ -27,12 +28,13 @@ use sepval_solve::run::ProgressObserver;
 
 use crate::CampaignError;
 use crate::assess::StartEvaluator;
-use crate::next::Planned;
 use crate::page::{self, RehearsalRelease, RehearsalRound, RehearsalSection};
 use crate::program::Campaign;
 use crate::record::{record_error, write_json};
-use crate::release::NewRelease;
 use crate::state::{Counts, State};
+use check::check_settled;
+pub use check::{CHECK_DIR, CandidateFlown};
+use fly::{Candidate, Flew, Release, fly};
 
 /// The format of CAMP/rehearsal.json.
 pub const REHEARSAL_FORMAT: &str = "sepval-campaign-rehearsal/1";
@@ -107,6 +109,10 @@ pub struct Rehearsal {
     pub rounds: Vec<RoundAgainstTruth>,
     /// Whether the campaign settled within the releases allowed.
     pub settled: bool,
+    /// The claim "settled" checked ([`check`]): each condition safe to fly when it was made,
+    /// flown in turn (empty: not asked for, not settled, or nothing was undecided).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub settled_check: Vec<CandidateFlown>,
     /// In words.
     pub words: String,
 }
@@ -148,6 +154,18 @@ impl Rehearsal {
                 round.counts.undecided,
                 round.false_clears,
                 round.false_fails
+            ));
+        }
+        for f in &self.settled_check {
+            out.push(format!(
+                "settled check: Mach {}, altitude {} m, alpha {} deg (P(fail) {:.3}; truly {}) would settle {}, unsettle {}",
+                crate::page::number(f.condition.mach),
+                crate::page::number(f.condition.altitude_m),
+                crate::page::number(f.condition.alpha_deg),
+                f.p_fail,
+                if f.truly_safe { "safe" } else { "UNSAFE" },
+                f.settled,
+                f.unsettled
             ));
         }
         out.push(format!("rehearsal: {}", self.words));
@@ -279,6 +297,16 @@ fn against(c: &Campaign, truth: &[TruthCondition]) -> Result<RoundAgainstTruth, 
     })
 }
 
+/// How long a rehearsal runs and what it checks at the end.
+#[derive(Debug, Clone, Copy)]
+pub struct Schedule {
+    /// The most releases to fly.
+    pub max_releases: usize,
+    /// Whether a campaign that settles with conditions undecided has the claim checked by
+    /// flying each safe candidate in turn ([`check`]).
+    pub check_settled: bool,
+}
+
 /// Runs the rehearsal on the campaign `c` (begun with `init`) against `truth`, whose envelope
 /// over the campaign's grid is `truth_at` ([`truth_envelope`]); writes CAMP/rehearsal.json
 /// after every round.
@@ -286,7 +314,7 @@ pub fn rehearse(
     c: &mut Campaign,
     truth: &Truth,
     truth_at: Vec<TruthCondition>,
-    max_releases: usize,
+    schedule: Schedule,
     start: &mut StartEvaluator<'_>,
     observer: &mut dyn ProgressObserver,
 ) -> Result<Rehearsal, CampaignError> {
@@ -296,13 +324,14 @@ pub fn rehearse(
         flown: Vec::new(),
         rounds: Vec::new(),
         settled: c.file.settled,
+        settled_check: Vec::new(),
         words: String::new(),
     };
     r.rounds.push(against(c, &r.truth)?);
     let flown_dir = c.dir.join("rehearsal");
     std::fs::create_dir_all(&flown_dir).map_err(|e| record_error(&flown_dir, e))?;
     let mut tumbled: Option<String> = None;
-    for k in 0..max_releases {
+    for k in 0..schedule.max_releases {
         if c.file.settled {
             break;
         }
@@ -312,7 +341,11 @@ pub fn rehearse(
         };
         let release = Release {
             truth,
-            planned: p,
+            at: Candidate {
+                index: p.index,
+                p_fail: p.p_fail,
+                expected_settled: p.expected_settled,
+            },
             number: k + 1,
             dir: &flown_dir,
         };
@@ -329,6 +362,9 @@ pub fn rehearse(
         r.settled = c.file.settled;
         write_json(&c.dir.join("rehearsal.json"), &r)?;
     }
+    if schedule.check_settled && r.settled && tumbled.is_none() {
+        r.settled_check = check_settled(c, truth, &r.truth, r.flown.len() + 1, start, observer)?;
+    }
     r.words = verdict(&r, tumbled);
     write_json(&c.dir.join("rehearsal.json"), &r)?;
     // The page again, now with the comparison with the truth first.
@@ -339,94 +375,6 @@ pub fn rehearse(
     };
     page::render(&view)?;
     Ok(r)
-}
-
-/// One release of a rehearsal: the truth flown at the planned condition, the release's
-/// number (1 for the first), and where its file goes.
-struct Release<'a> {
-    truth: &'a Truth,
-    planned: &'a Planned,
-    number: usize,
-    dir: &'a Path,
-}
-
-/// What flying a planned release did.
-enum Flew {
-    /// The release was added to the campaign.
-    Added(FlownRelease),
-    /// The truth diverged there (the store tumbles): nothing to add, and why.
-    Tumbled(FlownRelease, String),
-}
-
-/// Flies `release` in the truth (`truly_fails` there or not) and adds it to `c`.
-fn fly(
-    c: &mut Campaign,
-    release: &Release<'_>,
-    truly_fails: bool,
-    start: &mut StartEvaluator<'_>,
-    observer: &mut dyn ProgressObserver,
-) -> Result<Flew, CampaignError> {
-    let Release {
-        truth,
-        planned: p,
-        number,
-        dir,
-    } = *release;
-    let base = &truth.scenario;
-    let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
-    let s = c.grid.scenario(base, p.index);
-    let mut flown = FlownRelease {
-        condition: ConditionRecord::of(&s.flight),
-        p_fail_planned: p.p_fail,
-        truly_safe: !truly_fails,
-        expected_settled: p.expected_settled,
-        settled: 0,
-        unsettled: 0,
-    };
-    let data = match synthetic_flight_test(
-        &Simulator::new(&s),
-        &truth.factors,
-        &truth.effects,
-        &times,
-        Some(truth.noise_seed.wrapping_add(number as u64 - 1)),
-    ) {
-        Ok(data) => data,
-        Err(SimError::Diverged(d)) => {
-            flown.truly_safe = false;
-            let why = format!("release {number} tumbled ({d}); the rehearsal stopped there");
-            return Ok(Flew::Tumbled(flown, why));
-        }
-        Err(e) => {
-            return Err(CampaignError::Refused(format!(
-                "the truth at release {number}: {e}"
-            )));
-        }
-    };
-    let path: PathBuf = dir.join(format!("flown-{number:02}.csv"));
-    data.write(&path).map_err(|e| record_error(&path, e))?;
-    let bytes = std::fs::read(&path).map_err(|e| record_error(&path, e))?;
-    let before = c.current()?;
-    let release = NewRelease {
-        given: path,
-        sha256: hex_sha256(&bytes),
-        data,
-        scenario: c.grid.scenario(&c.scenario, p.index),
-        notes: Vec::new(),
-    };
-    crate::add::add(c, vec![release], start, observer)?;
-    let after = c.current()?;
-    let moved = |from: &dyn Fn(State) -> bool, to: &dyn Fn(State) -> bool| {
-        before
-            .iter()
-            .zip(&after)
-            .filter(|(b, a)| from(b.state) && to(a.state))
-            .count()
-    };
-    let undecided = |s: State| s == State::Undecided;
-    let decided = |s: State| s != State::Undecided;
-    flown.settled = moved(&undecided, &decided);
-    flown.unsettled = moved(&decided, &undecided);
-    Ok(Flew::Added(flown))
 }
 
 /// The rehearsal's verdict in words.
@@ -448,6 +396,9 @@ fn verdict(r: &Rehearsal, tumbled: Option<String>) -> String {
     if let Some(t) = tumbled {
         words = format!("{words}; {t}");
     }
+    if !r.settled_check.is_empty() {
+        words = format!("{words}; {}", check_words(&r.settled_check));
+    }
     let tumbles = r
         .truth
         .iter()
@@ -458,6 +409,28 @@ fn verdict(r: &Rehearsal, tumbled: Option<String>) -> String {
             "{words}; the truth tumbles (its simulation diverges) at {tumbles} of the grid's {} conditions, counted as failing",
             r.truth.len()
         );
+    }
+    words
+}
+
+/// The settled check in words.
+fn check_words(check: &[CandidateFlown]) -> String {
+    let n = check.len();
+    let settling: Vec<&CandidateFlown> = check.iter().filter(|f| f.settled > 0).collect();
+    let unsafe_ = check.iter().filter(|f| !f.truly_safe).count();
+    let mut words = if settling.is_empty() {
+        format!(
+            "\"settled\" checked by flying each of the {n} condition(s) then safe to fly in turn: none settles a condition"
+        )
+    } else {
+        let most = settling.iter().map(|f| f.settled).max().unwrap_or(0);
+        format!(
+            "\"settled\" checked by flying each of the {n} condition(s) then safe to fly in turn: WRONG, {} of them would settle conditions (up to {most})",
+            settling.len()
+        )
+    };
+    if unsafe_ > 0 {
+        words = format!("{words}; {unsafe_} of those candidates truly fail");
     }
     words
 }
