@@ -18,10 +18,10 @@ use sepval_core::number_text::Shown;
 use crate::error::{DavemlError, Place};
 use crate::map::{Map, Output, Role};
 use crate::parse::{
-    BreakpointDef, Function, GriddedTable, InputRef, Located, Parsed, PdfKind, TableDefn,
+    BreakpointDef, Function, GriddedTable, InputRef, Located, Parsed, Pdf, PdfKind, TableDefn,
     VariableDef,
 };
-use crate::units;
+use crate::units::{self, Conversion};
 
 /// The value a file gives a field.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,6 +41,55 @@ pub struct ImportedField {
     pub value: FieldValue,
     /// The element it came from.
     pub place: Place,
+    /// Its uncertainty, if the file gives one.
+    pub spread: Option<Spread>,
+}
+
+/// A field's uncertainty as the file gives it: a `normalPDF`'s bounds divided by its
+/// `numSigmas` (DAVE-ML 2.0 section 5.7), one standard deviation per value of the field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spread {
+    /// One standard deviation per value of the field, in its table's order (one for a
+    /// constant or when the file gives one for the whole table), in the scenario's units;
+    /// empty when unusable.
+    pub sd: Vec<f64>,
+    /// Why it cannot be read as standard deviations (a `uniformPDF`, no `numSigmas`, bounds
+    /// of another shape than the table's, or not given as numbers).
+    pub unusable: Option<String>,
+    /// Where its PDF is.
+    pub place: Place,
+}
+
+/// The spread of `pdf` over a field of `points` values in the file's order, its bounds
+/// converted by `c`.
+fn spread_of(pdf: &Pdf, points: usize, c: Conversion) -> Spread {
+    let unusable = |why: String| Spread {
+        sd: Vec::new(),
+        unusable: Some(why),
+        place: pdf.place.clone(),
+    };
+    if pdf.kind == PdfKind::Uniform {
+        return unusable(
+            "a uniformPDF: only a normalPDF gives a mean and standard deviation".into(),
+        );
+    }
+    let Some(k) = pdf.num_sigmas.filter(|k| *k > 0.0) else {
+        return unusable("a normalPDF without a numSigmas above 0: its bounds are not a known number of standard deviations".into());
+    };
+    let n = pdf.bounds.len();
+    if n != 1 && n != points {
+        return unusable(format!(
+            "a normalPDF with {n} bounds for a field of {points} values: expected one, or one per value"
+        ));
+    }
+    if pdf.bounds.iter().any(|b| *b < 0.0) {
+        return unusable("a normalPDF with a negative bound".into());
+    }
+    Spread {
+        sd: pdf.bounds.iter().map(|b| c.apply(*b).abs() / k).collect(),
+        unusable: None,
+        place: pdf.place.clone(),
+    }
 }
 
 /// What a DAVE-ML file gives the scenario.
@@ -119,8 +168,9 @@ pub fn import(p: &Parsed, map: &Map) -> Result<Imported, DavemlError> {
         let var = idx.variable(&f.item.output.item, &f.item.output.place)?;
         match map.role(&var.item.var_id, &var.item.name) {
             Some(Role::Output(o)) => {
-                let table = function_table(&idx, map, &f.item, var, o)?;
+                let (table, spread) = function_table(&idx, map, &f.item, var, o)?;
                 push(&mut out, o.target, FieldValue::Table(table), &f.place)?;
+                out.fields.last_mut().expect("pushed").spread = spread;
                 if let Some(note) = uncertainty_note(&idx, &f.item, var) {
                     out.notes.push(note);
                 }
@@ -178,6 +228,8 @@ fn constants(p: &Parsed, map: &Map, out: &mut Imported) -> Result<(), DavemlErro
             units::output(kind, &v.item.units).map_err(|e| units_error(&v.place, &v.item, e))?;
         let value = signed(o, c.apply(x));
         push(out, o.target, FieldValue::Constant(value), &v.place)?;
+        out.fields.last_mut().expect("pushed").spread =
+            v.item.uncertainty.as_ref().map(|p| spread_of(p, 1, c));
     }
     Ok(())
 }
@@ -206,6 +258,7 @@ fn push(
         target,
         value,
         place: at.clone(),
+        spread: None,
     });
     Ok(())
 }
@@ -237,13 +290,8 @@ fn units_error(at: &Place, v: &VariableDef, expected: &str) -> DavemlError {
 
 /// The note for an uncertainty sepval reads and does not carry.
 fn uncertainty_note(idx: &Index, f: &Function, var: &Located<VariableDef>) -> Option<String> {
-    let pdf = match &f.table.item {
-        TableDefn::Inline(t) => t.uncertainty,
-        TableDefn::Ref(id) => idx.tables.get(id.as_str()).and_then(|t| t.item.uncertainty),
-        TableDefn::Unsupported(_) => None,
-    }
-    .or(var.item.uncertainty)?;
-    let what = match pdf {
+    let pdf = pdf_of(idx, f, var)?;
+    let what = match pdf.kind {
         PdfKind::Normal => "normalPDF",
         PdfKind::Uniform => "uniformPDF",
     };
@@ -253,7 +301,21 @@ fn uncertainty_note(idx: &Index, f: &Function, var: &Located<VariableDef>) -> Op
     ))
 }
 
+/// The PDF of a function's table, else of its output variable.
+fn pdf_of<'a>(idx: &'a Index, f: &'a Function, var: &'a Located<VariableDef>) -> Option<&'a Pdf> {
+    match &f.table.item {
+        TableDefn::Inline(t) => t.uncertainty.as_ref(),
+        TableDefn::Ref(id) => idx
+            .tables
+            .get(id.as_str())
+            .and_then(|t| t.item.uncertainty.as_ref()),
+        TableDefn::Unsupported(_) => None,
+    }
+    .or(var.item.uncertainty.as_ref())
+}
+
 /// One input of a function: its sepval variable, conversion and breakpoints (converted).
+#[derive(Clone)]
 struct AxisIn {
     variable: Variable,
     breakpoints: Vec<f64>,
@@ -301,14 +363,15 @@ fn unsaturated(var: &Located<VariableDef>, data: &[f64]) -> Result<(), DavemlErr
     Ok(())
 }
 
-/// The table of a function whose output is the field `o`.
+/// The table of a function whose output is the field `o`, and its spread if the file gives
+/// one (in the table's order).
 fn function_table(
     idx: &Index,
     map: &Map,
     f: &Function,
     var: &Located<VariableDef>,
     o: Output,
-) -> Result<Table, DavemlError> {
+) -> Result<(Table, Option<Spread>), DavemlError> {
     let (table, table_place) = table_of(idx, f)?;
     if f.inputs.len() != table.breakpoints.len() {
         return Err(DavemlError::at(
@@ -361,14 +424,25 @@ fn function_table(
         units::output(kind, &var.item.units).map_err(|e| units_error(&var.place, &var.item, e))?;
     unsaturated(var, &table.data)?;
     let values: Vec<f64> = table.data.iter().map(|&x| signed(o, c.apply(x))).collect();
+    let mut spread = pdf_of(idx, f, var).map(|p| spread_of(p, points, c));
+    if let Some(s) = spread
+        .as_mut()
+        .filter(|s| s.sd.len() == points && points > 1)
+    {
+        // The standard deviations in the table's nesting order, as its values.
+        let (_, sd) = nest(axes.clone(), std::mem::take(&mut s.sd), kind)
+            .map_err(|m| DavemlError::at(&f.inputs[0].place, m))?;
+        s.sd = sd;
+    }
     let (axes, values) =
         nest(axes, values, kind).map_err(|m| DavemlError::at(&f.inputs[0].place, m))?;
-    Table::new(axes, values, kind).map_err(|m| {
+    let table = Table::new(axes, values, kind).map_err(|m| {
         DavemlError::at(
             &table_place,
             format!("as sepval field {}, the table {m}", o.target.field()),
         )
-    })
+    })?;
+    Ok((table, spread))
 }
 
 /// One input of a function, checked: mapped, linear, held outside, its breakpoints increasing.

@@ -69,6 +69,8 @@ pub struct ImportedModel {
     pub checked: usize,
     /// What was read and not carried, to say to the user.
     pub notes: Vec<String>,
+    /// Every field the file gave, with its value and its uncertainty if it has one.
+    pub given: Vec<import::ImportedField>,
 }
 
 /// The map: the default, with the map file's entries when one is given.
@@ -99,6 +101,7 @@ pub fn import_model(
         fields: imported.fields.iter().map(|f| f.target.field()).collect(),
         checked,
         notes: imported.notes,
+        given: imported.fields,
     })
 }
 
