@@ -6,6 +6,7 @@
 //! `sepval`.
 
 mod campaign;
+mod campaign_begin;
 mod checkpoint;
 mod cli;
 mod daveml;
