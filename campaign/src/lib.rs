@@ -39,6 +39,7 @@ pub mod release;
 pub mod request;
 pub mod rivals;
 pub mod seal;
+pub mod sources;
 pub mod state;
 
 pub use assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};

@@ -38,7 +38,6 @@ use std::path::Path;
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
-use serde::{Deserialize, Serialize};
 
 use sepval_common::evaluation::{Event, Job};
 use sepval_common::simulation::Simulator;
@@ -56,6 +55,7 @@ use crate::CampaignError;
 use crate::assess::StartEvaluator;
 use crate::prior::{Belief, Prior, PriorSource};
 use crate::release::NewRelease;
+pub use crate::sources::{FactorChange, PreflightRecord, TrajectoryRecord};
 
 /// The default model-form allowance of a pre-flight trajectory's positions \[m\].
 pub const DEFAULT_ALLOWANCE_M: f64 = 0.01;
@@ -101,60 +101,6 @@ pub struct Preflight {
     pub trajectories: Vec<NewRelease>,
     /// Their allowance.
     pub allowance: Allowance,
-}
-
-/// A pre-flight trajectory as campaign.json records it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TrajectoryRecord {
-    /// The file given (absolute).
-    pub given: String,
-    /// The SHA-256 of its bytes.
-    pub sha256: String,
-    /// Its condition, from its metadata.
-    pub condition: ConditionRecord,
-    /// Its samples fitted.
-    pub samples: usize,
-    /// What was said of it (a condition outside the grid, ...).
-    pub notes: Vec<String>,
-}
-
-/// One factor before and after the pre-flight trajectories.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FactorChange {
-    /// The factor.
-    pub factor: String,
-    /// The prior's belief.
-    pub before: Belief,
-    /// The fit's best value.
-    pub fitted: f64,
-    /// The posterior's (its marginal).
-    pub after: Belief,
-}
-
-/// The pre-flight fit as campaign.json records it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PreflightRecord {
-    /// The trajectories, in the order given.
-    pub trajectories: Vec<TrajectoryRecord>,
-    /// The model-form allowance of positions \[m\].
-    pub allowance_m: f64,
-    /// Of attitudes \[deg\].
-    pub allowance_deg: f64,
-    /// The measurement noise estimated from the trajectories: positions \[m\].
-    pub noise_pos_m: f64,
-    /// Attitudes \[deg\].
-    pub noise_att_deg: f64,
-    /// The fit's root-mean-square residual: positions \[m\].
-    pub rms_pos_m: f64,
-    /// Attitudes \[deg\].
-    pub rms_att_deg: f64,
-    /// The fit's directory in the campaign (its result.json).
-    pub fit_dir: String,
-    /// Every factor with a spread, before and after.
-    pub factors: Vec<FactorChange>,
 }
 
 /// The prior `prior` updated by the pre-flight trajectories `p` (module docs), the fit written

@@ -39,6 +39,8 @@ use sepval_core::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
 use sepval_fit::space::ParamSpace;
 use sepval_predict::sampling::ParameterDistribution;
 
+pub use crate::sources::{Belief, PriorSource};
+
 /// The format of a prior file.
 pub const PRIOR_FORMAT: &str = "sepval-prior/1";
 /// The standard deviations of the default prior: this share of each factor's range.
@@ -60,16 +62,6 @@ pub enum PriorError {
     },
 }
 
-/// One factor's belief.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Belief {
-    /// The mean.
-    pub mean: f64,
-    /// The standard deviation (0: held at the mean).
-    pub sd: f64,
-}
-
 /// The prior of the 17 factors, in table order.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Prior {
@@ -86,34 +78,6 @@ pub struct Prior {
     /// 2026-12-02: `source` says).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sources: Vec<PriorSource>,
-}
-
-/// One source of the prior, as campaign.json records it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum PriorSource {
-    /// The default prior (module docs).
-    Default,
-    /// A `--prior` file.
-    File {
-        /// The file (absolute).
-        path: String,
-        /// Its SHA-256.
-        sha256: String,
-        /// The factors it set.
-        factors: Vec<String>,
-    },
-    /// A `--prior-daveml` file ([`crate::prior_daveml`]).
-    Daveml {
-        /// The file (absolute).
-        path: String,
-        /// Its SHA-256.
-        sha256: String,
-        /// Each uncertain element and the factor it set.
-        mapped: Vec<crate::prior_daveml::Mapped>,
-    },
-    /// The `--preflight` trajectories fitted together ([`crate::preflight`]).
-    Preflight(crate::preflight::PreflightRecord),
 }
 
 #[derive(Deserialize)]
@@ -233,71 +197,7 @@ impl Prior {
 
     /// What the prior was made of, a line per source beyond the default, for `init` to say.
     pub fn lines(&self) -> Vec<String> {
-        let n = |v: f64| crate::page::number(v);
-        let mut out = Vec::new();
-        for s in &self.sources {
-            match s {
-                PriorSource::Default => {}
-                PriorSource::File { path, factors, .. } => {
-                    out.push(format!("{path} set {}", factors.join(", ")));
-                }
-                PriorSource::Daveml { path, mapped, .. } => {
-                    let each: Vec<String> = mapped
-                        .iter()
-                        .map(|m| {
-                            format!(
-                                "{} {} sd {} (from {})",
-                                m.factor,
-                                n(m.belief.mean),
-                                n(m.belief.sd),
-                                m.field
-                            )
-                        })
-                        .collect();
-                    out.push(format!("{path} set {}", each.join(", ")));
-                }
-                PriorSource::Preflight(p) => {
-                    out.push(format!(
-                        "{} pre-flight trajectories fitted (RMS {} m, {} deg; allowance {} m, {} deg in quadrature with their noise {} m, {} deg; the fit in {}/)",
-                        p.trajectories.len(),
-                        n(p.rms_pos_m),
-                        n(p.rms_att_deg),
-                        n(p.allowance_m),
-                        n(p.allowance_deg),
-                        n(p.noise_pos_m),
-                        n(p.noise_att_deg),
-                        p.fit_dir
-                    ));
-                    let mut narrowed: Vec<&crate::preflight::FactorChange> = p
-                        .factors
-                        .iter()
-                        .filter(|f| f.after.sd < 0.9 * f.before.sd)
-                        .collect();
-                    narrowed.sort_by(|a, b| {
-                        (a.after.sd / a.before.sd).total_cmp(&(b.after.sd / b.before.sd))
-                    });
-                    let each: Vec<String> = narrowed
-                        .iter()
-                        .map(|f| {
-                            format!(
-                                "{} {} sd {} (was {} sd {})",
-                                f.factor,
-                                n(f.after.mean),
-                                n(f.after.sd),
-                                n(f.before.mean),
-                                n(f.before.sd)
-                            )
-                        })
-                        .collect();
-                    out.push(if each.is_empty() {
-                        "no factor narrowed by a tenth or more: the trajectories do not see them within the allowance".into()
-                    } else {
-                        format!("narrowed: {}", each.join(", "))
-                    });
-                }
-            }
-        }
-        out
+        self.sources.iter().flat_map(PriorSource::lines).collect()
     }
 
     /// The factor-only parameter space of `table` and the prior as its distribution, truncated

@@ -28,8 +28,6 @@
 
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
-
 use sepval_common::correction::Target;
 use sepval_common::scenario::Scenario;
 use sepval_common::table::{Coefficient, Table};
@@ -38,20 +36,7 @@ use sepval_daveml::import::{FieldValue, ImportedField};
 
 use crate::CampaignError;
 use crate::prior::{Belief, Prior, PriorSource};
-
-/// An uncertain element of the file and the factor it set.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Mapped {
-    /// The element (file, line, tag).
-    pub element: String,
-    /// The sepval field, e.g. `aero.cm`.
-    pub field: String,
-    /// The factor.
-    pub factor: String,
-    /// Its belief from the file.
-    pub belief: Belief,
-}
+pub use crate::sources::Mapped;
 
 /// The factor that moves `t`, and whether it is an offset (else a multiplier).
 fn factor_of(t: Target) -> Option<(Factor, bool)> {

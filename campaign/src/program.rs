@@ -296,6 +296,15 @@ impl Campaign {
         Ok(c)
     }
 
+    /// What releases added to the campaign are read against.
+    pub fn against(&self) -> crate::release::Against<'_> {
+        crate::release::Against {
+            scenario: &self.scenario,
+            axes: &self.file.settings.axes,
+            grid: &self.grid,
+        }
+    }
+
     /// Removes what an interrupted command left: the staging directory, and the rounds and
     /// release copies it recorded creating that campaign.json does not name ([`journal`]);
     /// nothing else in the directory.

@@ -29,11 +29,11 @@ use sepval_common::scenario::Scenario as Base;
 use sepval_envelope::grid::Grid;
 
 use crate::CampaignError;
-use crate::program::Campaign;
 use crate::record::record_error;
 
 /// What a release is read against: the campaign's scenario, the flags of its grid's axes and
-/// its grid (a campaign's, or those `init` is about to begin with, for a pre-flight trajectory).
+/// its grid (a campaign's, `Campaign::against`, or those `init` is about to begin with, for a
+/// pre-flight trajectory).
 #[derive(Clone, Copy)]
 pub struct Against<'a> {
     /// The scenario.
@@ -42,17 +42,6 @@ pub struct Against<'a> {
     pub axes: &'a [(String, String)],
     /// The grid.
     pub grid: &'a Grid,
-}
-
-impl<'a> Against<'a> {
-    /// What releases added to `c` are read against.
-    pub fn campaign(c: &'a Campaign) -> Against<'a> {
-        Against {
-            scenario: &c.scenario,
-            axes: &c.file.settings.axes,
-            grid: &c.grid,
-        }
-    }
 }
 
 /// A release to add, read and screened ([`NewRelease::read`]).
@@ -83,21 +72,10 @@ pub fn key(q: Quantity) -> &'static str {
 
 impl NewRelease {
     /// The release in `path`, read with `policy` (what it leaves out told through `tell`),
-    /// flown at its own condition with the campaign's scenario, whose store it must carry,
-    /// and screened (module docs); `other_scenario`: a `# scenario_sha256` of another
-    /// scenario is accepted with a note.
+    /// flown at its own condition with the scenario of `c` (a campaign's, or the one `init`
+    /// begins), whose store it must carry, and screened (module docs); `other_scenario`: a
+    /// `# scenario_sha256` of another scenario is accepted with a note.
     pub fn read(
-        path: &Path,
-        c: &Campaign,
-        policy: Policy,
-        other_scenario: bool,
-        tell: inputs::Tell,
-    ) -> Result<NewRelease, CampaignError> {
-        NewRelease::read_against(path, Against::campaign(c), policy, other_scenario, tell)
-    }
-
-    /// [`NewRelease::read`] against `c` (a campaign's, or the one `init` begins).
-    pub fn read_against(
         path: &Path,
         c: Against<'_>,
         policy: Policy,

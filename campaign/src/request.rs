@@ -207,8 +207,7 @@ impl InitRequest<'_> {
                 CampaignError::Refused(format!("--preflight {}: {e}", p.display()))
             };
             let policy = sepval_common::telemetry::outliers::Policy::Refuse;
-            let t =
-                NewRelease::read_against(p, against, policy, true, &mut |_| {}).map_err(in_file)?;
+            let t = NewRelease::read(p, against, policy, true, &mut |_| {}).map_err(in_file)?;
             if let Some(o) = trajectories.iter().find(|o| o.sha256 == t.sha256) {
                 return Err(CampaignError::Refused(format!(
                     "--preflight {} is the same trajectory as {}: give each once",

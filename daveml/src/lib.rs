@@ -36,6 +36,7 @@ pub mod names;
 pub mod output;
 pub mod parse;
 pub mod shots;
+pub mod spread;
 pub mod units;
 pub mod xml;
 

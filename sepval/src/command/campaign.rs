@@ -135,7 +135,7 @@ fn add(a: CampaignAddArgs) -> Result<()> {
     let policy = a.outliers.policy();
     let mut new = Vec::new();
     for p in &a.data {
-        let release = NewRelease::read(p, &c, policy, a.other_scenario, &mut tell())
+        let release = NewRelease::read(p, c.against(), policy, a.other_scenario, &mut tell())
             .with_context(|| format!("--data {}", p.display()))?;
         for n in &release.notes {
             say!("note:      {n}");
