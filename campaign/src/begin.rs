@@ -23,7 +23,11 @@
 //! the samples cannot show that it would: more samples would).
 //!
 //! Only the prior is weighed: after a release the factors are the diagnosis's, correlated,
-//! and what they lack is learnt by flying.
+//! and what they lack is learnt by flying. A prior from pre-flight trajectories is correlated
+//! too ([`crate::preflight`]); narrowing one factor's marginal keeps the others' conditional
+//! on it, so its weight is still the ratio of its marginals (exact for the normal, near it
+//! where the truncation cuts little), while the joint narrowing's product of marginals is then
+//! an approximation.
 
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{Continuous, ContinuousCDF, Normal};
@@ -119,7 +123,7 @@ impl Narrowing {
     pub fn words(&self) -> String {
         if !self.mean_clears {
             return format!(
-                "even the prior's mean fails to clear (smallest clearance {} mm): no narrowing about that mean makes it safe to fly; what engineers know before flight must move the mean (a --prior of measured values) or the criterion must change",
+                "even the prior's mean fails to clear (smallest clearance {} mm): no narrowing about that mean makes it safe to fly; what engineers know before flight must move the mean (pre-flight trajectories, --preflight; the store's data, --prior-daveml; or a --prior of measured values) or the criterion must change",
                 number(self.mean_clearance_mm)
             );
         }
@@ -132,7 +136,7 @@ impl Narrowing {
         enough.sort_by(|a, b| share(b).total_cmp(&share(a)));
         if let (true, Some(j)) = (enough.is_empty(), &self.joint) {
             return format!(
-                "it would be safe to fly (P(fail) within {}) with {} known together to {:.0} % of their prior spreads: the pre-flight test to ask for; give what it measures as --prior",
+                "it would be safe to fly (P(fail) within {}) with {} known together to {:.0} % of their prior spreads: the pre-flight test to ask for; give it to `campaign init` as pre-flight trajectories (--preflight), the store's data with uncertainty (--prior-daveml) or a --prior",
                 self.fly_risk,
                 j.factors.join(", "),
                 100.0 * j.share_needed
@@ -151,7 +155,7 @@ impl Narrowing {
                 })
                 .collect();
             return format!(
-                "no single factor known better makes it safe to fly; the spreads that matter most: {}: narrow them together (a pre-flight test of the store's aerodynamics and ejector), or give a --prior of known accuracy",
+                "no single factor known better makes it safe to fly; the spreads that matter most: {}: narrow them together (a pre-flight test of the store's aerodynamics and ejector), or begin from pre-flight knowledge of known accuracy: trajectories (--preflight), the store's data with uncertainty (--prior-daveml) or a --prior",
                 top.join(", ")
             );
         }
@@ -169,7 +173,7 @@ impl Narrowing {
             })
             .collect();
         format!(
-            "it would be safe to fly (P(fail) within {}) with {}: the pre-flight test to ask for; give what it measures as --prior",
+            "it would be safe to fly (P(fail) within {}) with {}: the pre-flight test to ask for; give it to `campaign init` as pre-flight trajectories (--preflight), the store's data with uncertainty (--prior-daveml) or a --prior",
             self.fly_risk,
             each.join(", or ")
         )

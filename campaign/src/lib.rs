@@ -28,8 +28,10 @@ pub mod joint;
 mod journal;
 pub mod next;
 pub mod page;
+pub mod preflight;
 pub mod preposterior;
 pub mod prior;
+pub mod prior_daveml;
 pub mod program;
 pub mod record;
 pub mod rehearse;
@@ -37,6 +39,7 @@ pub mod release;
 pub mod request;
 pub mod rivals;
 pub mod seal;
+pub mod sources;
 pub mod state;
 
 pub use assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};
@@ -113,6 +116,18 @@ pub enum CampaignError {
     /// The prior (`--prior`).
     #[error(transparent)]
     Prior(#[from] PriorError),
+    /// The fit of the pre-flight trajectories (`--preflight`).
+    #[error("the fit of the pre-flight trajectories (--preflight)")]
+    Preflight(#[source] Box<sepval_fit::FitError>),
+    /// The store's data with uncertainty (`--prior-daveml`).
+    #[error("--prior-daveml {path}")]
+    Daveml {
+        /// The file.
+        path: String,
+        /// Why it cannot be read.
+        #[source]
+        source: Box<sepval_daveml::DavemlError>,
+    },
     /// The campaign's grid, as its settings name it.
     #[error(transparent)]
     Grid(#[from] sepval_envelope::GridError),

@@ -18,6 +18,15 @@
 //! A factor the file does not name keeps the default; a mean outside the factor's range, a
 //! standard deviation that is negative or not finite, or an unknown name is refused. A standard
 //! deviation of 0 holds the factor at its mean.
+//!
+//! Two more sources of what engineers know before flight narrow it (`sepval campaign init`,
+//! docs/campaign.md "Beginning from pre-flight knowledge"): the store's data with uncertainty in
+//! DAVE-ML (`--prior-daveml`, [`crate::prior_daveml`]) sets the factors its uncertain tables map
+//! to, and pre-flight trajectories (`--preflight`, [`crate::preflight`]) make the prior the
+//! Laplace approximation of the posterior, whose factors are correlated: its full covariance
+//! is kept ([`Prior::covariance`]) and a draw is mean + L z with L its Cholesky factor
+//! (Golub and Van Loan, *Matrix Computations*, 4th ed., 2013, section 4.2), each factor's
+//! `Belief` its marginal. [`Prior::sources`] records what it was made of, in order.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -29,6 +38,8 @@ use sepval_common::effects::EffectSet;
 use sepval_core::factors::{FACTOR_COUNT, Factor, FactorTable, Factors};
 use sepval_fit::space::ParamSpace;
 use sepval_predict::sampling::ParameterDistribution;
+
+pub use crate::sources::{Belief, PriorSource};
 
 /// The format of a prior file.
 pub const PRIOR_FORMAT: &str = "sepval-prior/1";
@@ -51,23 +62,22 @@ pub enum PriorError {
     },
 }
 
-/// One factor's belief.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Belief {
-    /// The mean.
-    pub mean: f64,
-    /// The standard deviation (0: held at the mean).
-    pub sd: f64,
-}
-
 /// The prior of the 17 factors, in table order.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Prior {
     /// Where it came from: `default` or the file.
     pub source: String,
-    /// Each factor's mean and standard deviation, by name.
+    /// Each factor's mean and standard deviation (its marginal, when correlated), by name.
     pub factors: BTreeMap<String, Belief>,
+    /// The factors' covariance in table order (17 x 17) when they are correlated (a pre-flight
+    /// fit's posterior); none: independent, each with its belief's standard deviation. Absent
+    /// from campaigns begun before 2026-12-02.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// What the prior was made of, in the order applied (empty in campaigns begun before
+    /// 2026-12-02: `source` says).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<PriorSource>,
 }
 
 #[derive(Deserialize)]
@@ -130,6 +140,8 @@ impl Prior {
         Prior {
             source: "default".into(),
             factors,
+            covariance: None,
+            sources: vec![PriorSource::Default],
         }
     }
 
@@ -150,6 +162,8 @@ impl Prior {
         }
         let mut prior = Prior::default_of(table);
         prior.source = path.display().to_string();
+        let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        let mut named = Vec::new();
         for (name, b) in file.factors {
             let Some(f) = Factor::from_name(&name) else {
                 return Err(bad(format!(
@@ -170,13 +184,24 @@ impl Prior {
                     b.sd
                 )));
             }
+            named.push(name.clone());
             prior.factors.insert(name, b);
         }
+        prior.sources.push(PriorSource::File {
+            path: absolute.display().to_string(),
+            sha256: sepval_common::scenario::hex_sha256(text.as_bytes()),
+            factors: named,
+        });
         Ok(prior)
     }
 
-    /// The factor-only parameter space of `table` and the prior as its distribution (the
-    /// factors independent, truncated to their ranges).
+    /// What the prior was made of, a line per source beyond the default, for `init` to say.
+    pub fn lines(&self) -> Vec<String> {
+        self.sources.iter().flat_map(PriorSource::lines).collect()
+    }
+
+    /// The factor-only parameter space of `table` and the prior as its distribution, truncated
+    /// to the factors' ranges: independent, or correlated by [`Prior::covariance`].
     pub fn distribution(&self, table: &FactorTable) -> (ParamSpace, ParameterDistribution) {
         let space = ParamSpace::new(table, &EffectSet::NONE);
         let at = |name: &str| self.factors.get(name).copied();
@@ -194,15 +219,41 @@ impl Prior {
             .map(|n| at(n).map_or(0.0, |b| b.sd))
             .collect();
         debug_assert_eq!(mean.len(), FACTOR_COUNT);
+        let factor = self
+            .covariance
+            .as_ref()
+            .and_then(|c| cholesky_of_spread(c, &std))
+            .unwrap_or_else(|| DMatrix::from_diagonal(&nalgebra::DVector::from_vec(std.clone())));
         let distribution = ParameterDistribution {
             mean,
-            factor: DMatrix::from_diagonal(&nalgebra::DVector::from_vec(std.clone())),
+            factor,
             lo: space.params.lo.clone(),
             hi: space.params.hi.clone(),
             std,
         };
         (space, distribution)
     }
+}
+
+/// The lower Cholesky factor of the covariance `c` over the factors with a spread (`std` > 0),
+/// the others' rows and columns 0 (held); none when `c` is not 17 x 17 or not positive
+/// definite there.
+pub fn cholesky_of_spread(c: &[Vec<f64>], std: &[f64]) -> Option<DMatrix<f64>> {
+    let n = std.len();
+    if c.len() != n || c.iter().any(|r| r.len() != n) {
+        return None;
+    }
+    let free: Vec<usize> = (0..n).filter(|&i| std[i] > 0.0).collect();
+    let m = free.len();
+    let sub = DMatrix::from_fn(m, m, |a, b| c[free[a]][free[b]]);
+    let l = nalgebra::Cholesky::new(sub)?.unpack();
+    let mut out = DMatrix::zeros(n, n);
+    for a in 0..m {
+        for b in 0..=a {
+            out[(free[a], free[b])] = l[(a, b)];
+        }
+    }
+    Some(out)
 }
 
 #[cfg(test)]

@@ -83,6 +83,8 @@ pub struct Init {
     pub clearance: ClearanceSettings,
     /// Threads of this process.
     pub threads: usize,
+    /// Pre-flight trajectories to take into the prior ([`crate::preflight`]).
+    pub preflight: Option<crate::preflight::Preflight>,
 }
 
 /// The file of `path` as the campaign records it.
@@ -120,8 +122,9 @@ pub fn grid_of(settings: &SettingsRecord, scenario: &Scenario) -> Result<Grid, C
 
 /// What `init` makes in the campaign's directory besides its lock: all that a failed `init`
 /// removes ([`Unmade`]).
-const INIT_MAKES: [&str; 8] = [
+const INIT_MAKES: [&str; 9] = [
     "campaign.json",
+    crate::preflight::FIT_DIR,
     "status.json",
     "envelope.csv",
     "report.html",
@@ -205,6 +208,20 @@ pub fn init(
         armed: true,
     };
     let (lock, _) = DirLock::take(dir)?;
+    let mut init = init;
+    if let Some(p) = init.preflight.take() {
+        let s = &init.settings;
+        let ga = sepval_solve::ga::GaSettings {
+            generations: s.generations,
+            seed: s.seed,
+            ..Default::default()
+        };
+        let scenario = s.scenario.as_ref().map(|r| Path::new(&r.path));
+        let fit = dir.join(crate::preflight::FIT_DIR);
+        let at = (&init.scenario.factors, scenario, ga);
+        let prior = crate::preflight::posterior(&s.prior, &p, at, &fit, start, observer)?;
+        init.settings.prior = prior;
+    }
     let file = CampaignFile {
         format: CAMPAIGN_FORMAT.into(),
         grid: init
@@ -277,6 +294,15 @@ impl Campaign {
         };
         c.tidy()?;
         Ok(c)
+    }
+
+    /// What releases added to the campaign are read against.
+    pub fn against(&self) -> crate::release::Against<'_> {
+        crate::release::Against {
+            scenario: &self.scenario,
+            axes: &self.file.settings.axes,
+            grid: &self.grid,
+        }
     }
 
     /// Removes what an interrupted command left: the staging directory, and the rounds and

@@ -25,9 +25,24 @@ use sepval_common::telemetry::outliers::Policy;
 use sepval_fit::conditions::Quantity;
 use sepval_fit::inputs;
 
+use sepval_common::scenario::Scenario as Base;
+use sepval_envelope::grid::Grid;
+
 use crate::CampaignError;
-use crate::program::Campaign;
 use crate::record::record_error;
+
+/// What a release is read against: the campaign's scenario, the flags of its grid's axes and
+/// its grid (a campaign's, `Campaign::against`, or those `init` is about to begin with, for a
+/// pre-flight trajectory).
+#[derive(Clone, Copy)]
+pub struct Against<'a> {
+    /// The scenario.
+    pub scenario: &'a Base,
+    /// The axes as given: (flag, `LO:HI:N`).
+    pub axes: &'a [(String, String)],
+    /// The grid.
+    pub grid: &'a Grid,
+}
 
 /// A release to add, read and screened ([`NewRelease::read`]).
 pub struct NewRelease {
@@ -57,12 +72,12 @@ pub fn key(q: Quantity) -> &'static str {
 
 impl NewRelease {
     /// The release in `path`, read with `policy` (what it leaves out told through `tell`),
-    /// flown at its own condition with the campaign's scenario, whose store it must carry,
-    /// and screened (module docs); `other_scenario`: a `# scenario_sha256` of another
-    /// scenario is accepted with a note.
+    /// flown at its own condition with the scenario of `c` (a campaign's, or the one `init`
+    /// begins), whose store it must carry, and screened (module docs); `other_scenario`: a
+    /// `# scenario_sha256` of another scenario is accepted with a note.
     pub fn read(
         path: &Path,
-        c: &Campaign,
+        c: Against<'_>,
         policy: Policy,
         other_scenario: bool,
         tell: inputs::Tell,
@@ -72,8 +87,8 @@ impl NewRelease {
         let bytes = std::fs::read(path).map_err(|e| record_error(path, e))?;
         let data = inputs::read(path, policy, tell).map_err(input)?;
         refuse_unstated(c, &data, &name)?;
-        let flown = inputs::event_scenario(&c.scenario, &data, &name).map_err(input)?;
-        inputs::check_store(&c.scenario, &data, &name, "the campaign's scenario").map_err(input)?;
+        let flown = inputs::event_scenario(c.scenario, &data, &name).map_err(input)?;
+        inputs::check_store(c.scenario, &data, &name, "the campaign's scenario").map_err(input)?;
         let mut notes = outside_grid(c, &flown.flight);
         if let Some(n) = other_scenario_note(&data, &flown, &name, other_scenario)? {
             notes.push(n);
@@ -89,9 +104,9 @@ impl NewRelease {
 }
 
 /// The quantities a campaign release must state: Mach, altitude and every axis of the grid.
-fn required(c: &Campaign) -> Vec<Quantity> {
+fn required(c: Against<'_>) -> Vec<Quantity> {
     let mut q = vec![Quantity::Mach, Quantity::AltitudeM];
-    for (flag, _) in &c.file.settings.axes {
+    for (flag, _) in c.axes {
         let axis = Quantity::ALL.iter().find(|a| a.flag() == flag);
         if let Some(a) = axis.filter(|a| !q.contains(a)) {
             q.push(*a);
@@ -101,7 +116,7 @@ fn required(c: &Campaign) -> Vec<Quantity> {
 }
 
 /// Refuses a release that does not state its condition (module docs).
-fn refuse_unstated(c: &Campaign, data: &Trajectory, name: &str) -> Result<(), CampaignError> {
+fn refuse_unstated(c: Against<'_>, data: &Trajectory, name: &str) -> Result<(), CampaignError> {
     let missing: Vec<&str> = required(c)
         .into_iter()
         .map(key)
@@ -118,7 +133,7 @@ fn refuse_unstated(c: &Campaign, data: &Trajectory, name: &str) -> Result<(), Ca
 
 /// The notes of a condition outside the campaign's grid: beyond an axis's range, or off the
 /// value of a quantity the grid holds fixed.
-fn outside_grid(c: &Campaign, f: &Flight) -> Vec<String> {
+fn outside_grid(c: Against<'_>, f: &Flight) -> Vec<String> {
     let conditions = &c.grid.conditions;
     let mut notes = Vec::new();
     for q in Quantity::ALL {

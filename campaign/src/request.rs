@@ -12,7 +12,7 @@
 //! - `--generations` within the genetic search's limits ([`sepval_solve::ga`]:
 //!   `MAX_GENERATIONS`, and `MAX_EVALUATIONS` at the study's population of 100).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use sepval_fit::inputs;
 use sepval_predict::ClearanceSettings;
@@ -21,9 +21,11 @@ use sepval_common::simulation::sample_times;
 use sepval_predict::condition::{MAX_SAMPLES, MAX_VALUE_BYTES};
 
 use crate::CampaignError;
+use crate::preflight::{Allowance, Preflight};
 use crate::prior::Prior;
 use crate::program::{Init, grid_of, input_record};
 use crate::record::SettingsRecord;
+use crate::release::{Against, NewRelease};
 
 /// The fewest samples per condition: a probability of failing estimated from fewer is one
 /// sample's (1 / 20 = 0.05, the default allowed probability).
@@ -57,6 +59,12 @@ pub struct InitRequest<'a> {
     pub generations: usize,
     /// `--prior` (none: the factors' default prior).
     pub prior: Option<&'a Path>,
+    /// `--prior-daveml`: the store's data with uncertainty.
+    pub prior_daveml: Option<&'a Path>,
+    /// `--preflight`: pre-flight trajectories.
+    pub preflight: &'a [PathBuf],
+    /// `--preflight-allowance-m` and `--preflight-allowance-deg`.
+    pub preflight_allowance: (f64, f64),
     /// Threads of this process.
     pub threads: usize,
 }
@@ -137,10 +145,13 @@ impl InitRequest<'_> {
                 "give at least one axis: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N".into(),
             ));
         }
-        let prior = match self.prior {
+        let mut prior = match self.prior {
             Some(p) => Prior::read(p, &scenario.factors)?,
             None => Prior::default_of(&scenario.factors),
         };
+        if let Some(p) = self.prior_daveml {
+            prior = crate::prior_daveml::read(p, &scenario, &prior)?;
+        }
         let clearance =
             ClearanceSettings::read(aircraft, self.store_shape, self.clearance_mm, &scenario)
                 .map_err(|e| CampaignError::Clearance(Box::new(e)))?;
@@ -161,12 +172,54 @@ impl InitRequest<'_> {
         let times = sample_times(scenario.integrator.t_end_s, scenario.integrator.rate_hz);
         let points = sepval_predict::simulate::Grid::of(&times).len();
         check_work(self.samples, self.generations, grid.len(), points)?;
+        let preflight = self.preflight(&scenario, &settings, &grid)?;
         Ok(Init {
             settings,
             scenario,
             grid,
             clearance,
             threads: self.threads,
+            preflight,
         })
+    }
+
+    /// The pre-flight trajectories read and screened as releases (each stating its
+    /// condition), each given once, and their allowance checked (none given: none).
+    fn preflight(
+        &self,
+        scenario: &sepval_common::scenario::Scenario,
+        settings: &SettingsRecord,
+        grid: &sepval_envelope::Grid,
+    ) -> Result<Option<Preflight>, CampaignError> {
+        let (m, deg) = self.preflight_allowance;
+        let allowance = Allowance::checked(m, deg)?;
+        if self.preflight.is_empty() {
+            return Ok(None);
+        }
+        let against = Against {
+            scenario,
+            axes: &settings.axes,
+            grid,
+        };
+        let mut trajectories: Vec<NewRelease> = Vec::new();
+        for p in self.preflight {
+            let in_file = |e: CampaignError| {
+                CampaignError::Refused(format!("--preflight {}: {e}", p.display()))
+            };
+            let policy = sepval_common::telemetry::outliers::Policy::Refuse;
+            let t = NewRelease::read(p, against, policy, true, &mut |_| {}).map_err(in_file)?;
+            if let Some(o) = trajectories.iter().find(|o| o.sha256 == t.sha256) {
+                return Err(CampaignError::Refused(format!(
+                    "--preflight {} is the same trajectory as {}: give each once",
+                    p.display(),
+                    o.given.display()
+                )));
+            }
+            trajectories.push(t);
+        }
+        Ok(Some(Preflight {
+            trajectories,
+            allowance,
+        }))
     }
 }

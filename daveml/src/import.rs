@@ -18,9 +18,11 @@ use sepval_core::number_text::Shown;
 use crate::error::{DavemlError, Place};
 use crate::map::{Map, Output, Role};
 use crate::parse::{
-    BreakpointDef, Function, GriddedTable, InputRef, Located, Parsed, PdfKind, TableDefn,
+    BreakpointDef, Function, GriddedTable, InputRef, Located, Parsed, Pdf, PdfKind, TableDefn,
     VariableDef,
 };
+pub use crate::spread::Spread;
+use crate::spread::spread_of;
 use crate::units;
 
 /// The value a file gives a field.
@@ -41,6 +43,8 @@ pub struct ImportedField {
     pub value: FieldValue,
     /// The element it came from.
     pub place: Place,
+    /// Its uncertainty, if the file gives one.
+    pub spread: Option<Spread>,
 }
 
 /// What a DAVE-ML file gives the scenario.
@@ -119,8 +123,9 @@ pub fn import(p: &Parsed, map: &Map) -> Result<Imported, DavemlError> {
         let var = idx.variable(&f.item.output.item, &f.item.output.place)?;
         match map.role(&var.item.var_id, &var.item.name) {
             Some(Role::Output(o)) => {
-                let table = function_table(&idx, map, &f.item, var, o)?;
+                let (table, spread) = function_table(&idx, map, &f.item, var, o)?;
                 push(&mut out, o.target, FieldValue::Table(table), &f.place)?;
+                out.fields.last_mut().expect("pushed").spread = spread;
                 if let Some(note) = uncertainty_note(&idx, &f.item, var) {
                     out.notes.push(note);
                 }
@@ -178,6 +183,8 @@ fn constants(p: &Parsed, map: &Map, out: &mut Imported) -> Result<(), DavemlErro
             units::output(kind, &v.item.units).map_err(|e| units_error(&v.place, &v.item, e))?;
         let value = signed(o, c.apply(x));
         push(out, o.target, FieldValue::Constant(value), &v.place)?;
+        out.fields.last_mut().expect("pushed").spread =
+            v.item.uncertainty.as_ref().map(|p| spread_of(p, 1, c));
     }
     Ok(())
 }
@@ -206,6 +213,7 @@ fn push(
         target,
         value,
         place: at.clone(),
+        spread: None,
     });
     Ok(())
 }
@@ -237,13 +245,8 @@ fn units_error(at: &Place, v: &VariableDef, expected: &str) -> DavemlError {
 
 /// The note for an uncertainty sepval reads and does not carry.
 fn uncertainty_note(idx: &Index, f: &Function, var: &Located<VariableDef>) -> Option<String> {
-    let pdf = match &f.table.item {
-        TableDefn::Inline(t) => t.uncertainty,
-        TableDefn::Ref(id) => idx.tables.get(id.as_str()).and_then(|t| t.item.uncertainty),
-        TableDefn::Unsupported(_) => None,
-    }
-    .or(var.item.uncertainty)?;
-    let what = match pdf {
+    let pdf = pdf_of(idx, f, var)?;
+    let what = match pdf.kind {
         PdfKind::Normal => "normalPDF",
         PdfKind::Uniform => "uniformPDF",
     };
@@ -253,7 +256,21 @@ fn uncertainty_note(idx: &Index, f: &Function, var: &Located<VariableDef>) -> Op
     ))
 }
 
+/// The PDF of a function's table, else of its output variable.
+fn pdf_of<'a>(idx: &'a Index, f: &'a Function, var: &'a Located<VariableDef>) -> Option<&'a Pdf> {
+    match &f.table.item {
+        TableDefn::Inline(t) => t.uncertainty.as_ref(),
+        TableDefn::Ref(id) => idx
+            .tables
+            .get(id.as_str())
+            .and_then(|t| t.item.uncertainty.as_ref()),
+        TableDefn::Unsupported(_) => None,
+    }
+    .or(var.item.uncertainty.as_ref())
+}
+
 /// One input of a function: its sepval variable, conversion and breakpoints (converted).
+#[derive(Clone)]
 struct AxisIn {
     variable: Variable,
     breakpoints: Vec<f64>,
@@ -301,14 +318,15 @@ fn unsaturated(var: &Located<VariableDef>, data: &[f64]) -> Result<(), DavemlErr
     Ok(())
 }
 
-/// The table of a function whose output is the field `o`.
+/// The table of a function whose output is the field `o`, and its spread if the file gives
+/// one (in the table's order).
 fn function_table(
     idx: &Index,
     map: &Map,
     f: &Function,
     var: &Located<VariableDef>,
     o: Output,
-) -> Result<Table, DavemlError> {
+) -> Result<(Table, Option<Spread>), DavemlError> {
     let (table, table_place) = table_of(idx, f)?;
     if f.inputs.len() != table.breakpoints.len() {
         return Err(DavemlError::at(
@@ -361,14 +379,25 @@ fn function_table(
         units::output(kind, &var.item.units).map_err(|e| units_error(&var.place, &var.item, e))?;
     unsaturated(var, &table.data)?;
     let values: Vec<f64> = table.data.iter().map(|&x| signed(o, c.apply(x))).collect();
+    let mut spread = pdf_of(idx, f, var).map(|p| spread_of(p, points, c));
+    if let Some(s) = spread
+        .as_mut()
+        .filter(|s| s.sd.len() == points && points > 1)
+    {
+        // The standard deviations in the table's nesting order, as its values.
+        let (_, sd) = nest(axes.clone(), std::mem::take(&mut s.sd), kind)
+            .map_err(|m| DavemlError::at(&f.inputs[0].place, m))?;
+        s.sd = sd;
+    }
     let (axes, values) =
         nest(axes, values, kind).map_err(|m| DavemlError::at(&f.inputs[0].place, m))?;
-    Table::new(axes, values, kind).map_err(|m| {
+    let table = Table::new(axes, values, kind).map_err(|m| {
         DavemlError::at(
             &table_place,
             format!("as sepval field {}, the table {m}", o.target.field()),
         )
-    })
+    })?;
+    Ok((table, spread))
 }
 
 /// One input of a function, checked: mapped, linear, held outside, its breakpoints increasing.

@@ -36,6 +36,7 @@ pub mod names;
 pub mod output;
 pub mod parse;
 pub mod shots;
+pub mod spread;
 pub mod units;
 pub mod xml;
 
@@ -69,6 +70,8 @@ pub struct ImportedModel {
     pub checked: usize,
     /// What was read and not carried, to say to the user.
     pub notes: Vec<String>,
+    /// Every field the file gave, with its value and its uncertainty if it has one.
+    pub given: Vec<import::ImportedField>,
 }
 
 /// The map: the default, with the map file's entries when one is given.
@@ -99,6 +102,7 @@ pub fn import_model(
         fields: imported.fields.iter().map(|f| f.target.field()).collect(),
         checked,
         notes: imported.notes,
+        given: imported.fields,
     })
 }
 

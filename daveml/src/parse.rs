@@ -36,6 +36,22 @@ pub enum PdfKind {
     Uniform,
 }
 
+/// An `uncertainty` (DAVE-ML 2.0 section 5.7): its PDF, its `numSigmas` and the numbers of its
+/// `bounds`, kept so that a reader of the store's uncertainty (`sepval campaign init
+/// --prior-daveml`) has them; before 2026-12-02 only the PDF's kind was kept.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pdf {
+    /// `normalPDF` or `uniformPDF`.
+    pub kind: PdfKind,
+    /// A `normalPDF`'s `numSigmas`: its bounds are that many standard deviations.
+    pub num_sigmas: Option<f64>,
+    /// The numbers of its `bounds` (their `dataTable`'s, or their text): one, or one per value
+    /// of its table; empty when given otherwise (a `variableRef`).
+    pub bounds: Vec<f64>,
+    /// Where the PDF is.
+    pub place: Place,
+}
+
 /// A `variableDef`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VariableDef {
@@ -52,7 +68,7 @@ pub struct VariableDef {
     /// The line of its `calculation`, if it has one.
     pub calculation: Option<Place>,
     /// Its `uncertainty`'s PDF, if it has one.
-    pub uncertainty: Option<PdfKind>,
+    pub uncertainty: Option<Pdf>,
 }
 
 /// A `breakpointDef`.
@@ -76,7 +92,7 @@ pub struct GriddedTable {
     /// `dataTable`, last breakpoint set fastest.
     pub data: Vec<f64>,
     /// Its `uncertainty`'s PDF, if it has one.
-    pub uncertainty: Option<PdfKind>,
+    pub uncertainty: Option<Pdf>,
 }
 
 /// An `independentVarRef`.
@@ -286,13 +302,30 @@ impl<'a, 'input> Reader<'a, 'input> {
             .collect()
     }
 
-    fn pdf(&self, n: Node) -> Option<PdfKind> {
-        let u = self.child(n, "uncertainty")?;
-        if self.child(u, "uniformPDF").is_some() {
-            Some(PdfKind::Uniform)
-        } else {
-            Some(PdfKind::Normal)
+    fn pdf(&self, n: Node) -> Result<Option<Pdf>, DavemlError> {
+        let Some(u) = self.child(n, "uncertainty") else {
+            return Ok(None);
+        };
+        let (kind, at) = match (self.child(u, "uniformPDF"), self.child(u, "normalPDF")) {
+            (Some(p), _) => (PdfKind::Uniform, p),
+            (None, Some(p)) => (PdfKind::Normal, p),
+            (None, None) => (PdfKind::Normal, u),
+        };
+        let num_sigmas = self.optional_number(at, "numSigmas")?;
+        let mut bounds = Vec::new();
+        for b in self.elements(at, "bounds") {
+            match self.child(b, "dataTable") {
+                Some(t) => bounds.extend(self.numbers(t)?),
+                None if self.child(b, "variableRef").is_none() => bounds.extend(self.numbers(b)?),
+                None => {}
+            }
         }
+        Ok(Some(Pdf {
+            kind,
+            num_sigmas,
+            bounds,
+            place: self.place(at),
+        }))
     }
 
     fn variable(&self, n: Node) -> Result<VariableDef, DavemlError> {
@@ -306,7 +339,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                 self.optional_number(n, "maxValue")?,
             ),
             calculation: self.child(n, "calculation").map(|c| self.place(c)),
-            uncertainty: self.pdf(n),
+            uncertainty: self.pdf(n)?,
         })
     }
 
@@ -328,7 +361,7 @@ impl<'a, 'input> Reader<'a, 'input> {
             gt_id: n.attribute("gtID").map(str::to_string),
             breakpoints,
             data: self.numbers(self.required(n, "dataTable")?)?,
-            uncertainty: self.pdf(n),
+            uncertainty: self.pdf(n)?,
         })
     }
 

@@ -69,6 +69,21 @@ pub struct CampaignInitArgs {
     /// nominal value, a sixth of the study's range as its standard deviation].
     #[arg(long, value_name = "FILE")]
     pub prior: Option<PathBuf>,
+    /// The store's data with uncertainty (DAVE-ML 2.0, a `normalPDF` on its tables, as
+    /// `sepval update --daveml` writes it): each uncertain table sets the factor that moves it.
+    #[arg(long, value_name = "FILE.xml")]
+    pub prior_daveml: Option<PathBuf>,
+    /// A pre-flight trajectory (a captive-trajectory test or a CFD release: CSV stating its
+    /// condition as a release does; repeatable), fitted into the prior with the allowance below.
+    #[arg(long, value_name = "FILE.csv")]
+    pub preflight: Vec<PathBuf>,
+    /// The model-form allowance of pre-flight positions, added in quadrature to their noise
+    /// (they are not flight).
+    #[arg(long, default_value_t = 0.01, value_name = "M")]
+    pub preflight_allowance_m: f64,
+    /// The model-form allowance of pre-flight attitudes.
+    #[arg(long, default_value_t = 1.0, value_name = "DEG")]
+    pub preflight_allowance_deg: f64,
     /// Samples per condition.
     #[arg(long, default_value_t = 1000, value_name = "N")]
     pub samples: usize,

@@ -33,6 +33,9 @@ fn init(a: CampaignInitArgs) -> Result<()> {
     let init = request(&a)?;
     let mut start = starter(&spec);
     let c = begin(&a, init, &mut start)?;
+    for l in c.file.settings.prior.lines() {
+        say!("prior:     {l}");
+    }
     say!("campaign:  {}", page::headline(&c.file));
     say!("report:    {}", a.out.join("report.html").display());
     Ok(())
@@ -57,6 +60,9 @@ fn request(a: &CampaignInitArgs) -> Result<Init> {
         seed: a.seed,
         generations: a.generations,
         prior: a.prior.as_deref(),
+        prior_daveml: a.prior_daveml.as_deref(),
+        preflight: &a.preflight,
+        preflight_allowance: (a.preflight_allowance_m, a.preflight_allowance_deg),
         threads: count("--threads", a.eval.threads)?,
     };
     Ok(request.read()?)
@@ -132,7 +138,7 @@ fn add(a: CampaignAddArgs) -> Result<()> {
     let policy = a.outliers.policy();
     let mut new = Vec::new();
     for p in &a.data {
-        let release = NewRelease::read(p, &c, policy, a.other_scenario, &mut tell())
+        let release = NewRelease::read(p, c.against(), policy, a.other_scenario, &mut tell())
             .with_context(|| format!("--data {}", p.display()))?;
         for n in &release.notes {
             say!("note:      {n}");

@@ -6,6 +6,7 @@
 //! `sepval`.
 
 mod campaign;
+mod campaign_begin;
 mod campaign_wall;
 mod checkpoint;
 mod cli;
