@@ -134,11 +134,9 @@ impl Rehearsal {
         let mut out = Vec::new();
         for (k, f) in self.flown.iter().enumerate() {
             out.push(format!(
-                "release {}: Mach {}, altitude {} m, alpha {} deg (P(fail) planned {:.3}; truly {}; expected to settle {:.1}, settled {})",
+                "release {}: {} (P(fail) planned {:.3}; truly {}; expected to settle {:.1}, settled {})",
                 k + 1,
-                crate::page::number(f.condition.mach),
-                crate::page::number(f.condition.altitude_m),
-                crate::page::number(f.condition.alpha_deg),
+                at(&f.condition),
                 f.p_fail_planned,
                 if f.truly_safe { "safe" } else { "UNSAFE" },
                 f.expected_settled,
@@ -158,10 +156,8 @@ impl Rehearsal {
         }
         for f in &self.settled_check {
             out.push(format!(
-                "settled check: Mach {}, altitude {} m, alpha {} deg (P(fail) {:.3}; truly {}) would settle {}, unsettle {}",
-                crate::page::number(f.condition.mach),
-                crate::page::number(f.condition.altitude_m),
-                crate::page::number(f.condition.alpha_deg),
+                "settled check: {} (P(fail) {:.3}; truly {}) would settle {}, unsettle {}",
+                at(&f.condition),
                 f.p_fail,
                 if f.truly_safe { "safe" } else { "UNSAFE" },
                 f.settled,
@@ -411,6 +407,16 @@ fn verdict(r: &Rehearsal, tumbled: Option<String>) -> String {
         );
     }
     words
+}
+
+/// A condition in words: its Mach, altitude and alpha.
+fn at(c: &ConditionRecord) -> String {
+    format!(
+        "Mach {}, altitude {} m, alpha {} deg",
+        page::number(c.mach),
+        page::number(c.altitude_m),
+        page::number(c.alpha_deg)
+    )
 }
 
 /// The settled check in words.
