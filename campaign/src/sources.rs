@@ -118,75 +118,74 @@ impl PriorSource {
     /// What this source made of the prior, in a line or two for `init` to say (none for the
     /// default).
     pub fn lines(&self) -> Vec<String> {
-        let n = |v: f64| number(v);
-        let mut out = Vec::new();
-        {
-            match self {
-                Self::Default => {}
-                Self::File { path, factors, .. } => {
-                    out.push(format!("{path} set {}", factors.join(", ")));
-                }
-                Self::Daveml { path, mapped, .. } => {
-                    let each: Vec<String> = mapped
-                        .iter()
-                        .map(|m| {
-                            format!(
-                                "{} {} sd {} (from {})",
-                                m.factor,
-                                n(m.belief.mean),
-                                n(m.belief.sd),
-                                m.field
-                            )
-                        })
-                        .collect();
-                    out.push(format!("{path} set {}", each.join(", ")));
-                }
-                Self::Preflight(p) => {
-                    out.push(format!(
-                        "{} pre-flight trajectories fitted (RMS {} m, {} deg; allowance {} m, {} deg in quadrature with their noise {} m, {} deg; the fit in {}/)",
-                        p.trajectories.len(),
-                        n(p.rms_pos_m),
-                        n(p.rms_att_deg),
-                        n(p.allowance_m),
-                        n(p.allowance_deg),
-                        n(p.noise_pos_m),
-                        n(p.noise_att_deg),
-                        p.fit_dir
-                    ));
-                    let mut narrowed: Vec<&FactorChange> = p
-                        .factors
-                        .iter()
-                        .filter(|f| f.after.sd < 0.9 * f.before.sd)
-                        .collect();
-                    narrowed.sort_by(|a, b| {
-                        (a.after.sd / a.before.sd).total_cmp(&(b.after.sd / b.before.sd))
-                    });
-                    let each: Vec<String> = narrowed
-                        .iter()
-                        .map(|f| {
-                            format!(
-                                "{} {} sd {} (was {} sd {})",
-                                f.factor,
-                                n(f.after.mean),
-                                n(f.after.sd),
-                                n(f.before.mean),
-                                n(f.before.sd)
-                            )
-                        })
-                        .collect();
-                    out.push(if each.is_empty() {
-                        "no factor narrowed by a tenth or more: the trajectories do not see them within the allowance".into()
-                    } else {
-                        format!("narrowed: {}", each.join(", "))
-                    });
-                }
+        match self {
+            Self::Default => Vec::new(),
+            Self::File { path, factors, .. } => vec![format!("{path} set {}", factors.join(", "))],
+            Self::Daveml { path, mapped, .. } => {
+                let each: Vec<String> = mapped
+                    .iter()
+                    .map(|m| {
+                        format!(
+                            "{} {} sd {} (from {})",
+                            m.factor,
+                            number(m.belief.mean),
+                            number(m.belief.sd),
+                            m.field
+                        )
+                    })
+                    .collect();
+                vec![format!("{path} set {}", each.join(", "))]
             }
+            Self::Preflight(p) => p.lines(),
         }
-        out
     }
 }
 
-/// A number in six significant digits, as the campaign's pages write them.
+impl PreflightRecord {
+    /// What the fit of the pre-flight trajectories made of the prior: the fit, then the
+    /// factors it narrowed by a tenth or more, most narrowed first.
+    fn lines(&self) -> Vec<String> {
+        let fit = format!(
+            "{} pre-flight trajectories fitted (RMS {} m, {} deg; allowance {} m, {} deg in quadrature with their noise {} m, {} deg; the fit in {}/)",
+            self.trajectories.len(),
+            number(self.rms_pos_m),
+            number(self.rms_att_deg),
+            number(self.allowance_m),
+            number(self.allowance_deg),
+            number(self.noise_pos_m),
+            number(self.noise_att_deg),
+            self.fit_dir
+        );
+        let mut narrowed: Vec<&FactorChange> = self
+            .factors
+            .iter()
+            .filter(|f| f.after.sd < 0.9 * f.before.sd)
+            .collect();
+        narrowed.sort_by(|a, b| (a.after.sd / a.before.sd).total_cmp(&(b.after.sd / b.before.sd)));
+        let each: Vec<String> = narrowed
+            .iter()
+            .map(|f| {
+                format!(
+                    "{} {} sd {} (was {} sd {})",
+                    f.factor,
+                    number(f.after.mean),
+                    number(f.after.sd),
+                    number(f.before.mean),
+                    number(f.before.sd)
+                )
+            })
+            .collect();
+        let narrowing = if each.is_empty() {
+            "no factor narrowed by a tenth or more: the trajectories do not see them within the allowance".into()
+        } else {
+            format!("narrowed: {}", each.join(", "))
+        };
+        vec![fit, narrowing]
+    }
+}
+
+/// A number in six significant digits, as the campaign's pages write them (`page::number`,
+/// which this module cannot use: page reads the records, sources are part of them).
 fn number(v: f64) -> String {
     sepval_report::words::significant(v, 6)
 }
