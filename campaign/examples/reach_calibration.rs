@@ -18,10 +18,10 @@ use sepval_common::scenario::Scenario;
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
 use sepval_core::factors::Factors;
-use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::sigma::Sigma;
 use sepval_fit::space::ParamSpace;
 use sepval_fit::{FitOptions, run_fit};
+use sepval_run::inputs::InputsRecord;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_solve::run::NoProgress;
@@ -142,7 +142,7 @@ fn main() {
             let a_flight = at(&model, ma, aa).flight;
             for &(mb, ab) in &predicted_at {
                 let b = at(&model, mb, ab);
-                let r = sepval_fit::domain::reach(&[&a_flight], &b.flight);
+                let r = sepval_run::domain::reach(&[&a_flight], &b.flight);
                 if r < 0.25 {
                     continue;
                 }

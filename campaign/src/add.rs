@@ -15,12 +15,12 @@ use sepval_common::scenario::Scenario;
 use sepval_common::telemetry::Trajectory;
 use sepval_diagnose::DiagnoseOptions;
 use sepval_fit::FitOptions;
-use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::sigma::Sigma;
 use sepval_predict::bands::{BandInputs, bands};
 use sepval_predict::check::{Check, check};
 use sepval_predict::record::ConditionRecord;
 use sepval_predict::simulate::{self, GridTrajectory, data_on_grid};
+use sepval_run::inputs::InputsRecord;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_solve::run::ProgressObserver;
@@ -207,6 +207,7 @@ fn diagnose(
         validation: None,
         given_terms: Vec::new(),
         strict_tables: false,
+        clearance: None,
     };
     let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
     sepval_diagnose::diagnose(&options, evaluator.as_mut(), observer).map_err(|e| {

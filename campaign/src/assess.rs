@@ -214,7 +214,7 @@ impl<'m> FormBand<'m> {
     pub(crate) fn of(model: &'m Model) -> FormBand<'m> {
         let flown = model.flown();
         let refs: Vec<&Flight> = flown.iter().collect();
-        let covered = sepval_fit::domain::covered_reach(&refs, &[]);
+        let covered = sepval_run::domain::covered_reach(&refs, &[]);
         FormBand {
             model,
             flown,
@@ -248,7 +248,7 @@ impl<'m> FormBand<'m> {
         };
         let refs: Vec<&Flight> = self.flown.iter().collect();
         let flight = &job.events()[0].simulator.scenario().flight;
-        let r = reach::uncovered(sepval_fit::domain::reach(&refs, flight), self.covered);
+        let r = reach::uncovered(sepval_run::domain::reach(&refs, flight), self.covered);
         reach::widen(&mut sd, &reach::motion(ran), r);
         Ok((sd, r))
     }

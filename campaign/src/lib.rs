@@ -136,13 +136,13 @@ pub enum CampaignError {
     Job(#[from] sepval_common::evaluation::JobError),
     /// The campaign's scenario, as its settings name it.
     #[error(transparent)]
-    Inputs(Box<sepval_fit::inputs::InputError>),
+    Inputs(Box<sepval_run::inputs::InputError>),
     /// The campaign's geometry, as its settings name it.
     #[error(transparent)]
     Clearance(Box<sepval_predict::clearance::ClearanceInputError>),
     /// The directory is locked by another command.
     #[error(transparent)]
-    Locked(#[from] sepval_fit::out_dir::OutDirError),
+    Locked(#[from] sepval_run::out_dir::OutDirError),
     /// The outputs.
     #[error(transparent)]
     Outputs(#[from] sepval_report::OutputError),

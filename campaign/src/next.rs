@@ -36,8 +36,8 @@ use statrs::distribution::ContinuousCDF;
 
 use sepval_common::scenario::Flight;
 use sepval_envelope::Grid;
-use sepval_fit::domain::{covered_reach, reach};
 use sepval_predict::reach::{effective, uncovered};
+use sepval_run::domain::{covered_reach, reach};
 
 use crate::joint;
 use crate::preposterior::{Pair, Spread, normal, outcome, tail_spreads};
@@ -382,8 +382,8 @@ mod tests {
     use sepval_common::scenario::Scenario;
     use sepval_envelope::Row;
     use sepval_envelope::grid::Axis;
-    use sepval_fit::conditions::Quantity;
     use sepval_predict::record::ConditionRecord;
+    use sepval_run::conditions::Quantity;
 
     /// A grid of five Mach numbers whose conditions fail with `p_fail`, median clearance `p50`.
     fn envelope(p_fail: [f64; 5], p50: [f64; 5]) -> (Grid, Vec<Assessed>) {

@@ -211,7 +211,7 @@ fn state_map(
     let (xq, xv) = axes
         .first()
         .copied()
-        .unwrap_or((sepval_fit::conditions::Quantity::Mach, &one));
+        .unwrap_or((sepval_run::conditions::Quantity::Mach, &one));
     let ny = axes.get(1).map_or(1, |(_, v)| v.len());
     let mut cells = vec![vec![0u8; xv.len()]; ny];
     for a in assessed {

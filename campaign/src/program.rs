@@ -20,12 +20,12 @@ use sepval_common::scenario::{Scenario, hex_sha256};
 use sepval_common::simulation::Simulator;
 use sepval_common::telemetry::Trajectory;
 use sepval_envelope::grid::{Axis, Grid};
-use sepval_fit::conditions::Quantity;
-use sepval_fit::inputs;
-use sepval_fit::out_dir::DirLock;
 use sepval_predict::ClearanceSettings;
 use sepval_predict::ensemble::Ensemble;
 use sepval_predict::record::ConditionRecord;
+use sepval_run::conditions::Quantity;
+use sepval_run::inputs;
+use sepval_run::out_dir::DirLock;
 use sepval_solve::run::ProgressObserver;
 
 use crate::assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};

@@ -22,8 +22,8 @@ use std::path::{Path, PathBuf};
 use sepval_common::scenario::{Flight, Scenario, hex_sha256};
 use sepval_common::telemetry::Trajectory;
 use sepval_common::telemetry::outliers::Policy;
-use sepval_fit::conditions::Quantity;
-use sepval_fit::inputs;
+use sepval_run::conditions::Quantity;
+use sepval_run::inputs;
 
 use sepval_common::scenario::Scenario as Base;
 use sepval_envelope::grid::Grid;

@@ -14,8 +14,8 @@
 
 use std::path::{Path, PathBuf};
 
-use sepval_fit::inputs;
 use sepval_predict::ClearanceSettings;
+use sepval_run::inputs;
 
 use sepval_common::simulation::sample_times;
 use sepval_predict::condition::{MAX_SAMPLES, MAX_VALUE_BYTES};

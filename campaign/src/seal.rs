@@ -6,7 +6,7 @@
 //! grid value or a state edited by hand was believed by `status`, `add` and `next`.
 //!
 //! The canonical form is that of the fit's and the diagnosis's records
-//! ([`sepval_fit::record`]): the compact JSON of the part's value, keys sorted, numbers in
+//! ([`sepval_run::sealed`]): the compact JSON of the part's value, keys sorted, numbers in
 //! serde_json's shortest form that reads back exactly; whitespace, key order and `0.5` against
 //! `5e-1` do not matter, every change of a value does, and so does a part added or removed.
 //! Like theirs the digests detect edits; they are no signature.

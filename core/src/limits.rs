@@ -20,7 +20,7 @@ pub const MAX_SPAN_S: f64 = 3600.0;
 pub const MAX_POSITION_M: f64 = 1e5;
 /// The largest Mach number of the model's domain (docs/model.md section 1, "The model's
 /// domain": the aerodynamics carry no compressibility beyond what a Mach table gives). A
-/// condition beyond it is not flown (`sepval_fit::domain`) and a table's Mach breakpoint
+/// condition beyond it is not flown (`sepval_run::domain`) and a table's Mach breakpoint
 /// beyond it is refused (`sepval_common::table::Variable::domain`).
 pub const MAX_MACH: f64 = 3.0;
 /// Largest plausible Euler angle in telemetry (ten turns) \[deg\].

@@ -10,7 +10,7 @@ use std::time::Instant;
 use sepval_common::evaluation::Job;
 use sepval_common::extension::{Term, TermRecord, extension_toml};
 use sepval_core::factors::FACTOR_COUNT;
-use sepval_fit::model_spec::ModelSpec;
+use sepval_run::model_spec::ModelSpec;
 
 use crate::answer::{Answer, Rival, Setting};
 use crate::contender::Contender;

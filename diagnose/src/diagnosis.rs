@@ -10,9 +10,9 @@ use super::{
     DiscoveredTerm, DiscoveryStep, Gain, Reconstruction, ResidualReport, ValidationReport,
 };
 use sepval_common::extension::TermRecord;
-use sepval_fit::checkpoint::InputsRecord;
-use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::results::ChannelRms;
+use sepval_run::inputs::InputsRecord;
+use sepval_run::model_spec::ModelSpec;
 use sepval_solve::identifiability::Identifiability;
 
 /// One parameter's estimate.
@@ -292,7 +292,7 @@ pub struct Diagnosis {
     /// The clearance to the aircraft of the answer's trajectory of each release, when the
     /// diagnosis was given `--aircraft` (docs/envelope.md section 14.2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub clearance: Option<Vec<sepval_fit::results::ReleaseClearance>>,
+    pub clearance: Option<Vec<sepval_run::clearance::ReleaseClearance>>,
     /// Models that explain part of the data but not as well as the answer (mimics).
     pub alternatives: Vec<Alternative>,
     /// The discovered extension and its gain, when discovery verified one.

@@ -58,12 +58,13 @@ use sepval_common::evaluation::{Candidate, Counted, EvalError, Evaluator, Job};
 use sepval_common::extension::Term;
 use sepval_core::atomic_file::WriteError;
 
-use sepval_fit::inputs::Releases;
 use sepval_fit::space::{FreeTerm, ParamSpace};
 use sepval_fit::{BaselineSearch, FitError, FitOptions, Method, run_fit};
 use sepval_report::OutputError;
 use sepval_report::figures::FigureError;
 use sepval_report::html::HtmlError;
+use sepval_run::clearance::{ClearReleases, ReleaseClearance};
+use sepval_run::inputs::Releases;
 use sepval_solve::lm::{LmResult, LmSettings, Stall};
 use sepval_solve::run::{ProgressObserver, RunError};
 
@@ -89,7 +90,7 @@ pub enum DiagnoseError {
     Baseline(#[source] FitError),
     /// The releases (`--data`, `--validate`) that cannot be read.
     #[error(transparent)]
-    Inputs(Box<sepval_fit::inputs::InputError>),
+    Inputs(Box<sepval_run::inputs::InputError>),
     /// The extension given (`--extension`) that cannot be read.
     #[error(transparent)]
     GivenExtension(sepval_common::extension::ExtensionError),
@@ -136,6 +137,12 @@ pub enum DiagnoseError {
     /// An output file that cannot be written.
     #[error(transparent)]
     Output(OutputError),
+    /// The answer's model could not be rebuilt to fly its releases for their clearance.
+    #[error("the answer of the diagnosis")]
+    Answer(#[from] sepval_fit::rebuild::RebuildError),
+    /// The clearance of the answer's releases (`--aircraft`) could not be found.
+    #[error(transparent)]
+    Clearance(sepval_run::clearance::StageError),
 }
 
 impl From<OutputError> for DiagnoseError {
@@ -254,6 +261,9 @@ pub struct DiagnoseOptions {
     pub given_terms: Vec<Term>,
     /// Refuse (before the catalogue and discovery) when the baseline leaves a scenario table.
     pub strict_tables: bool,
+    /// The clearance of the answer's releases (`--aircraft`), found before diagnosis.json is
+    /// written and recorded in it (`clearance`).
+    pub clearance: Option<Arc<dyn ClearReleases>>,
 }
 
 impl DiagnoseOptions {
@@ -272,6 +282,7 @@ impl DiagnoseOptions {
             validation: None,
             given_terms: Vec::new(),
             strict_tables: false,
+            clearance: None,
         }
     }
 }
@@ -285,7 +296,7 @@ impl DiagnoseOptions {
         releases: &Releases,
         search: &BaselineSearch,
         out: PathBuf,
-        tell: sepval_fit::inputs::Tell,
+        tell: sepval_run::inputs::Tell,
     ) -> Result<(Job, DiagnoseOptions)> {
         let read = releases
             .read(tell)
@@ -427,11 +438,29 @@ pub fn diagnose(
         evaluations: counted.count(),
     };
     sepval_core::cancel::check().map_err(RunError::from)?;
-    let analysis = analyse(options, &setting, decided, t0)?;
+    let mut analysis = analyse(options, &setting, decided, t0)?;
+    analysis.diagnosis.clearance = answer_clearance(job, options, &analysis.diagnosis)?;
     stage_clock::lap("analysis");
     write_outputs(&options.out, &setting, &analysis, progress)?;
     stage_clock::lap("outputs");
     Ok(analysis.diagnosis)
+}
+
+/// The clearance of the releases flown by the answer of `d` (with `options.clearance`,
+/// `--aircraft`): its model rebuilt as `sepval predict` flies it, at its recorded estimate.
+fn answer_clearance(
+    job: &Arc<Job>,
+    options: &DiagnoseOptions,
+    d: &Diagnosis,
+) -> Result<Option<Vec<ReleaseClearance>>> {
+    let Some(stage) = &options.clearance else {
+        return Ok(None);
+    };
+    let id = d.identifiability.as_ref();
+    let table = job.factor_table();
+    let answer = sepval_fit::rebuild::candidate_at_estimate(&d.model, "the answer", table, id)?;
+    let of = stage.releases(job, answer, &options.out);
+    Ok(Some(of.map_err(DiagnoseError::Clearance)?))
 }
 
 /// The rivals, best first, each with the contender it came from.
@@ -497,6 +526,7 @@ fn baseline_fit(
         method: Method::GaLm,
         out: options.out.join("baseline"),
         resume: None,
+        clearance: None,
         ..options.fit.clone()
     };
     let out = run_fit(&fit, evaluator, progress);

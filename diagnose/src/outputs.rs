@@ -94,7 +94,7 @@ pub(super) fn write_outputs(
         steps.written(1);
     }
     let html = report_html(d, &figures)?;
-    w.file("diagnosis.json", &sepval_fit::record::sealed(d))?;
+    w.file("diagnosis.json", &sepval_run::sealed::sealed(d))?;
     steps.written(1);
     w.file("report.html", html.as_bytes())?;
     steps.written(1);

@@ -1,10 +1,11 @@
 //! DIR/diagnosis.json as a record other commands read (`sepval plan`, `sepval predict`,
 //! `sepval envelope`): written sealed with its digest and read through
-//! [`sepval_fit::record::read_record`], which checks what they read against its range.
+//! [`sepval_run::sealed::read_record`], which checks what they read against its range.
 
-use sepval_fit::model_spec::ModelSpec;
-use sepval_fit::record::{
-    FieldError, Record, check_factors, check_identifiability, check_noise, check_rms, field,
+use sepval_fit::result_check::check_rms;
+use sepval_run::model_spec::ModelSpec;
+use sepval_run::sealed::{
+    FieldError, Record, check_factors, check_identifiability, check_noise, field,
 };
 
 use crate::{DIAGNOSIS_FORMAT, Diagnosis};

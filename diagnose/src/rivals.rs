@@ -27,8 +27,8 @@ use std::sync::Arc;
 use sepval_common::effects::{CATALOGUE, EffectSet};
 use sepval_common::evaluation::Job;
 use sepval_common::extension::{Axis, Regressor, TermRecord};
-use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::refine::{ModelLm, refine_together};
+use sepval_run::model_spec::ModelSpec;
 use sepval_solve::lm::LmSettings;
 
 use crate::answer::{Answer, Setting};

@@ -12,9 +12,9 @@ use sepval_common::evaluation::{InProcess, Job};
 use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
 use sepval_diagnose::{DiagnoseError, DiagnoseOptions, diagnose};
-use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::sigma::Sigma;
 use sepval_fit::{FitOptions, Method};
+use sepval_run::inputs::InputsRecord;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
@@ -66,6 +66,8 @@ fn options(out: &Path, job: &Job) -> DiagnoseOptions {
             },
             lm: lm.clone(),
             lm_probe: lm.clone(),
+            clearance: None,
+            strict_tables: false,
         },
         out: out.to_path_buf(),
         candidate_lm: LmSettings {
@@ -76,6 +78,7 @@ fn options(out: &Path, job: &Job) -> DiagnoseOptions {
         validation: None,
         given_terms: Vec::new(),
         strict_tables: false,
+        clearance: None,
     }
 }
 

@@ -1,8 +1,8 @@
 //! The envelope's grid: each axis given as `LO:HI:N` (N values from LO to HI, evenly spaced;
 //! N = 1 holds the axis at LO, and so is refused unless LO = HI: `0.6:1.2:1` would drop HI), the conditions their product around the condition of the
 //! source's first release (an axis not given stays there), each range checked as a plan's is
-//! (`sepval_fit::conditions`: finite, ordered, a condition the scenario can fly, within the
-//! model's domain and its tables' breakpoints, `sepval_fit::domain`). At most [`MAX_CONDITIONS`] conditions and [`MAX_POINTS`]
+//! (`sepval_run::conditions`: finite, ordered, a condition the scenario can fly, within the
+//! model's domain and its tables' breakpoints, `sepval_run::domain`). At most [`MAX_CONDITIONS`] conditions and [`MAX_POINTS`]
 //! per axis.
 //!
 //! The map shows the first two varied axes in the order Mach, altitude, alpha, beta, gamma;
@@ -10,7 +10,7 @@
 //! highest probability of failing to clear).
 
 use sepval_common::scenario::{Flight, Scenario};
-use sepval_fit::conditions::{ConditionError, Conditions, Quantity, Range};
+use sepval_run::conditions::{ConditionError, Conditions, Quantity, Range};
 
 /// The most conditions of one envelope.
 pub const MAX_CONDITIONS: usize = 2500;

@@ -8,8 +8,8 @@
 
 use std::path::{Path, PathBuf};
 
-use sepval_fit::conditions::Quantity;
 use sepval_report::figures::{EnvelopeMap, MapAxis, Safety, envelope_map};
+use sepval_run::conditions::Quantity;
 
 use crate::grid::Grid;
 use crate::record::EnvelopeFile;

@@ -55,7 +55,7 @@ pub fn prepare(
     axes: &[Axis],
     threads: usize,
     out: &Path,
-    tell: sepval_fit::inputs::Tell,
+    tell: sepval_run::inputs::Tell,
 ) -> Result<Prepared, PrepareError> {
     let settings = Settings {
         samples: inputs.samples,

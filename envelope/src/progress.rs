@@ -18,7 +18,7 @@ use sepval_core::atomic_file::{WriteError, write_atomically};
 use sepval_core::input_file::{InputFileError, read_string};
 use sepval_core::limits::MAX_JSON_BYTES;
 
-use sepval_fit::out_dir::Claim;
+use sepval_run::out_dir::Claim;
 
 use crate::row::Row;
 

@@ -2,8 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use sepval_fit::conditions::Quantity;
 use sepval_predict::clearance::ALLOWED_PROBABILITY;
+use sepval_run::conditions::Quantity;
 
 use crate::row::Row;
 use crate::summary::{Summary, summarise};

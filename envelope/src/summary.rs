@@ -3,7 +3,7 @@
 //! cleared Mach 0.60-0.85; not cleared Mach 0.90-0.95"). With more than two axes varied a
 //! cell is cleared only when every condition it covers is.
 
-use sepval_fit::conditions::Quantity;
+use sepval_run::conditions::Quantity;
 
 use crate::grid::Grid;
 use crate::row::Row;

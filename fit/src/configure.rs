@@ -13,10 +13,10 @@ use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
 
 use crate::checkpoint::Checkpoint;
-use crate::inputs::{self, Tell};
 use crate::resume::{self, InputPaths};
 use crate::sigma::Sigma;
 use crate::{FitError, FitOptions, Method};
+use sepval_run::inputs::{self, Tell};
 
 /// The flags of `sepval fit`, as given.
 #[derive(Debug, Clone)]
@@ -100,6 +100,8 @@ pub fn configure(request: FitRequest, tell: Tell) -> Result<(Job, FitOptions), F
             budget: r.lm_budget.min(800),
             ..LmSettings::default()
         },
+        clearance: None,
+        strict_tables: false,
     };
     Ok((job, options))
 }

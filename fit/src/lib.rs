@@ -10,16 +10,14 @@
 //!   by any [`Evaluator`](sepval_common::evaluation::Evaluator) (threads of this process or
 //!   worker processes: the fit never knows which);
 //! - [`checkpoint`] and [`rerun`]: one checkpoint per generation, resumption and replay;
-//! - [`results`]: DIR/result.json; [`record`]: the one writer (sealed with a digest) and
-//!   reader (parse errors, format, digest, ranges) of records other commands read; [`out_dir`]: output directories, locked and protected;
+//! - [`results`]: DIR/result.json, a sealed record (`sepval_run::sealed`) whose ranges
+//!   [`result_check`] states;
 //! - [`refine`]: a model refined to the optimum by Levenberg-Marquardt, several sharing each
 //!   batch;
-//! - [`model_spec`]: a fitted model as files hold it, rebuilt exactly by other commands;
-//! - [`domain`]: where a fitted model may be flown (refused outside, said when far from the
-//!   releases), for every command that flies one at a new condition;
-//! - [`inputs`]: what a run reads (scenario, factors, effects, releases screened and
-//!   checked) read into a job;
 //! - [`sigma`]: the noise that weights the goals; [`method`]: which searches to run.
+//!
+//! What a run reads and where it writes (the output directory, the input readers, the sealed
+//! records, the flight domain) are `sepval-run`'s, which every command shares.
 //!
 //! The library returns typed errors and prints nothing: progress reaches the caller through a
 //! [`ProgressObserver`](sepval_solve::run::ProgressObserver).
@@ -29,19 +27,14 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod checkpoint;
-pub mod conditions;
 pub mod configure;
-pub mod domain;
-pub mod inputs;
 pub mod method;
-pub mod model_spec;
-pub mod out_dir;
 pub mod pipeline;
 pub mod problem;
 pub mod rebuild;
-pub mod record;
 pub mod refine;
 pub mod rerun;
+pub mod result_check;
 pub mod results;
 pub mod resume;
 pub mod sigma;

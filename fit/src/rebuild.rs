@@ -7,9 +7,10 @@
 
 use sepval_common::evaluation::Candidate;
 use sepval_core::factors::FactorTable;
+use sepval_solve::identifiability::Identifiability;
 
-use crate::model_spec::{ModelSpec, ModelSpecError};
 use crate::space::{FreeTerm, ParamSpace};
+use sepval_run::model_spec::{ModelSpec, ModelSpecError};
 
 /// A term's coefficient may move within this many times its estimate either way (the bounds
 /// of the diagnosis's refits of discovered terms).
@@ -108,4 +109,38 @@ pub fn model_name(c: &Candidate) -> String {
     } else {
         parts.join(" + ")
     }
+}
+
+/// `x`, the values of `space`'s parameters, at a record's estimate: each parameter that
+/// `identifiability` names takes its recorded value, clamped to its bounds (a value that is not
+/// finite leaves the rebuilt one). The answer of a diagnosis is flown at these values by
+/// `sepval predict`, and its releases' clearance by the diagnosis.
+pub fn at_estimate(space: &ParamSpace, x: &mut [f64], identifiability: &Identifiability) {
+    let id = identifiability;
+    for (j, name) in space.params.names.iter().enumerate() {
+        if let Some(k) = id.names.iter().position(|n| n == name) {
+            let v = id.parameters[k].value;
+            if v.is_finite() {
+                x[j] = v.clamp(space.params.lo[j], space.params.hi[j]);
+            }
+        }
+    }
+}
+
+/// The candidate of `spec` (named `which` in errors) rebuilt against `table` at its recorded
+/// estimate ([`at_estimate`], when the record holds one).
+pub fn candidate_at_estimate(
+    spec: &ModelSpec,
+    which: &str,
+    table: &FactorTable,
+    identifiability: Option<&Identifiability>,
+) -> Result<Candidate, RebuildError> {
+    let Rebuilt { space, mut x, .. } = rebuild(spec, which, table)?;
+    if let Some(id) = identifiability {
+        at_estimate(&space, &mut x, id);
+    }
+    space.candidate(&x).map_err(|e| RebuildError::Factors {
+        which: which.to_string(),
+        message: e.to_string(),
+    })
 }

@@ -216,7 +216,7 @@ pub enum RerunError {
     },
     /// The inputs of the rerun (its releases, scenario or extension) that cannot be read.
     #[error(transparent)]
-    Inputs(#[from] crate::inputs::InputError),
+    Inputs(#[from] sepval_run::inputs::InputError),
     /// The extension given is not the one the checkpoint was made with (the releases and the
     /// scenario are).
     #[error(
@@ -254,7 +254,7 @@ pub fn job(
     path: &Path,
     given: &crate::resume::InputPaths,
     outliers: Option<Policy>,
-    tell: crate::inputs::Tell,
+    tell: sepval_run::inputs::Tell,
 ) -> Result<Job, RerunError> {
     let recorded = &checkpoint.inputs;
     let data = if given.data.is_empty() {
@@ -265,14 +265,14 @@ pub fn job(
     let scenario = given.scenario.as_deref().or(recorded.scenario.as_deref());
     let extension = given.extension.as_deref().or(recorded.extension.as_deref());
     let policy = outliers.unwrap_or(recorded.outliers);
-    let (job, _) = crate::inputs::job(data, scenario, extension, policy, tell)?;
+    let (job, _) = sepval_run::inputs::job(data, scenario, extension, policy, tell)?;
     let Err(e) = checkpoint.check_job(&job, path) else {
         return Ok(job);
     };
     if let (Some(x), CheckpointError::OtherJob { .. }) = (&given.extension, &e) {
         let recorded_x = recorded.extension.as_deref();
         let same_but_extension = job.data_sha256() == checkpoint.data_sha256
-            && crate::inputs::job(data, scenario, recorded_x, policy, &mut |_| {})
+            && sepval_run::inputs::job(data, scenario, recorded_x, policy, &mut |_| {})
                 .is_ok_and(|(j, _)| j.scenario_sha256() == checkpoint.scenario_sha256);
         if same_but_extension {
             return Err(RerunError::OtherExtension {

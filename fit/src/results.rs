@@ -1,12 +1,13 @@
 //! The fit's results file, DIR/result.json, and the per-channel residual summary.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 
 use sepval_common::evaluation::Job;
 use sepval_common::goals::residual;
 use sepval_common::propagator::Observation;
 use sepval_core::factors::Factors;
+use sepval_run::clearance::ReleaseClearance;
+use sepval_run::inputs::InputsRecord;
 use sepval_solve::best::BestSoFar;
 use serde::{Deserialize, Serialize};
 
@@ -52,48 +53,6 @@ pub struct FitResult {
     pub clearance: Option<Vec<ReleaseClearance>>,
     /// How this run was executed (not part of the deterministic result).
     pub run: RunInfo,
-}
-
-/// The clearance of one release's trajectory (docs/envelope.md section 14.2), as result.json and
-/// diagnosis.json record it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ReleaseClearance {
-    /// The release.
-    pub release: String,
-    /// The criterion \[mm\].
-    pub criterion_mm: f64,
-    /// The smallest clearance once the store has moved the ejector's stroke \[mm\].
-    pub min_clearance_mm: f64,
-    /// Its time \[s\].
-    pub t_min_s: f64,
-    /// The store's part that comes closest.
-    pub store_part: String,
-    /// The aircraft's part it comes closest to.
-    pub aircraft_part: String,
-    /// Whether the smallest clearance keeps the criterion.
-    pub clears: bool,
-    /// Whether the store moved the stroke within the record (else every sample counts).
-    pub free_flight_reached: bool,
-}
-
-/// Where the fit's inputs came from (so that `rerun` and `--resume` can find them again, and
-/// `sepval predict` the releases fitted); checkpoints, result.json and diagnosis.json hold it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct InputsRecord {
-    /// Data files (absolute paths); empty for the embedded default flight test.
-    pub data: Vec<PathBuf>,
-    /// Scenario file (absolute path); none for the embedded default.
-    pub scenario: Option<PathBuf>,
-    /// Model-extension file (absolute path), if any.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub extension: Option<PathBuf>,
-    /// What was done with outliers in the data (docs/model.md section 6); written only when
-    /// they were dropped, so that a record of the default reads and hashes as before.
-    #[serde(
-        default,
-        skip_serializing_if = "sepval_common::telemetry::outliers::Policy::is_refuse"
-    )]
-    pub outliers: sepval_common::telemetry::outliers::Policy,
 }
 
 /// The noise floor.

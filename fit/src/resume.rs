@@ -10,8 +10,8 @@ use sepval_solve::hill::HillSettings;
 
 use crate::Method;
 use crate::checkpoint::{Checkpoint, CheckpointError};
-use crate::out_dir::Input;
 use crate::sigma::Sigma;
+use sepval_run::out_dir::Input;
 
 /// Why a checkpoint cannot be gone on with as asked.
 #[derive(Debug, thiserror::Error)]

@@ -21,7 +21,7 @@
 
 #![deny(clippy::float_cmp)]
 
-pub use sepval_fit::conditions;
+pub use sepval_run::conditions;
 pub mod information;
 pub mod models;
 pub mod outputs;
@@ -67,7 +67,15 @@ pub enum PlanError {
         /// The directory.
         path: PathBuf,
         /// Why.
-        source: sepval_fit::record::RecordError,
+        source: sepval_run::sealed::RecordError,
+    },
+    /// The releases the diagnosis was made from, which do not read again.
+    #[error("--from {}: the releases the diagnosis was made from", path.display())]
+    Releases {
+        /// The directory.
+        path: PathBuf,
+        /// Why.
+        source: Box<sepval_run::inputs::InputError>,
     },
     /// A model of the diagnosis that cannot be rebuilt.
     #[error("the models of the diagnosis")]
@@ -85,7 +93,7 @@ pub enum PlanError {
 
 /// The diagnosis in `dir` (DIR/diagnosis.json of `sepval diagnose`, format
 /// [`sepval_diagnose::DIAGNOSIS_FORMAT`]), read and checked by the records' one reader
-/// ([`sepval_fit::record::read_record`]: parse errors with line and column, format, digest,
+/// ([`sepval_run::sealed::read_record`]: parse errors with line and column, format, digest,
 /// ranges).
 pub fn read_diagnosis(dir: &Path) -> Result<Diagnosis, PlanError> {
     let bad = |message: String| PlanError::NotADiagnosis {
@@ -103,10 +111,26 @@ pub fn read_diagnosis(dir: &Path) -> Result<Diagnosis, PlanError> {
             "holds no diagnosis.json: not the output of `sepval diagnose`".into(),
         ));
     }
-    sepval_fit::record::read_record(&path, "diagnosis").map_err(|source| PlanError::Record {
+    sepval_run::sealed::read_record(&path, "diagnosis").map_err(|source| PlanError::Record {
         path: dir.to_path_buf(),
         source,
     })
+}
+
+/// The diagnosis in `dir` ([`read_diagnosis`]) and the job of the releases it was made from,
+/// read again as it read them (what the screening leaves out told to `tell`).
+pub fn read_from(
+    dir: &Path,
+    tell: sepval_run::inputs::Tell,
+) -> Result<(Diagnosis, Job), PlanError> {
+    let diagnosis = read_diagnosis(dir)?;
+    let flown = sepval_run::inputs::recorded_job(&diagnosis.inputs, tell).map_err(|e| {
+        PlanError::Releases {
+            path: dir.to_path_buf(),
+            source: Box::new(e),
+        }
+    })?;
+    Ok((diagnosis, flown))
 }
 
 /// A plan's inputs, checked, before anything is simulated.

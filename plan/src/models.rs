@@ -1,5 +1,5 @@
 //! The models a plan compares: the diagnosis's answer and each of its rivals, rebuilt from
-//! DIR/diagnosis.json (`model`, and each rival's `model`: `sepval_fit::model_spec`), each with
+//! DIR/diagnosis.json (`model`, and each rival's `model`: `sepval_run::model_spec`), each with
 //! the free parameters a refit would move (the 17 factors, its effects' parameters, its terms'
 //! coefficients: the parameters of the diagnosis's own refits, `sepval_fit::space`, locators
 //! held) and the forward-difference steps of its sensitivities.
@@ -8,9 +8,9 @@ use sepval_common::evaluation::Candidate;
 use sepval_common::extension::Family;
 use sepval_core::factors::FactorTable;
 use sepval_diagnose::Diagnosis;
-use sepval_fit::model_spec::ModelSpec;
 use sepval_fit::rebuild::{Rebuilt, rebuild};
 use sepval_fit::space::ParamSpace;
+use sepval_run::model_spec::ModelSpec;
 
 /// Forward-difference step of a sensitivity, as a fraction of the parameter's range (the
 /// refinement's own, `sepval_solve::lm::LmSettings::fd_step`).

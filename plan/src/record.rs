@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use sepval_fit::model_spec::ModelSpec;
+use sepval_run::model_spec::ModelSpec;
 
 use crate::conditions::Quantity;
 use crate::ranking::{RankedCondition, Standing};

@@ -12,8 +12,8 @@ use sepval_common::propagator::Observation;
 use sepval_common::scenario::Scenario;
 use sepval_common::synthetic::default_flight_test;
 use sepval_core::factors::{Factor, Factors};
-use sepval_fit::model_spec::{EffectValues, ModelSpec};
 use sepval_fit::space::Noise;
+use sepval_run::model_spec::{EffectValues, ModelSpec};
 use sepval_solve::run::NoProgress;
 
 use super::*;

@@ -2,7 +2,7 @@
 //! scenario of `--scenario COND.toml` must fly the store that was fitted (the same store,
 //! ejector, aerodynamics, interference, factor table and extension terms as the releases
 //! fitted: only `[flight]`, the name and the integrator may differ) at a condition within the
-//! model's domain ([`sepval_fit::domain`]), `--level` lies in (0, 1), and `--samples` is at
+//! model's domain ([`sepval_run::domain`]), `--level` lies in (0, 1), and `--samples` is at
 //! least [`min_samples`] of the level (20 / (1 - level)), at most [`MAX_SAMPLES`], and their
 //! trajectories at the band's points fit [`MAX_VALUE_BYTES`].
 
@@ -11,7 +11,7 @@ use std::path::Path;
 use sepval_common::scenario::{Scenario, StoreDifference};
 use sepval_common::telemetry::outliers::Policy;
 use sepval_core::number_text::Shown;
-use sepval_fit::inputs;
+use sepval_run::inputs;
 
 /// The most samples of one prediction.
 pub const MAX_SAMPLES: usize = 100_000;
@@ -49,7 +49,7 @@ pub enum ConditionError {
     #[error("the condition's {domain}")]
     Domain {
         /// Which quantity, and the domain.
-        domain: sepval_fit::domain::DomainError,
+        domain: sepval_run::domain::DomainError,
     },
     /// A scenario of another store.
     #[error(
@@ -74,12 +74,12 @@ pub enum FlownError {
         name: String,
         /// Why.
         #[source]
-        source: Box<sepval_fit::inputs::InputError>,
+        source: Box<sepval_run::inputs::InputError>,
     },
     /// Its metadata that does not read, or its store that is not the condition's (the error
     /// names the file).
     #[error(transparent)]
-    Release(Box<sepval_fit::inputs::InputError>),
+    Release(Box<sepval_run::inputs::InputError>),
     /// The flown release's metadata names another condition than the prediction's.
     #[error(
         "--data {name}: its metadata says it was flown at {flown}, not at the condition of --scenario ({condition})"
@@ -110,7 +110,7 @@ impl crate::Flown {
         path: &Path,
         (scenario_name, condition): (&str, &Scenario),
         policy: Policy,
-        tell: sepval_fit::inputs::Tell,
+        tell: sepval_run::inputs::Tell,
     ) -> Result<crate::Flown, FlownError> {
         let name = path.display().to_string();
         let data = inputs::read(path, policy, tell).map_err(|source| FlownError::Read {
@@ -205,7 +205,7 @@ impl Settings {
 }
 
 /// Checks that `condition` flies the store of `fitted` ([`Scenario::store_difference`]),
-/// within the model's domain ([`sepval_fit::domain`]).
+/// within the model's domain ([`sepval_run::domain`]).
 pub fn check_condition(fitted: &Scenario, condition: &Scenario) -> Result<(), ConditionError> {
     if let Some(difference) = fitted.store_difference(condition) {
         return Err(ConditionError::OtherStore {
@@ -213,5 +213,5 @@ pub fn check_condition(fitted: &Scenario, condition: &Scenario) -> Result<(), Co
             fitted: fitted.name.clone(),
         });
     }
-    sepval_fit::domain::check(condition).map_err(|domain| ConditionError::Domain { domain })
+    sepval_run::domain::check(condition).map_err(|domain| ConditionError::Domain { domain })
 }

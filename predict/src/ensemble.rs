@@ -1,6 +1,6 @@
 //! The models a prediction draws from and their weights (docs/prediction.md section 13.2): the
 //! source's answer and each of its rivals, rebuilt from their model records
-//! (`sepval_fit::model_spec`) with the free parameters their refits move (the 17 factors, the
+//! (`sepval_run::model_spec`) with the free parameters their refits move (the 17 factors, the
 //! effects' parameters, the terms' coefficients, as `sepval plan` rebuilds them), weighted by
 //! their evidence: w_m = exp(-delta_BIC_m / 2), normalised to sum 1 (the BIC approximation of
 //! the posterior probability of each model with equal prior odds: R. E. Kass and A. E.
@@ -69,15 +69,7 @@ impl Ensemble {
                 name, space, mut x, ..
             } = rebuild(&m.spec, &which, table)?;
             if i == 0 {
-                let id = &source.identifiability;
-                for (j, name) in space.params.names.iter().enumerate() {
-                    if let Some(k) = id.names.iter().position(|n| n == name) {
-                        let v = id.parameters[k].value;
-                        if v.is_finite() {
-                            x[j] = v.clamp(space.params.lo[j], space.params.hi[j]);
-                        }
-                    }
-                }
+                sepval_fit::rebuild::at_estimate(&space, &mut x, &source.identifiability);
             }
             let candidate = space.candidate(&x).map_err(|e| EnsembleError::Factors {
                 which: which.clone(),

@@ -34,6 +34,7 @@ pub mod condition;
 pub mod discrepancy;
 pub mod ensemble;
 mod excess;
+pub mod one_release;
 pub mod outputs;
 mod page;
 pub mod reach;
@@ -136,7 +137,7 @@ pub struct Prepared {
     pub settings: Settings,
     /// The clearance to assess, if any ([`Prepared::with_clearance`]).
     pub clearance: Option<ClearanceSettings>,
-    /// When the condition lies far from every release fitted ([`sepval_fit::domain::far`]),
+    /// When the condition lies far from every release fitted ([`sepval_run::domain::far`]),
     /// the sentence that says so: the first of the prediction's summary.
     pub extrapolation: Option<String>,
     /// How far the condition lies from the nearest release fitted beyond the reach the
@@ -206,14 +207,14 @@ pub fn prepare(
         .iter()
         .map(|e| &e.simulator.scenario().flight)
         .collect();
-    let extrapolation = sepval_fit::domain::far(&releases, &condition.flight);
+    let extrapolation = sepval_run::domain::far(&releases, &condition.flight);
     let validated: Vec<&sepval_common::scenario::Flight> = held_out
         .iter()
         .map(|e| &e.simulator.scenario().flight)
         .collect();
     let reach = reach::uncovered(
-        sepval_fit::domain::reach(&releases, &condition.flight),
-        sepval_fit::domain::covered_reach(&releases, &validated),
+        sepval_run::domain::reach(&releases, &condition.flight),
+        sepval_run::domain::covered_reach(&releases, &validated),
     );
     Ok(Prepared {
         source,

@@ -3,9 +3,9 @@
 //! release flown, so that a condition far from every release is not cleared on the factors'
 //! spread alone.
 //!
-//! The rule: r the reach of the condition ([`sepval_fit::domain::reach`]: 0 at a release, 1
+//! The rule: r the reach of the condition ([`sepval_run::domain::reach`]: 0 at a release, 1
 //! as far as 0.1 in Mach), r_h the reach the held-out releases cover
-//! ([`sepval_fit::domain::covered_reach`]: the farthest a release was predicted without being
+//! ([`sepval_run::domain::covered_reach`]: the farthest a release was predicted without being
 //! fitted; 0 with one release and none validated), m_c(t) = |ybar_c(t) - ybar_c(0)| the
 //! store's own motion on channel c (ybar the mean of the samples that ran), and
 //!

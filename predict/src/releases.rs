@@ -3,8 +3,9 @@
 //! ([`simulate`]), the store's distance to the aircraft along it ([`trace`], the geometry's
 //! swept distance), one [`ReleaseClearance`] per release for result.json and diagnosis.json,
 //! and `clearance.csv` and `figures/clearance.png` written into the run's directory
-//! ([`write()`]). A stage of the fit and the diagnosis: the binary only asks for it when
-//! `--aircraft` is given and prints its lines ([`line()`]).
+//! ([`write()`]). A stage of the fit and the diagnosis ([`Stage`], their
+//! [`ClearReleases`]): the binary gives it to them when `--aircraft` is given, and prints the
+//! lines of what they record ([`line()`]).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -12,16 +13,13 @@ use std::sync::Arc;
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, InProcess, Job};
 use sepval_common::telemetry::Trajectory;
 use sepval_core::cancel;
-use sepval_diagnose::Diagnosis;
-use sepval_fit::results::ReleaseClearance;
 use sepval_geometry::{GeometryError, Pose, Trace};
 use sepval_report::figures::{ClearanceSeries, clearance_figure};
 use sepval_report::words::csv_text;
 use sepval_report::{OutputError, Written};
+use sepval_run::clearance::{ClearReleases, ReleaseClearance, StageError};
 
 use crate::clearance::ClearanceSettings;
-use crate::ensemble::{Ensemble, EnsembleError};
-use crate::source::{Source, SourceError};
 
 /// The releases' clearance that could not be computed or written.
 #[derive(Debug, thiserror::Error)]
@@ -33,9 +31,6 @@ pub enum ReleasesError {
     /// The answer does not fly every release.
     #[error("the answer does not simulate every release: {0}")]
     NotFlown(String),
-    /// The answer of a diagnosis, rebuilt.
-    #[error("the answer of the diagnosis")]
-    Answer(#[source] Box<AnswerError>),
     /// A release's clearance.
     #[error("the clearance of release {release}")]
     Trace {
@@ -50,15 +45,27 @@ pub enum ReleasesError {
     Outputs(#[from] OutputError),
 }
 
-/// Why a diagnosis's answer could not be rebuilt.
-#[derive(Debug, thiserror::Error)]
-pub enum AnswerError {
-    /// Its record, as a prediction reads it.
-    #[error(transparent)]
-    Source(#[from] SourceError),
-    /// Its model.
-    #[error(transparent)]
-    Ensemble(#[from] EnsembleError),
+/// The clearance stage of a fit or a diagnosis (`--aircraft`): the releases flown by their
+/// answer in this process on `threads` threads, their clearance found and written.
+pub struct Stage {
+    /// The geometry and the criterion.
+    pub settings: ClearanceSettings,
+    /// The threads that fly the releases.
+    pub threads: usize,
+}
+
+impl ClearReleases for Stage {
+    fn releases(
+        &self,
+        job: &Arc<Job>,
+        candidate: Candidate,
+        out: &Path,
+    ) -> Result<Vec<ReleaseClearance>, StageError> {
+        let flown = simulate(job, candidate, self.threads)?;
+        let of = of_releases(&self.settings, &flown)?;
+        write(&self.settings, &flown, &of, out)?;
+        Ok(of.into_iter().map(|(r, _)| r).collect())
+    }
 }
 
 /// The clearance of one trajectory along its samples.
@@ -126,18 +133,6 @@ pub fn simulate(
             (ev.name.clone(), traj)
         })
         .collect())
-}
-
-/// The candidate of a diagnosis's answer (`d`, written to `dir`), rebuilt as a prediction
-/// rebuilds it from diagnosis.json, for the job it was diagnosed on.
-pub fn diagnosis_answer(d: &Diagnosis, dir: &Path, job: &Job) -> Result<Candidate, ReleasesError> {
-    let answer = || -> Result<Candidate, AnswerError> {
-        let source = Source::of_diagnosis(d.clone(), dir)?;
-        Ok(Ensemble::of(&source, job.factor_table())?
-            .answer()
-            .candidate)
-    };
-    answer().map_err(|e| ReleasesError::Answer(Box::new(e)))
 }
 
 /// A release's clearance in one line, as the fit and the diagnosis print it.

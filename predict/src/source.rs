@@ -11,12 +11,12 @@ use std::path::{Path, PathBuf};
 
 use sepval_common::evaluation::{Event, Job};
 use sepval_common::telemetry::outliers::Policy;
-use sepval_fit::checkpoint::InputsRecord;
-use sepval_fit::inputs::{self, InputError, Tell};
-use sepval_fit::model_spec::ModelSpec;
-use sepval_fit::record::{Record, read_record};
 use sepval_fit::results::FitResult;
 use sepval_fit::space::Noise;
+use sepval_run::inputs::InputsRecord;
+use sepval_run::inputs::{self, InputError, Tell};
+use sepval_run::model_spec::ModelSpec;
+use sepval_run::sealed::{Record, read_record};
 use sepval_solve::identifiability::Identifiability;
 
 /// A `--from` directory that cannot be predicted from.
@@ -167,7 +167,7 @@ pub fn read_source(dir: &Path) -> Result<Source, SourceError> {
 }
 
 /// The record `dir/file`, read and checked by the records' one reader
-/// ([`sepval_fit::record::read_record`]: parse errors with line and column, format, digest,
+/// ([`sepval_run::sealed::read_record`]: parse errors with line and column, format, digest,
 /// ranges).
 fn read<T: Record>(dir: &Path, file: &'static str, label: &'static str) -> Result<T, SourceError> {
     read_record(&dir.join(file), label).map_err(|e| SourceError::Record {

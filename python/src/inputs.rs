@@ -71,7 +71,7 @@ pub fn store_telemetry(
 /// The scenario of `path` (the embedded default without one) as JSON of the TOML that `sepval
 /// scenario` writes.
 pub fn scenario_json(path: Option<&Path>) -> Result<String> {
-    let scenario = sepval_fit::inputs::scenario(path, None)?;
+    let scenario = sepval_run::inputs::scenario(path, None)?;
     let text = sepval_cli::command::scenario::toml_text(&scenario);
     let value: toml::Value = toml::from_str(&text).context("the scenario's TOML reads back")?;
     Ok(serde_json::to_string(&value)?)
@@ -164,7 +164,7 @@ pub fn store_factors(
     write: bool,
 ) -> Result<PathBuf> {
     let s = match scenario {
-        ScenarioGiven::File(p) => sepval_fit::inputs::scenario(Some(p), None)?,
+        ScenarioGiven::File(p) => sepval_run::inputs::scenario(Some(p), None)?,
         ScenarioGiven::Dict(j) => scenario_of_json(j, "(a dict)")?,
         ScenarioGiven::Default => Scenario::embedded_default(),
     };

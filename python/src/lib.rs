@@ -146,7 +146,7 @@ mod _native {
     /// the marker.
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
-        use sepval_fit::out_dir::{LOCK_FILE, MARKER_FILE};
+        use sepval_run::out_dir::{LOCK_FILE, MARKER_FILE};
         m.add("BOOKKEEPING", (LOCK_FILE, MARKER_FILE))
     }
 }

@@ -120,7 +120,7 @@ pub enum UpdateError {
     /// The releases (`--data`, `--validate`) or the store (`--scenario`, `--extension`) that
     /// cannot be read.
     #[error(transparent)]
-    Inputs(Box<sepval_fit::inputs::InputError>),
+    Inputs(Box<sepval_run::inputs::InputError>),
     /// The baseline search's settings or noise levels refused.
     #[error(transparent)]
     Search(sepval_fit::FitError),

@@ -6,10 +6,10 @@ use std::time::Instant;
 use sepval_common::evaluation::{Evaluator, Job};
 use sepval_common::scenario::Scenario;
 use sepval_core::factors::{Factor, Factors};
-use sepval_fit::inputs::{self, Releases};
 use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_fit::{BaselineSearch, FitError, FitOptions, Method, run_fit};
+use sepval_run::inputs::{self, Releases};
 use sepval_solve::lm::{LmSettings, Stall};
 use sepval_solve::run::{ProgressObserver, RunError};
 
@@ -65,7 +65,7 @@ impl UpdateOptions {
         search: &BaselineSearch,
         free: Option<&[String]>,
         out: &std::path::Path,
-        tell: sepval_fit::inputs::Tell,
+        tell: sepval_run::inputs::Tell,
     ) -> Result<(Job, UpdateOptions)> {
         let free = free_factors(free)?;
         let input = |e| UpdateError::Inputs(Box::new(e));
@@ -176,6 +176,7 @@ fn baseline(
     let fit = FitOptions {
         method: Method::GaLm,
         resume: None,
+        clearance: None,
         ..options.fit.clone()
     };
     let out = run_fit(&fit, evaluator, progress).map_err(|e| match e {

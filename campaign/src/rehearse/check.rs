@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use sepval_core::cancel;
-use sepval_fit::out_dir::LOCK_FILE;
 use sepval_predict::record::ConditionRecord;
+use sepval_run::out_dir::LOCK_FILE;
 use sepval_solve::run::ProgressObserver;
 
 use super::fly::{Candidate, Flew, Release, fly};

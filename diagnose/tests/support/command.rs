@@ -15,7 +15,7 @@ use sepval_common::evaluation::InProcess;
 use sepval_common::telemetry::outliers::Policy;
 use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose};
 use sepval_fit::BaselineSearch;
-use sepval_fit::inputs::Releases;
+use sepval_run::inputs::Releases;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::run::NoProgress;
 use serde_json::Value;

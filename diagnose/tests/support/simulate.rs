@@ -1,6 +1,6 @@
 //! `sepval simulate` in process, for the test binaries that make releases as the command does
 //! (included by `#[path]` in `diagnose/tests/catalogue`, `diagnose/tests/discovery` and
-//! `plan/tests/closing`): the model, factors and effects read by `sepval_fit::inputs`, simulated
+//! `plan/tests/closing`): the model, factors and effects read by `sepval_run::inputs`, simulated
 //! and noised by `sepval_common::synthetic`, written by `Trajectory::write`, as
 //! `sepval/src/command/simulate.rs` calls them. The lines that command adds to the file for
 //! people (the command line, and an extension's file and terms) are not written: a diagnosis
@@ -12,7 +12,7 @@ use std::path::Path;
 use sepval_common::simulation::{Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test_logged;
 use sepval_common::telemetry::Trajectory;
-use sepval_fit::inputs;
+use sepval_run::inputs;
 
 /// The flags of one `sepval simulate` run (files by their paths).
 #[derive(Default)]

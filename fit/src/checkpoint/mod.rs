@@ -137,7 +137,7 @@ pub const CHECKPOINT_FORMAT: &str = "sepval-ga-checkpoint/2";
 /// Format tag of the checkpoints written before the digest (refused).
 pub const CHECKPOINT_FORMAT_1: &str = "sepval-ga-checkpoint/1";
 
-pub use crate::results::InputsRecord;
+use sepval_run::inputs::InputsRecord;
 
 /// One generation's checkpoint.
 ///
@@ -185,8 +185,7 @@ struct FormatOnly {
 impl Checkpoint {
     /// Path of generation `g`'s checkpoint in the run directory `dir`.
     pub fn path(dir: &Path, generation: usize) -> PathBuf {
-        dir.join("generations")
-            .join(format!("gen-{generation:04}.json"))
+        sepval_run::out_dir::generation_path(dir, generation)
     }
 
     /// Where the same fit wrote the previous generation's checkpoint, if this one is at `path`:

@@ -12,12 +12,13 @@ use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::{LmResult, LmSettings};
 use sepval_solve::run::{Ask, Control, Observer, Progress, RunError, SearchError, Solver};
 
-use crate::checkpoint::{CHECKPOINT_FORMAT, Checkpoint, InputsRecord};
+use crate::checkpoint::{CHECKPOINT_FORMAT, Checkpoint};
 use crate::problem::OnModel;
 use crate::refine::ModelLm;
 use crate::results::Probe;
 use crate::sigma::Sigma;
 use crate::space::{Noise, ParamSpace};
+use sepval_run::inputs::InputsRecord;
 
 /// A refinement is tried during ga+lm when the search has stagnated (the best weighted goal
 /// improved by less than 1 % over the last 10 generations) or at generations 10, 20, 40, 80,

@@ -30,7 +30,7 @@ use sepval_solve::identifiability::{Identifiability, identifiability};
 use sepval_solve::lm::{LmResult, LmSettings};
 use sepval_solve::run::{Observer, ProgressObserver, RunError, ShowProgress, Solver, run};
 
-use crate::checkpoint::{Checkpoint, CheckpointError, InputsRecord};
+use crate::checkpoint::{Checkpoint, CheckpointError};
 use crate::method::Method;
 use crate::problem::Evaluate;
 use crate::refine::ModelLm;
@@ -40,6 +40,8 @@ use crate::results::{
 use crate::sigma::Sigma;
 use crate::space::{Noise, ParamSpace};
 use searches::MethodDone;
+use sepval_run::clearance::ClearReleases;
+use sepval_run::inputs::InputsRecord;
 
 /// Everything a fit needs besides the evaluator.
 #[derive(Clone)]
@@ -64,6 +66,12 @@ pub struct FitOptions {
     pub lm: LmSettings,
     /// Refinement attempts during a genetic search (`ga+lm`).
     pub lm_probe: LmSettings,
+    /// The clearance of the best fit's releases (`--aircraft`), found before result.json is
+    /// written and recorded in it (`clearance`); none for a baseline.
+    pub clearance: Option<Arc<dyn ClearReleases>>,
+    /// Refuse, before result.json is written, a best fit that leaves a scenario table
+    /// (`--strict-tables`).
+    pub strict_tables: bool,
 }
 
 impl FitOptions {
@@ -91,6 +99,8 @@ impl FitOptions {
                 budget: lm.budget.min(800),
                 ..LmSettings::default()
             },
+            clearance: None,
+            strict_tables: false,
         }
     }
 }
@@ -176,7 +186,7 @@ pub enum FitError {
     Figure(#[from] FigureError),
     /// The releases, the scenario, the extension or the truth's factors that cannot be read.
     #[error(transparent)]
-    Inputs(Box<crate::inputs::InputError>),
+    Inputs(Box<sepval_run::inputs::InputError>),
     /// The checkpoint resumed from does not fit the run asked for.
     #[error(transparent)]
     Resume(#[from] crate::resume::ResumeError),
@@ -196,6 +206,16 @@ pub enum FitError {
         /// Why it does not.
         why: String,
     },
+    /// The best fit left a scenario table and `strict_tables` refuses that: one line per event
+    /// and table.
+    #[error(
+        "--strict-tables: the best fit {} (result.json not written)",
+        .0.join("; and ")
+    )]
+    TablesLeft(Vec<String>),
+    /// The clearance of the best fit's releases (`--aircraft`) could not be found.
+    #[error(transparent)]
+    Clearance(sepval_run::clearance::StageError),
     /// The genetic search ended before its first generation.
     #[error("the genetic search did not start")]
     GaNotStarted,
@@ -346,7 +366,16 @@ pub fn run_fit(
         resolution,
         best,
     };
-    let result = fit_result(&cx, found, evaluator.describe(), start);
+    let mut result = fit_result(&cx, found, evaluator.describe(), start);
+    let left = result.tables_left();
+    if options.strict_tables && !left.is_empty() {
+        return Err(FitError::TablesLeft(left));
+    }
+    if let (Some(stage), Some(best)) = (&options.clearance, best) {
+        let candidate = Candidate::baseline(best);
+        let of = stage.releases(evaluator.job(), candidate, &options.out);
+        result.clearance = Some(of.map_err(FitError::Clearance)?);
+    }
     write_result(&options.out, &result)?;
     Ok(FitOutput {
         result,

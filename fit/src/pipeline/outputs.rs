@@ -299,6 +299,6 @@ pub(super) fn method_result(
 
 /// Writes DIR/result.json atomically.
 pub fn write_result(dir: &Path, result: &FitResult) -> Result<(), FitError> {
-    crate::record::write_record(&dir.join("result.json"), result)?;
+    sepval_run::sealed::write_record(&dir.join("result.json"), result)?;
     Ok(())
 }

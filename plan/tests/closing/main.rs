@@ -26,8 +26,8 @@ use std::time::Instant;
 use sepval_common::evaluation::InProcess;
 use sepval_common::scenario::{Aero, Scenario};
 use sepval_common::table::DerivativeCoefficient;
-use sepval_fit::inputs;
 use sepval_plan::{Quantity, Range, plan_file, prepare, read_diagnosis, write_outputs};
+use sepval_run::inputs;
 use sepval_solve::run::NoProgress;
 use serde_json::Value;
 

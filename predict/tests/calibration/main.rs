@@ -30,8 +30,8 @@ fn bands_hold_the_truth_and_are_not_too_wide() {
         // where nothing measured how the model's form carries.
         let fitted: Vec<_> = c.fitted.iter().collect();
         let beyond = sepval_predict::reach::uncovered(
-            sepval_fit::domain::reach(&fitted, &c.predicted),
-            sepval_fit::domain::covered_reach(&fitted, &[]),
+            sepval_run::domain::reach(&fitted, &c.predicted),
+            sepval_run::domain::covered_reach(&fitted, &[]),
         );
         if beyond <= 0.0 {
             assert!(m.width_ratio < MAX_WIDTH_RATIO, "{}: {m:?}", c.cause.name());

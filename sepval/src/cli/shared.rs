@@ -25,8 +25,8 @@ pub struct InputArgs {
 
 impl InputArgs {
     /// The releases these flags fit, and `validate` held out, each read with `--outliers`.
-    pub fn releases<'a>(&'a self, validate: &'a [PathBuf]) -> sepval_fit::inputs::Releases<'a> {
-        sepval_fit::inputs::Releases {
+    pub fn releases<'a>(&'a self, validate: &'a [PathBuf]) -> sepval_run::inputs::Releases<'a> {
+        sepval_run::inputs::Releases {
             data: &self.data,
             validate,
             scenario: self.model.scenario.as_deref(),

@@ -3,8 +3,8 @@
 use std::sync::Arc;
 
 use anyhow::{Result, bail};
-use sepval_fit::out_dir::Request;
 use sepval_report::figures::throughput_figure;
+use sepval_run::out_dir::Request;
 use sepval_transport::bench::{BenchOptions, Transport, run_bench, series, table, write_csv};
 use sepval_transport::ipc::MAX_WORKERS;
 
@@ -59,7 +59,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             resume: None,
         },
     )?;
-    let (job, _) = sepval_fit::inputs::job(&[], None, None, Default::default(), &mut tell())?;
+    let (job, _) = sepval_run::inputs::job(&[], None, None, Default::default(), &mut tell())?;
     note!(
         "benchmarking {} simulations of the default event per measurement, median of {} \
          interleaved rounds, on {} core(s)",

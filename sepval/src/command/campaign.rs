@@ -8,7 +8,7 @@ use sepval_campaign::page;
 use sepval_campaign::program::{Campaign, Init};
 use sepval_campaign::release::NewRelease;
 use sepval_campaign::request::InitRequest;
-use sepval_fit::inputs;
+use sepval_run::inputs;
 
 use super::starter;
 use super::{count, evaluator_spec, tell};

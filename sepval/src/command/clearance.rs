@@ -1,15 +1,14 @@
 //! `--aircraft`, `--store-shape` and `--clearance-mm`: the geometry read and checked by
-//! [`ClearanceSettings::read`] (docs/geometry.md), and the clearance of a fit's or a
-//! diagnosis's releases asked of [`sepval_predict::releases`] and said.
+//! [`ClearanceSettings::read`] (docs/geometry.md); for a fit and a diagnosis, the stage that
+//! finds their releases' clearance before they seal their record ([`stage`],
+//! [`sepval_predict::releases::Stage`]), and its lines from the record ([`lines`]).
 
-use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::Result;
-use sepval_common::evaluation::{Candidate, Job};
 use sepval_common::scenario::Scenario;
-use sepval_fit::results::ReleaseClearance;
 use sepval_predict::{ClearanceSettings, releases};
+use sepval_run::clearance::{ClearReleases, ReleaseClearance};
 
 use crate::cli::GeometryArgs;
 
@@ -24,27 +23,22 @@ pub fn settings(args: &GeometryArgs, scenario: &Scenario) -> Result<Option<Clear
     Ok(Some(c))
 }
 
-/// The clearance of the answer's trajectories of a fit or diagnosis in `out`, for
-/// `--aircraft` given ([`sepval_predict::releases`]): `candidate` flies each release of `job`
-/// on `threads` threads; clearance.csv and figures/clearance.png are written, `record`
-/// (result.json or diagnosis.json, named `file`) is rewritten with its `clearance`, and one
-/// line per release is printed.
-pub fn record_releases<T: serde::Serialize>(
-    c: &ClearanceSettings,
-    (job, candidate, threads): (&Arc<Job>, Candidate, usize),
-    out: &Path,
-    file: &str,
-    record: &mut T,
-    set: impl FnOnce(&mut T, Vec<ReleaseClearance>),
-) -> Result<()> {
-    let flown = releases::simulate(job, candidate, threads)?;
-    let of = releases::of_releases(c, &flown)?;
-    releases::write(c, &flown, &of, out)?;
-    let records: Vec<ReleaseClearance> = of.into_iter().map(|(r, _)| r).collect();
-    for r in &records {
-        say!("clearance: {}", releases::line(r));
-    }
-    set(record, records);
-    sepval_fit::record::write_record(&out.join(file), record)?;
-    Ok(())
+/// The clearance stage of a fit or a diagnosis of releases at `scenario`'s store, flying them
+/// on `threads` threads; `None` without `--aircraft`.
+pub fn stage(
+    args: &GeometryArgs,
+    scenario: &Scenario,
+    threads: usize,
+) -> Result<Option<Arc<dyn ClearReleases>>> {
+    let stage = settings(args, scenario)?.map(|settings| {
+        let stage: Arc<dyn ClearReleases> = Arc::new(releases::Stage { settings, threads });
+        stage
+    });
+    Ok(stage)
+}
+
+/// One line per release of what a record holds of their clearance.
+pub fn lines(records: Option<&Vec<ReleaseClearance>>) -> String {
+    let line = |r| format!("clearance: {}\n", releases::line(r));
+    records.into_iter().flatten().map(line).collect()
 }

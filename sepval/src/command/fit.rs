@@ -1,18 +1,21 @@
 //! `sepval fit`: the factors fitted to measured data by the study's searches (and refinement).
 
+use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::Result;
 use sepval_common::evaluation::Job;
 use sepval_fit::checkpoint::Checkpoint;
 use sepval_fit::configure::FitRequest;
-use sepval_fit::out_dir::{Claim, Request, RunDir};
 use sepval_fit::pipeline::{FitOutput, write_fit_figures};
 use sepval_fit::resume::{self, InputPaths};
 use sepval_fit::{FitOptions, Method, run_fit};
+use sepval_run::out_dir::Claim;
 use sepval_solve::ga::GaSettings;
+use sepval_solve::run::ProgressObserver;
 
-use super::{clearance, evaluator_spec, notices, tell};
+use super::sequence::{Evaluators, Run, Said, Writes, execute};
+use super::{clearance, evaluator_spec, tell};
 use crate::cli::{FitArgs, MethodArg};
 
 /// The library's method of `--method`.
@@ -26,65 +29,81 @@ pub fn method(m: MethodArg) -> Method {
     }
 }
 
-/// Runs `sepval fit`: the flags to a validated configuration, the run, the rendering. The run
-/// directory is claimed (locked and checked) first, so that no worker starts for a refused
-/// `--out`, but changed only once everything is checked, a resumed checkpoint re-evaluated and
-/// replayed included: a refusal deletes and rewrites nothing.
+/// Runs `sepval fit`: the flags made a request (the checkpoint resumed from, the releases,
+/// the settings and the geometry read and checked), then the command's sequence, whose
+/// confirmation re-evaluates and replays a resumed checkpoint before the directory changes.
 pub fn run(args: FitArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let resume = args.resume.as_deref().map(Checkpoint::load).transpose()?;
-    let run_dir = claim(&args, resume.as_ref())?;
-    let FitConfig { job, options } = configure(&args, resume)?;
-    let base = job.events()[0].simulator.scenario().clone();
-    let geometry = clearance::settings(&args.geometry, &base)?;
-    let mut evaluator = spec.start(Arc::new(job), notices())?;
-    if let (Some(c), Some(path)) = (&options.resume, args.resume.as_deref()) {
-        // Its members re-evaluated and its generation replayed before going on from it.
-        let report = sepval_fit::rerun::confirm(c, path, evaluator.as_mut())?;
-        note!(
-            "sepval: resuming from {}: {}",
-            path.display(),
-            report.checked()
-        );
-    }
-    for removed in run_dir.prepare()? {
-        note!(
-            "sepval: removed {} (a later generation of the continuation being replaced)",
-            removed.display()
-        );
-    }
-    let mut output = run_fit(&options, evaluator.as_mut(), &mut *crate::front::progress())?;
-    if let Some(c) = &geometry {
-        best_clearance(c, &args, evaluator.job(), &mut output)?;
-    }
-    render(&args, evaluator.job(), &output)?;
-    run_dir.commit();
-    // Tables left by the best fit: reported, or an error with --strict-tables.
-    let left = output.result.tables_left();
-    if args.tables.strict_tables && !left.is_empty() {
-        anyhow::bail!(
-            "--strict-tables: the best fit {} (result.json records it)",
-            left.join("; and ")
-        );
-    }
-    for l in &left {
-        note!("warning: {l}");
-    }
-    Ok(())
+    let writes = writes(&args, resume.as_ref());
+    let FitConfig { job, mut options } = configure(&args, resume)?;
+    let base = job.events()[0].simulator.scenario();
+    let threads = super::count("--threads", args.eval.threads)?;
+    options.clearance = clearance::stage(&args.geometry, base, threads)?;
+    options.strict_tables = args.tables.strict_tables;
+    let job = Arc::new(job);
+    let request = Request {
+        args,
+        job: Arc::clone(&job),
+        options,
+    };
+    execute(&spec, writes, Some(job), request)
 }
 
-/// A fit as the flags ask for it, validated: the job to run and the options of the run.
-struct FitConfig {
-    job: Job,
+/// A fit asked for by the flags, configured.
+struct Request {
+    args: FitArgs,
+    job: Arc<Job>,
     options: FitOptions,
 }
 
-/// The run directory, claimed before anything runs (no worker is started for a refused --out)
-/// and changed by nothing yet. It may be none of the run's inputs: with `--resume`, the
-/// checkpoint and its run directory too, unless the run goes on in that directory (so
-/// `--resume DIR/generations/gen-0005.json --overwrite --out DIR` is refused: it would clear
-/// the checkpoint it resumes from).
-fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
+impl Run for Request {
+    type Found = FitOutput;
+
+    fn confirm(&mut self, evaluators: &mut Evaluators<'_>) -> Result<()> {
+        if let (Some(c), Some(path)) = (&self.options.resume, self.args.resume.as_deref()) {
+            // Its members re-evaluated and its generation replayed before going on from it.
+            let report = sepval_fit::rerun::confirm(c, path, evaluators.one()?)?;
+            note!(
+                "sepval: resuming from {}: {}",
+                path.display(),
+                report.checked()
+            );
+        }
+        Ok(())
+    }
+
+    fn run(
+        &mut self,
+        evaluators: &mut Evaluators<'_>,
+        progress: &mut dyn ProgressObserver,
+    ) -> Result<FitOutput> {
+        Ok(run_fit(&self.options, evaluators.one()?, progress)?)
+    }
+
+    /// The figures (unless `--no-figures`: result.json is the fit's); the tables left by the
+    /// best fit told (`--strict-tables` refused them before result.json was written).
+    fn write(&self, output: FitOutput, out: &Path, _wall_s: f64) -> Result<Said> {
+        let result = &output.result;
+        let mut summary = clearance::lines(result.clearance.as_ref());
+        summary.push_str(&result.summary());
+        if !self.args.no_figures {
+            let n = write_fit_figures(out, &self.job, &output)?.len();
+            let dir = out.join("figures");
+            summary.push_str(&format!("{n} figures in {}\n", dir.display()));
+        }
+        let json = out.join("result.json");
+        summary.push_str(&format!("results in {}\n", json.display()));
+        let warnings = result.tables_left();
+        Ok(Said { summary, warnings })
+    }
+}
+
+/// Where the fit writes and what it reads. Its directory may be none of the run's inputs: with
+/// `--resume`, the checkpoint and its run directory too, unless the run goes on in that
+/// directory (so `--resume DIR/generations/gen-0005.json --overwrite --out DIR` is refused: it
+/// would clear the checkpoint it resumes from).
+fn writes(args: &FitArgs, resume: Option<&Checkpoint>) -> Writes {
     let claim = match (&args.resume, resume, args.overwrite.overwrite) {
         (_, _, true) => Claim::Overwrite,
         (Some(path), Some(c), false) => Claim::Resume {
@@ -103,15 +122,19 @@ fn claim(args: &FitArgs, resume: Option<&Checkpoint>) -> Result<RunDir> {
         "resume from one of its checkpoints (--resume {})",
         args.out.join("generations/gen-NNNN.json").display()
     );
-    super::claim_out(
-        &args.out,
-        Request {
-            command: "fit",
-            claim,
-            inputs: &read,
-            resume: Some(resume_hint),
-        },
-    )
+    Writes {
+        out: args.out.clone(),
+        command: "fit",
+        claim,
+        inputs: read,
+        resume: Some(resume_hint),
+    }
+}
+
+/// A fit as the flags ask for it, validated: the job to run and the options of the run.
+struct FitConfig {
+    job: Job,
+    options: FitOptions,
 }
 
 /// The flags (and the checkpoint resumed from) as a validated configuration
@@ -144,52 +167,4 @@ fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
     };
     let (job, options) = sepval_fit::configure::configure(request, &mut tell())?;
     Ok(FitConfig { job, options })
-}
-
-/// The clearance of the best fit's trajectories (`--aircraft`): clearance.csv, the figure and
-/// result.json's `clearance`.
-fn best_clearance(
-    c: &sepval_predict::ClearanceSettings,
-    args: &FitArgs,
-    job: &Arc<Job>,
-    output: &mut FitOutput,
-) -> Result<()> {
-    let Some(best) = output
-        .result
-        .methods
-        .values()
-        .min_by(|a, b| a.best.weighted.total_cmp(&b.best.weighted))
-    else {
-        return Ok(());
-    };
-    let candidate = sepval_common::evaluation::Candidate::baseline(best.best.factors);
-    let threads = super::count("--threads", args.eval.threads)?;
-    clearance::record_releases(
-        c,
-        (job, candidate, threads),
-        &args.out,
-        "result.json",
-        &mut output.result,
-        |r, v| r.clearance = Some(v),
-    )
-}
-
-/// The summary on stdout, the figures (unless --no-figures), and where the result is.
-fn render(args: &FitArgs, job: &Job, output: &FitOutput) -> Result<()> {
-    crate::front::out(&output.result.summary());
-    if !args.no_figures {
-        figures(&args.out, job, output)?;
-    }
-    say!("results in {}", args.out.join("result.json").display());
-    Ok(())
-}
-
-fn figures(dir: &std::path::Path, job: &Job, output: &FitOutput) -> Result<()> {
-    let written = write_fit_figures(dir, job, output)?;
-    say!(
-        "{} figures in {}",
-        written.len(),
-        dir.join("figures").display()
-    );
-    Ok(())
 }

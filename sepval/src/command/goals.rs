@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use sepval_common::goals::{Goals, goals_between};
 use sepval_common::telemetry::Trajectory;
-use sepval_fit::inputs::screen::{read_screened, screen};
+use sepval_run::inputs::screen::{read_screened, screen};
 
 use super::tell;
 use crate::cli::GoalsArgs;

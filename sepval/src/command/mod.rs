@@ -19,6 +19,7 @@ pub mod predict;
 pub mod rerun;
 pub mod scenario;
 pub mod selftest;
+pub mod sequence;
 pub mod simulate;
 pub mod update;
 
@@ -27,7 +28,7 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{EvalError, Evaluator, Job};
-use sepval_fit::out_dir::{Claim, Input, Request, RunDir};
+use sepval_run::out_dir::{Claim, Input, Request, RunDir};
 use sepval_transport::flags::{EvaluatorFlags, Kind};
 use sepval_transport::link::{Notice, Notices};
 use sepval_transport::spec::{EvaluatorSpec, Starter};
@@ -126,25 +127,6 @@ pub fn fresh_or_overwrite(overwrite: &crate::cli::OverwriteArgs) -> Claim {
     }
 }
 
-/// The inputs a `--from` directory records (the releases, scenario and extension it was fitted
-/// with, and the releases it held out): a run from it may not write where they are.
-pub fn recorded_inputs(
-    from: &Path,
-    record: &sepval_fit::results::InputsRecord,
-    held_out: &[PathBuf],
-) -> Vec<Input> {
-    let whose = format!("--from {}", from.display());
-    let mut out = vec![Input::directory("--from", from)];
-    let files = record
-        .data
-        .iter()
-        .chain(&record.scenario)
-        .chain(&record.extension)
-        .chain(held_out);
-    out.extend(files.map(|p| Input::recorded(&whose, p)));
-    out
-}
-
 /// The geometry files of `--aircraft` and `--store-shape`, as inputs.
 pub fn geometry_inputs(g: &crate::cli::GeometryArgs) -> Vec<Input> {
     let mut out = input_files("--aircraft", &g.aircraft);
@@ -178,7 +160,7 @@ pub fn scenario_inputs(scenario: Option<&PathBuf>, extension: Option<&PathBuf>) 
 /// Refuses a file `--out` that is one of the run's `inputs` (the same file by any name),
 /// before any work: a run that wrote it would destroy what it reads.
 pub fn out_file_apart(out: &Path, inputs: &[Input]) -> Result<()> {
-    sepval_fit::out_dir::check_file(out, inputs).with_context(|| format!("--out {}", out.display()))
+    sepval_run::out_dir::check_file(out, inputs).with_context(|| format!("--out {}", out.display()))
 }
 
 /// Input files given by `flag` (none, one or several).

@@ -1,62 +1,57 @@
 //! `sepval plan`: the next release to fly, from a diagnosis.
 
+use std::path::Path;
 use std::sync::Arc;
-use std::time::Instant;
 
-use anyhow::{Context, Result};
-use sepval_fit::out_dir::Request;
-use sepval_plan::{Range, plan, plan_file, prepare, read_diagnosis, write_outputs};
+use anyhow::Result;
+use sepval_plan::{Plan, Prepared, Range, plan, plan_file, prepare, read_from};
+use sepval_solve::run::ProgressObserver;
 
-use super::{evaluator_spec, notices, tell};
+use super::sequence::{Evaluators, Run, Said, Writes, execute};
+use super::{evaluator_spec, tell};
 use crate::cli::PlanArgs;
 
-/// Runs `sepval plan`. Every input (the flags, the diagnosis, its releases, the ranges against
-/// its scenario) is checked before the output directory is claimed or a worker started, so a
-/// refusal writes nothing; the directory is cleared (`--overwrite`) only once the plan is made.
+/// Runs `sepval plan`: the flags made a request (the diagnosis, its releases and the ranges
+/// against its scenario read and checked), then the command's sequence.
 pub fn run(args: PlanArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let ranges = ranges(&args);
-    let diagnosis = read_diagnosis(&args.from)?;
-    let record = diagnosis.inputs.clone();
-    let (flown, _) = sepval_fit::inputs::job(
-        &record.data,
-        record.scenario.as_deref(),
-        record.extension.as_deref(),
-        record.outliers,
-        &mut tell(),
-    )
-    .with_context(|| {
-        format!(
-            "--from {}: the releases the diagnosis was made from",
-            args.from.display()
-        )
-    })?;
-    let read = super::recorded_inputs(&args.from, &record, &[]);
+    let (diagnosis, flown) = read_from(&args.from, &mut tell())?;
+    let read = sepval_run::out_dir::recorded_inputs(&args.from, &diagnosis.inputs, &[]);
     let prepared = prepare(diagnosis, &flown, &ranges, args.points)?;
-    let run_dir = super::claim_out(
-        &args.out,
-        Request {
-            command: "plan",
-            claim: super::fresh_or_overwrite(&args.overwrite),
-            inputs: &read,
-            resume: None,
-        },
-    )?;
-    let start = Instant::now();
-    let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
-    let found = plan(
-        &prepared,
-        evaluator.as_mut(),
-        &mut *crate::front::progress(),
-    )?;
-    drop(evaluator);
-    let file = plan_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
-    // Cleared (--overwrite) only now: a run stopped while it computed leaves the earlier one.
-    run_dir.prepare()?;
-    write_outputs(&prepared, &found, &file, &args.out)?;
-    crate::front::out(&sepval_plan::summary(&file, &args.out));
-    run_dir.commit();
-    Ok(())
+    let writes = Writes {
+        out: args.out.clone(),
+        command: "plan",
+        claim: super::fresh_or_overwrite(&args.overwrite),
+        inputs: read,
+        resume: None,
+    };
+    let job = Arc::new(prepared.job.clone());
+    execute(&spec, writes, Some(job), Request { args, prepared })
+}
+
+/// A plan asked for by the flags, prepared.
+struct Request {
+    args: PlanArgs,
+    prepared: Prepared,
+}
+
+impl Run for Request {
+    type Found = Plan;
+
+    fn run(
+        &mut self,
+        evaluators: &mut Evaluators<'_>,
+        progress: &mut dyn ProgressObserver,
+    ) -> Result<Plan> {
+        Ok(plan(&self.prepared, evaluators.one()?, progress)?)
+    }
+
+    fn write(&self, found: Plan, out: &Path, wall_s: f64) -> Result<Said> {
+        let file = plan_file(&self.prepared, &found, &self.args.from, wall_s);
+        sepval_plan::write_outputs(&self.prepared, &found, &file, out)?;
+        Ok(Said::summary(sepval_plan::summary(&file, out)))
+    }
 }
 
 /// The ranges of the five condition flags given (parsed by clap), in the order of `[flight]`.

@@ -1,25 +1,38 @@
 //! `sepval predict`: a release not flown, with its bands, from a fit or a diagnosis; with
 //! `--data`, the post-flight check of a flown release against them.
 
+use std::path::Path;
 use std::sync::Arc;
-use std::time::Instant;
 
 use anyhow::{Context, Result};
-use sepval_fit::inputs;
-use sepval_fit::out_dir::Request;
 use sepval_predict::{
-    Flown, Settings, SourceInputs, predict, prediction_file, prepare, source_inputs, write_outputs,
+    Flown, Prediction, Prepared, Settings, SourceInputs, predict, prediction_file, prepare,
+    source_inputs, write_outputs,
 };
+use sepval_run::inputs;
+use sepval_solve::run::ProgressObserver;
 
-use super::{clearance, count, evaluator_spec, input_files, notices, tell};
+use super::sequence::{Evaluators, Run, Said, Writes, execute};
+use super::{clearance, count, evaluator_spec, input_files, tell};
 use crate::cli::PredictArgs;
 
-/// Runs `sepval predict`. Every input (the flags, the source, its releases, the condition, the
-/// flown release) is checked before the output directory is claimed or a worker started, so a
-/// refusal writes nothing; the directory is cleared (`--overwrite`) only once the prediction
-/// is made, just before its files are written.
+/// Runs `sepval predict`: the flags made a request (every input read and checked: the source,
+/// its releases, the condition, the flown release), then the command's sequence.
 pub fn run(args: PredictArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
+    let (writes, request) = request(args)?;
+    let job = Arc::new(request.prepared.job.clone());
+    execute(&spec, writes, Some(job), request)
+}
+
+/// A prediction asked for by the flags, prepared.
+struct Request {
+    args: PredictArgs,
+    prepared: Prepared,
+}
+
+/// The flags and what they name, read and checked; where the prediction writes.
+fn request(args: PredictArgs) -> Result<(Writes, Request)> {
     let settings = Settings {
         samples: args.samples,
         level: args.level,
@@ -40,7 +53,8 @@ pub fn run(args: PredictArgs) -> Result<()> {
         policy,
         &mut tell(),
     )?;
-    let mut read = super::recorded_inputs(&args.from, &source.inputs, &source.held_out);
+    let mut read =
+        sepval_run::out_dir::recorded_inputs(&args.from, &source.inputs, &source.held_out);
     read.extend(input_files("--scenario", [&args.scenario]));
     read.extend(input_files("--extension", &args.extension));
     read.extend(input_files("--data", &args.data));
@@ -65,28 +79,30 @@ pub fn run(args: PredictArgs) -> Result<()> {
         Some(c) => prepared.with_clearance(c),
         None => prepared,
     };
-    let run_dir = super::claim_out(
-        &args.out,
-        Request {
-            command: "predict",
-            claim: super::fresh_or_overwrite(&args.overwrite),
-            inputs: &read,
-            resume: None,
-        },
-    )?;
-    let start = Instant::now();
-    let mut evaluator = spec.start(Arc::new(prepared.job.clone()), notices())?;
-    let found = predict(
-        &prepared,
-        evaluator.as_mut(),
-        &mut *crate::front::progress(),
-    )?;
-    drop(evaluator);
-    let file = prediction_file(&prepared, &found, &args.from, start.elapsed().as_secs_f64());
-    // Cleared (--overwrite) only now: a run stopped while it computed leaves the earlier one.
-    run_dir.prepare()?;
-    write_outputs(&found, &file, &args.out)?;
-    crate::front::out(&sepval_predict::summary(&file, &args.out));
-    run_dir.commit();
-    Ok(())
+    let writes = Writes {
+        out: args.out.clone(),
+        command: "predict",
+        claim: super::fresh_or_overwrite(&args.overwrite),
+        inputs: read,
+        resume: None,
+    };
+    Ok((writes, Request { args, prepared }))
+}
+
+impl Run for Request {
+    type Found = Prediction;
+
+    fn run(
+        &mut self,
+        evaluators: &mut Evaluators<'_>,
+        progress: &mut dyn ProgressObserver,
+    ) -> Result<Prediction> {
+        Ok(predict(&self.prepared, evaluators.one()?, progress)?)
+    }
+
+    fn write(&self, found: Prediction, out: &Path, wall_s: f64) -> Result<Said> {
+        let file = prediction_file(&self.prepared, &found, &self.args.from, wall_s);
+        write_outputs(&found, &file, out)?;
+        Ok(Said::summary(sepval_predict::summary(&file, out)))
+    }
 }

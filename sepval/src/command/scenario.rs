@@ -6,7 +6,7 @@
 use anyhow::{Context, Result};
 use sepval_common::scenario::Scenario;
 use sepval_core::atomic_file::write_atomically;
-use sepval_fit::inputs;
+use sepval_run::inputs;
 
 use crate::cli::ScenarioArgs;
 

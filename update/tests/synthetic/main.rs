@@ -19,9 +19,9 @@ use sepval_common::synthetic::synthetic_flight_test;
 use sepval_common::table::{Axis, Table, TableKind, Tabulated, Variable};
 use sepval_common::telemetry::Trajectory;
 use sepval_core::factors::Factors;
-use sepval_fit::checkpoint::InputsRecord;
 use sepval_fit::sigma::Sigma;
 use sepval_fit::{FitOptions, Method};
+use sepval_run::inputs::InputsRecord;
 use sepval_solve::ga::GaSettings;
 use sepval_solve::hill::HillSettings;
 use sepval_solve::lm::LmSettings;
@@ -120,6 +120,8 @@ fn run_update(
                 budget: 800,
                 ..LmSettings::default()
             },
+            clearance: None,
+            strict_tables: false,
         },
         lm: LmSettings {
             max_iterations: 200,

@@ -8,6 +8,7 @@
 use std::path::{Component, Path, PathBuf};
 
 use super::error::OutDirError;
+use crate::inputs::InputsRecord;
 
 /// Something a run reads, as the flag that gives it names it.
 #[derive(Debug, Clone)]
@@ -72,6 +73,22 @@ impl Input {
             directory: true,
         }
     }
+}
+
+/// What a `--from` directory records a run read (the releases, scenario and extension of its
+/// record, and the releases it held out), with the directory itself: a run from it may not
+/// write where they are.
+pub fn recorded_inputs(from: &Path, record: &InputsRecord, held_out: &[PathBuf]) -> Vec<Input> {
+    let whose = format!("--from {}", from.display());
+    let mut out = vec![Input::directory("--from", from)];
+    let files = record
+        .data
+        .iter()
+        .chain(&record.scenario)
+        .chain(&record.extension)
+        .chain(held_out);
+    out.extend(files.map(|p| Input::recorded(&whose, p)));
+    out
 }
 
 /// `path` resolved: absolute, symbolic links and `..` resolved as far as it exists, the rest

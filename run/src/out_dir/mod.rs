@@ -37,13 +37,19 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 pub use error::OutDirError;
-pub use inputs::{Input, check_file};
+pub use inputs::{Input, check_file, recorded_inputs};
 pub use lock::{DirLock, LOCK_FILE};
 pub use marker::MARKER_FILE;
 
 use error::io;
 
-use crate::checkpoint::Checkpoint;
+/// Where a search's checkpoint of generation `generation` lies in its run directory `dir`
+/// (`DIR/generations/gen-NNNN.json`, `sepval_fit::checkpoint`): a directory's own checkpoints
+/// are what a resumed run keeps and `--overwrite` refuses to remove.
+pub fn generation_path(dir: &Path, generation: usize) -> PathBuf {
+    dir.join("generations")
+        .join(format!("gen-{generation:04}.json"))
+}
 
 /// How a run uses its directory.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -376,7 +382,7 @@ fn later_generations(dir: &Path, generation: usize) -> Result<Vec<PathBuf>, OutD
             .strip_prefix("gen-")
             .and_then(|n| n.strip_suffix(".json"))
             .and_then(|n| n.parse::<usize>().ok())
-            .filter(|&g| e.path() == Checkpoint::path(dir, g));
+            .filter(|&g| e.path() == generation_path(dir, g));
         let is_file = e.file_type().is_ok_and(|t| t.is_file());
         if is_file && named.is_some_and(|g| g > generation) {
             later.push(e.path());

@@ -12,7 +12,7 @@
 //!
 //! # Digest
 //!
-//! As checkpoints carry one ([`crate::checkpoint`]), a record carries `digest`: the SHA-256
+//! As a fit's checkpoints carry one (`sepval_fit::checkpoint`), a record carries `digest`: the SHA-256
 //! (lower-case hex) of its *canonical form*, the compact JSON (`serde_json::to_vec`) of the
 //! record's JSON value with the top-level `digest` key left out. The value's object keys are in
 //! serde_json's map order (sorted), and numbers are spelled in serde_json's shortest form that
@@ -286,20 +286,6 @@ pub fn check_noise(pos_m: f64, att_deg: f64) -> Result<(), FieldError> {
     )
 }
 
-/// Checks a residual RMS per channel at `at`: finite and >= 0.
-pub fn check_rms(at: &str, rms: &crate::results::ChannelRms) -> Result<(), FieldError> {
-    let names = ["x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"];
-    for (name, v) in names.iter().zip(rms.as_array()) {
-        field(
-            format!("{at}.{name}"),
-            v,
-            v.is_finite() && v >= 0.0,
-            "a finite RMS >= 0",
-        )?;
-    }
-    Ok(())
-}
-
 /// Checks the identifiability of a record's answer at `at`: every value finite, every
 /// standard error finite and >= 0, every correlation in [-1, 1], the correlation matrix
 /// square over the parameters.
@@ -361,33 +347,6 @@ pub fn check_factors(at: &str, f: &sepval_core::factors::Factors) -> Result<(), 
         )?;
     }
     Ok(())
-}
-
-impl Record for crate::results::FitResult {
-    const FORMAT: &'static str = crate::results::RESULT_FORMAT;
-    const COMMAND: &'static str = "fit";
-
-    /// What `sepval predict` reads: the noise, each method's best (factors, weighted goal,
-    /// residual RMS) and the identifiability.
-    fn check(&self) -> Result<(), FieldError> {
-        check_noise(self.sigma_pos_m, self.sigma_att_deg)?;
-        for (name, m) in &self.methods {
-            let at = format!("methods.{name}.best");
-            check_factors(&format!("{at}.factors"), &m.best.factors)?;
-            let w = m.best.weighted;
-            field(
-                format!("{at}.weighted"),
-                w,
-                w.is_finite() && w >= 0.0,
-                "a finite weighted goal >= 0",
-            )?;
-            check_rms(&format!("{at}.channel_rms"), &m.best.channel_rms)?;
-        }
-        if let Some(i) = &self.identifiability {
-            check_identifiability("identifiability", i)?;
-        }
-        Ok(())
-    }
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@
 //! leaves out is told through the `tell` callback.
 
 pub mod error;
+mod recorded;
 pub mod screen;
 
 use std::path::{Path, PathBuf};
@@ -27,7 +28,26 @@ use sepval_core::factors::{FactorTable, Factors};
 pub use error::{InputError, Twice};
 pub use screen::{Release, Screened, check_store, read_screened, refuse_duplicates, refuse_twice};
 
-use crate::checkpoint::InputsRecord;
+pub use recorded::InputsRecord;
+
+/// The job of the releases a record (`--from DIR`) was made from, read again as they were
+/// read then (its data, scenario, extension and outliers policy).
+pub fn recorded_job(record: &InputsRecord, tell: Tell) -> Result<Job, InputError> {
+    let InputsRecord {
+        data,
+        scenario,
+        extension,
+        outliers,
+    } = record;
+    let (job, _) = job(
+        data,
+        scenario.as_deref(),
+        extension.as_deref(),
+        *outliers,
+        tell,
+    )?;
+    Ok(job)
+}
 
 /// Where the words of the reading go (`--outliers drop: left out ...`).
 pub type Tell<'a> = &'a mut dyn FnMut(String);
