@@ -133,12 +133,8 @@ fn a_resume_refused_over_changed_inputs_keeps_the_later_generations_byte_for_byt
             let mut resume = inputs.to_vec();
             resume.extend(["--resume", "F/generations/gen-0002.json", "--out", "F"]);
             resume.extend_from_slice(overwrite);
-            // With --overwrite, F is refused first: it is the run directory of the checkpoint.
-            let expected = if overwrite.is_empty() {
-                expected
-            } else {
-                "F is the run directory F of --resume F/generations/gen-0002.json"
-            };
+            // Every input is checked before the directory is claimed (command/sequence.rs),
+            // so the changed input is refused first, with --overwrite or without.
             let stderr = refused(&fit(d, "4", &resume), expected);
             assert!(!stderr.contains("removed"), "{stderr}");
             assert!(
@@ -149,6 +145,20 @@ fn a_resume_refused_over_changed_inputs_keeps_the_later_generations_byte_for_byt
         }
         std::fs::write(path, original).unwrap();
     }
+    // The inputs as they were: with --overwrite, F is refused as the run directory of the
+    // checkpoint it resumes from (clearing it would remove the checkpoint), and stays as it was.
+    let mut resume = inputs.to_vec();
+    resume.extend([
+        "--resume",
+        "F/generations/gen-0002.json",
+        "--out",
+        "F",
+        "--overwrite",
+    ]);
+    let expected = "F is the run directory F of --resume F/generations/gen-0002.json";
+    let stderr = refused(&fit(d, "4", &resume), expected);
+    assert!(!stderr.contains("removed"), "{stderr}");
+    assert!(snapshot(&d.join("F")) == before, "F changed");
 }
 
 #[test]
