@@ -109,12 +109,12 @@ pub enum DavemlError {
         source: sepval_common::scenario::ScenarioError,
     },
     /// An output that cannot be written.
-    #[error("{path}: {message}")]
+    #[error("{path}: {reason}")]
     Output {
         /// The output path.
         path: PathBuf,
         /// What is wrong.
-        message: String,
+        reason: crate::export::ExportError,
     },
     /// Writing failed.
     #[error(transparent)]
