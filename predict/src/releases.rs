@@ -14,7 +14,8 @@ use sepval_common::telemetry::Trajectory;
 use sepval_core::cancel;
 use sepval_diagnose::Diagnosis;
 use sepval_fit::results::ReleaseClearance;
-use sepval_geometry::{GeometryError, Pose, Trace};
+pub use sepval_geometry::GeometryError;
+use sepval_geometry::{Pose, Trace};
 use sepval_report::figures::{ClearanceSeries, clearance_figure};
 use sepval_report::words::csv_text;
 use sepval_report::{OutputError, Written};
@@ -30,9 +31,15 @@ pub enum ReleasesError {
     /// The answer's simulation.
     #[error("the answer's trajectories")]
     Simulate(#[source] EvalError),
-    /// The answer does not fly every release.
-    #[error("the answer does not simulate every release: {0}")]
-    NotFlown(String),
+    /// The evaluator answered nothing.
+    #[error("the answer does not simulate every release: no evaluation came back")]
+    NoEvaluation,
+    /// The answer's evaluation carries no trajectories: its outcome says why.
+    #[error("the answer does not simulate every release: {outcome:?}")]
+    NotFlown {
+        /// The evaluation's outcome.
+        outcome: sepval_common::evaluation::Outcome,
+    },
     /// The answer of a diagnosis, rebuilt.
     #[error("the answer of the diagnosis")]
     Answer(#[source] Box<AnswerError>),
@@ -108,9 +115,9 @@ pub fn simulate(
         .evaluate(&[candidate], true)
         .map_err(ReleasesError::Simulate)?
         .pop()
-        .ok_or_else(|| ReleasesError::NotFlown("no evaluation came back".into()))?;
+        .ok_or(ReleasesError::NoEvaluation)?;
     let Some(samples) = e.samples else {
-        return Err(ReleasesError::NotFlown(format!("{:?}", e.outcome)));
+        return Err(ReleasesError::NotFlown { outcome: e.outcome });
     };
     Ok(job
         .events()
