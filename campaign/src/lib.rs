@@ -114,7 +114,7 @@ pub enum CampaignError {
     },
     /// A release, a flag or a step refused.
     #[error(transparent)]
-    Refused(#[from] Refusal),
+    Refused(Box<Refusal>),
     /// The store's data with uncertainty (`--prior-daveml`) that cannot be taken into the
     /// prior.
     #[error("--prior-daveml {path}: {reason}")]
@@ -122,7 +122,7 @@ pub enum CampaignError {
         /// The file.
         path: String,
         /// Why.
-        reason: prior_daveml::PriorDavemlError,
+        reason: Box<prior_daveml::PriorDavemlError>,
     },
     /// The prior (`--prior`).
     #[error(transparent)]
@@ -160,6 +160,12 @@ pub enum CampaignError {
     /// A signal asked the process to stop.
     #[error("interrupted by a signal: the campaign is as it was before the command")]
     Interrupted,
+}
+
+impl From<Refusal> for CampaignError {
+    fn from(r: Refusal) -> Self {
+        CampaignError::Refused(Box::new(r))
+    }
 }
 
 impl From<sepval_core::cancel::Cancelled> for CampaignError {

@@ -64,7 +64,7 @@ pub fn read(path: &Path, scenario: &Scenario, prior: &Prior) -> Result<Prior, Ca
     let model = sepval_daveml::read_model(path, &map, scenario).map_err(daveml)?;
     let refuse = |reason: PriorDavemlError| CampaignError::PriorDaveml {
         path: name.clone(),
-        reason,
+        reason: Box::new(reason),
     };
     let from_file: Vec<&String> = prior
         .sources

@@ -253,7 +253,7 @@ pub enum RerunError {
         /// The checkpoint.
         path: PathBuf,
         /// Why.
-        reason: ReplayFailure,
+        reason: Box<ReplayFailure>,
     },
     /// The inputs of the rerun (its releases, scenario or extension) that cannot be read.
     #[error(transparent)]
@@ -336,7 +336,7 @@ pub fn check(
     checkpoint.check_job(evaluator.job(), path)?;
     let replay_error = |reason: ReplayFailure| RerunError::Replay {
         path: path.to_path_buf(),
-        reason,
+        reason: Box::new(reason),
     };
     let state = &checkpoint.state;
     // The search that replays the generation, with what it starts from, or why there is none.

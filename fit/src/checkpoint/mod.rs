@@ -102,7 +102,7 @@ pub enum CheckpointError {
         /// The file.
         path: PathBuf,
         /// What differs (`changed: state.population[4]`).
-        what: DigestMismatch,
+        what: Box<DigestMismatch>,
     },
     /// The file does not fit this sepval or its job, or its content is inconsistent.
     #[error("checkpoint {path}: {reason}")]
@@ -110,7 +110,7 @@ pub enum CheckpointError {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        reason: ContentError,
+        reason: Box<ContentError>,
     },
     /// A job other than the checkpoint's.
     #[error(
@@ -227,7 +227,7 @@ impl Checkpoint {
         };
         let invalid = |reason: ContentError| CheckpointError::Invalid {
             path: path.to_path_buf(),
-            reason,
+            reason: Box::new(reason),
         };
         let format = serde_json::from_str::<FormatOnly>(&text)
             .map_err(parse)?
@@ -251,7 +251,7 @@ impl Checkpoint {
         c.check_digest(&stored)
             .map_err(|what| CheckpointError::Edited {
                 path: path.to_path_buf(),
-                what,
+                what: Box::new(what),
             })?;
         c.check_content().map_err(invalid)?;
         c.digest = Some(stored);
@@ -288,7 +288,7 @@ impl Checkpoint {
         self.check_members(job)
             .map_err(|reason| CheckpointError::Invalid {
                 path: path.to_path_buf(),
-                reason,
+                reason: Box::new(reason),
             })
     }
 }
