@@ -13,6 +13,7 @@
 //! when equal; every `independentVarRef` `extrapolate="neither"` and `interpolate="linear"`
 //! (sepval's tables hold their edges and are linear).
 
+use crate::error::ExportError;
 use std::collections::BTreeSet;
 
 use sepval_common::correction::Target;
@@ -76,31 +77,6 @@ struct BreakpointSet {
     id: String,
     variable: Variable,
     values: Vec<f64>,
-}
-
-/// A scenario, or bands, that cannot be written as DAVE-ML.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum ExportError {
-    /// A scenario with an aircraft flowfield.
-    #[error(
-        "the scenario's interference is an aircraft flowfield ([flowfield], docs/model.md section 3b), which sepval does not write as DAVE-ML: only its aerodynamic tables would be exported and the field lost"
-    )]
-    Flowfield,
-    /// A band of a field the scenario does not write.
-    #[error("a band for {field}, a field the scenario leaves out")]
-    BandWithoutField {
-        /// The band's field.
-        field: String,
-    },
-    /// A band without one value per value of its table.
-    #[error("the band of {field} has {values} values, not one per value of its table")]
-    BandValues {
-        /// The band's field.
-        field: String,
-        /// The band's values.
-        values: usize,
-    },
 }
 
 /// The scenario's fields as a DAVE-ML 2.0 document (text).

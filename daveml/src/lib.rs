@@ -47,8 +47,8 @@ use sepval_core::atomic_file::write_atomically;
 use sepval_core::input_file::read_string;
 
 pub use bands::{CorrectionSpread, bands};
-pub use error::{DavemlError, Mismatch, Place};
-pub use export::{Band, ExportError, Provenance, to_daveml};
+pub use error::{DavemlError, ExportError, Mismatch, Place};
+pub use export::{Band, Provenance, to_daveml};
 pub use map::Map;
 
 /// Largest DAVE-ML file sepval reads \[bytes\]: 256 MiB, room for tables of several million
