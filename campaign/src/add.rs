@@ -25,13 +25,13 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_solve::run::ProgressObserver;
 
-use crate::CampaignError;
 use crate::assess::{AssessSettings, FormBand, Model, StartEvaluator};
 use crate::journal;
 use crate::program::{Campaign, STAGING, fitted_model};
 use crate::record::{CAMPAIGN_FORMAT, ReleaseRecord, record_error};
 use crate::release::{NewRelease, overlap};
 use crate::seal::read_sealed;
+use crate::{CampaignError, Refusal};
 
 /// The noise of a prediction's bands before any release was fitted: the synthetic flight
 /// tests' (docs/model.md section 6).
@@ -129,37 +129,43 @@ fn refuse_known(
     known: Option<&Job>,
     releases: &[NewRelease],
 ) -> Result<(), CampaignError> {
-    let same_flight = |name: &dyn std::fmt::Display, other: &str, shared: usize, d: &Trajectory| {
-        CampaignError::Refused(format!(
-            "{name} shares {shared} of its {} samples (time and value, bit for bit) with {other}: the same flight, wholly or in part, would count twice as evidence; each release is added once",
-            d.len()
-        ))
+    let same_flight = |name: &str, other: String, flown: bool, shared: usize, d: &Trajectory| {
+        CampaignError::from(Refusal::SameFlight {
+            name: name.to_string(),
+            other,
+            flown,
+            shared,
+            samples: d.len(),
+        })
     };
     for (i, r) in releases.iter().enumerate() {
-        let name = r.given.display();
+        let name = r.given.display().to_string();
         if let Some(k) = c.file.releases.iter().find(|k| k.sha256 == r.sha256) {
-            return Err(CampaignError::Refused(format!(
-                "{name} is already in the campaign as {} (given as {}): each release is added once",
-                k.file, k.given
-            )));
+            return Err(Refusal::AlreadyIn {
+                name,
+                file: k.file.clone(),
+                given: k.given.clone(),
+            }
+            .into());
         }
         let flown = known.map_or(&[][..], |j| j.events());
         for (k, e) in flown.iter().enumerate() {
             if let Some(shared) = overlap(&e.data, &r.data) {
-                let other = format!("{}, flown already", c.file.releases[k].file);
-                return Err(same_flight(&name, &other, shared, &r.data));
+                let other = c.file.releases[k].file.clone();
+                return Err(same_flight(&name, other, true, shared, &r.data));
             }
         }
         for o in &releases[..i] {
             if o.sha256 == r.sha256 {
-                return Err(CampaignError::Refused(format!(
-                    "{name} is the same release as {}: give each release once",
-                    o.given.display()
-                )));
+                return Err(Refusal::GivenTwice {
+                    name,
+                    other: o.given.display().to_string(),
+                }
+                .into());
             }
             if let Some(shared) = overlap(&o.data, &r.data) {
-                let other = format!("{}, given beside it", o.given.display());
-                return Err(same_flight(&name, &other, shared, &r.data));
+                let other = o.given.display().to_string();
+                return Err(same_flight(&name, other, false, shared, &r.data));
             }
         }
     }
@@ -177,8 +183,8 @@ fn diagnose(
     observer: &mut dyn ProgressObserver,
 ) -> Result<(), CampaignError> {
     let s = &c.file.settings;
-    let sigma = Sigma::resolve(job, None, None)
-        .map_err(|e| CampaignError::Refused(format!("the noise of the releases: {e}")))?;
+    let sigma =
+        Sigma::resolve(job, None, None).map_err(|reason| Refusal::ReleasesNoise { reason })?;
     let inputs = InputsRecord {
         data: c
             .file

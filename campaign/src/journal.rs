@@ -37,16 +37,11 @@ fn is_created_name(rel: &str) -> bool {
 pub(crate) fn claim(dir: &Path, rel: &str) -> Result<(), CampaignError> {
     let path = dir.join(rel);
     if std::fs::symlink_metadata(&path).is_ok() {
-        return Err(CampaignError::Refused(format!(
-            "{} is there already, and the campaign's record (campaign.json) does not name it: \
-             the campaign would put its {} there; move it out of the campaign directory",
-            path.display(),
-            if rel.starts_with("rounds/") {
-                "next round"
-            } else {
-                "copy of the release"
-            }
-        )));
+        return Err(crate::Refusal::Occupied {
+            round: rel.starts_with("rounds/"),
+            path,
+        }
+        .into());
     }
     Ok(())
 }

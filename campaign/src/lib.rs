@@ -34,6 +34,7 @@ pub mod prior;
 pub mod prior_daveml;
 pub mod program;
 pub mod record;
+pub mod refusal;
 pub mod rehearse;
 pub mod release;
 pub mod request;
@@ -46,6 +47,7 @@ pub use assess::{AssessSettings, Fitted, Model, StartEvaluator, assess};
 pub use next::{Plan, Planned, plan};
 pub use prior::{Prior, PriorError};
 pub use record::{CAMPAIGN_FORMAT, CampaignFile, NEXT_FORMAT, NextFile, StatusFile};
+pub use refusal::Refusal;
 pub use state::{Assessed, Counts, State};
 
 use sepval_common::evaluation::EvalError;
@@ -110,9 +112,18 @@ pub enum CampaignError {
         /// What it must be, and why.
         expected: String,
     },
-    /// A release or a flag refused.
-    #[error("{0}")]
-    Refused(String),
+    /// A release, a flag or a step refused.
+    #[error(transparent)]
+    Refused(Box<Refusal>),
+    /// The store's data with uncertainty (`--prior-daveml`) that cannot be taken into the
+    /// prior.
+    #[error("--prior-daveml {path}: {reason}")]
+    PriorDaveml {
+        /// The file.
+        path: String,
+        /// Why.
+        reason: Box<prior_daveml::PriorDavemlError>,
+    },
     /// The prior (`--prior`).
     #[error(transparent)]
     Prior(#[from] PriorError),
@@ -149,6 +160,12 @@ pub enum CampaignError {
     /// A signal asked the process to stop.
     #[error("interrupted by a signal: the campaign is as it was before the command")]
     Interrupted,
+}
+
+impl From<Refusal> for CampaignError {
+    fn from(r: Refusal) -> Self {
+        CampaignError::Refused(Box::new(r))
+    }
 }
 
 impl From<sepval_core::cancel::Cancelled> for CampaignError {

@@ -51,11 +51,11 @@ use sepval_solve::ga::GaSettings;
 use sepval_solve::lm::LmSettings;
 use sepval_solve::run::ProgressObserver;
 
-use crate::CampaignError;
 use crate::assess::StartEvaluator;
 use crate::prior::{Belief, Prior, PriorSource};
 use crate::release::NewRelease;
 pub use crate::sources::{FactorChange, PreflightRecord, TrajectoryRecord};
+use crate::{CampaignError, Refusal};
 
 /// The default model-form allowance of a pre-flight trajectory's positions \[m\].
 pub const DEFAULT_ALLOWANCE_M: f64 = 0.01;
@@ -124,9 +124,8 @@ pub fn posterior(
         })
         .collect();
     let job = Job::new(events)?;
-    let noise = Sigma::resolve(&job, None, None).map_err(|e| {
-        CampaignError::Refused(format!("the noise of the pre-flight trajectories: {e}"))
-    })?;
+    let noise =
+        Sigma::resolve(&job, None, None).map_err(|reason| Refusal::PreflightNoise { reason })?;
     let sigma = Sigma {
         pos_m: noise.pos_m.hypot(p.allowance.pos_m),
         att_deg: noise.att_deg.hypot(p.allowance.att_deg),
@@ -154,11 +153,7 @@ pub fn posterior(
             CampaignError::Preflight(Box::new(e))
         }
     })?;
-    let lm = out.refined.ok_or_else(|| {
-        CampaignError::Refused(
-            "the fit of the pre-flight trajectories found no refined optimum (its Levenberg-Marquardt refinement did not finish): their information cannot be weighed".into(),
-        )
-    })?;
+    let lm = out.refined.ok_or(Refusal::PreflightNotRefined)?;
     let space = ParamSpace::new(table, &sepval_common::effects::EffectSet::NONE);
     let (mean, cov) = laplace(prior, &space, &lm.x, &lm.residuals, &lm.jacobian)?;
     let mut after = prior.clone();
@@ -227,12 +222,13 @@ pub fn laplace(
 ) -> Result<(Vec<f64>, DMatrix<f64>), CampaignError> {
     let n = space.len();
     if x_hat.len() != n || jac.ncols() != n || jac.nrows() != r.len() {
-        return Err(CampaignError::Refused(format!(
-            "the pre-flight fit's Jacobian is {} x {} for {} residuals and {n} factors",
-            jac.nrows(),
-            jac.ncols(),
-            r.len()
-        )));
+        return Err(Refusal::JacobianShape {
+            rows: jac.nrows(),
+            columns: jac.ncols(),
+            residuals: r.len(),
+            factors: n,
+        }
+        .into());
     }
     let belief = |j: usize| {
         prior
@@ -262,15 +258,9 @@ pub fn laplace(
         rhs[k] += p0 * b.mean;
     }
     if !a.iter().all(|v| v.is_finite()) {
-        return Err(CampaignError::Refused(
-            "the pre-flight fit's Jacobian holds numbers that are not finite: its information cannot be weighed".into(),
-        ));
+        return Err(Refusal::JacobianNotFinite.into());
     }
-    let chol = nalgebra::Cholesky::new(a).ok_or_else(|| {
-        CampaignError::Refused(
-            "the pre-flight posterior's precision is not positive definite: its information cannot be weighed".into(),
-        )
-    })?;
+    let chol = nalgebra::Cholesky::new(a).ok_or(Refusal::PrecisionNotPositive)?;
     let mu_free = chol.solve(&rhs);
     let cov_free = chol.inverse();
     let mut mean: Vec<f64> = (0..n).map(|j| belief(j).mean).collect();

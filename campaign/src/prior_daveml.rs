@@ -62,7 +62,10 @@ pub fn read(path: &Path, scenario: &Scenario, prior: &Prior) -> Result<Prior, Ca
     };
     let map = sepval_daveml::load_map(None).map_err(daveml)?;
     let model = sepval_daveml::read_model(path, &map, scenario).map_err(daveml)?;
-    let refuse = |m: String| CampaignError::Refused(format!("--prior-daveml {name}: {m}"));
+    let refuse = |reason: PriorDavemlError| CampaignError::PriorDaveml {
+        path: name.clone(),
+        reason: Box::new(reason),
+    };
     let from_file: Vec<&String> = prior
         .sources
         .iter()
@@ -75,26 +78,25 @@ pub fn read(path: &Path, scenario: &Scenario, prior: &Prior) -> Result<Prior, Ca
     let mut out = prior.clone();
     let mut mapped: Vec<Mapped> = Vec::new();
     for f in model.given.iter().filter(|f| f.spread.is_some()) {
-        let m = map_field(f, scenario, &scenario.factors).map_err(|m| refuse(m.to_string()))?;
+        let m = map_field(f, scenario, &scenario.factors).map_err(&refuse)?;
         if let Some(prev) = mapped.iter().find(|p| p.factor == m.factor) {
-            return Err(refuse(format!(
-                "{} and {} both map to {}: give the store's data once",
-                prev.element, m.element, m.factor
-            )));
+            return Err(refuse(PriorDavemlError::Twice {
+                first: prev.element.clone(),
+                second: m.element.clone(),
+                factor: m.factor.clone(),
+            }));
         }
         if from_file.contains(&&m.factor) {
-            return Err(refuse(format!(
-                "{} sets {}, which the --prior file sets too: give each factor's belief once",
-                m.element, m.factor
-            )));
+            return Err(refuse(PriorDavemlError::AlsoInPriorFile {
+                element: m.element.clone(),
+                factor: m.factor.clone(),
+            }));
         }
         out.factors.insert(m.factor.clone(), m.belief);
         mapped.push(m);
     }
     if mapped.is_empty() {
-        return Err(refuse(
-            "gives no uncertainty (no normalPDF on a table or constant sepval reads): nothing to take into the prior".into(),
-        ));
+        return Err(refuse(PriorDavemlError::NoUncertainty));
     }
     let bytes = std::fs::read(path).map_err(|e| crate::record::record_error(path, e))?;
     let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
@@ -112,20 +114,22 @@ fn map_field(
     f: &ImportedField,
     scenario: &Scenario,
     table: &FactorTable,
-) -> Result<Mapped, String> {
+) -> Result<Mapped, PriorDavemlError> {
     let spread = f.spread.as_ref().expect("an uncertain field");
     let element = spread.place.to_string();
     let field = f.target.field();
-    let at = format!("{element} (the uncertainty of sepval field {field})");
+    let refuse = |reason: FieldRefusal| PriorDavemlError::Field {
+        element: element.clone(),
+        field: field.clone(),
+        reason,
+    };
     if let Some(why) = &spread.unusable {
-        return Err(format!("{at}: {why}"));
+        return Err(refuse(FieldRefusal::Unusable { why: why.clone() }));
     }
     let Some((factor, offset)) = factor_of(f.target) else {
-        return Err(format!(
-            "{at}: no factor of the 17 offsets or scales this field (a factor offsets a static coefficient or scales an interference increment), so its uncertainty cannot be mapped to the prior"
-        ));
+        return Err(refuse(FieldRefusal::NoFactor));
     };
-    let (values, base) = values_and_base(f, scenario).map_err(|m| format!("{at}: {m}"))?;
+    let (values, base) = values_and_base(f, scenario).map_err(&refuse)?;
     let sd_at = |i: usize| spread.sd[if spread.sd.len() == 1 { 0 } else { i }];
     let effect: Vec<f64> = if offset {
         vec![1.0; base.len()]
@@ -134,10 +138,10 @@ fn map_field(
     };
     let e2: f64 = effect.iter().map(|e| e * e).sum();
     if !(e2 > 0.0 && e2.is_finite()) {
-        return Err(format!(
-            "{at}: the scenario's {field} is 0 everywhere, so {} scales nothing and the uncertainty cannot be mapped to it",
-            factor.name()
-        ));
+        return Err(refuse(FieldRefusal::ScalesNothing {
+            field: field.clone(),
+            factor: factor.name(),
+        }));
     }
     let ed: f64 = (0..values.len())
         .map(|i| effect[i] * (values[i] - base[i]))
@@ -152,14 +156,13 @@ fn map_field(
     };
     let spec = table.spec(factor);
     if !(belief.mean.is_finite() && spec.contains(belief.mean) && belief.sd.is_finite()) {
-        return Err(format!(
-            "{at}: maps to {} = {} (sd {}), outside the factor's range {} to {}: the file's table is not the scenario's moved by that factor",
-            factor.name(),
-            belief.mean,
-            belief.sd,
-            spec.min,
-            spec.max
-        ));
+        return Err(refuse(FieldRefusal::OutOfRange {
+            factor: factor.name(),
+            mean: belief.mean,
+            sd: belief.sd,
+            min: spec.min,
+            max: spec.max,
+        }));
     }
     Ok(Mapped {
         element,
@@ -170,7 +173,7 @@ fn map_field(
 }
 
 /// The file's values of a field and the campaign scenario's at the same points.
-fn values_and_base(f: &ImportedField, s: &Scenario) -> Result<(Vec<f64>, Vec<f64>), String> {
+fn values_and_base(f: &ImportedField, s: &Scenario) -> Result<(Vec<f64>, Vec<f64>), FieldRefusal> {
     let base = sepval_daveml::assemble::field(s, f.target);
     let constant = |c: Option<&Coefficient>| match c {
         None => Some(0.0),
@@ -180,9 +183,7 @@ fn values_and_base(f: &ImportedField, s: &Scenario) -> Result<(Vec<f64>, Vec<f64
     match &f.value {
         FieldValue::Constant(v) => match constant(base) {
             Some(b) => Ok((vec![*v], vec![b])),
-            None => Err(
-                "the file gives a constant where the campaign's scenario has a table: its uncertainty cannot be compared point by point".into(),
-            ),
+            None => Err(FieldRefusal::ConstantForTable),
         },
         FieldValue::Table(t) => {
             let points = grid_points(t);
@@ -195,7 +196,7 @@ fn values_and_base(f: &ImportedField, s: &Scenario) -> Result<(Vec<f64>, Vec<f64
                     }
                     at
                 }
-                _ => return Err("the campaign scenario's table is not read".into()),
+                _ => return Err(FieldRefusal::TableNotRead),
             };
             Ok((t.values().to_vec(), b))
         }
@@ -221,20 +222,118 @@ fn grid_points(t: &Table) -> Vec<Vec<f64>> {
 }
 
 /// The scenario's table `base` at the point `x` of the file's table `t`.
-fn base_at(base: &Table, t: &Table, x: &[f64]) -> Result<f64, String> {
+fn base_at(base: &Table, t: &Table, x: &[f64]) -> Result<f64, FieldRefusal> {
     let mut at = Vec::with_capacity(base.axes().len());
     for a in base.axes() {
         let k = t
             .axes()
             .iter()
             .position(|b| b.variable == a.variable)
-            .ok_or_else(|| {
-                format!(
-                    "the campaign's scenario tabulates the field over {}, which the file's table is not: the two cannot be compared point by point",
-                    a.variable.csv_name()
-                )
+            .ok_or(FieldRefusal::OtherAxis {
+                variable: a.variable,
             })?;
         at.push(x[k]);
     }
     Ok(base.value_at(&at))
+}
+
+/// Store data with uncertainty (`--prior-daveml`) that cannot be taken into the prior.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PriorDavemlError {
+    /// Two fields mapped to one factor.
+    #[error("{first} and {second} both map to {factor}: give the store's data once")]
+    Twice {
+        /// The first field's element.
+        first: String,
+        /// The second's.
+        second: String,
+        /// The factor.
+        factor: String,
+    },
+    /// A factor the `--prior` file sets too.
+    #[error(
+        "{element} sets {factor}, which the --prior file sets too: give each factor's belief once"
+    )]
+    AlsoInPriorFile {
+        /// The field's element.
+        element: String,
+        /// The factor.
+        factor: String,
+    },
+    /// A file without uncertainty sepval reads.
+    #[error(
+        "gives no uncertainty (no normalPDF on a table or constant sepval reads): nothing to take into the prior"
+    )]
+    NoUncertainty,
+    /// One uncertain field that cannot be mapped to a factor.
+    #[error("{element} (the uncertainty of sepval field {field}): {reason}")]
+    Field {
+        /// The element that gives the uncertainty (file, line and element).
+        element: String,
+        /// The sepval field.
+        field: String,
+        /// Why.
+        reason: FieldRefusal,
+    },
+}
+
+/// Why one uncertain field cannot be mapped to a factor.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FieldRefusal {
+    /// An uncertainty the DAVE-ML reader could not use (its words).
+    #[error("{why}")]
+    Unusable {
+        /// Why, as the reader says it.
+        why: String,
+    },
+    /// A field no factor moves.
+    #[error(
+        "no factor of the 17 offsets or scales this field (a factor offsets a static coefficient or scales an interference increment), so its uncertainty cannot be mapped to the prior"
+    )]
+    NoFactor,
+    /// A constant in the file where the scenario has a table.
+    #[error(
+        "the file gives a constant where the campaign's scenario has a table: its uncertainty cannot be compared point by point"
+    )]
+    ConstantForTable,
+    /// A table of the scenario that was not read.
+    #[error("the campaign scenario's table is not read")]
+    TableNotRead,
+    /// An axis of the scenario's table that the file's table lacks.
+    #[error(
+        "the campaign's scenario tabulates the field over {}, which the file's table is not: the two cannot be compared point by point",
+        variable.csv_name()
+    )]
+    OtherAxis {
+        /// The axis's variable.
+        variable: sepval_common::table::Variable,
+    },
+    /// A multiplier of a field that is 0 everywhere.
+    #[error(
+        "the scenario's {field} is 0 everywhere, so {factor} scales nothing and the uncertainty cannot be mapped to it"
+    )]
+    ScalesNothing {
+        /// The field.
+        field: String,
+        /// The factor.
+        factor: &'static str,
+    },
+    /// A belief outside the factor's range.
+    #[error(
+        "maps to {factor} = {mean} (sd {sd}), outside the factor's range {min} to {max}: the file's table is not the scenario's moved by that factor"
+    )]
+    OutOfRange {
+        /// The factor.
+        factor: &'static str,
+        /// The belief's mean.
+        mean: f64,
+        /// Its standard deviation.
+        sd: f64,
+        /// The factor's lower bound.
+        min: f64,
+        /// Its upper bound.
+        max: f64,
+    },
 }

@@ -113,7 +113,9 @@ pub fn grid_of(settings: &SettingsRecord, scenario: &Scenario) -> Result<Grid, C
             let q = quantities
                 .iter()
                 .find(|q| q.flag() == flag)
-                .ok_or_else(|| CampaignError::Refused(format!("{flag}: not an axis")))?;
+                .ok_or_else(|| crate::Refusal::NotAnAxis {
+                    flag: flag.to_string(),
+                })?;
             Ok::<_, CampaignError>(Axis::parse(*q, text)?)
         })
         .collect::<Result<_, _>>()?;

@@ -125,10 +125,11 @@ fn refuse_unstated(c: Against<'_>, data: &Trajectory, name: &str) -> Result<(), 
     if missing.is_empty() {
         return Ok(());
     }
-    Err(CampaignError::Refused(format!(
-        "{name} does not state its condition: no `# {}` line; a campaign release names its Mach, altitude and every axis of the grid in its metadata (e.g. `# mach = 0.8`), so that it is recorded where it was flown, not at the scenario's condition",
-        missing.join(" = ...`, `# ")
-    )))
+    Err(crate::Refusal::Unstated {
+        name: name.to_string(),
+        missing: missing.into_iter().map(str::to_string).collect(),
+    }
+    .into())
 }
 
 /// The notes of a condition outside the campaign's grid: beyond an axis's range, or off the
@@ -192,17 +193,17 @@ fn other_scenario_note(
     if recorded == ours {
         return Ok(None);
     }
-    let what = format!(
-        "{name} was made with another scenario than the campaign's at its condition (its `# scenario_sha256` {recorded}, the campaign's {ours})"
-    );
     if accepted {
         Ok(Some(format!(
-            "{what}: accepted as another simulation of the same store (--other-scenario)"
+            "{name} was made with another scenario than the campaign's at its condition (its `# scenario_sha256` {recorded}, the campaign's {ours}): accepted as another simulation of the same store (--other-scenario)"
         )))
     } else {
-        Err(CampaignError::Refused(format!(
-            "{what}: a campaign's releases are of its store and scenario; give --other-scenario if this is another simulation (or a flight) of the same store"
-        )))
+        Err(crate::Refusal::OtherScenario {
+            name: name.to_string(),
+            recorded: recorded.to_string(),
+            ours: ours.to_string(),
+        }
+        .into())
     }
 }
 

@@ -20,12 +20,12 @@ use sepval_run::inputs;
 use sepval_common::simulation::sample_times;
 use sepval_predict::condition::{MAX_SAMPLES, MAX_VALUE_BYTES};
 
-use crate::CampaignError;
 use crate::preflight::{Allowance, Preflight};
 use crate::prior::Prior;
 use crate::program::{Init, grid_of, input_record};
 use crate::record::SettingsRecord;
 use crate::release::{Against, NewRelease};
+use crate::{CampaignError, Refusal};
 
 /// The fewest samples per condition: a probability of failing estimated from fewer is one
 /// sample's (1 / 20 = 0.05, the default allowed probability).
@@ -134,16 +134,12 @@ impl InitRequest<'_> {
         let allowed = probability("--allowed", self.allowed)?;
         let fly_risk = probability("--fly-risk", self.fly_risk)?;
         let Some(aircraft) = self.aircraft else {
-            return Err(CampaignError::Refused(
-                "--aircraft FILE is required: the aircraft's geometry (e.g. examples/geometry/aircraft.toml)".into(),
-            ));
+            return Err(Refusal::NoAircraft.into());
         };
         let scenario = inputs::scenario(self.scenario, None)
             .map_err(|e| CampaignError::Inputs(Box::new(e)))?;
         if self.axes.is_empty() {
-            return Err(CampaignError::Refused(
-                "give at least one axis: --mach, --altitude-m, --alpha-deg, --beta-deg or --gamma-deg, each LO:HI:N".into(),
-            ));
+            return Err(Refusal::NoAxis.into());
         }
         let mut prior = match self.prior {
             Some(p) => Prior::read(p, &scenario.factors)?,
@@ -203,17 +199,18 @@ impl InitRequest<'_> {
         };
         let mut trajectories: Vec<NewRelease> = Vec::new();
         for p in self.preflight {
-            let in_file = |e: CampaignError| {
-                CampaignError::Refused(format!("--preflight {}: {e}", p.display()))
+            let in_file = |e: CampaignError| Refusal::Preflight {
+                path: p.clone(),
+                reason: Box::new(e),
             };
             let policy = sepval_common::telemetry::outliers::Policy::Refuse;
             let t = NewRelease::read(p, against, policy, true, &mut |_| {}).map_err(in_file)?;
             if let Some(o) = trajectories.iter().find(|o| o.sha256 == t.sha256) {
-                return Err(CampaignError::Refused(format!(
-                    "--preflight {} is the same trajectory as {}: give each once",
-                    p.display(),
-                    o.given.display()
-                )));
+                return Err(Refusal::PreflightTwice {
+                    path: p.to_path_buf(),
+                    other: o.given.clone(),
+                }
+                .into());
             }
             trajectories.push(t);
         }

@@ -87,7 +87,7 @@ impl RunSetup {
             let changed = field
                 .with_change(folded.field)
                 .and_then(|f| f.with_shape_table_change(&folded.shape));
-            run.flowfield = Some(changed.map_err(CorrectionError::Values)?);
+            run.flowfield = Some(changed.map_err(CorrectionError::FieldChange)?);
         }
         run.corrections = corrections;
         Ok(run)

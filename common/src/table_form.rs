@@ -198,19 +198,12 @@ fn interference_table(i: &crate::scenario::Interference) -> String {
 
 /// Writes the constant coefficients of `scenario` (without tables) as tables; the interference
 /// too when `interference` is set. Refuses a scenario that already has tables, or a flowfield.
-pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, String> {
+pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, TableFormError> {
     if scenario.has_tables() {
-        return Err(
-            "the scenario already has tables: only a constant form is written as tables".into(),
-        );
+        return Err(TableFormError::HasTables);
     }
     if scenario.flowfield.is_some() {
-        return Err(
-            "the scenario has a [flowfield], which acts through the store's slopes CZ_alpha and \
-             CY_beta (docs/model.md section 3b): the table form writes them as static tables \
-             over alpha and beta, so it is written for a scenario without a field only"
-                .into(),
-        );
+        return Err(TableFormError::Flowfield);
     }
     let mach = mach_breakpoints(scenario.flight.mach);
     let static_csv = static_table(&scenario.aero, &mach);
@@ -249,6 +242,20 @@ pub fn table_form(scenario: &Scenario, interference: bool) -> Result<TableForm, 
         }
     }
     Ok(TableForm { scenario: s, files })
+}
+
+/// A scenario whose table form is not written.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TableFormError {
+    /// A scenario with tables already.
+    #[error("the scenario already has tables: only a constant form is written as tables")]
+    HasTables,
+    /// A scenario with an aircraft flowfield.
+    #[error(
+        "the scenario has a [flowfield], which acts through the store's slopes CZ_alpha and CY_beta (docs/model.md section 3b): the table form writes them as static tables over alpha and beta, so it is written for a scenario without a field only"
+    )]
+    Flowfield,
 }
 
 /// Why a scenario in table form could not be written into its directory. Nothing was written.

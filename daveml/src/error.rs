@@ -109,12 +109,12 @@ pub enum DavemlError {
         source: sepval_common::scenario::ScenarioError,
     },
     /// An output that cannot be written.
-    #[error("{path}: {message}")]
+    #[error("{path}: {reason}")]
     Output {
         /// The output path.
         path: PathBuf,
         /// What is wrong.
-        message: String,
+        reason: ExportError,
     },
     /// Writing failed.
     #[error(transparent)]
@@ -141,4 +141,29 @@ impl DavemlError {
             message: message.into(),
         }
     }
+}
+
+/// A scenario, or bands, that cannot be written as DAVE-ML.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// A scenario with an aircraft flowfield.
+    #[error(
+        "the scenario's interference is an aircraft flowfield ([flowfield], docs/model.md section 3b), which sepval does not write as DAVE-ML: only its aerodynamic tables would be exported and the field lost"
+    )]
+    Flowfield,
+    /// A band of a field the scenario does not write.
+    #[error("a band for {field}, a field the scenario leaves out")]
+    BandWithoutField {
+        /// The band's field.
+        field: String,
+    },
+    /// A band without one value per value of its table.
+    #[error("the band of {field} has {values} values, not one per value of its table")]
+    BandValues {
+        /// The band's field.
+        field: String,
+        /// The band's values.
+        values: usize,
+    },
 }

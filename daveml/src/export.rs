@@ -13,6 +13,7 @@
 //! when equal; every `independentVarRef` `extrapolate="neither"` and `interpolate="linear"`
 //! (sepval's tables hold their edges and are linear).
 
+use crate::error::ExportError;
 use std::collections::BTreeSet;
 
 use sepval_common::correction::Target;
@@ -79,16 +80,11 @@ struct BreakpointSet {
 }
 
 /// The scenario's fields as a DAVE-ML 2.0 document (text).
-pub fn to_daveml(s: &Scenario, bands: &[Band], prov: &Provenance) -> Result<String, String> {
+pub fn to_daveml(s: &Scenario, bands: &[Band], prov: &Provenance) -> Result<String, ExportError> {
     if s.flowfield.is_some() {
         // Its increments would be written as zeros and the field itself not at all: a file
         // that flies another store (docs/daveml.md).
-        return Err(
-            "the scenario's interference is an aircraft flowfield ([flowfield], \
-                    docs/model.md section 3b), which sepval does not write as DAVE-ML: \
-                    only its aerodynamic tables would be exported and the field lost"
-                .to_string(),
-        );
+        return Err(ExportError::Flowfield);
     }
     let fields: Vec<Written> = Target::all()
         .into_iter()
@@ -102,19 +98,17 @@ pub fn to_daveml(s: &Scenario, bands: &[Band], prov: &Provenance) -> Result<Stri
         .collect();
     for b in bands {
         let Some(w) = fields.iter().find(|w| w.target == b.target) else {
-            return Err(format!(
-                "a band for {}, a field the scenario leaves out",
-                b.target.field()
-            ));
+            return Err(ExportError::BandWithoutField {
+                field: b.target.field(),
+            });
         };
         match w.value {
             Coefficient::Table(t) if t.values().len() == b.sigma.len() => {}
             _ => {
-                return Err(format!(
-                    "the band of {} has {} values, not one per value of its table",
-                    b.target.field(),
-                    b.sigma.len()
-                ));
+                return Err(ExportError::BandValues {
+                    field: b.target.field(),
+                    values: b.sigma.len(),
+                });
             }
         }
     }

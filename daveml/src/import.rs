@@ -260,11 +260,11 @@ fn uncertainty_note(idx: &Index, f: &Function, var: &Located<VariableDef>) -> Op
 fn pdf_of<'a>(idx: &'a Index, f: &'a Function, var: &'a Located<VariableDef>) -> Option<&'a Pdf> {
     match &f.table.item {
         TableDefn::Inline(t) => t.uncertainty.as_ref(),
-        TableDefn::Ref(id) => idx
+        TableDefn::Ref { gt_id: id } => idx
             .tables
             .get(id.as_str())
             .and_then(|t| t.item.uncertainty.as_ref()),
-        TableDefn::Unsupported(_) => None,
+        TableDefn::Simple | TableDefn::Unsupported { .. } => None,
     }
     .or(var.item.uncertainty.as_ref())
 }
@@ -280,7 +280,7 @@ struct AxisIn {
 fn table_of<'a>(idx: &'a Index, f: &'a Function) -> Result<(&'a GriddedTable, Place), DavemlError> {
     match &f.table.item {
         TableDefn::Inline(t) => Ok((t, f.table.place.clone())),
-        TableDefn::Ref(id) => idx
+        TableDefn::Ref { gt_id: id } => idx
             .tables
             .get(id.as_str())
             .map(|t| (&t.item, t.place.clone()))
@@ -290,14 +290,23 @@ fn table_of<'a>(idx: &'a Index, f: &'a Function) -> Result<(&'a GriddedTable, Pl
                     format!("unknown table `{id}`: no <griddedTableDef> has this gtID"),
                 )
             }),
-        TableDefn::Unsupported(what) => Err(DavemlError::at(
-            &f.table.place,
-            format!(
-                "function `{}` is {what}: sepval imports gridded tables (griddedTableDef) only",
-                f.name
-            ),
+        TableDefn::Simple => Err(not_gridded(
+            f,
+            "a simple function (independentVarPts/dependentVarPts)",
         )),
+        TableDefn::Unsupported { tag } => Err(not_gridded(f, &format!("a <{tag}>"))),
     }
+}
+
+/// The refusal of function `f`, whose table is `what` and not gridded.
+fn not_gridded(f: &Function, what: &str) -> DavemlError {
+    DavemlError::at(
+        &f.table.place,
+        format!(
+            "function `{}` is {what}: sepval imports gridded tables (griddedTableDef) only",
+            f.name
+        ),
+    )
 }
 
 /// Refuses an output whose `minValue`/`maxValue` would saturate its table's `data`.

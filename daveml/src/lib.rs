@@ -47,7 +47,7 @@ use sepval_core::atomic_file::write_atomically;
 use sepval_core::input_file::read_string;
 
 pub use bands::{CorrectionSpread, bands};
-pub use error::{DavemlError, Mismatch, Place};
+pub use error::{DavemlError, ExportError, Mismatch, Place};
 pub use export::{Band, Provenance, to_daveml};
 pub use map::Map;
 
@@ -119,9 +119,9 @@ pub fn write_model(
     bands: &[Band],
     prov: &Provenance,
 ) -> Result<(), DavemlError> {
-    let text = to_daveml(s, bands, prov).map_err(|message| DavemlError::Output {
+    let text = to_daveml(s, bands, prov).map_err(|reason| DavemlError::Output {
         path: path.to_path_buf(),
-        message,
+        reason,
     })?;
     write_atomically(path, text.as_bytes())?;
     Ok(())

@@ -12,7 +12,8 @@
 //! (`staticShot`s of `checkInputs` and `checkOutputs` `signal`s: `signalName` or `varID`,
 //! `signalUnits`, `signalValue`, `tol`). Elements sepval does not use (`provenance`,
 //! `description`, `reference`, ...) are skipped; elements it cannot represent are kept as
-//! [`TableDefn::Unsupported`] so the map stage can refuse them where they matter.
+//! [`TableDefn::Simple`] or [`TableDefn::Unsupported`] so the map stage can refuse them where
+//! they matter.
 
 use roxmltree::{Document, Node, ParsingOptions};
 
@@ -114,11 +115,19 @@ pub struct InputRef {
 #[derive(Debug, Clone, PartialEq)]
 pub enum TableDefn {
     /// A `griddedTableRef` to a `griddedTableDef` by `gtID`.
-    Ref(String),
+    Ref {
+        /// The `gtID`.
+        gt_id: String,
+    },
     /// A `griddedTableDef` inside the `functionDefn`.
     Inline(GriddedTable),
-    /// Something else (an ungridded table, simple `independentVarPts`): refused when used.
-    Unsupported(String),
+    /// A simple function (`independentVarPts`/`dependentVarPts`): refused when used.
+    Simple,
+    /// Another element (an ungridded table): refused when used.
+    Unsupported {
+        /// The element's tag name.
+        tag: String,
+    },
 }
 
 /// A `function`.
@@ -368,12 +377,7 @@ impl<'a, 'input> Reader<'a, 'input> {
     fn function(&self, n: Node) -> Result<Function, DavemlError> {
         let name = n.attribute("name").unwrap_or("").to_string();
         if let Some(pts) = self.child(n, "independentVarPts") {
-            let table = self.located(
-                pts,
-                TableDefn::Unsupported(
-                    "a simple function (independentVarPts/dependentVarPts)".to_string(),
-                ),
-            );
+            let table = self.located(pts, TableDefn::Simple);
             let out = self.required(n, "dependentVarPts")?;
             let output = self.located(out, self.attr(out, "varID")?);
             return Ok(Function {
@@ -391,15 +395,20 @@ impl<'a, 'input> Reader<'a, 'input> {
         let output = self.located(out, self.attr(out, "varID")?);
         let defn = self.required(n, "functionDefn")?;
         let table = match defn.children().find(Node::is_element) {
-            Some(t) if t.tag_name().name() == "griddedTableRef" => {
-                self.located(t, TableDefn::Ref(self.attr(t, "gtID")?))
-            }
+            Some(t) if t.tag_name().name() == "griddedTableRef" => self.located(
+                t,
+                TableDefn::Ref {
+                    gt_id: self.attr(t, "gtID")?,
+                },
+            ),
             Some(t) if t.tag_name().name() == "griddedTableDef" => {
                 self.located(t, TableDefn::Inline(self.table(t)?))
             }
             Some(t) => self.located(
                 t,
-                TableDefn::Unsupported(format!("a <{}>", t.tag_name().name())),
+                TableDefn::Unsupported {
+                    tag: t.tag_name().name().to_string(),
+                },
             ),
             None => return Err(DavemlError::at(&self.place(defn), "is empty")),
         };

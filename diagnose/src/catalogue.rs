@@ -20,6 +20,7 @@ use sepval_fit::refine::{ModelLm, refine_together};
 use sepval_fit::space::{Noise, ParamSpace};
 use sepval_solve::identifiability::identifiability;
 use sepval_solve::lm::{LmResult, LmSettings};
+use sepval_solve::run::SearchError;
 use sepval_solve::stats::f_test;
 
 /// Refines a model again from its optimum until it converges (a reference model must be
@@ -100,7 +101,7 @@ fn try_extensions(
     ids: &[usize],
     noise: Noise,
     settings: &LmSettings,
-) -> Result<Vec<(usize, std::result::Result<Fitted, String>)>> {
+) -> Result<Vec<(usize, std::result::Result<Fitted, SearchError>)>> {
     let table = *job.factor_table();
     let mut runs = Vec::new();
     let mut sets = Vec::new();
@@ -130,7 +131,7 @@ fn try_extensions(
         .zip(runs)
         .map(|((index, effects), run)| {
             let fitted = match run.failure() {
-                Some(reason) => Err(reason.to_string()),
+                Some(reason) => Err(reason.clone()),
                 None => Ok(Fitted {
                     effects,
                     terms: Vec::new(),
@@ -221,7 +222,7 @@ pub(super) fn select(
                     skipped.push(SkippedRefit {
                         stage: format!("catalogue round {round}"),
                         model: CATALOGUE[index].id().to_string(),
-                        reason,
+                        reason: reason.to_string(),
                     });
                     continue;
                 }

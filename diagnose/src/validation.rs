@@ -2,7 +2,9 @@
 //! baseline, the answer and the alternatives on each, and the verdict's caution when an
 //! alternative predicts clearly better than the answer (docs/discovery.md section 11.5).
 
-use sepval_common::evaluation::{Candidate, Job};
+use std::sync::Arc;
+
+use sepval_common::evaluation::{Candidate, Job, JobError, Outcome};
 use serde::{Deserialize, Serialize};
 
 use sepval_fit::space::Noise;
@@ -49,14 +51,14 @@ pub(super) fn validate(
     v.events()
         .iter()
         .map(|e| {
-            let one = Job::new(vec![e.clone()]);
+            let one = Job::new(vec![e.clone()]).map_err(Arc::new);
             let goals = |c: &Candidate| -> Prediction {
-                let job = one.as_ref().map_err(|e| e.to_string())?;
+                let job = one.as_ref().map_err(|e| NotPredicted::Job(Arc::clone(e)))?;
                 let ev = job.evaluate(c);
-                ev.outcome
-                    .goals()
-                    .map(|g| (g.j_pos_m, g.j_att_deg))
-                    .ok_or_else(|| format!("{:?}", ev.outcome))
+                match ev.outcome.goals() {
+                    Some(g) => Ok((g.j_pos_m, g.j_att_deg)),
+                    None => Err(NotPredicted::Outcome(ev.outcome)),
+                }
             };
             let (b, a) = (goals(base), goals(answer));
             let others: Vec<(String, Prediction)> = alternatives
@@ -95,7 +97,18 @@ pub(super) fn validate(
 }
 
 /// A model's goals on a validation event (J_pos \[m\], J_att \[deg\]), or why it did not simulate.
-type Prediction = std::result::Result<(f64, f64), String>;
+type Prediction = std::result::Result<(f64, f64), NotPredicted>;
+
+/// Why a model did not predict a validation event.
+#[derive(Debug, Clone, thiserror::Error)]
+enum NotPredicted {
+    /// The event does not make a job.
+    #[error("{0}")]
+    Job(Arc<JobError>),
+    /// The run did not reach its goals (diverged, failed).
+    #[error("{0:?}")]
+    Outcome(Outcome),
+}
 
 /// A caveat for the verdict when an alternative predicts the events not fitted clearly better
 /// than the answer (its sum over events of `(J_pos/sigma_pos)^2 + (J_att/sigma_att)^2` below

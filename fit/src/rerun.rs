@@ -17,6 +17,7 @@
 use std::collections::BTreeSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, Job, Outcome};
 use sepval_common::telemetry::outliers::Policy;
@@ -91,18 +92,58 @@ impl fmt::Display for Origin {
 }
 
 /// The replay of the generation.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub enum Replay {
     /// Replayed, and the state came out identical.
     Same(Origin),
     /// Replayed, and these parts of the state differ (`state.rng`, `state.population[3]`).
     Differs(Origin, Vec<String>),
     /// Not replayed, for this reason.
-    Skipped(String),
+    Skipped(NoReplay),
+}
+
+/// Why a generation is not replayed (the members are still re-evaluated).
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum NoReplay {
+    /// The checkpoint of the generation before is not there.
+    #[error("the previous generation's checkpoint {} is not there", path.display())]
+    Missing {
+        /// Where it would be.
+        path: PathBuf,
+    },
+    /// The checkpoint of the generation before cannot be read, or is of another job.
+    #[error("{0}")]
+    Unreadable(Arc<CheckpointError>),
+    /// A checkpoint there that is not of the generation before in the same fit.
+    #[error("{} is not the previous generation of the same fit", path.display())]
+    NotPrevious {
+        /// The checkpoint.
+        path: PathBuf,
+    },
+    /// No checkpoint of a generation before (tests).
+    #[cfg(test)]
+    #[error("no previous checkpoint")]
+    NoPrevious,
+}
+
+/// Why a generation that could be replayed was not.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReplayFailure {
+    /// The search could not be started or resumed from the state before.
+    #[error("{0}")]
+    Ga(GaError),
+    /// The search could not ask or be told a generation.
+    #[error("{0}")]
+    Run(RunError),
+    /// The search asked for nothing more.
+    #[error("the search is already finished")]
+    Finished,
 }
 
 /// The outcome of [`check`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Report {
     /// The checkpoint's generation.
     pub generation: usize,
@@ -207,12 +248,12 @@ pub enum RerunError {
     #[error(transparent)]
     Eval(#[from] EvalError),
     /// The generation cannot be replayed.
-    #[error("checkpoint {path}: the generation cannot be replayed: {message}")]
+    #[error("checkpoint {path}: the generation cannot be replayed: {reason}")]
     Replay {
         /// The checkpoint.
         path: PathBuf,
         /// Why.
-        message: String,
+        reason: Box<ReplayFailure>,
     },
     /// The inputs of the rerun (its releases, scenario or extension) that cannot be read.
     #[error(transparent)]
@@ -293,9 +334,9 @@ pub fn check(
     evaluator: &mut dyn Evaluator,
 ) -> Result<Report, RerunError> {
     checkpoint.check_job(evaluator.job(), path)?;
-    let replay_error = |message: String| RerunError::Replay {
+    let replay_error = |reason: ReplayFailure| RerunError::Replay {
         path: path.to_path_buf(),
-        message,
+        reason: Box::new(reason),
     };
     let state = &checkpoint.state;
     // The search that replays the generation, with what it starts from, or why there is none.
@@ -307,7 +348,7 @@ pub fn check(
                 None => GaSearch::new(settings, weights, genes),
                 Some(before) => GaSearch::resume(settings, weights, genes, before.state),
             }
-            .map_err(|e: GaError| replay_error(e.to_string()))?;
+            .map_err(|e: GaError| replay_error(ReplayFailure::Ga(e)))?;
             Ok((origin, search))
         }
         Err(why) => Err(why),
@@ -316,8 +357,8 @@ pub fn check(
         Ok((_, search)) => {
             search
                 .ask()
-                .map_err(|e: RunError| replay_error(e.to_string()))?
-                .ok_or_else(|| replay_error("the search is already finished".into()))?
+                .map_err(|e: RunError| replay_error(ReplayFailure::Run(e)))?
+                .ok_or_else(|| replay_error(ReplayFailure::Finished))?
                 .points
         }
         Err(_) => Vec::new(),
@@ -354,7 +395,7 @@ pub fn check(
         Ok((origin, mut search)) => {
             search
                 .tell(told.into_iter().map(|e| e.outcome).collect())
-                .map_err(|e: RunError| replay_error(e.to_string()))?;
+                .map_err(|e: RunError| replay_error(ReplayFailure::Run(e)))?;
             let replayed = Checkpoint {
                 state: search.state().cloned().expect("told a generation"),
                 ..checkpoint.clone()
@@ -412,19 +453,16 @@ fn previous(
     checkpoint: &Checkpoint,
     path: &Path,
     evaluator: &dyn Evaluator,
-) -> Result<(Origin, Option<Checkpoint>), String> {
+) -> Result<(Origin, Option<Checkpoint>), NoReplay> {
     let Some(before_path) = checkpoint.previous_path(path) else {
         return Ok((Origin::Seed, None));
     };
     if !before_path.exists() {
-        return Err(format!(
-            "the previous generation's checkpoint {} is not there",
-            before_path.display()
-        ));
+        return Err(NoReplay::Missing { path: before_path });
     }
     let before = Checkpoint::load(&before_path)
         .and_then(|b| b.check_job(evaluator.job(), &before_path).map(|()| b))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| NoReplay::Unreadable(Arc::new(e)))?;
     let same_settings = GaSettings {
         generations: checkpoint.settings.generations,
         ..before.settings.clone()
@@ -433,10 +471,7 @@ fn previous(
         || before.sigma != checkpoint.sigma
         || before.state.generation + 1 != checkpoint.state.generation
     {
-        return Err(format!(
-            "{} is not the previous generation of the same fit",
-            before_path.display()
-        ));
+        return Err(NoReplay::NotPrevious { path: before_path });
     }
     Ok((Origin::Previous(before_path), Some(before)))
 }
@@ -460,7 +495,7 @@ mod tests {
                 saved: goals(0.1),
                 rerun: goals(0.1 + 1e-17),
             }],
-            replay: Replay::Skipped("no previous checkpoint".into()),
+            replay: Replay::Skipped(NoReplay::NoPrevious),
             arithmetic,
         }
     }

@@ -11,7 +11,7 @@
 use nalgebra::DMatrix;
 
 use crate::refit::log_det_with_prior;
-use crate::simulate::Simulated;
+use crate::simulate::{Missing, Simulated};
 
 /// The information of the answer's parameters.
 #[derive(Debug, Clone)]
@@ -19,7 +19,7 @@ pub struct Information {
     /// ln det of the information of the releases flown (with the prior).
     pub flown_log_det: f64,
     /// Per condition: the gain in ln det, or why the answer's sensitivities are missing.
-    pub gains: Vec<Result<f64, String>>,
+    pub gains: Vec<Result<f64, Missing>>,
 }
 
 /// The information gain of every condition (the answer is model 0).
@@ -36,7 +36,10 @@ pub fn information(sims: &Simulated) -> Information {
     let gains = runs.normal[sims.flown..]
         .iter()
         .map(|n| {
-            let n = n.as_ref().map_err(|r| format!("the answer: {r}"))?;
+            let n = n.as_ref().map_err(|r| Missing::Model {
+                model: "the answer".into(),
+                why: Box::new(r.clone()),
+            })?;
             Ok(log_det_with_prior(&(&flown + &n.gram)) - flown_log_det)
         })
         .collect();

@@ -85,11 +85,12 @@ pub fn rank(
             let gain = information.gains[k].clone();
             let mut why: Vec<String> = Vec::new();
             if let Err(r) = &pairs {
-                why.push(r.clone());
+                why.push(r.to_string());
             }
             if let Err(r) = &gain {
-                if !why.contains(r) {
-                    why.push(r.clone());
+                let r = r.to_string();
+                if !why.contains(&r) {
+                    why.push(r);
                 }
             }
             let standing = if !why.is_empty() {

@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::models::Models;
 use crate::refit::Normal;
-use crate::simulate::Simulated;
+use crate::simulate::{Missing, Simulated};
 
 /// The margin above which a release separates two models: the BIC distance of strong
 /// evidence (Kass and Raftery 1995), the diagnosis's own rival margin.
@@ -52,7 +52,7 @@ pub struct Separations {
     /// Every pair at the releases flown alone (what the new release adds to).
     pub flown: Vec<PairSeparation>,
     /// Per condition: every pair, or why a model could not be compared there.
-    pub conditions: Vec<Result<Vec<PairSeparation>, String>>,
+    pub conditions: Vec<Result<Vec<PairSeparation>, Missing>>,
 }
 
 impl Separations {
@@ -114,13 +114,16 @@ pub fn separations(models: &Models, sims: &Simulated) -> Separations {
     let conditions = (sims.flown..sims.samples.len())
         .map(|e| {
             let samples = flown_samples + sims.samples[e];
-            let with = |a: usize, b: usize, n: &Normal| -> Result<Normal, String> {
+            let with = |a: usize, b: usize, n: &Normal| -> Result<Normal, Missing> {
                 let normal = sims.runs[b].normal[e]
                     .as_ref()
-                    .map_err(|r| format!("{}: {r}", models.list[b].name))?;
-                let (rhs, vv) = normal.cross[a]
-                    .as_ref()
-                    .ok_or_else(|| format!("{} did not run", models.list[a].name))?;
+                    .map_err(|r| Missing::Model {
+                        model: models.list[b].name.clone(),
+                        why: Box::new(r.clone()),
+                    })?;
+                let (rhs, vv) = normal.cross[a].as_ref().ok_or_else(|| Missing::DidNotRun {
+                    model: models.list[a].name.clone(),
+                })?;
                 let mut n = n.clone();
                 n.add(&normal.gram, rhs, *vv);
                 Ok(n)

@@ -55,7 +55,7 @@ pub enum SimulateError {
         /// The release.
         event: String,
         /// Why.
-        reason: String,
+        reason: Missing,
     },
     /// Too many conditions or samples to hold the sensitivities.
     #[error(
@@ -132,9 +132,9 @@ pub struct EventNormal {
 #[derive(Debug, Clone)]
 pub struct ModelRuns {
     /// Its trajectory at each event, or why it has none (diverged, failed).
-    pub nominal: Vec<Result<Vec<Observation>, String>>,
+    pub nominal: Vec<Result<Vec<Observation>, Missing>>,
     /// Its normal equations at each event, or why they are missing (a step diverged).
-    pub normal: Vec<Result<EventNormal, String>>,
+    pub normal: Vec<Result<EventNormal, Missing>>,
 }
 
 /// Every model at every event.
@@ -226,9 +226,54 @@ struct Runner<'a> {
 }
 
 /// Per event, the samples of a run or why there are none.
-type EventSamples = Vec<Result<Vec<Observation>, String>>;
+type EventSamples = Vec<Result<Vec<Observation>, Missing>>;
 /// Per event, a model's sensitivity columns or why there are none.
-type EventColumns = Vec<Result<Vec<Vec<f64>>, String>>;
+type EventColumns = Vec<Result<Vec<Vec<f64>>, Missing>>;
+
+/// Why a model's run, its sensitivities or a condition's numbers are missing (the plan says
+/// so for the condition).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Missing {
+    /// The store tumbled.
+    #[error("diverged at t = {t_s:.3} s (the store tumbles)")]
+    Diverged {
+        /// When \[s\].
+        t_s: f64,
+    },
+    /// The run failed: the outcome's reason (the simulator's words, carried as text in every
+    /// evaluation's outcome).
+    #[error("{reason}")]
+    Failed {
+        /// The outcome's reason.
+        reason: String,
+    },
+    /// An evaluation without samples.
+    #[error("no samples")]
+    NoSamples,
+    /// The run of a parameter's step.
+    #[error("a step of {parameter}: {why}")]
+    Step {
+        /// The parameter stepped.
+        parameter: String,
+        /// Why its run is missing.
+        why: Box<Missing>,
+    },
+    /// A model's numbers.
+    #[error("{model}: {why}")]
+    Model {
+        /// The model (`the answer`, a rival's name).
+        model: String,
+        /// Why they are missing.
+        why: Box<Missing>,
+    },
+    /// A model that did not run at the condition.
+    #[error("{model} did not run")]
+    DidNotRun {
+        /// The model.
+        model: String,
+    },
+}
 
 impl Runner<'_> {
     /// The simulations run: the evaluator's, and the events re-run in this process.
@@ -275,11 +320,9 @@ impl Runner<'_> {
             self.reruns += 1;
             out.push(match (ev.outcome, ev.samples) {
                 (_, Some(mut s)) => Ok(s.remove(0)),
-                (Outcome::Diverged { t_s, .. }, None) => {
-                    Err(format!("diverged at t = {t_s:.3} s (the store tumbles)"))
-                }
-                (Outcome::Failed { reason }, None) => Err(reason),
-                (Outcome::Goals { .. }, None) => Err("no samples".into()),
+                (Outcome::Diverged { t_s, .. }, None) => Err(Missing::Diverged { t_s }),
+                (Outcome::Failed { reason }, None) => Err(Missing::Failed { reason }),
+                (Outcome::Goals { .. }, None) => Err(Missing::NoSamples),
             });
         }
         Ok(out)
@@ -311,7 +354,12 @@ impl Runner<'_> {
                     };
                     match s {
                         Ok(s) => cols.push(difference(&s, y, noise, scale)),
-                        Err(r) => *col = Err(format!("a step of {}: {r}", m.space.params.names[j])),
+                        Err(r) => {
+                            *col = Err(Missing::Step {
+                                parameter: m.space.params.names[j].clone(),
+                                why: Box::new(r),
+                            });
+                        }
                     }
                 }
                 j += 1;
@@ -339,7 +387,7 @@ fn reduce(
     columns: &EventColumns,
     nominal: &[EventSamples],
     noise: Noise,
-) -> Vec<Result<EventNormal, String>> {
+) -> Vec<Result<EventNormal, Missing>> {
     columns
         .iter()
         .enumerate()

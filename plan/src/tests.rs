@@ -258,7 +258,7 @@ fn with_rivals_the_pairs_separated_rank_first_then_the_hardest_pair_then_informa
     // leave the third at 1, the last separates none but leaves its hardest pair at 2. The
     // smallest separation alone would recommend the last; the count puts it last, and the
     // information gain decides between the equal first two.
-    let pairs = |seps: [f64; 3]| -> Result<Vec<PairSeparation>, String> {
+    let pairs = |seps: [f64; 3]| -> Result<Vec<PairSeparation>, crate::simulate::Missing> {
         let models = [[0, 1], [0, 2], [1, 2]];
         Ok(models
             .iter()

@@ -359,7 +359,7 @@ fn refit(
 /// A fit's trajectory at one release and the variance of its factor band there.
 struct FactorBand {
     /// The fit's trajectory at the release's grid, or why it does not run.
-    nominal: Result<GridTrajectory, String>,
+    nominal: Result<GridTrajectory, crate::simulate::NoTrajectory>,
     /// The variance of the draws at each grid point (zeros without draws).
     var: Vec<[f64; 6]>,
     /// The grid.
@@ -402,7 +402,9 @@ fn factor_band(
     let runs = run_candidates(&mut evaluator, n, &candidate, &grid, &mut NoProgress)?;
     let evaluations = runs.evaluations;
     let mut runs = runs.trajectories.into_iter();
-    let nominal = runs.next().unwrap_or_else(|| Err("no run".into()));
+    let nominal = runs
+        .next()
+        .unwrap_or(Err(crate::simulate::NoTrajectory::NoRun));
     let drawn: Vec<GridTrajectory> = runs.filter_map(Result::ok).collect();
     let var = (0..grid.len())
         .map(|k| std::array::from_fn(|c| variance(drawn.iter().map(|d| d[k][c]))))

@@ -93,7 +93,7 @@ pub enum PredictError {
         /// Samples.
         samples: usize,
         /// The first one's reason.
-        first: String,
+        first: simulate::NoTrajectory,
     },
     /// The outputs.
     #[error(transparent)]
@@ -287,7 +287,10 @@ pub fn predict_with(
     )?;
     progress.finish();
     if runs.failed() == n {
-        let first = runs.trajectories[0].clone().err().unwrap_or_default();
+        let first = runs.trajectories[0]
+            .clone()
+            .err()
+            .unwrap_or(simulate::NoTrajectory::NoRun);
         return Err(PredictError::AllDiverged { samples: n, first });
     }
     let calibration = prepared.calibration();

@@ -13,7 +13,8 @@ use std::sync::Arc;
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, InProcess, Job};
 use sepval_common::telemetry::Trajectory;
 use sepval_core::cancel;
-use sepval_geometry::{GeometryError, Pose, Trace};
+pub use sepval_geometry::GeometryError;
+use sepval_geometry::{Pose, Trace};
 use sepval_report::figures::{ClearanceSeries, clearance_figure};
 use sepval_report::words::csv_text;
 use sepval_report::{OutputError, Written};
@@ -28,9 +29,15 @@ pub enum ReleasesError {
     /// The answer's simulation.
     #[error("the answer's trajectories")]
     Simulate(#[source] EvalError),
-    /// The answer does not fly every release.
-    #[error("the answer does not simulate every release: {0}")]
-    NotFlown(String),
+    /// The evaluator answered nothing.
+    #[error("the answer does not simulate every release: no evaluation came back")]
+    NoEvaluation,
+    /// The answer's evaluation carries no trajectories: its outcome says why.
+    #[error("the answer does not simulate every release: {outcome:?}")]
+    NotFlown {
+        /// The evaluation's outcome.
+        outcome: sepval_common::evaluation::Outcome,
+    },
     /// A release's clearance.
     #[error("the clearance of release {release}")]
     Trace {
@@ -115,9 +122,9 @@ pub fn simulate(
         .evaluate(&[candidate], true)
         .map_err(ReleasesError::Simulate)?
         .pop()
-        .ok_or_else(|| ReleasesError::NotFlown("no evaluation came back".into()))?;
+        .ok_or(ReleasesError::NoEvaluation)?;
     let Some(samples) = e.samples else {
-        return Err(ReleasesError::NotFlown(format!("{:?}", e.outcome)));
+        return Err(ReleasesError::NotFlown { outcome: e.outcome });
     };
     Ok(job
         .events()

@@ -89,11 +89,36 @@ pub fn release_job(scenario: &Scenario, times_s: &[f64], name: &str) -> Result<J
 /// continuous along time).
 pub type GridTrajectory = Vec<[f64; 6]>;
 
+/// Why a candidate has no trajectory.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum NoTrajectory {
+    /// The store tumbled.
+    #[error("diverged at t = {t_s:.3} s (the store tumbles)")]
+    Diverged {
+        /// When \[s\].
+        t_s: f64,
+    },
+    /// The run failed: the outcome's reason (the simulator's words, carried as text in every
+    /// evaluation's outcome).
+    #[error("{reason}")]
+    Failed {
+        /// The outcome's reason.
+        reason: String,
+    },
+    /// An evaluation without samples.
+    #[error("no samples")]
+    NoSamples,
+    /// No evaluation at all.
+    #[error("no run")]
+    NoRun,
+}
+
 /// The runs of a list of candidates at the first event of a job.
 #[derive(Debug, Clone, Default)]
 pub struct Runs {
     /// Per candidate, its trajectory at the grid, or why it has none.
-    pub trajectories: Vec<Result<GridTrajectory, String>>,
+    pub trajectories: Vec<Result<GridTrajectory, NoTrajectory>>,
     /// Simulations run.
     pub evaluations: u64,
 }
@@ -129,11 +154,9 @@ pub fn run_candidates(
         for e in evaluations {
             runs.trajectories.push(match (e.samples, e.outcome) {
                 (Some(s), _) => Ok(on_grid(&s[0], grid)),
-                (None, Outcome::Diverged { t_s, .. }) => {
-                    Err(format!("diverged at t = {t_s:.3} s (the store tumbles)"))
-                }
-                (None, Outcome::Failed { reason }) => Err(reason),
-                (None, Outcome::Goals { .. }) => Err("no samples".into()),
+                (None, Outcome::Diverged { t_s, .. }) => Err(NoTrajectory::Diverged { t_s }),
+                (None, Outcome::Failed { reason }) => Err(NoTrajectory::Failed { reason }),
+                (None, Outcome::Goals { .. }) => Err(NoTrajectory::NoSamples),
             });
         }
         progress.progress(&Progress {

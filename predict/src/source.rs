@@ -50,6 +50,16 @@ pub enum SourceError {
         /// What is wrong.
         message: String,
     },
+    /// A record whose covariance determines no parameter's standard error.
+    #[error("--from {}: {file}: {reason}", path.display())]
+    Undetermined {
+        /// The directory.
+        path: PathBuf,
+        /// `result.json` or `diagnosis.json`.
+        file: &'static str,
+        /// How many parameters, and which are not identifiable.
+        reason: Undetermined,
+    },
     /// A fit without a covariance of its factors (`--method ga` or `hill`).
     #[error(
         "--from {}: the fit ran --method {methods}, which estimates no covariance of the factors; fit with --method ga+lm (or hill+lm) to predict from it",
@@ -118,7 +128,7 @@ pub struct Source {
 /// Refuses a covariance that determines no parameter's standard error (a fit of fewer
 /// residuals than parameters: every one not identifiable): draws from it would hold every
 /// parameter, and its bands would leave out the factors' uncertainty whole.
-fn some_determined(id: &Identifiability) -> Result<(), String> {
+fn some_determined(id: &Identifiability) -> Result<(), Undetermined> {
     let determined = id
         .parameters
         .iter()
@@ -126,11 +136,23 @@ fn some_determined(id: &Identifiability) -> Result<(), String> {
     if determined || id.parameters.is_empty() {
         return Ok(());
     }
-    Err(format!(
-        "determines the standard error of none of its {} parameters (not identifiable from its releases: {}): bands from it would leave out the factors' uncertainty; fit more of the release, or more releases",
-        id.parameters.len(),
-        id.not_identifiable.join(", ")
-    ))
+    Err(Undetermined {
+        parameters: id.parameters.len(),
+        not_identifiable: id.not_identifiable.clone(),
+    })
+}
+
+/// A covariance that determines no parameter's standard error.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "determines the standard error of none of its {parameters} parameters (not identifiable from its releases: {}): bands from it would leave out the factors' uncertainty; fit more of the release, or more releases",
+    not_identifiable.join(", ")
+)]
+pub struct Undetermined {
+    /// The parameters.
+    pub parameters: usize,
+    /// Those not identifiable, by name.
+    pub not_identifiable: Vec<String>,
 }
 
 /// The `data_sha256` of the baseline fit a diagnosis in `dir` wrote (`baseline/result.json`,
@@ -207,7 +229,11 @@ impl Source {
         let identifiability = d.identifiability.clone().ok_or_else(|| {
             bad("records no covariance of the answer's parameters (`identifiability`, written by sepval since predict): diagnose again with this sepval".into())
         })?;
-        some_determined(&identifiability).map_err(bad)?;
+        some_determined(&identifiability).map_err(|reason| SourceError::Undetermined {
+            path: dir.to_path_buf(),
+            file,
+            reason,
+        })?;
         let mut models = vec![SourceModel {
             spec: d.model.clone(),
             delta_bic: 0.0,
@@ -259,7 +285,11 @@ fn fit_source(dir: &Path) -> Result<Source, SourceError> {
             methods: methods.join(", "),
         });
     };
-    some_determined(&identifiability).map_err(bad)?;
+    some_determined(&identifiability).map_err(|reason| SourceError::Undetermined {
+        path: dir.to_path_buf(),
+        file,
+        reason,
+    })?;
     let inputs = r.inputs.clone().ok_or_else(|| {
         bad("records no `inputs` (written by an older sepval): fit again with this sepval".into())
     })?;

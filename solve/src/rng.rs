@@ -32,11 +32,17 @@ pub struct RngState {
 #[non_exhaustive]
 pub enum RngStateError {
     /// The seed is not 64 hex digits.
-    #[error("generator seed `{0}` is not 64 hexadecimal digits")]
-    Seed(String),
+    #[error("generator seed `{seed_hex}` is not 64 hexadecimal digits")]
+    Seed {
+        /// The seed read.
+        seed_hex: String,
+    },
     /// The word position is not a number.
-    #[error("generator position `{0}` is not a non-negative integer")]
-    Position(String),
+    #[error("generator position `{word_pos}` is not a non-negative integer")]
+    Position {
+        /// The position read.
+        word_pos: String,
+    },
 }
 
 impl RngState {
@@ -51,7 +57,9 @@ impl RngState {
 
     /// A generator in this state.
     pub fn restore(&self) -> Result<SearchRng, RngStateError> {
-        let bad = || RngStateError::Seed(self.seed_hex.clone());
+        let bad = || RngStateError::Seed {
+            seed_hex: self.seed_hex.clone(),
+        };
         // Checked byte by byte before any slicing: text that is not ASCII (or holds a sign,
         // which `from_str_radix` would take) is refused, never sliced inside a character.
         let hex = self.seed_hex.as_bytes();
@@ -65,12 +73,13 @@ impl RngState {
         }
         let digits = self.word_pos.as_bytes();
         if digits.is_empty() || !digits.iter().all(u8::is_ascii_digit) {
-            return Err(RngStateError::Position(self.word_pos.clone()));
+            return Err(RngStateError::Position {
+                word_pos: self.word_pos.clone(),
+            });
         }
-        let pos: u128 = self
-            .word_pos
-            .parse()
-            .map_err(|_| RngStateError::Position(self.word_pos.clone()))?;
+        let pos: u128 = self.word_pos.parse().map_err(|_| RngStateError::Position {
+            word_pos: self.word_pos.clone(),
+        })?;
         let mut rng = ChaCha8Rng::from_seed(seed);
         rng.set_stream(self.stream);
         rng.set_word_pos(pos);
@@ -118,7 +127,7 @@ mod tests {
         ] {
             assert_eq!(
                 seed(text.clone()).restore().map(|_| ()),
-                Err(RngStateError::Seed(text))
+                Err(RngStateError::Seed { seed_hex: text })
             );
         }
         for pos in [
@@ -135,7 +144,9 @@ mod tests {
             };
             assert_eq!(
                 s.restore().map(|_| ()),
-                Err(RngStateError::Position(pos.to_string()))
+                Err(RngStateError::Position {
+                    word_pos: pos.to_string()
+                })
             );
         }
         assert!(good.restore().is_ok());

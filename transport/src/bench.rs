@@ -62,9 +62,12 @@ impl Transport {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum BenchError {
-    /// A setting out of range.
-    #[error("{0}")]
-    Setting(String),
+    /// A count of 0 where at least one is needed.
+    #[error("{setting} 0: expected at least 1")]
+    Zero {
+        /// The setting ("evaluations", "repeat").
+        setting: &'static str,
+    },
     /// A transport that could not be started.
     #[error("starting {transport} with {workers} worker(s)")]
     Start {
@@ -222,11 +225,7 @@ fn start(
         }
         #[cfg(not(feature = "zenoh"))]
         Transport::Zenoh => {
-            return Err(TransportError::NotBuilt(
-                "transport zenoh: this sepval was built without the zenoh feature \
-                 (cargo build --release --features zenoh)"
-                    .into(),
-            ));
+            return Err(TransportError::NotBuilt { transport: "zenoh" });
         }
     };
     spec.start(Arc::clone(job), quiet())
@@ -285,12 +284,12 @@ pub fn run_bench(
     progress: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, BenchError> {
     if options.evals == 0 {
-        return Err(BenchError::Setting(
-            "evaluations 0: expected at least 1".into(),
-        ));
+        return Err(BenchError::Zero {
+            setting: "evaluations",
+        });
     }
     if options.repeat == 0 {
-        return Err(BenchError::Setting("repeat 0: expected at least 1".into()));
+        return Err(BenchError::Zero { setting: "repeat" });
     }
     let batch = candidates(&job, options.evals);
     let warm = candidates(&job, 8.min(options.evals));

@@ -68,9 +68,14 @@ pub enum CodecError {
     /// Bytes after the end of the message.
     #[error("{0} unexpected bytes after the message")]
     Trailing(usize),
-    /// A field that contradicts another.
-    #[error("{0}")]
-    Inconsistent(String),
+    /// A chunk whose header counts other requests than follow it.
+    #[error("chunk header counts {announced} requests, {follow} follow")]
+    ChunkCount {
+        /// The requests its header counts.
+        announced: u32,
+        /// The requests that follow.
+        follow: usize,
+    },
 }
 
 /// Kinds of frames.
@@ -377,11 +382,10 @@ impl Frame {
         match self {
             Frame::Chunk(c) => Ok(Incoming::Chunk(c)),
             Frame::Quit(reason) => Ok(Incoming::Stop(Stopped::Quit(reason))),
-            Frame::Dropped(reason) => Err(crate::TransportError::Dropped(reason)),
-            other => Err(crate::TransportError::Protocol(format!(
-                "the coordinator sent {}, which coordinators do not send",
-                Frame::name_of(Some(&other))
-            ))),
+            Frame::Dropped(reason) => Err(crate::TransportError::Dropped { reason }),
+            other => Err(crate::TransportError::NotACoordinatorFrame {
+                frame: Frame::name_of(Some(&other)),
+            }),
         }
     }
 
@@ -490,10 +494,10 @@ impl Frame {
                 let header = r.chunk_header()?;
                 let n = r.count("chunk", MAX_CHUNK, REQUEST_SIZE)?;
                 if n != header.count as usize {
-                    return Err(CodecError::Inconsistent(format!(
-                        "chunk header counts {} requests, {n} follow",
-                        header.count
-                    )));
+                    return Err(CodecError::ChunkCount {
+                        announced: header.count,
+                        follow: n,
+                    });
                 }
                 let requests = (0..n)
                     .map(|_| get_request(&mut r))

@@ -55,12 +55,37 @@ pub enum FlagsError {
     /// A value refused.
     #[error(transparent)]
     Value(#[from] FlagError),
-    /// Flags that do not go together (the message names them).
-    #[error("{0}")]
-    Combination(String),
-    /// The worker executable, which iceoryx2 workers are spawned from, cannot be found.
-    #[error("{0}")]
-    Worker(String),
+    /// `--listen` or `--zenoh-config` without `--evaluator zenoh`.
+    #[error("--listen and --zenoh-config are for --evaluator zenoh")]
+    ZenohFlags,
+    /// `--evaluator zenoh` without `--listen`.
+    #[error("--evaluator zenoh needs --listen ENDPOINT (e.g. tcp/0.0.0.0:7447)")]
+    NoListen,
+    /// `--attach` with `--evaluator zenoh`.
+    #[error("--attach is for --evaluator ipc; zenoh workers always join by themselves")]
+    AttachZenoh,
+    /// `--evaluator zenoh` in a build without the zenoh transport.
+    #[error(
+        "--evaluator zenoh: this sepval was built without the zenoh transport; rebuild with `cargo build --release --features zenoh`"
+    )]
+    NoZenoh,
+    /// `--attach` for a command that evaluates several jobs.
+    #[error(
+        "--attach {run}: workers attached by hand serve one job of a run, and `{command}` runs {jobs}; leave out --attach (sepval starts the iceoryx2 workers of each job) or use --evaluator zenoh, whose workers serve every job of the run"
+    )]
+    AttachSeveralJobs {
+        /// The run id given to `--attach`.
+        run: RunId,
+        /// The command.
+        command: String,
+        /// The jobs it runs ("one per condition").
+        jobs: String,
+    },
+    /// The worker executable, which iceoryx2 workers are spawned from, cannot be found: the
+    /// caller's error (the front end finds the executable), shown with its causes (not a
+    /// `source`: the message holds them).
+    #[error("{}", crate::error_chain(&**.0))]
+    Worker(Box<dyn std::error::Error + Send + Sync>),
     /// `--listen` refused.
     #[error("--listen")]
     Listen(#[source] crate::TransportError),
@@ -69,14 +94,12 @@ pub enum FlagsError {
 impl EvaluatorFlags {
     /// The evaluator the flags ask for, checked (nothing is started); `worker` finds the worker
     /// executable when workers are to be spawned.
-    pub fn spec(
+    pub fn spec<E: Into<Box<dyn std::error::Error + Send + Sync>>>(
         &self,
-        worker: impl FnOnce() -> Result<PathBuf, String>,
+        worker: impl FnOnce() -> Result<PathBuf, E>,
     ) -> Result<EvaluatorSpec, FlagsError> {
         if self.kind != Kind::Zenoh && (self.listen.is_some() || self.zenoh_config.is_some()) {
-            return Err(FlagsError::Combination(
-                "--listen and --zenoh-config are for --evaluator zenoh".into(),
-            ));
+            return Err(FlagsError::ZenohFlags);
         }
         let chunk_deadline = seconds("--worker-timeout", self.worker_timeout_s)?;
         let join_timeout = seconds("--join-timeout", self.join_timeout_s)?;
@@ -104,7 +127,7 @@ impl EvaluatorFlags {
                     None => (
                         self.run_id.clone().unwrap_or_else(RunId::fresh),
                         Launch::Spawn {
-                            executable: worker().map_err(FlagsError::Worker)?,
+                            executable: worker().map_err(|e| FlagsError::Worker(e.into()))?,
                         },
                     ),
                 };
@@ -132,16 +155,10 @@ impl EvaluatorFlags {
     ) -> Result<EvaluatorSpec, FlagsError> {
         use crate::zenoh::{ZenohOptions, validate_endpoint};
         use sepval_core::flag_value::count_or;
-        let listen = self.listen.clone().ok_or_else(|| {
-            FlagsError::Combination(
-                "--evaluator zenoh needs --listen ENDPOINT (e.g. tcp/0.0.0.0:7447)".into(),
-            )
-        })?;
+        let listen = self.listen.clone().ok_or(FlagsError::NoListen)?;
         validate_endpoint(&listen).map_err(FlagsError::Listen)?;
         if self.attach.is_some() {
-            return Err(FlagsError::Combination(
-                "--attach is for --evaluator ipc; zenoh workers always join by themselves".into(),
-            ));
+            return Err(FlagsError::AttachZenoh);
         }
         let workers = count_or("--workers", self.workers, 1)?;
         Ok(EvaluatorSpec::Zenoh {
@@ -163,11 +180,7 @@ impl EvaluatorFlags {
         _: Duration,
         _: impl Fn(usize) -> DispatchOptions,
     ) -> Result<EvaluatorSpec, FlagsError> {
-        Err(FlagsError::Combination(
-            "--evaluator zenoh: this sepval was built without the zenoh transport; \
-             rebuild with `cargo build --release --features zenoh`"
-                .into(),
-        ))
+        Err(FlagsError::NoZenoh)
     }
 
     /// Refuses `--attach` for `command`, which evaluates several jobs one after another (an
@@ -175,11 +188,11 @@ impl EvaluatorFlags {
     /// job and leave with it, so the next would wait for workers that never come back.
     pub fn several_jobs(&self, command: &str, jobs: &str) -> Result<(), FlagsError> {
         match &self.attach {
-            Some(run) => Err(FlagsError::Combination(format!(
-                "--attach {run}: workers attached by hand serve one job of a run, and `{command}` runs \
-                 {jobs}; leave out --attach (sepval starts the iceoryx2 workers of each job) or use \
-                 --evaluator zenoh, whose workers serve every job of the run"
-            ))),
+            Some(run) => Err(FlagsError::AttachSeveralJobs {
+                run: run.clone(),
+                command: command.to_string(),
+                jobs: jobs.to_string(),
+            }),
             None => Ok(()),
         }
     }

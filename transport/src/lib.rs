@@ -89,8 +89,11 @@ pub enum TransportError {
     #[error(transparent)]
     RunId(#[from] run_id::RunIdError),
     /// Another coordinator serves this run id.
-    #[error("run {0} already has a coordinator: choose another run id")]
-    RunTaken(String),
+    #[error("run {run} already has a coordinator: choose another run id")]
+    RunTaken {
+        /// The run.
+        run: String,
+    },
     /// An iceoryx2 operation failed.
     #[error("{what}: {detail}")]
     Iceoryx {
@@ -128,12 +131,40 @@ pub enum TransportError {
         #[source]
         source: codec::CodecError,
     },
-    /// The other side broke the protocol.
-    #[error("{0}")]
-    Protocol(String),
+    /// The coordinator sent a frame coordinators do not send.
+    #[error("the coordinator sent {frame}, which coordinators do not send")]
+    NotACoordinatorFrame {
+        /// What it sent ([`codec::Frame::name_of`]).
+        frame: &'static str,
+    },
+    /// A worker's first frame was not the job setup.
+    #[error("expected the job setup first, received {frame}")]
+    SetupNotFirst {
+        /// What arrived ([`codec::Frame::name_of`]).
+        frame: &'static str,
+    },
+    /// A frame announced longer than a frame may be.
+    #[error("frame of {len} bytes exceeds the {limit}-byte limit")]
+    FrameTooLong {
+        /// The length announced.
+        len: usize,
+        /// The limit.
+        limit: usize,
+    },
+    /// A second evaluator of a zenoh run while the first is in use.
+    #[error(
+        "an evaluator of this zenoh run is still in use: a command evaluates one job at a time"
+    )]
+    ZenohRunInUse,
+    /// The zenoh session closed under the coordinator.
+    #[error("the zenoh session closed")]
+    ZenohClosed,
     /// The coordinator refused this worker.
-    #[error("the coordinator dropped this worker: {0}")]
-    Dropped(String),
+    #[error("the coordinator dropped this worker: {reason}")]
+    Dropped {
+        /// The coordinator's words (free text from the other process, as it sent them).
+        reason: String,
+    },
     /// No coordinator answered a worker.
     #[error(
         "no coordinator of run {run} answered {place} within {seconds} s: is it running, and is \
@@ -148,8 +179,13 @@ pub enum TransportError {
         seconds: f64,
     },
     /// A transport this build does not have.
-    #[error("{0}")]
-    NotBuilt(String),
+    #[error(
+        "transport {transport}: this sepval was built without the {transport} feature (cargo build --release --features {transport})"
+    )]
+    NotBuilt {
+        /// The transport (and its cargo feature).
+        transport: &'static str,
+    },
     /// zenoh refused or failed.
     #[error("zenoh: {context}: {message}")]
     Zenoh {
@@ -160,12 +196,29 @@ pub enum TransportError {
     },
     /// An endpoint that is not `PROTOCOL/HOST:PORT`.
     #[error(
-        "endpoint {0:?}: expected PROTOCOL/HOST:PORT with an explicit port, e.g. tcp/192.0.2.7:7447"
+        "endpoint {endpoint:?}: expected PROTOCOL/HOST:PORT with an explicit port, e.g. tcp/192.0.2.7:7447"
     )]
-    Endpoint(String),
-    /// Serving a chunk failed (a gateway's local workers).
-    #[error("serving a chunk: {0}")]
-    Serve(String),
+    Endpoint {
+        /// The endpoint given.
+        endpoint: String,
+    },
+    /// A server that answered another number of chunks than it was given.
+    #[error("serving a chunk: {answers} answers for {chunks} chunks")]
+    ServedCount {
+        /// The answers.
+        answers: usize,
+        /// The chunks served.
+        chunks: usize,
+    },
+    /// A gateway whose local iceoryx2 workers are gone.
+    #[error("serving a chunk: the host's iceoryx2 workers are gone")]
+    LocalGone,
+    /// A gateway whose local iceoryx2 workers failed (the message shows the failure's chain).
+    #[error("serving a chunk: the host's iceoryx2 workers failed: {}", error_chain(.cause.as_ref()))]
+    LocalFailed {
+        /// The failure of the local run (not a `source`: the message holds its chain).
+        cause: Box<sepval_common::evaluation::EvalError>,
+    },
 }
 
 impl From<TransportError> for EvalError {

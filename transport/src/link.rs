@@ -45,11 +45,35 @@ pub enum LinkEvent {
     Notice(Notice),
 }
 
+/// Why a chunk could not be sent to a worker (the dispatcher drops the worker).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SendError {
+    /// A worker the link does not know.
+    #[error("no worker {worker}")]
+    NoWorker {
+        /// The worker.
+        worker: WorkerId,
+    },
+    /// Writing the frame to the worker's socket failed.
+    #[error("{0}")]
+    Write(std::io::Error),
+    /// The transport library refused the message: its words (free text from zenoh or
+    /// iceoryx2, not a type this crate can name).
+    #[error("{what}{detail}")]
+    Refused {
+        /// What was attempted, with ": " when there is one ("sending a request chunk: ").
+        what: &'static str,
+        /// The library's error text.
+        detail: String,
+    },
+}
+
 /// The coordinator's end of a transport.
 pub trait Link {
     /// Sends `chunk` to `worker`. An error means the worker cannot be reached any more: the
     /// dispatcher drops it and re-dispatches its work.
-    fn send(&mut self, worker: WorkerId, chunk: &Chunk) -> Result<(), String>;
+    fn send(&mut self, worker: WorkerId, chunk: &Chunk) -> Result<(), SendError>;
 
     /// Waits at most `timeout` for something to happen (returning early once anything has),
     /// and appends what happened to `events`. Liveness checks run here. An error ends the

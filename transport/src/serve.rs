@@ -98,11 +98,10 @@ pub fn serve(
         }
         let answers = server.serve(&group)?;
         if answers.len() != group.len() {
-            return Err(TransportError::Serve(format!(
-                "{} answers for {} chunks",
-                answers.len(),
-                group.len()
-            )));
+            return Err(TransportError::ServedCount {
+                answers: answers.len(),
+                chunks: group.len(),
+            });
         }
         for a in &answers {
             link.answer(a)?;

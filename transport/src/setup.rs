@@ -54,13 +54,21 @@ pub enum SetupError {
     /// Bytes that do not decode.
     #[error("setup bytes do not decode")]
     Decode(#[from] CodecError),
-    /// A scenario or data text that does not parse.
-    #[error("setup event `{event}`: {message}")]
-    Content {
+    /// An event's scenario that does not parse or check.
+    #[error("setup event `{event}`: {reason}")]
+    Scenario {
         /// The event.
         event: String,
         /// What failed.
-        message: String,
+        reason: sepval_common::scenario::ScenarioError,
+    },
+    /// An event's samples that no telemetry file may hold.
+    #[error("setup event `{event}`: {reason}")]
+    Samples {
+        /// The event.
+        event: String,
+        /// What is wrong with them.
+        reason: SampleError,
     },
     /// An invalid job.
     #[error(transparent)]
@@ -83,9 +91,32 @@ pub fn hex(digest: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// What makes an event's samples, as they arrived in a setup, unusable.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SampleError {
+    /// A value beyond the plausible bounds, or not finite.
+    #[error("sample {sample} holds a value that no telemetry file may hold")]
+    Implausible {
+        /// The sample.
+        sample: usize,
+    },
+    /// A time not after the previous sample's.
+    #[error("sample {sample}: time {time_s} s is not after the previous sample's")]
+    NotAfter {
+        /// The sample.
+        sample: usize,
+        /// Its time \[s\].
+        time_s: f64,
+    },
+    /// No samples.
+    #[error("no samples")]
+    None,
+}
+
 /// Checks samples that arrived as numbers as a telemetry file's are checked: finite, within the
 /// plausible bounds, times increasing.
-fn check_samples(d: &Trajectory) -> Result<(), String> {
+fn check_samples(d: &Trajectory) -> Result<(), SampleError> {
     use sepval_core::limits::{MAX_ANGLE_DEG, MAX_POSITION_M, MAX_SPAN_S};
     for k in 0..d.len() {
         let t = d.times_s[k];
@@ -94,18 +125,17 @@ fn check_samples(d: &Trajectory) -> Result<(), String> {
             && d.pos_m[k].iter().all(|v| within(v, MAX_POSITION_M))
             && d.att_deg[k].iter().all(|v| within(v, MAX_ANGLE_DEG)))
         {
-            return Err(format!(
-                "sample {k} holds a value that no telemetry file may hold"
-            ));
+            return Err(SampleError::Implausible { sample: k });
         }
         if k > 0 && t <= d.times_s[k - 1] {
-            return Err(format!(
-                "sample {k}: time {t} s is not after the previous sample's"
-            ));
+            return Err(SampleError::NotAfter {
+                sample: k,
+                time_s: t,
+            });
         }
     }
     if d.is_empty() {
-        return Err("no samples".into());
+        return Err(SampleError::None);
     }
     Ok(())
 }
@@ -178,12 +208,12 @@ pub fn decode_setup(header: &SetupHeader, bytes: &[u8]) -> Result<Job, SetupErro
     for _ in 0..n {
         let name = r.text("event name")?;
         let scenario_toml = r.text_up_to("scenario", MAX_SETUP)?;
-        let content = |message: String| SetupError::Content {
-            event: name.clone(),
-            message,
-        };
-        let scenario =
-            Scenario::from_toml_str(&scenario_toml, &name).map_err(|x| content(x.to_string()))?;
+        let scenario = Scenario::from_toml_str(&scenario_toml, &name).map_err(|reason| {
+            SetupError::Scenario {
+                event: name.clone(),
+                reason,
+            }
+        })?;
         let n = r.count("samples", MAX_SAMPLES, 56)?;
         let mut data = Trajectory {
             times_s: Vec::with_capacity(n),
@@ -197,7 +227,10 @@ pub fn decode_setup(header: &SetupHeader, bytes: &[u8]) -> Result<Job, SetupErro
             data.pos_m.push([v[1], v[2], v[3]]);
             data.att_deg.push([v[4], v[5], v[6]]);
         }
-        check_samples(&data).map_err(content)?;
+        check_samples(&data).map_err(|reason| SetupError::Samples {
+            event: name.clone(),
+            reason,
+        })?;
         events.push(Event {
             name,
             simulator: Simulator::new(&scenario),

@@ -119,11 +119,7 @@ impl Starter {
                     d
                 }
                 None if Arc::strong_count(&self.zenoh) > 1 => {
-                    return Err(TransportError::Protocol(
-                        "an evaluator of this zenoh run is still in use: a command evaluates \
-                         one job at a time"
-                            .into(),
-                    ));
+                    return Err(TransportError::ZenohRunInUse);
                 }
                 None => {
                     crate::zenoh::validate_endpoint(&link.listen)?;

@@ -16,7 +16,7 @@ use sepval_common::evaluation::Job;
 use sepval_core::cancel;
 
 use crate::codec::{Frame, MAX_SETUP};
-use crate::link::{Incoming, Link, LinkEvent, Stopped, WorkerId, WorkerLink};
+use crate::link::{Incoming, Link, LinkEvent, SendError, Stopped, WorkerId, WorkerLink};
 use crate::setup::{decode_setup, encode_setup};
 use crate::wire::Answer;
 use crate::{RunId, TransportError, io};
@@ -46,9 +46,10 @@ pub(crate) fn read_frame(r: &mut impl Read) -> Result<Option<Frame>, TransportEr
     }
     let len = u32::from_le_bytes(len) as usize;
     if len > MAX_FRAME {
-        return Err(TransportError::Protocol(format!(
-            "frame of {len} bytes exceeds the {MAX_FRAME}-byte limit"
-        )));
+        return Err(TransportError::FrameTooLong {
+            len,
+            limit: MAX_FRAME,
+        });
     }
     // The buffer grows with the bytes that arrive, a step at a time: a corrupt length (up to
     // MAX_FRAME) allocates one step, not the gigabyte it announces.
@@ -195,12 +196,12 @@ impl UdsLink {
 }
 
 impl Link for UdsLink {
-    fn send(&mut self, worker: WorkerId, chunk: &crate::wire::Chunk) -> Result<(), String> {
+    fn send(&mut self, worker: WorkerId, chunk: &crate::wire::Chunk) -> Result<(), SendError> {
         let s = self
             .streams
             .get_mut(&worker)
-            .ok_or_else(|| format!("no worker {worker}"))?;
-        write_frame(s, &Frame::Chunk(chunk.clone())).map_err(|e| e.to_string())
+            .ok_or(SendError::NoWorker { worker })?;
+        write_frame(s, &Frame::Chunk(chunk.clone())).map_err(SendError::Write)
     }
 
     fn poll(
@@ -281,10 +282,9 @@ impl UdsWorker {
                 (decode_setup(&header, &bytes)?, header.sha256)
             }
             other => {
-                return Err(TransportError::Protocol(format!(
-                    "expected the job setup first, received {}",
-                    Frame::name_of(other.as_ref())
-                )));
+                return Err(TransportError::SetupNotFirst {
+                    frame: Frame::name_of(other.as_ref()),
+                });
             }
         };
         stream

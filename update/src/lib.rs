@@ -95,12 +95,12 @@ pub enum UpdateError {
     #[error("--validate gave no release")]
     NoValidation,
     /// A correction that does not merge into the store's coefficient.
-    #[error("the updated store: `{field}` {message}")]
+    #[error("the updated store: `{field}` {reason}")]
     Merge {
         /// The scenario's field.
         field: String,
         /// Why.
-        message: String,
+        reason: store::MergeError,
     },
     /// The updated store is not a valid scenario.
     #[error("the updated store")]
@@ -110,13 +110,19 @@ pub enum UpdateError {
     Free(Vec<usize>),
     /// A name of `--free` that is not a factor's.
     #[error(
-        "--free {0}: not one of the 17 factors (expected a comma-separated list of {names})",
+        "--free {name}: not one of the 17 factors (expected a comma-separated list of {names})",
         names = sepval_core::factors::Factor::NAMES.join(", ")
     )]
-    FreeName(String),
+    FreeName {
+        /// The name given.
+        name: String,
+    },
     /// A name of `--free` given twice.
-    #[error("--free {0}: given twice")]
-    FreeTwice(String),
+    #[error("--free {name}: given twice")]
+    FreeTwice {
+        /// The name given again.
+        name: String,
+    },
     /// The releases (`--data`, `--validate`) or the store (`--scenario`, `--extension`) that
     /// cannot be read.
     #[error(transparent)]

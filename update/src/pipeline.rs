@@ -91,9 +91,10 @@ pub fn free_factors(names: Option<&[String]>) -> Result<Vec<usize>> {
     };
     let mut out = Vec::new();
     for name in names {
-        let f = Factor::from_name(name).ok_or_else(|| UpdateError::FreeName(name.clone()))?;
+        let f =
+            Factor::from_name(name).ok_or_else(|| UpdateError::FreeName { name: name.clone() })?;
         if out.contains(&f.index()) {
-            return Err(UpdateError::FreeTwice(name.clone()));
+            return Err(UpdateError::FreeTwice { name: name.clone() });
         }
         out.push(f.index());
     }

@@ -25,6 +25,42 @@ use sepval_common::table_form::interference_distances;
 
 use crate::UpdateError;
 
+/// A correction that does not merge into the store's field (the caller names the field).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum MergeError {
+    /// A correction of the flowfield, for a scenario without one.
+    #[error("the scenario has no [flowfield]")]
+    NoFlowfield,
+    /// A correction of the half depth of a field whose shape is a table.
+    #[error("the flowfield's shape is a table: no half depth to correct")]
+    NoHalfDepth,
+    /// A corrected 1 / L_z not above 0.
+    #[error("1 / half_depth_m would be {inverse} per m")]
+    HalfDepth {
+        /// 1 / L_z corrected \[1/m\].
+        inverse: f64,
+    },
+    /// A correction of the reversal depth of a field whose shape is a table.
+    #[error("the flowfield's shape is a table: no reversal depth to correct")]
+    NoReversal,
+    /// A corrected 1 / z_r below 0.
+    #[error("1 / reversal_m would be {inverse} per m")]
+    Reversal {
+        /// 1 / z_r corrected \[1/m\].
+        inverse: f64,
+    },
+    /// A correction of the shape table, for a scenario without one.
+    #[error("the scenario has no [flowfield] shape table")]
+    NoShapeTable,
+    /// The shape table and its correction do not make a shape.
+    #[error(transparent)]
+    Shape(#[from] sepval_common::correction::FieldChangeError),
+    /// The merged table is not a table of its field.
+    #[error(transparent)]
+    Table(#[from] sepval_common::table::TableShapeError),
+}
+
 /// The updated store: its scenario (tables as file references) and its table files.
 #[derive(Debug, Clone)]
 pub struct Store {
@@ -119,30 +155,28 @@ fn set(s: &mut Scenario, target: Target, c: Coefficient) {
 /// value): the half depth 1 / (1 / L_z + change) and the reversal depth 1 / (1 / z_r +
 /// change), or none when that is 0 (`change` in 1/m, added to the inverse); the upwash's and
 /// sidewash's change with alpha plus `change` \[deg/deg\].
-fn set_field_part(s: &mut Scenario, part: FieldPart, change: f64) -> Result<(), String> {
+fn set_field_part(s: &mut Scenario, part: FieldPart, change: f64) -> Result<(), MergeError> {
     let Some(field) = s.flowfield.as_mut() else {
-        return Err("the scenario has no [flowfield]".into());
+        return Err(MergeError::NoFlowfield);
     };
     match part {
         FieldPart::HalfDepth => {
             let Some(l_z) = field.half_depth_m else {
-                return Err("the flowfield's shape is a table: no half depth to correct".into());
+                return Err(MergeError::NoHalfDepth);
             };
             let inverse = 1.0 / l_z + change;
             if inverse.is_nan() || inverse <= 0.0 {
-                return Err(format!("1 / half_depth_m would be {inverse} per m"));
+                return Err(MergeError::HalfDepth { inverse });
             }
             field.half_depth_m = Some(1.0 / inverse);
         }
         FieldPart::Reversal => {
             if field.shape_is_tabulated() {
-                return Err(
-                    "the flowfield's shape is a table: no reversal depth to correct".into(),
-                );
+                return Err(MergeError::NoReversal);
             }
             let inverse = field.reversal_m.map_or(0.0, |z_r| 1.0 / z_r) + change;
             if inverse < 0.0 {
-                return Err(format!("1 / reversal_m would be {inverse} per m"));
+                return Err(MergeError::Reversal { inverse });
             }
             field.reversal_m = (inverse > 0.0).then(|| 1.0 / inverse);
         }
@@ -154,9 +188,9 @@ fn set_field_part(s: &mut Scenario, part: FieldPart, change: f64) -> Result<(), 
 
 /// The flowfield's shape table of `s` with the correction (`depth_m`, `change`) added: the
 /// table the runs fitted it with (`corrected_shape`, the same function to the bit).
-fn set_shape_table(s: &mut Scenario, depth_m: &[f64], change: &[f64]) -> Result<(), String> {
+fn set_shape_table(s: &mut Scenario, depth_m: &[f64], change: &[f64]) -> Result<(), MergeError> {
     let Some(shape) = s.flowfield.as_mut().and_then(|f| f.shape.as_mut()) else {
-        return Err("the scenario has no [flowfield] shape table".into());
+        return Err(MergeError::NoShapeTable);
     };
     let (depth, g) = corrected_shape(&shape.depth_m, &shape.g, depth_m, change)?;
     shape.depth_m = depth;
@@ -178,7 +212,7 @@ fn merged(
     s: &Scenario,
     target: Target,
     corrections: &[(&Correction, &[f64])],
-) -> Result<Coefficient, String> {
+) -> Result<Coefficient, MergeError> {
     let base = current(s, target);
     let k = kind(target);
     let decay = InterferenceDecay::new(s.interference.lambda_m, s.interference.s_end_m);
@@ -241,7 +275,7 @@ fn merged(
         }
         values.push(value_at(&point));
     }
-    Table::new(axes, values, k).map(Coefficient::Table)
+    Ok(Coefficient::Table(Table::new(axes, values, k)?))
 }
 
 /// The store of `base` (its `[[correction]]` list ignored) with `corrections` merged, each with
@@ -263,9 +297,9 @@ pub fn updated_store(
         if on.is_empty() {
             continue;
         }
-        let c = merged(base, target, &on).map_err(|message| UpdateError::Merge {
+        let c = merged(base, target, &on).map_err(|reason| UpdateError::Merge {
             field: target.field(),
-            message,
+            reason,
         })?;
         set(&mut s, target, c);
     }
@@ -275,9 +309,9 @@ pub fn updated_store(
             Target::ShapeTable => set_shape_table(&mut s, &c.breakpoints, v),
             _ => Ok(()),
         };
-        merged.map_err(|message| UpdateError::Merge {
+        merged.map_err(|reason| UpdateError::Merge {
             field: c.target.field(),
-            message,
+            reason,
         })?;
     }
     s.validate("the updated store")

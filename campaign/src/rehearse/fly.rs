@@ -86,9 +86,7 @@ pub(super) fn fly(
             return Ok(Flew::Tumbled(flown, why));
         }
         Err(e) => {
-            return Err(CampaignError::Refused(format!(
-                "the truth at release {number}: {e}"
-            )));
+            return Err(crate::Refusal::TruthAtRelease { number, reason: e }.into());
         }
     };
     let path: PathBuf = dir.join(format!("flown-{number:02}.csv"));

@@ -14,6 +14,7 @@ mod fly;
 use serde::{Deserialize, Serialize};
 
 use sepval_common::effects::EffectSet;
+use sepval_common::propagator::Diverged;
 use sepval_common::scenario::Scenario;
 use sepval_common::simulation::{SimError, Simulator, sample_times};
 use sepval_common::synthetic::synthetic_flight_test;
@@ -31,6 +32,7 @@ use crate::assess::StartEvaluator;
 use crate::page::{self, RehearsalRelease, RehearsalRound, RehearsalSection};
 use crate::program::Campaign;
 use crate::record::{record_error, write_json};
+use crate::refusal::{Refusal, TruthAt};
 use crate::state::{Counts, State};
 use check::check_settled;
 pub use check::{CHECK_DIR, CandidateFlown};
@@ -218,23 +220,17 @@ pub fn truth_envelope(
     let base = &truth.scenario;
     let times = sample_times(base.integrator.t_end_s, base.integrator.rate_hz);
     let criterion_m = clearance.criterion_m;
-    let mut first_tumble: Option<String> = None;
+    let mut first_tumble: Option<(TruthAt, Diverged)> = None;
     let envelope = (0..grid.len())
         .map(|k| {
             cancel::check()?;
             let s = grid.scenario(base, k);
             let f = &s.flight;
-            let at = format!(
-                "the truth at Mach {}, altitude {} m, alpha {} deg (condition {} of the grid)",
-                page::number(f.mach),
-                page::number(f.altitude_m),
-                page::number(f.alpha_deg),
-                k + 1
-            );
-            let refused = |what: String| {
-                CampaignError::Refused(format!(
-                    "{at} {what}: a rehearsal's truth must be traced at every condition of its grid (check --truth-factors, --truth-effect and the grid)"
-                ))
+            let at = TruthAt {
+                mach: f.mach,
+                altitude_m: f.altitude_m,
+                alpha_deg: f.alpha_deg,
+                condition: k + 1,
             };
             let min_m = match synthetic_flight_test(
                 &Simulator::new(&s),
@@ -245,17 +241,18 @@ pub fn truth_envelope(
             ) {
                 Ok(flown) => {
                     releases::trace(clearance, &flown)
-                        .map_err(|e| {
-                            refused(format!("cannot be traced against the aircraft ({e})"))
+                        .map_err(|reason| Refusal::TruthUntraced {
+                            at: at.clone(),
+                            reason,
                         })?
                         .min
                         .distance_m
                 }
                 Err(SimError::Diverged(d)) => {
-                    first_tumble.get_or_insert(format!("{at} does not fly ({d})"));
+                    first_tumble.get_or_insert((at, d));
                     f64::NAN
                 }
-                Err(e) => return Err(refused(format!("cannot be simulated ({e})"))),
+                Err(reason) => return Err(Refusal::TruthUnsimulated { at, reason }.into()),
             };
             Ok(TruthCondition {
                 condition: ConditionRecord::of(&s.flight),
@@ -265,11 +262,11 @@ pub fn truth_envelope(
         })
         .collect::<Result<Vec<_>, CampaignError>>()?;
     if envelope.iter().all(|t| t.min_clearance_mm.is_nan()) {
-        return Err(CampaignError::Refused(format!(
-            "{}, nor at any other of the grid's {} conditions: a rehearsal's truth must fly somewhere in its grid (check --truth-factors, --truth-effect and the grid)",
-            first_tumble.unwrap_or_default(),
-            envelope.len()
-        )));
+        return Err(Refusal::TruthNeverFlies {
+            first: first_tumble,
+            conditions: envelope.len(),
+        }
+        .into());
     }
     Ok(envelope)
 }

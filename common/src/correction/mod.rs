@@ -47,12 +47,14 @@
 //! from carriage ([`CorrectionRun::evaluate`]). A run without correction values takes none of
 //! these paths.
 
+mod error;
 mod run;
 
 use serde::{Deserialize, Serialize};
 
 use crate::table::Variable;
 
+pub use error::{CorrectionError, FieldChangeError};
 pub use run::{CorrectionRun, CorrectionValues, Folded, ShapeChange};
 
 /// Most correction values one run carries (over all its corrections): a candidate holds them
@@ -270,36 +272,6 @@ pub struct Correction {
     pub breakpoints: Vec<f64>,
 }
 
-/// What makes a correction or its values unusable (the caller says where).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum CorrectionError {
-    /// A field no correction can change.
-    #[error(
-        "`field` `{0}` is not a field a correction can change (expected aero.ca0, aero.cy ... aero.cn, a derivative such as aero.cm_alpha_per_rad, interference.dcx0 ... interference.dcn0, flowfield.half_depth_m or flowfield.reversal_m)"
-    )]
-    Field(String),
-    /// A variable the field cannot be corrected over.
-    #[error("`variable` `{variable}`: {field} may be corrected over {allowed} only")]
-    Variable {
-        /// The field.
-        field: String,
-        /// The variable given.
-        variable: String,
-        /// The variables allowed.
-        allowed: String,
-    },
-    /// Breakpoints that are not finite and strictly increasing, or none.
-    #[error("`breakpoints` {0}")]
-    Breakpoints(String),
-    /// More corrections or values than a run carries.
-    #[error("{0}")]
-    TooMany(String),
-    /// A candidate whose values do not fit the scenario's corrections.
-    #[error("{0}")]
-    Values(String),
-}
-
 impl CorrectionRecord {
     /// The record of `c`.
     pub fn of(c: &Correction) -> CorrectionRecord {
@@ -312,8 +284,9 @@ impl CorrectionRecord {
 
     /// The correction it describes, checked.
     pub fn correction(&self) -> Result<Correction, CorrectionError> {
-        let target = Target::of_field(&self.field)
-            .ok_or_else(|| CorrectionError::Field(self.field.clone()))?;
+        let target = Target::of_field(&self.field).ok_or_else(|| CorrectionError::Field {
+            field: self.field.clone(),
+        })?;
         let allowed = target.variables();
         let variable = allowed
             .iter()
@@ -330,27 +303,19 @@ impl CorrectionRecord {
             })?;
         let b = &self.breakpoints;
         if b.is_empty() {
-            return Err(CorrectionError::Breakpoints(
-                "is empty: expected at least one".into(),
-            ));
+            return Err(CorrectionError::NoBreakpoints);
         }
         if let Some(x) = b.iter().find(|x| !x.is_finite()) {
-            return Err(CorrectionError::Breakpoints(format!(
-                "holds {x}: expected finite numbers"
-            )));
+            return Err(CorrectionError::BreakpointNotFinite { value: *x });
         }
         if let Some(k) = (1..b.len()).find(|&k| b[k] <= b[k - 1]) {
-            return Err(CorrectionError::Breakpoints(format!(
-                "are not strictly increasing ({} then {})",
-                b[k - 1],
-                b[k]
-            )));
+            return Err(CorrectionError::BreakpointsNotIncreasing {
+                before: b[k - 1],
+                after: b[k],
+            });
         }
         if b.len() > MAX_CORRECTION_VALUES {
-            return Err(CorrectionError::TooMany(format!(
-                "{} breakpoints: a run carries at most {MAX_CORRECTION_VALUES} correction values",
-                b.len()
-            )));
+            return Err(CorrectionError::TooManyBreakpoints { count: b.len() });
         }
         Ok(Correction {
             target,
@@ -369,10 +334,9 @@ pub fn check_all(
     if records.len() > MAX_CORRECTIONS {
         return Err((
             MAX_CORRECTIONS,
-            CorrectionError::TooMany(format!(
-                "{} corrections: at most {MAX_CORRECTIONS}",
-                records.len()
-            )),
+            CorrectionError::TooManyCorrections {
+                count: records.len(),
+            },
         ));
     }
     let mut out = Vec::with_capacity(records.len());
@@ -381,12 +345,7 @@ pub fn check_all(
         let c = r.correction().map_err(|e| (k, e))?;
         values += c.breakpoints.len();
         if values > MAX_CORRECTION_VALUES {
-            return Err((
-                k,
-                CorrectionError::TooMany(format!(
-                    "{values} correction values up to this one: a run carries at most {MAX_CORRECTION_VALUES}"
-                )),
-            ));
+            return Err((k, CorrectionError::TooManyValuesUpTo { count: values }));
         }
         out.push(c);
     }
@@ -405,15 +364,14 @@ pub fn corrected_shape(
     g: &[f64],
     knots_m: &[f64],
     change: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), String> {
+) -> Result<(Vec<f64>, Vec<f64>), FieldChangeError> {
     let mut union: Vec<f64> = depth_m.iter().chain(knots_m).copied().collect();
     union.sort_by(f64::total_cmp);
     union.dedup();
     if union.len() > MAX_SHAPE_POINTS {
-        return Err(format!(
-            "the flowfield's shape table and its correction have {} depths together: expected at most {MAX_SHAPE_POINTS}",
-            union.len()
-        ));
+        return Err(FieldChangeError::ShapeDepths {
+            depths: union.len(),
+        });
     }
     let sum: Vec<f64> = union
         .iter()
@@ -423,10 +381,7 @@ pub fn corrected_shape(
     #[allow(clippy::float_cmp)]
     let at_carriage_is_one = sum[0] == 1.0;
     if union.first() != Some(&0.0) || !at_carriage_is_one {
-        return Err(format!(
-            "the flowfield's corrected shape is {} at carriage: expected 1 (a correction of the shape starts at depth 0 with the value 0)",
-            sum[0]
-        ));
+        return Err(FieldChangeError::ShapeAtCarriage { value: sum[0] });
     }
     Ok((union, sum))
 }

@@ -33,10 +33,7 @@ impl CorrectionValues {
     /// scenario is checked when a run is set up, as the factors are).
     pub fn of(v: &[f64]) -> Result<CorrectionValues, CorrectionError> {
         if v.len() > MAX_CORRECTION_VALUES {
-            return Err(CorrectionError::TooMany(format!(
-                "{} correction values: a run carries at most {MAX_CORRECTION_VALUES}",
-                v.len()
-            )));
+            return Err(CorrectionError::TooManyValues { count: v.len() });
         }
         let mut c = CorrectionValues::NONE;
         c.values[..v.len()].copy_from_slice(v);
@@ -154,17 +151,17 @@ impl CorrectionRun {
         }
         let needed: usize = corrections.iter().map(|c| c.breakpoints.len()).sum();
         if values.len() != needed {
-            return Err(CorrectionError::Values(format!(
-                "the candidate carries {} correction values, the scenario's corrections have {needed} breakpoints",
-                values.len()
-            )));
+            return Err(CorrectionError::ValueCount {
+                carried: values.len(),
+                needed,
+            });
         }
         let v = values.as_slice();
         if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-            return Err(CorrectionError::Values(format!(
-                "correction value {k} is {}: expected a finite number",
-                v[k]
-            )));
+            return Err(CorrectionError::ValueNotFinite {
+                index: k,
+                value: v[k],
+            });
         }
         let mut at = 0;
         for c in corrections {

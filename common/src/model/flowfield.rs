@@ -31,7 +31,7 @@ use std::sync::Arc;
 use super::flowfield_grid::FieldGrid;
 pub use super::flowfield_shape::ShapeRun;
 use super::tables::AeroAtMach;
-use crate::correction::ShapeChange;
+use crate::correction::{FieldChangeError, ShapeChange};
 use crate::scenario::{FlowfieldSpec, MAX_STATIONS, MachScaling};
 use sepval_core::factors::{Factor, Factors};
 
@@ -267,17 +267,13 @@ impl FlowfieldRun {
     /// part the field does not have is changed (a table's shape has no depths; tables over
     /// position scale with alpha by their zero-lift angle, not a slope). A part not changed
     /// (0) keeps the field's bits.
-    pub fn with_change(mut self, change: [f64; 4]) -> Result<Self, String> {
+    pub fn with_change(mut self, change: [f64; 4]) -> Result<Self, FieldChangeError> {
         if change[..2].iter().any(|&c| c != 0.0) {
             self = self.with_shape_change([change[0], change[1]])?;
         }
         if change[2..].iter().any(|&c| c != 0.0) {
             if self.grid.is_some() {
-                return Err(
-                    "the flowfield is given as tables over position: it scales with alpha by its \
-                     zero-lift angle, with no upwash_per_alpha or sidewash_per_alpha to correct"
-                        .to_string(),
-                );
+                return Err(FieldChangeError::GridPerAlpha);
             }
             self.upwash[0] = self.per_alpha_rad[0].mul_add(change[2], self.upwash[0]);
             self.sidewash[0] = self.per_alpha_rad[1].mul_add(change[3], self.sidewash[0]);
@@ -288,15 +284,15 @@ impl FlowfieldRun {
     /// The field with its shape table corrected by `change` (a correction `flowfield.shape`
     /// over depth, [`crate::correction::corrected_shape`]); refused when the shape is not a
     /// table. No change keeps the field's bits.
-    pub fn with_shape_table_change(mut self, change: &ShapeChange) -> Result<Self, String> {
+    pub fn with_shape_table_change(
+        mut self,
+        change: &ShapeChange,
+    ) -> Result<Self, FieldChangeError> {
         if change.len == 0 {
             return Ok(self);
         }
         let Some(shape) = &self.shape else {
-            return Err(
-                "the flowfield's shape is not a table over depth: it has no table to correct"
-                    .to_string(),
-            );
+            return Err(FieldChangeError::NoShapeTable);
         };
         let n = change.len;
         self.shape = Some(shape.corrected(&change.depth_m[..n], &change.value[..n])?);
@@ -327,24 +323,21 @@ impl FlowfieldRun {
     }
 
     /// The shape changed by `change` \[1/m\] (added to 1 / L_z and 1 / z_r).
-    fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, String> {
+    fn with_shape_change(mut self, change: [f64; 2]) -> Result<Self, FieldChangeError> {
         if self.shape_is_tabulated() {
-            return Err(
-                "the flowfield's shape is a table: it has no half depth or reversal depth to correct"
-                    .to_string(),
-            );
+            return Err(FieldChangeError::ShapeIsTable);
         }
         let inv_half_depth = 1.0 / self.half_depth_m + change[0];
         let inv_reversal = self.inv_reversal_per_m + change[1];
         if !(inv_half_depth > 0.0 && inv_half_depth.is_finite()) {
-            return Err(format!(
-                "the flowfield's corrected 1 / half_depth_m is {inv_half_depth} per m: expected above 0"
-            ));
+            return Err(FieldChangeError::HalfDepth {
+                inverse: inv_half_depth,
+            });
         }
         if !(inv_reversal >= 0.0 && inv_reversal.is_finite()) {
-            return Err(format!(
-                "the flowfield's corrected 1 / reversal_m is {inv_reversal} per m: expected 0 or above"
-            ));
+            return Err(FieldChangeError::Reversal {
+                inverse: inv_reversal,
+            });
         }
         self.inv_half_depth_change_per_m += change[0];
         self.inv_reversal_per_m = inv_reversal;

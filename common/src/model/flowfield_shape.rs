@@ -2,7 +2,7 @@
 //! table"): section 1's piecewise-linear interpolation (`correction::interpolate`), held at the
 //! ends, for one run and for the lanes of a batch.
 
-use crate::correction::{corrected_shape, interpolate};
+use crate::correction::{FieldChangeError, corrected_shape, interpolate};
 use crate::lanes::Real;
 use crate::scenario::MAX_SHAPE_POINTS;
 
@@ -54,7 +54,7 @@ impl ShapeRun {
     }
 
     /// The table with the correction (`knots_m`, `change`) added ([`corrected_shape`]).
-    pub fn corrected(&self, knots_m: &[f64], change: &[f64]) -> Result<ShapeRun, String> {
+    pub fn corrected(&self, knots_m: &[f64], change: &[f64]) -> Result<ShapeRun, FieldChangeError> {
         let n = self.points;
         let (depth_m, g) = corrected_shape(&self.depth_m[..n], &self.g[..n], knots_m, change)?;
         Ok(ShapeRun::new(&depth_m, &g))

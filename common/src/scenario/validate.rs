@@ -29,7 +29,10 @@ impl Scenario {
             .map_err(|(k, e)| c.bad(&format!("correction[{k}]"), e.to_string()))?;
         for (k, x) in corrections.iter().enumerate() {
             let why = match x.target {
-                crate::correction::Target::ShapeTable => self.check_shape_table_correction(x).err(),
+                crate::correction::Target::ShapeTable => self
+                    .check_shape_table_correction(x)
+                    .err()
+                    .map(|e| e.to_string()),
                 crate::correction::Target::Field(part) => {
                     self.field_part_refusal(part).map(str::to_string)
                 }
@@ -78,12 +81,13 @@ impl Scenario {
     fn check_shape_table_correction(
         &self,
         x: &crate::correction::Correction,
-    ) -> Result<(), String> {
+    ) -> Result<(), crate::correction::FieldChangeError> {
+        use crate::correction::FieldChangeError;
         let Some(shape) = self.flowfield.as_ref().and_then(|f| f.shape.as_ref()) else {
-            return Err("the scenario has no [flowfield] shape table to correct".into());
+            return Err(FieldChangeError::NoShapeTableToCorrect);
         };
         if x.breakpoints.first() != Some(&0.0) {
-            return Err("a correction of the shape starts at depth 0 (where g stays 1)".into());
+            return Err(FieldChangeError::ShapeNotFromCarriage);
         }
         let zeros = vec![0.0; x.breakpoints.len()];
         crate::correction::corrected_shape(&shape.depth_m, &shape.g, &x.breakpoints, &zeros)

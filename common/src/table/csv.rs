@@ -463,7 +463,7 @@ impl Header {
                 Column::Value(..) => None,
             })
             .collect();
-        Table::new(axes, values, kind).map_err(|reason| self.error(1, reason))
+        Table::new(axes, values, kind).map_err(|reason| self.error(1, reason.to_string()))
     }
 }
 

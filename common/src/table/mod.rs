@@ -41,7 +41,6 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use sepval_core::limits::{MAX_MACH, MAX_POSITION_M};
-use sepval_core::number_text::Shown;
 use sepval_core::units::{M_PER_FT, M_PER_IN};
 
 pub use sepval_core::limits::MAX_TABLE_VALUES;
@@ -207,7 +206,7 @@ impl Kind {
     }
 
     /// A variable every table of this kind spans.
-    fn required(self) -> Option<Variable> {
+    pub(super) fn required(self) -> Option<Variable> {
         match self {
             Kind::Interference => Some(Variable::Distance),
             _ => None,
@@ -242,7 +241,7 @@ impl Kind {
         }
     }
 
-    fn what(self) -> &'static str {
+    pub(super) fn what(self) -> &'static str {
         match self {
             Kind::Static => "a static coefficient",
             Kind::Derivative => "a derivative",
@@ -252,7 +251,7 @@ impl Kind {
         }
     }
 
-    fn allowed_list(self, sep: &str) -> String {
+    pub(super) fn allowed_list(self, sep: &str) -> String {
         self.allowed()
             .iter()
             .map(|v| v.csv_name())
@@ -283,62 +282,8 @@ impl Table {
     /// A checked table of `kind`: one to three axes, each allowed for the kind and in nesting
     /// order, at least two finite strictly increasing breakpoints each, one finite value per
     /// grid point. The message says what is wrong (the caller says where).
-    pub fn new(axes: Vec<Axis>, values: Vec<f64>, kind: Kind) -> Result<Table, String> {
-        if axes.is_empty() || axes.len() > 3 {
-            return Err(format!(
-                "has {} axes: expected one to three of {}",
-                axes.len(),
-                kind.allowed_list(", ")
-            ));
-        }
-        let mut previous: Option<Variable> = None;
-        for a in &axes {
-            if !kind.allowed().contains(&a.variable) {
-                return Err(format!(
-                    "is a table over {}: {} may be tabulated over {} only",
-                    a.variable.csv_name(),
-                    kind.what(),
-                    kind.allowed_list(", ")
-                ));
-            }
-            let rank = |v: Variable| kind.allowed().iter().position(|&w| w == v);
-            if previous.is_some_and(|p| rank(p) >= rank(a.variable)) {
-                return Err(format!(
-                    "axes must nest in the order {}",
-                    kind.allowed_list(", ")
-                ));
-            }
-            previous = Some(a.variable);
-            check_breakpoints(a.variable, &a.breakpoints)?;
-        }
-        if let Some(r) = kind.required()
-            && !axes.iter().any(|a| a.variable == r)
-        {
-            return Err(format!(
-                "has no {} axis: {} is tabulated over {} at least",
-                r.csv_name(),
-                kind.what(),
-                r.csv_name()
-            ));
-        }
-        let points: usize = axes.iter().map(|a| a.breakpoints.len()).product();
-        if points > MAX_TABLE_VALUES {
-            return Err(format!(
-                "has {points} grid points, more than the limit of {MAX_TABLE_VALUES}"
-            ));
-        }
-        if values.len() != points {
-            return Err(format!(
-                "has {} values for a grid of {points} points",
-                values.len()
-            ));
-        }
-        if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-            return Err(format!(
-                "value {k} is {}: expected finite values",
-                values[k]
-            ));
-        }
+    pub fn new(axes: Vec<Axis>, values: Vec<f64>, kind: Kind) -> Result<Table, TableShapeError> {
+        check::check_table(&axes, &values, kind)?;
         Ok(Table { axes, values })
     }
 
@@ -393,56 +338,6 @@ impl Table {
     fn shape(&self) -> Vec<usize> {
         self.axes.iter().map(|a| a.breakpoints.len()).collect()
     }
-}
-
-fn check_breakpoints(v: Variable, b: &[f64]) -> Result<(), String> {
-    if b.len() < 2 {
-        return Err(format!(
-            "axis {} has {} breakpoint(s): expected at least 2 (give a constant instead of a table)",
-            v.csv_name(),
-            b.len()
-        ));
-    }
-    for (k, x) in b.iter().enumerate() {
-        if !x.is_finite() {
-            return Err(format!(
-                "axis {} breakpoint {k} is {x}: expected finite values",
-                v.csv_name()
-            ));
-        }
-        let (lo, hi, why) = v.domain();
-        if !(lo..=hi).contains(x) {
-            return Err(format!(
-                "axis {0} breakpoint {1} is outside {0}'s domain, {2} to {3}{4} ({why})",
-                v.csv_name(),
-                Shown(*x),
-                Shown(lo),
-                Shown(hi),
-                unit_suffix(v)
-            ));
-        }
-        if k > 0 && *x <= b[k - 1] {
-            return Err(format!(
-                "axis {} breakpoints are not strictly increasing: {x} after {}",
-                v.csv_name(),
-                b[k - 1]
-            ));
-        }
-        // An interval is interpolated across by its width's inverse: a width below 1e-308 (or
-        // above 1e308) has none that is finite and non-zero, and the value there would be NaN.
-        if k > 0 {
-            let inv = 1.0 / (x - b[k - 1]);
-            if !(inv.is_finite() && inv > 0.0) {
-                return Err(format!(
-                    "axis {} breakpoints {} and {x} are too close together or too far apart to \
-                     interpolate between (their spacing's inverse is {inv})",
-                    v.csv_name(),
-                    b[k - 1]
-                ));
-            }
-        }
-    }
-    Ok(())
 }
 
 /// ` deg`, ` m`, or nothing for Mach: the unit after a number in a message.
@@ -546,7 +441,7 @@ impl<K: TableKind> Tabulated<K> {
     }
 
     /// A table, checked for this kind.
-    pub fn table(t: Table) -> Result<Self, String> {
+    pub fn table(t: Table) -> Result<Self, TableShapeError> {
         Table::new(t.axes, t.values, K::KIND).map(|t| Tabulated {
             value: Coefficient::Table(t),
             kind: PhantomData,
@@ -587,11 +482,13 @@ impl<K: TableKind> Tabulated<K> {
     }
 }
 
+mod check;
 mod csv;
 mod error;
 mod excursion;
 mod prepared;
 mod serde_form;
+pub use check::TableShapeError;
 pub use csv::*;
 pub use error::*;
 pub use excursion::*;

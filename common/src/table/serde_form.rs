@@ -72,14 +72,11 @@ enum Nested {
 }
 
 impl RawTable {
-    fn into_coefficient(self, kind: Kind) -> Result<Coefficient, String> {
+    fn into_coefficient(self, kind: Kind) -> Result<Coefficient, InlineTableError> {
         let axes = self.axes(kind);
         if let Some(csv) = self.csv {
             if !axes.is_empty() || self.values.is_some() {
-                return Err(
-                    "a table is either a file (`csv`) or inline (axes and `values`), not both"
-                        .into(),
-                );
+                return Err(InlineTableError::FileAndInline);
             }
             return Ok(Coefficient::File(TableFile {
                 csv,
@@ -87,17 +84,10 @@ impl RawTable {
             }));
         }
         if self.column.is_some() {
-            return Err("`column` names a column of a `csv` file; there is none".into());
+            return Err(InlineTableError::ColumnWithoutFile);
         }
         let Some(values) = self.values else {
-            return Err(format!(
-                "an inline table needs its breakpoints ({}) and `values`",
-                kind.allowed()
-                    .iter()
-                    .map(|v| format!("`{}`", v.key()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
+            return Err(InlineTableError::NoValues { kind });
         };
         // Every axis is checked first, so that a ragged `values` is reported against a good
         // grid.
@@ -105,7 +95,7 @@ impl RawTable {
         Table::new(axes.clone(), vec![0.0; shape.iter().product()], kind)?;
         let last_axis = axes[shape.len() - 1].variable.csv_name();
         let flat = values.flatten(&shape, last_axis)?;
-        Table::new(axes, flat, kind).map(Coefficient::Table)
+        Ok(Coefficient::Table(Table::new(axes, flat, kind)?))
     }
 
     /// The axes given, in the kind's nesting order (a variable it may not span goes last, to
@@ -142,30 +132,43 @@ impl RawTable {
 impl Nested {
     /// The values, row-major, checked against the grid's `shape` (one array per axis, one value
     /// per breakpoint; `last_axis` names the innermost axis in a message).
-    fn flatten(self, shape: &[usize], last_axis: &str) -> Result<Vec<f64>, String> {
-        let ragged = |what: &str, k: usize, found: usize, expected: usize| {
-            Err(format!(
-                "`values`{what} {k} has {found} values, expected {expected} (one per breakpoint of the {last_axis} axis)"
-            ))
+    fn flatten(
+        self,
+        shape: &[usize],
+        last_axis: &'static str,
+    ) -> Result<Vec<f64>, InlineTableError> {
+        let ragged = |plane: Option<usize>, row: usize, found: usize, expected: usize| {
+            Err(InlineTableError::Ragged {
+                plane,
+                row,
+                found,
+                expected,
+                last_axis,
+            })
         };
         match (self, shape) {
             (Nested::D1(v), [n]) => {
                 if v.len() != *n {
-                    return Err(format!(
-                        "`values` has {} values, expected {n} (one per breakpoint)",
-                        v.len()
-                    ));
+                    return Err(InlineTableError::Count {
+                        found: v.len(),
+                        expected: *n,
+                        of: "values",
+                    });
                 }
                 Ok(v)
             }
             (Nested::D2(rows), [n0, n1]) => {
                 if rows.len() != *n0 {
-                    return Err(format!("`values` has {} rows, expected {n0}", rows.len()));
+                    return Err(InlineTableError::Count {
+                        found: rows.len(),
+                        expected: *n0,
+                        of: "rows",
+                    });
                 }
                 let mut flat = Vec::with_capacity(n0 * n1);
                 for (k, r) in rows.into_iter().enumerate() {
                     if r.len() != *n1 {
-                        return ragged(" row", k, r.len(), *n1);
+                        return ragged(None, k, r.len(), *n1);
                     }
                     flat.extend(r);
                 }
@@ -173,22 +176,24 @@ impl Nested {
             }
             (Nested::D3(planes), [n0, n1, n2]) => {
                 if planes.len() != *n0 {
-                    return Err(format!(
-                        "`values` has {} planes, expected {n0}",
-                        planes.len()
-                    ));
+                    return Err(InlineTableError::Count {
+                        found: planes.len(),
+                        expected: *n0,
+                        of: "planes",
+                    });
                 }
                 let mut flat = Vec::with_capacity(n0 * n1 * n2);
                 for (k, p) in planes.into_iter().enumerate() {
                     if p.len() != *n1 {
-                        return Err(format!(
-                            "`values` plane {k} has {} rows, expected {n1}",
-                            p.len()
-                        ));
+                        return Err(InlineTableError::PlaneRows {
+                            plane: k,
+                            found: p.len(),
+                            expected: *n1,
+                        });
                     }
                     for r in p {
                         if r.len() != *n2 {
-                            return ragged(&format!(" plane {k} row"), 0, r.len(), *n2);
+                            return ragged(Some(k), 0, r.len(), *n2);
                         }
                         flat.extend(r);
                     }
@@ -201,10 +206,10 @@ impl Nested {
                     Nested::D2(_) => 2,
                     Nested::D3(_) => 3,
                 };
-                Err(format!(
-                    "`values` is nested {depth} deep for a table of {} axes: nest one array per axis",
-                    s.len()
-                ))
+                Err(InlineTableError::Depth {
+                    depth,
+                    axes: s.len(),
+                })
             }
         }
     }
@@ -242,4 +247,80 @@ impl<'de, K: TableKind> Deserialize<'de> for Tabulated<K> {
         }
         d.deserialize_any(V(PhantomData))
     }
+}
+
+/// What makes an inline table (or a table's `csv` reference) in a scenario unusable; serde
+/// reports it at the table's place in the file.
+#[derive(Debug, thiserror::Error)]
+enum InlineTableError {
+    /// Both a file and inline values.
+    #[error("a table is either a file (`csv`) or inline (axes and `values`), not both")]
+    FileAndInline,
+    /// A column without a file.
+    #[error("`column` names a column of a `csv` file; there is none")]
+    ColumnWithoutFile,
+    /// Breakpoints without values.
+    #[error(
+        "an inline table needs its breakpoints ({}) and `values`",
+        kind.allowed()
+            .iter()
+            .map(|v| format!("`{}`", v.key()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )]
+    NoValues {
+        /// What the table tabulates.
+        kind: Kind,
+    },
+    /// The outermost array of `values` not one entry per breakpoint of the first axis.
+    #[error(
+        "`values` has {found} {of}, expected {expected}{}",
+        if *of == "values" { " (one per breakpoint)" } else { "" }
+    )]
+    Count {
+        /// The entries given.
+        found: usize,
+        /// The breakpoints of the first axis.
+        expected: usize,
+        /// What the entries are: "values", "rows" or "planes".
+        of: &'static str,
+    },
+    /// A plane of a three-axis table without one row per breakpoint of the second axis.
+    #[error("`values` plane {plane} has {found} rows, expected {expected}")]
+    PlaneRows {
+        /// The plane.
+        plane: usize,
+        /// Its rows.
+        found: usize,
+        /// The breakpoints of the second axis.
+        expected: usize,
+    },
+    /// A row without one value per breakpoint of the last axis.
+    #[error(
+        "`values`{} row {row} has {found} values, expected {expected} (one per breakpoint of the {last_axis} axis)",
+        plane.map(|k| format!(" plane {k}")).unwrap_or_default()
+    )]
+    Ragged {
+        /// Its plane, in a table of three axes.
+        plane: Option<usize>,
+        /// The row (0 in a plane: the message says which plane).
+        row: usize,
+        /// Its values.
+        found: usize,
+        /// The breakpoints of the last axis.
+        expected: usize,
+        /// The last axis.
+        last_axis: &'static str,
+    },
+    /// `values` nested to another depth than the axes.
+    #[error("`values` is nested {depth} deep for a table of {axes} axes: nest one array per axis")]
+    Depth {
+        /// Its depth.
+        depth: usize,
+        /// The axes.
+        axes: usize,
+    },
+    /// Axes or values the table refuses.
+    #[error(transparent)]
+    Shape(#[from] super::TableShapeError),
 }

@@ -194,6 +194,7 @@ fn a_band_that_does_not_fit_its_table_is_refused() {
         }],
         &provenance(),
     )
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("not one per value of its table"), "{e}");
 }

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::Checkpoint;
+use super::content::DigestMismatch;
 use sepval_solve::ga::GaState;
 
 /// Hex digits of a part's digest.
@@ -108,39 +109,30 @@ impl Checkpoint {
     }
 
     /// Checks `stored` against the content; on a mismatch, says what differs.
-    pub(super) fn check_digest(&self, stored: &Digest) -> Result<(), String> {
+    pub(super) fn check_digest(&self, stored: &Digest) -> Result<(), DigestMismatch> {
         let parts = self.parts();
         let whole = hex_sha256(&self.canonical_form()) == stored.sha256;
-        let changed: Vec<&str> = parts
+        let changed: Vec<String> = parts
             .iter()
             .filter(|(name, hash)| stored.parts.get(name) != Some(hash))
-            .map(|(name, _)| name.as_str())
+            .map(|(name, _)| name.clone())
             .collect();
         let names: BTreeSet<&str> = parts.iter().map(|(name, _)| name.as_str()).collect();
-        let gone: Vec<&str> = stored
+        let gone: Vec<String> = stored
             .parts
             .keys()
-            .map(String::as_str)
-            .filter(|name| !names.contains(name))
+            .filter(|name| !names.contains(name.as_str()))
+            .cloned()
             .collect();
         if whole && changed.is_empty() && gone.is_empty() {
             return Ok(());
         }
-        if whole {
-            // The content is the one digested: the record of its parts was edited.
-            return Err("changed: digest.parts".into());
-        }
-        let mut what = Vec::new();
-        if !changed.is_empty() {
-            what.push(format!("changed: {}", listed(&changed)));
-        }
-        if !gone.is_empty() {
-            what.push(format!("gone: {}", listed(&gone)));
-        }
-        if what.is_empty() {
-            what.push("changed: digest.sha256".into());
-        }
-        Err(what.join("; "))
+        // When the content is the one digested, the record of its parts was edited.
+        Err(DigestMismatch {
+            changed,
+            gone,
+            parts_only: whole,
+        })
     }
 }
 
@@ -153,7 +145,7 @@ fn part<T: Serialize + ?Sized>(name: &str, value: &T) -> (String, String) {
 }
 
 /// `a, b, c and 4 more`.
-fn listed(names: &[&str]) -> String {
+pub(super) fn listed(names: &[String]) -> String {
     let mut text = names[..names.len().min(NAMED)].join(", ");
     if names.len() > NAMED {
         text.push_str(&format!(" and {} more", names.len() - NAMED));

@@ -61,6 +61,7 @@
 //! those with an infinite statistic, could not be read anyway: it was written as `null`). Run
 //! the fit again to get checkpoints of the current format.
 
+mod content;
 mod digest;
 mod verify;
 
@@ -70,6 +71,7 @@ use sepval_common::evaluation::Job;
 use sepval_core::atomic_file::{WriteError, write_atomically};
 use serde::{Deserialize, Serialize};
 
+pub use self::content::{ContentError, DigestMismatch, MemberError};
 pub use self::digest::Digest;
 use crate::sigma::Sigma;
 use sepval_solve::ga::{GaSettings, GaState};
@@ -100,15 +102,15 @@ pub enum CheckpointError {
         /// The file.
         path: PathBuf,
         /// What differs (`changed: state.population[4]`).
-        what: String,
+        what: Box<DigestMismatch>,
     },
     /// The file does not fit this sepval or its job, or its content is inconsistent.
-    #[error("checkpoint {path}: {message}")]
+    #[error("checkpoint {path}: {reason}")]
     Invalid {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        message: String,
+        reason: Box<ContentError>,
     },
     /// A job other than the checkpoint's.
     #[error(
@@ -222,44 +224,33 @@ impl Checkpoint {
             path: path.to_path_buf(),
             source,
         };
-        let invalid = |message: String| CheckpointError::Invalid {
+        let invalid = |reason: ContentError| CheckpointError::Invalid {
             path: path.to_path_buf(),
-            message,
+            reason: Box::new(reason),
         };
         let format = serde_json::from_str::<FormatOnly>(&text)
             .map_err(parse)?
             .format;
         if format == CHECKPOINT_FORMAT_1 {
-            return Err(invalid(format!(
-                "format `{format}` was written by an earlier sepval, without a digest of its \
-                 content, so an edit to it cannot be detected: this sepval reads only \
-                 `{CHECKPOINT_FORMAT}`; run the fit again"
-            )));
+            return Err(invalid(ContentError::EarlierFormat { format }));
         }
         if format != CHECKPOINT_FORMAT {
-            return Err(invalid(format!(
-                "format `{format}`, this sepval reads `{CHECKPOINT_FORMAT}`"
-            )));
+            return Err(invalid(ContentError::OtherFormat { format }));
         }
         let mut c: Checkpoint = serde_json::from_str(&text).map_err(parse)?;
         let file: serde_json::Value = serde_json::from_str(&text).map_err(parse)?;
         let stored = c.digest.take();
         if let Some(key) = digest::unread_key(&file, &serde_json::to_value(&c).expect("serialises"))
         {
-            return Err(invalid(format!(
-                "`{key}` is not part of a sepval checkpoint (edited by hand?)"
-            )));
+            return Err(invalid(ContentError::UnknownKey { key }));
         }
         let Some(stored) = stored else {
-            return Err(invalid(
-                "no digest of its content (`digest`): edited by hand, or not written by sepval"
-                    .into(),
-            ));
+            return Err(invalid(ContentError::NoDigest));
         };
         c.check_digest(&stored)
             .map_err(|what| CheckpointError::Edited {
                 path: path.to_path_buf(),
-                what,
+                what: Box::new(what),
             })?;
         c.check_content().map_err(invalid)?;
         c.digest = Some(stored);
@@ -294,9 +285,9 @@ impl Checkpoint {
             ));
         }
         self.check_members(job)
-            .map_err(|message| CheckpointError::Invalid {
+            .map_err(|reason| CheckpointError::Invalid {
                 path: path.to_path_buf(),
-                message,
+                reason: Box::new(reason),
             })
     }
 }

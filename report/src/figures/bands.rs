@@ -5,11 +5,11 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::FigureError;
 use super::kit::{
     LegendMark, band_polygon, colour, draw_legend_strip, draw_mesh, draw_polyline, fmt_tick,
     padded_range, plottable, render, text, tint,
 };
+use super::{FigureError, FigureInput};
 
 /// The six channels: caption and unit, in the order of a sample's values.
 const CHANNELS: [(&str, &str); 6] = [
@@ -54,10 +54,10 @@ pub fn band_figure(
         if b.lo.len() != n || b.mid.len() != n || b.hi.len() != n {
             return Err(FigureError::Input {
                 path: path.to_path_buf(),
-                message: format!(
-                    "band of {} has edges of another length than {n} times",
-                    CHANNELS[k].0
-                ),
+                reason: FigureInput::BandEdges {
+                    channel: CHANNELS[k].0,
+                    times: n,
+                },
             });
         }
     }
@@ -66,7 +66,11 @@ pub fn band_figure(
     {
         return Err(FigureError::Input {
             path: path.to_path_buf(),
-            message: format!("data {label:?} has {} samples for {n} times", d.len()),
+            reason: FigureInput::Data {
+                label: label.to_string(),
+                samples: d.len(),
+                times: n,
+            },
         });
     }
     render(path, (1600, 1000), |root| {

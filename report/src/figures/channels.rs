@@ -5,11 +5,11 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::FigureError;
 use super::kit::{
     LegendMark, colour, draw_legend_strip, draw_mesh, draw_polyline, fmt_tick, padded_range,
     render, text,
 };
+use super::{FigureError, FigureInput};
 
 /// The six channels: caption and unit, in the order of a sample's values.
 const CHANNELS: [(&str, &str); 6] = [
@@ -34,11 +34,11 @@ pub fn channel_figure(
         if values.len() != times_s.len() {
             return Err(FigureError::Input {
                 path: path.to_path_buf(),
-                message: format!(
-                    "set {label:?} has {} samples for {} times",
-                    values.len(),
-                    times_s.len()
-                ),
+                reason: FigureInput::Set {
+                    label: label.to_string(),
+                    samples: values.len(),
+                    times: times_s.len(),
+                },
             });
         }
     }

@@ -25,12 +25,12 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::FigureError;
 use super::kit::{
     Chart2d, DrawResult, Root, box_mark, colour, draw_dashed, draw_legend, draw_mesh,
     estimate_width, fmt_tick, legend_corner, line_mark, padded_range, padded_range_from_zero,
     plottable, plottable_point, render, segments, text,
 };
+use super::{FigureError, FigureInput};
 
 /// One release's clearance along time.
 #[derive(Debug, Clone, Copy)]
@@ -88,9 +88,9 @@ pub fn clearance_figure(
     series: &[ClearanceSeries<'_>],
     criterion_m: f64,
 ) -> Result<(), FigureError> {
-    let layout = Layout::of(series, criterion_m).map_err(|message| FigureError::Input {
+    let layout = Layout::of(series, criterion_m).map_err(|e| FigureError::Input {
         path: path.to_path_buf(),
-        message: format!("clearance figure: {message}"),
+        reason: FigureInput::Clearance(e),
     })?;
     render(path, SIZE_PX, |root| {
         let (_, body) = root.split_vertically(8);
@@ -142,32 +142,66 @@ pub(super) struct Layout {
     pub(super) held_until_s: f64,
 }
 
+/// A clearance figure's series or criterion that cannot be drawn.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ClearanceInput {
+    /// No series.
+    #[error("no release to draw")]
+    NoRelease,
+    /// A criterion that is not finite or is negative.
+    #[error("the criterion must be finite and not negative, found {criterion_m} m")]
+    Criterion {
+        /// The criterion \[m\].
+        criterion_m: f64,
+    },
+    /// A release whose clearances are not one per time.
+    #[error("release {label:?} has {clearances} clearances for {times} times")]
+    Lengths {
+        /// The release.
+        label: String,
+        /// Its clearances.
+        clearances: usize,
+        /// Its times.
+        times: usize,
+    },
+    /// A release whose free-from time is not finite.
+    #[error(
+        "release {label:?}: the time from which the clearance counts must be finite, found {free_from_s} s"
+    )]
+    FreeFrom {
+        /// The release.
+        label: String,
+        /// The time from which its clearance counts \[s\].
+        free_from_s: f64,
+    },
+}
+
 impl Layout {
     /// Checks `series` and `criterion_m` and decides the ranges; what does not fit, in words.
-    pub(super) fn of(series: &[ClearanceSeries<'_>], criterion_m: f64) -> Result<Self, String> {
+    pub(super) fn of(
+        series: &[ClearanceSeries<'_>],
+        criterion_m: f64,
+    ) -> Result<Self, ClearanceInput> {
         if series.is_empty() {
-            return Err("no release to draw".to_string());
+            return Err(ClearanceInput::NoRelease);
         }
         if !(plottable(criterion_m) && criterion_m >= 0.0) {
-            return Err(format!(
-                "the criterion must be finite and not negative, found {criterion_m} m"
-            ));
+            return Err(ClearanceInput::Criterion { criterion_m });
         }
         for s in series {
             if s.t_s.len() != s.clearance_m.len() {
-                return Err(format!(
-                    "release {:?} has {} clearances for {} times",
-                    s.label,
-                    s.clearance_m.len(),
-                    s.t_s.len()
-                ));
+                return Err(ClearanceInput::Lengths {
+                    label: s.label.to_string(),
+                    clearances: s.clearance_m.len(),
+                    times: s.t_s.len(),
+                });
             }
             if !plottable(s.free_from_s) {
-                return Err(format!(
-                    "release {:?}: the time from which the clearance counts must be finite, \
-                     found {} s",
-                    s.label, s.free_from_s
-                ));
+                return Err(ClearanceInput::FreeFrom {
+                    label: s.label.to_string(),
+                    free_from_s: s.free_from_s,
+                });
             }
         }
         let criterion_mm = 1e3 * criterion_m;

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::FigureError;
 use super::kit::{DrawResult, Root, draw_mesh, fmt_tick, plottable, render, text};
+use super::{FigureError, FigureInput};
 
 /// One axis of a condition map: its label and its values (increasing).
 #[derive(Debug, Clone, Copy)]
@@ -70,11 +70,11 @@ pub(super) fn check_cells<T>(
     if cells.len() != rows || cells.iter().any(|r| r.len() != x.values.len()) {
         return Err(FigureError::Input {
             path: path.to_path_buf(),
-            message: format!(
-                "the map must be {rows} rows of {} cells, found {} rows",
-                x.values.len(),
-                cells.len()
-            ),
+            reason: FigureInput::Map {
+                rows,
+                columns: x.values.len(),
+                found: cells.len(),
+            },
         });
     }
     Ok(())

@@ -7,12 +7,12 @@ use std::path::Path;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::FigureError;
 use super::kit::{
     Chart2d, DrawResult, FLOOR_GREY, LegendMark, Root, band_polygon, colour, draw_dashed,
     draw_legend_strip, draw_mesh, draw_polyline, fmt_tick, padded_range, plottable,
     plottable_point, render, text, tint,
 };
+use super::{FigureError, FigureInput};
 
 /// One correction: its value and standard deviation along its variable, what the releases
 /// explored, its breakpoints, and (optionally) the evidence it was chosen from.
@@ -59,15 +59,14 @@ pub fn correction_figure(
         {
             return Err(FigureError::Input {
                 path: path.to_path_buf(),
-                message: format!(
-                    "panel {:?}: {} points, {} values, {} standard deviations, {} breakpoints for {} values",
-                    p.caption,
-                    p.x.len(),
-                    p.value.len(),
-                    p.std.len(),
-                    p.knots.0.len(),
-                    p.knots.1.len()
-                ),
+                reason: FigureInput::CorrectionPanel {
+                    caption: p.caption.to_string(),
+                    points: p.x.len(),
+                    values: p.value.len(),
+                    stds: p.std.len(),
+                    breakpoints: p.knots.0.len(),
+                    knot_values: p.knots.1.len(),
+                },
             });
         }
     }

@@ -6,8 +6,8 @@ use plotters::prelude::*;
 use plotters::style::FontTransform;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::FigureError;
 use super::kit::{DrawResult, Root, estimate_width, fmt_tick, render, text};
+use super::{FigureError, FigureInput};
 
 /// The most rows and columns a correlation figure draws (2 px a cell).
 const MAX_CORRELATION_NAMES: usize = 450;
@@ -45,9 +45,9 @@ pub fn correlation_figure(
     rho: &[Vec<f64>],
     title: &str,
 ) -> Result<(), FigureError> {
-    check_shape(names.len(), rho).map_err(|message| FigureError::Input {
+    check_shape(names.len(), rho).map_err(|reason| FigureError::Input {
         path: path.to_path_buf(),
-        message,
+        reason,
     })?;
     let layout = Layout::of(names);
     let (width, height) = (layout.width, layout.height);
@@ -69,18 +69,19 @@ pub fn correlation_figure(
 }
 
 /// Checks that `rho` is n × n and that n is not above [`MAX_CORRELATION_NAMES`].
-fn check_shape(n: usize, rho: &[Vec<f64>]) -> Result<(), String> {
+fn check_shape(n: usize, rho: &[Vec<f64>]) -> Result<(), FigureInput> {
     if rho.len() != n || rho.iter().any(|row| row.len() != n) {
-        let shape: Vec<usize> = rho.iter().map(Vec::len).collect();
-        return Err(format!(
-            "the correlation matrix must be {n} × {n} for {n} names, found {} rows of lengths {shape:?}",
-            rho.len()
-        ));
+        return Err(FigureInput::CorrelationShape {
+            n,
+            rows: rho.len(),
+            lengths: rho.iter().map(Vec::len).collect(),
+        });
     }
     if n > MAX_CORRELATION_NAMES {
-        return Err(format!(
-            "{n} names: a correlation figure draws at most {MAX_CORRELATION_NAMES}"
-        ));
+        return Err(FigureInput::CorrelationNames {
+            n,
+            max: MAX_CORRELATION_NAMES,
+        });
     }
     Ok(())
 }

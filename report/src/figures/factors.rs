@@ -7,11 +7,11 @@ use plotters::prelude::*;
 use plotters::style::FontTransform;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::FigureError;
 use super::kit::{
     Chart2d, DrawResult, Root, box_mark, colour, draw_dashed, draw_legend, estimate_width,
     fmt_tick, line_mark, plottable, render, text,
 };
+use super::{FigureError, FigureInput};
 
 /// `value` normalised to `range` ((value − min) / (max − min)), if that can be drawn.
 fn normalise(value: f64, (min, max): (f64, f64)) -> Option<f64> {
@@ -36,10 +36,10 @@ pub fn factor_figure(
     methods: &[(&str, &[f64])],
     truth: Option<&[f64]>,
 ) -> Result<(), FigureError> {
-    check_lengths(names.len(), ranges.len(), methods, truth).map_err(|message| {
+    check_lengths(names.len(), ranges.len(), methods, truth).map_err(|reason| {
         FigureError::Input {
             path: path.to_path_buf(),
-            message,
+            reason,
         }
     })?;
     let bars = Bars::of(ranges, methods, truth);
@@ -71,20 +71,24 @@ fn check_lengths(
     ranges: usize,
     methods: &[(&str, &[f64])],
     truth: Option<&[f64]>,
-) -> Result<(), String> {
+) -> Result<(), FigureInput> {
     if ranges != n {
-        return Err(format!("{n} factor names but {ranges} ranges"));
+        return Err(FigureInput::FactorRanges { names: n, ranges });
     }
     for (label, values) in methods {
         if values.len() != n {
-            return Err(format!(
-                "method {label:?} gives {} values for {n} factors",
-                values.len()
-            ));
+            return Err(FigureInput::MethodValues {
+                label: label.to_string(),
+                values: values.len(),
+                factors: n,
+            });
         }
     }
     if let Some(given) = truth.map(<[f64]>::len).filter(|&len| len != n) {
-        return Err(format!("the truth gives {given} values for {n} factors"));
+        return Err(FigureInput::TruthValues {
+            values: given,
+            factors: n,
+        });
     }
     Ok(())
 }

@@ -5,12 +5,12 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::FigureError;
 use super::kit::{
     DrawResult, FLOOR_GREY, LegendMark, Root, colour, draw_dashed, draw_legend_strip, draw_mesh,
     draw_polyline, fmt_tick, padded_range, plottable, plottable_point, render, segments, text,
     tint,
 };
+use super::{FigureError, FigureInput};
 
 /// One event's reconstructed increment on one axis: per window, its mid-time, the increment
 /// and the increment's standard deviation (three vectors of one length).
@@ -81,36 +81,31 @@ pub fn increment_figure(
 
 /// Refuses series and found-term curves whose vectors differ in length.
 fn check_lengths(path: &Path, panels: &[IncrementPanel]) -> Result<(), FigureError> {
-    let refuse = |message: String| FigureError::Input {
+    let refuse = |reason: FigureInput| FigureError::Input {
         path: path.to_path_buf(),
-        message,
+        reason,
     };
     for panel in panels {
         for s in &panel.series {
             if s.value.len() != s.t_s.len() || s.std.len() != s.t_s.len() {
-                return Err(refuse(format!(
-                    "panel {:?}, series {:?}: {} times, {} values and {} standard deviations \
-                     (one of each per window)",
-                    panel.axis,
-                    s.label,
-                    s.t_s.len(),
-                    s.value.len(),
-                    s.std.len()
-                )));
+                return Err(refuse(FigureInput::IncrementSeries {
+                    axis: panel.axis.to_string(),
+                    label: s.label.to_string(),
+                    times: s.t_s.len(),
+                    values: s.value.len(),
+                    stds: s.std.len(),
+                }));
             }
         }
         for (j, (times, values)) in panel.model.iter().enumerate() {
             if values.len() != times.len() {
-                let event = panel
-                    .series
-                    .get(j)
-                    .map_or_else(|| format!("event {}", j + 1), |s| format!("{:?}", s.label));
-                return Err(refuse(format!(
-                    "panel {:?}, found-terms curve of {event}: {} times for {} values",
-                    panel.axis,
-                    times.len(),
-                    values.len()
-                )));
+                return Err(refuse(FigureInput::IncrementModel {
+                    axis: panel.axis.to_string(),
+                    event: j,
+                    label: panel.series.get(j).map(|s| s.label.to_string()),
+                    times: times.len(),
+                    values: values.len(),
+                }));
             }
         }
     }

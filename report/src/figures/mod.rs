@@ -71,6 +71,7 @@ mod envelope_map;
 mod envelope_scale;
 mod factors;
 mod increments;
+mod input;
 mod kit;
 mod pareto;
 mod residuals;
@@ -93,6 +94,7 @@ pub use envelope_map::{EnvelopeMap, envelope_map};
 pub use envelope_scale::Safety;
 pub use factors::factor_figure;
 pub use increments::{IncrementPanel, IncrementSeries, increment_figure};
+pub use input::FigureInput;
 pub use pareto::pareto_figure;
 pub use residuals::residual_figure;
 pub use state_counts::{RoundCounts, state_counts_figure};
@@ -126,12 +128,12 @@ pub struct Series<'a> {
 #[non_exhaustive]
 pub enum FigureError {
     /// The inputs do not fit together (for example fewer names than factors).
-    #[error("{}: {message}", path.display())]
+    #[error("{}: {reason}", path.display())]
     Input {
         /// The figure file.
         path: PathBuf,
         /// What does not fit.
-        message: String,
+        reason: FigureInput,
     },
     /// The embedded font could not be loaded.
     #[error("{}: cannot load the embedded font DejaVuSans.ttf", path.display())]
@@ -139,7 +141,8 @@ pub enum FigureError {
         /// The figure file.
         path: PathBuf,
     },
-    /// The plotting library failed to draw the figure.
+    /// The plotting library failed to draw the figure (its words: plotters' error borrows the
+    /// image being drawn, and a panic carries text only).
     #[error("{}: cannot draw the figure: {message}", path.display())]
     Draw {
         /// The figure file.

@@ -4,11 +4,11 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::FigureError;
 use super::kit::{
     FLOOR_GREY, LegendMark, colour, draw_legend_strip, draw_mesh, draw_polyline, fmt_tick,
     padded_range, plottable, render, text,
 };
+use super::{FigureError, FigureInput};
 
 /// The six residual channels: caption, unit, whether the channel is a position.
 const RESIDUAL_CHANNELS: [(&str, &str, bool); 6] = [
@@ -39,11 +39,11 @@ pub fn residual_figure(
         if values.len() != times_s.len() {
             return Err(FigureError::Input {
                 path: path.to_path_buf(),
-                message: format!(
-                    "residual set {label:?} has {} samples for {} times",
-                    values.len(),
-                    times_s.len()
-                ),
+                reason: FigureInput::Residuals {
+                    label: label.to_string(),
+                    samples: values.len(),
+                    times: times_s.len(),
+                },
             });
         }
     }

@@ -86,9 +86,14 @@ pub enum GaError {
     /// A saved generator that cannot be restored.
     #[error(transparent)]
     Rng(#[from] RngStateError),
-    /// A state that does not fit the settings or the problem.
-    #[error("GA state does not fit: {0}")]
-    State(String),
+    /// A state whose population does not have the settings' size.
+    #[error("GA state does not fit: population of {members} members, settings say {population}")]
+    Population {
+        /// The state's members.
+        members: usize,
+        /// The settings' population.
+        population: usize,
+    },
     /// The evaluator failed.
     #[error(transparent)]
     Eval(#[from] EvalError),
@@ -288,11 +293,10 @@ impl GaSearch {
     ) -> Result<Self, GaError> {
         let mut s = GaSearch::new(settings, weights, genes)?;
         if state.population.len() != s.settings.population {
-            return Err(GaError::State(format!(
-                "population of {} members, settings say {}",
-                state.population.len(),
-                s.settings.population
-            )));
+            return Err(GaError::Population {
+                members: state.population.len(),
+                population: s.settings.population,
+            });
         }
         state.rng.restore()?;
         s.state = Some(state);

@@ -26,7 +26,7 @@ use zenoh::sample::SampleKind;
 
 use super::{Role, keys, zerr};
 use crate::codec::{CodecError, Frame};
-use crate::link::{Link, LinkEvent, NextJob, Notice, WorkerId};
+use crate::link::{Link, LinkEvent, NextJob, Notice, SendError, WorkerId};
 use crate::setup::encode_setup_as;
 use crate::wire::{Chunk, PROTOCOL_VERSION};
 use crate::{RunId, TransportError};
@@ -324,16 +324,19 @@ impl ZenohLink {
 }
 
 impl Link for ZenohLink {
-    fn send(&mut self, worker: WorkerId, chunk: &Chunk) -> Result<(), String> {
+    fn send(&mut self, worker: WorkerId, chunk: &Chunk) -> Result<(), SendError> {
         let w = self
             .workers
             .values()
             .find(|w| w.id == worker)
-            .ok_or_else(|| format!("no worker {worker}"))?;
+            .ok_or(SendError::NoWorker { worker })?;
         w.publisher
             .put(Frame::Chunk(chunk.clone()).encode())
             .wait()
-            .map_err(|e| e.to_string())
+            .map_err(|e| SendError::Refused {
+                what: "",
+                detail: e.to_string(),
+            })
     }
 
     fn poll(
@@ -347,7 +350,7 @@ impl Link for ZenohLink {
             Ok(h) => self.heard(h, events)?,
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => {
-                return Err(TransportError::Protocol("the zenoh session closed".into()));
+                return Err(TransportError::ZenohClosed);
             }
         }
         while let Ok(h) = self.heard.try_recv() {

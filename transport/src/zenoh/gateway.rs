@@ -56,17 +56,11 @@ impl Server for Gateway {
     }
 
     fn serve(&mut self, chunks: &[Chunk]) -> Result<Vec<Answer>, TransportError> {
-        let local = self
-            .local
-            .as_mut()
-            .ok_or_else(|| TransportError::Serve("the host's iceoryx2 workers are gone".into()))?;
+        let local = self.local.as_mut().ok_or(TransportError::LocalGone)?;
         serve_chunks(&self.job, chunks, |batch, with_samples| {
-            local.evaluate(batch, with_samples).map_err(|e| {
-                TransportError::Serve(format!(
-                    "the host's iceoryx2 workers failed: {}",
-                    crate::error_chain(&e)
-                ))
-            })
+            local
+                .evaluate(batch, with_samples)
+                .map_err(|e| TransportError::LocalFailed { cause: Box::new(e) })
         })
     }
 

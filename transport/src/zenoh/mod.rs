@@ -51,7 +51,9 @@ pub fn zerr(context: impl Into<String>) -> impl FnOnce(zenoh::Error) -> Transpor
 /// Checks an endpoint given on the command line: `PROTOCOL/HOST:PORT`, port not 0 (workers must
 /// know where to connect).
 pub fn validate_endpoint(endpoint: &str) -> Result<(), TransportError> {
-    let bad = || TransportError::Endpoint(endpoint.to_string());
+    let bad = || TransportError::Endpoint {
+        endpoint: endpoint.to_string(),
+    };
     let (proto, addr) = endpoint.split_once('/').ok_or_else(bad)?;
     if proto.is_empty() || !proto.chars().all(|c| c.is_ascii_alphanumeric()) {
         return Err(bad());

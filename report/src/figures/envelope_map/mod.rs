@@ -18,7 +18,6 @@ use std::path::Path;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::FigureError;
 use super::condition_map::{MapAxis, NO_VALUE_GREY, edges};
 use super::contour::{
     GridError, Segment, check_axis, check_shape, contour_segments, row_crossings,
@@ -28,6 +27,7 @@ use super::kit::{
     Chart2d, DrawResult, LegendMark, RING_RADIUS_PX, draw_mesh, fmt_tick, plottable,
     plottable_point, render, ring_style, text, titled_with_legend,
 };
+use super::{FigureError, FigureInput};
 use plotters::coord::types::RangedCoordf64;
 
 /// The colour of the marks of releases flown (blue: on no colour of the scale).
@@ -70,16 +70,15 @@ pub struct EnvelopeMap<'a> {
 /// without) of one value per x value, and a criterion that is not finite are refused with
 /// [`FigureError::Input`] before anything is written.
 pub fn envelope_map(path: &Path, map: &EnvelopeMap<'_>) -> Result<(), FigureError> {
-    let input = |message: String| FigureError::Input {
+    let input = |reason: FigureInput| FigureError::Input {
         path: path.to_path_buf(),
-        message,
+        reason,
     };
-    let checked = check(map).map_err(|e| input(format!("envelope map: {e}")))?;
+    let checked = check(map).map_err(|e| input(FigureInput::EnvelopeGrid(e)))?;
     if !plottable(map.criterion) {
-        return Err(input(format!(
-            "envelope map: the criterion must be finite, found {}",
-            map.criterion
-        )));
+        return Err(input(FigureInput::EnvelopeCriterion {
+            criterion: map.criterion,
+        }));
     }
     let scale = Scale::new(
         checked.cells.iter().flatten().copied(),
@@ -94,7 +93,7 @@ pub fn envelope_map(path: &Path, map: &EnvelopeMap<'_>) -> Result<(), FigureErro
     };
     let flown = Flown::within(map.flown, &extent, map.y.is_some());
     let contour =
-        contour(map, &checked, &extent).map_err(|e| input(format!("envelope map: {e}")))?;
+        contour(map, &checked, &extent).map_err(|e| input(FigureInput::EnvelopeGrid(e)))?;
     let entries = legend(map, &checked, &contour, &flown);
     render(path, (1200, 900), |root| {
         let rest = titled_with_legend(root, map.title, &entries)?;

@@ -36,7 +36,7 @@ use sepval_core::cancel;
 use super::{
     COORDINATOR_NODE, IN_FLIGHT_PER_WORKER, MAX_WORKERS, node, node_states, presence, run_config,
 };
-use crate::link::{Link, LinkEvent, Notice, WorkerId};
+use crate::link::{Link, LinkEvent, Notice, SendError, WorkerId};
 use crate::wire::{Chunk, Hello, MAGIC, PROTOCOL_VERSION};
 use crate::{RunId, TransportError, iox};
 use port::{Port, Received};
@@ -137,7 +137,9 @@ impl IpcLink {
         // Stale resources of processes killed in an earlier run with this id.
         node.try_cleanup_dead_nodes();
         if presence(&cfg, COORDINATOR_NODE)?.alive > 1 {
-            return Err(TransportError::RunTaken(options.run_id.to_string()));
+            return Err(TransportError::RunTaken {
+                run: options.run_id.to_string(),
+            });
         }
         let services = RunServices::create(&node)?;
         if options.launch == Launch::Attach {
@@ -371,10 +373,10 @@ impl IpcLink {
 }
 
 impl Link for IpcLink {
-    fn send(&mut self, worker: WorkerId, chunk: &Chunk) -> Result<(), String> {
+    fn send(&mut self, worker: WorkerId, chunk: &Chunk) -> Result<(), SendError> {
         self.ports
             .get_mut(&worker)
-            .ok_or_else(|| format!("no worker {worker}"))?
+            .ok_or(SendError::NoWorker { worker })?
             .send(chunk)
     }
 

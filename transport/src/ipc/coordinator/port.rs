@@ -14,6 +14,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 
 use super::super::{REQUEST_BUFFER, names, open_chunk_service, service_name};
+use crate::link::SendError;
 use crate::wire::{Answer, Chunk, ChunkHeader, Hello, WireObservation, WireRequest, WireResponse};
 use crate::{TransportError, iox};
 
@@ -82,16 +83,22 @@ impl Port {
     }
 
     /// Sends `chunk` and wakes the worker. An error means the worker cannot be reached.
-    pub(super) fn send(&mut self, chunk: &Chunk) -> Result<(), String> {
+    pub(super) fn send(&mut self, chunk: &Chunk) -> Result<(), SendError> {
         let mut sample = self
             .requests
             .loan_slice_uninit(chunk.requests.len())
-            .map_err(|e| format!("loaning a request chunk: {e:?}"))?;
+            .map_err(|e| SendError::Refused {
+                what: "loaning a request chunk: ",
+                detail: format!("{e:?}"),
+            })?;
         *sample.user_header_mut() = chunk.header;
         sample
             .write_from_fn(|k| chunk.requests[k])
             .send()
-            .map_err(|e| format!("sending a request chunk: {e:?}"))?;
+            .map_err(|e| SendError::Refused {
+                what: "sending a request chunk: ",
+                detail: format!("{e:?}"),
+            })?;
         let _ = self.wake.notify();
         Ok(())
     }
