@@ -59,6 +59,8 @@ MAY_USE = {
                "sepval-update", "sepval-campaign", "sepval-geometry", "sepval-report",
                "sepval-daveml"},
     "sepval-daveml": {"sepval-core", "sepval-common"},
+    # The estimate from the shape: the store TOML's reader, the table form, the DAVE-ML export.
+    "sepval-aero": {"sepval-core", "sepval-common", "sepval-geometry", "sepval-daveml"},
     "sepval-worker": {"sepval-core", "sepval-common", "sepval-transport"},
     # The Python package's extension module: the commands of the binary's library, the model
     # library's readers, the solvers' progress and the output directories' bookkeeping names.

@@ -30,6 +30,7 @@ mod input;
 mod mesh_distance;
 mod parts;
 mod primitives;
+mod shape;
 mod stl;
 mod store;
 mod trace;
@@ -39,6 +40,7 @@ pub use clearance::{CARRIAGE_TOLERANCE_M, Closest, Geometry, Pose};
 pub use domain::{MAX_ANGLE_DEG, MAX_COORDINATE_M, MAX_SIZE_M, MIN_SIZE_M};
 pub use error::{CarriageOverlap, GeometryError};
 pub use input::{MAX_FILE_BYTES, MAX_TRIANGLES};
+pub use shape::{FinShape, Nose, RevolutionShape, StoreShape};
 pub use trace::{Smallest, Trace};
 
 /// What asks a long computation of this crate to stop (reading and building a mesh, the

@@ -1,0 +1,171 @@
+//! The component build-up at one Mach number (Missile DATCOM's approach: W. B. Blake, *Missile
+//! DATCOM User's Manual, 1997 FORTRAN 90 Revision*, AFRL-VA-WP-TR-1998-3009; Barrowman 1967):
+//! the body's and the fins' normal forces summed with the interference factors, the centre of
+//! pressure their moment over their sum, and from it and the fins' lift at their arm the
+//! derivatives in docs/model.md's conventions:
+//!
+//! - CZ_alpha = -CN_alpha; CY_beta = -CN_alpha (a body of revolution with 3 or 4 fins);
+//! - Cm_alpha = -CN_alpha (x_cp - x_cg) / d (nose up positive, stable negative), Cn_beta =
+//!   -Cm_alpha (stable positive);
+//! - Cm_q = Cn_r = body's + fins' -2 CN_alpha,fins (K_W(B) + K_B(W)) ((x_fin - x_cg) / d)^2,
+//!   per rad of q d / 2V (a pitch rate q meets the fins at q (x_fin - x_cg) / V);
+//! - Cl_p from the fins' strip theory ([`crate::fins::roll_damping_per_rad`]).
+//!
+//! Each value carries its stated uncertainty ([`Accuracy`], docs/aero.md): the fraction of the
+//! value (or, for the centre of pressure, of the body's length) its method's validation gives.
+
+use sepval_common::atmosphere::AirState;
+
+use crate::body::{self, BodyTerms};
+use crate::config::Configuration;
+use crate::drag::{self, AxialParts};
+use crate::fins::{self, Regime};
+
+/// The stated accuracies, as fractions (docs/aero.md says where each comes from). The bands
+/// written with the estimate read each as one standard deviation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Accuracy {
+    /// CN_alpha, subsonic and supersonic: 10 % (Missile DATCOM's goal, as commonly quoted).
+    pub cn_alpha: f64,
+    /// CN_alpha in the transonic bridge: 25 % (ours: the bridge is not a method).
+    pub cn_alpha_bridge: f64,
+    /// The centre of pressure, as a fraction of the body's length: 4 % (DATCOM's goal).
+    pub x_cp_of_length: f64,
+    /// Cm_q and Cn_r: 30 % (ours, from the Basic Finner comparison of docs/aero.md).
+    pub damping: f64,
+    /// Cl_p: 20 % (ours, from the Basic Finner comparison of docs/aero.md).
+    pub roll_damping: f64,
+    /// CA0: 20 % (DATCOM's goal), 30 % in the bridge (ours).
+    pub axial: f64,
+    /// CA0 in the bridge.
+    pub axial_bridge: f64,
+    /// The viscous crossflow term: 30 % (ours, after Jorgensen 1977's comparisons).
+    pub crossflow: f64,
+}
+
+/// The accuracies this crate states.
+pub const ACCURACY: Accuracy = Accuracy {
+    cn_alpha: 0.10,
+    cn_alpha_bridge: 0.25,
+    x_cp_of_length: 0.04,
+    damping: 0.30,
+    roll_damping: 0.20,
+    axial: 0.20,
+    axial_bridge: 0.30,
+    crossflow: 0.30,
+};
+
+/// A value and its stated uncertainty (one standard deviation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimated {
+    /// The estimate.
+    pub value: f64,
+    /// Its stated uncertainty.
+    pub sigma: f64,
+}
+
+/// Everything estimated at one Mach number.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MachPoint {
+    /// Mach number.
+    pub mach: f64,
+    /// Which fin method gave it.
+    pub regime: Regime,
+    /// CN_alpha of the whole store \[1/rad\].
+    pub cn_alpha_per_rad: Estimated,
+    /// The fins' part of it, with interference \[1/rad\].
+    pub cn_alpha_fins_per_rad: f64,
+    /// K_W(B) and K_B(W).
+    pub interference: (f64, f64),
+    /// Centre of pressure behind the nose tip \[m\].
+    pub x_cp_m: Estimated,
+    /// Cm_alpha about the CG \[1/rad\].
+    pub cm_alpha_per_rad: Estimated,
+    /// Cm_q = Cn_r, per rad of q d / 2V.
+    pub cm_q_per_rad: Estimated,
+    /// Cl_p, per rad of p d / 2V.
+    pub cl_p_per_rad: Estimated,
+    /// CA0 and its parts.
+    pub ca0: Estimated,
+    /// CA0's parts.
+    pub axial_parts: AxialParts,
+}
+
+/// The build-up of `c` (body terms `b`) at `mach` in `air`.
+pub fn at_mach(c: &Configuration, b: &BodyTerms, mach: f64, air: &AirState) -> MachPoint {
+    let d = c.diameter_m;
+    let r = 0.5 * d;
+    let cn_body = b.cn_alpha_nose_per_rad + b.cn_alpha_boattail_per_rad;
+    let moment_body =
+        b.cn_alpha_nose_per_rad * b.x_cp_nose_m + b.cn_alpha_boattail_per_rad * b.x_cp_boattail_m;
+    let (mut cn, mut moment, mut cm_q, mut cl_p) = (cn_body, moment_body, b.cm_q_per_rad, 0.0);
+    let (mut cn_fins, mut k) = (0.0, (1.0, 0.0));
+    let regime = match &c.fins {
+        None => fins::regime(mach, 1.0),
+        Some(p) => {
+            let cl_alpha = fins::cl_alpha_per_rad(p, mach);
+            k = fins::interference(p.tau);
+            // N/2 panels' worth of the pair's slope (Barrowman 1967 section 3.3), on S_ref.
+            let cn_panels = 0.5 * f64::from(p.count) * cl_alpha * p.area_m2 / c.area_ref_m2;
+            cn_fins = cn_panels * (k.0 + k.1);
+            let x_fin = p.leading_edge_m + fins::x_cp_from_root_le_m(p, mach);
+            cn += cn_fins;
+            moment += cn_fins * x_fin;
+            cm_q += -2.0 * cn_fins * ((x_fin - c.cg_m) / d).powi(2);
+            cl_p = fins::roll_damping_per_rad(p, cl_alpha, r, c.area_ref_m2, d);
+            fins::regime(mach, p.aspect_ratio)
+        }
+    };
+    let x_cp = moment / cn;
+    let cm_alpha = -cn * (x_cp - c.cg_m) / d;
+    let bridge = regime == Regime::Bridge;
+    let a = ACCURACY;
+    let frac = if bridge {
+        a.cn_alpha_bridge
+    } else {
+        a.cn_alpha
+    };
+    let sigma_cn = frac * cn.abs();
+    let sigma_x = a.x_cp_of_length * c.length_m;
+    let sigma_cm = ((sigma_cn * (x_cp - c.cg_m) / d).powi(2) + (cn * sigma_x / d).powi(2)).sqrt();
+    let parts = drag::axial(c, mach, air, b.wetted_m2);
+    let ca0 = parts.total();
+    let ca_frac = if bridge { a.axial_bridge } else { a.axial };
+    MachPoint {
+        mach,
+        regime,
+        cn_alpha_per_rad: Estimated {
+            value: cn,
+            sigma: sigma_cn,
+        },
+        cn_alpha_fins_per_rad: cn_fins,
+        interference: k,
+        x_cp_m: Estimated {
+            value: x_cp,
+            sigma: sigma_x,
+        },
+        cm_alpha_per_rad: Estimated {
+            value: cm_alpha,
+            sigma: sigma_cm,
+        },
+        cm_q_per_rad: Estimated {
+            value: cm_q,
+            sigma: a.damping * cm_q.abs(),
+        },
+        cl_p_per_rad: Estimated {
+            value: cl_p,
+            sigma: a.roll_damping * cl_p.abs(),
+        },
+        ca0: Estimated {
+            value: ca0,
+            sigma: ca_frac * ca0,
+        },
+        axial_parts: parts,
+    }
+}
+
+/// The crossflow's normal force and pitching moment about the CG at `alpha_rad`: (CN, Cm).
+pub fn crossflow(c: &Configuration, b: &BodyTerms, alpha_rad: f64) -> (f64, f64) {
+    let cn = body::crossflow_cn(b, c.area_ref_m2, alpha_rad);
+    (cn, -cn * (b.x_planform_m - c.cg_m) / c.diameter_m)
+}
