@@ -57,7 +57,7 @@ MAY_USE = {
     "sepval": {"sepval-core", "sepval-common", "sepval-transport", "sepval-solve", "sepval-run",
                "sepval-fit", "sepval-diagnose", "sepval-plan", "sepval-predict", "sepval-envelope",
                "sepval-update", "sepval-campaign", "sepval-geometry", "sepval-report",
-               "sepval-daveml"},
+               "sepval-daveml", "sepval-aero"},
     "sepval-daveml": {"sepval-core", "sepval-common"},
     # The estimate from the shape: the store TOML's reader, the table form, the DAVE-ML export.
     "sepval-aero": {"sepval-core", "sepval-common", "sepval-geometry", "sepval-daveml"},

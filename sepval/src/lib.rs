@@ -40,6 +40,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Envelope(args) => command::envelope::run(*args),
         Command::Update(args) => command::update::run(*args),
         Command::Campaign(c) => command::campaign::run(c),
+        Command::Aero(args) => command::aero::run(args),
         Command::Bench(args) => command::bench::run(args),
         Command::Gateway(args) => command::gateway::run(args),
         Command::Selftest(c) => command::selftest::run(c),

@@ -66,6 +66,8 @@ pub enum Command {
     /// fly, each release flown added, until the envelope is settled (docs/campaign.md).
     #[command(subcommand)]
     Campaign(CampaignCommand),
+    /// Estimate a store's freestream aerodynamics from its shape (docs/aero.md).
+    Aero(AeroArgs),
     /// Measure simulations per second against worker count for each transport.
     Bench(BenchArgs),
     /// Check the Pareto machinery on problems with known fronts.
@@ -430,6 +432,25 @@ pub struct GoalsArgs {
     pub sim: PathBuf,
     #[command(flatten)]
     pub outliers: OutlierArgs,
+}
+
+#[derive(clap::Args)]
+pub struct AeroArgs {
+    /// The store's shape: a store TOML (docs/geometry.md: body of revolution, nose, fins).
+    #[arg(long, value_name = "SHAPE.toml")]
+    pub store_shape: PathBuf,
+    /// Mach numbers LO:HI:N (N points from LO to HI), within 0.05 to 2.
+    #[arg(long, value_name = "LO:HI:N", default_value = sepval_aero::grid::DEFAULT_MACH)]
+    pub mach: String,
+    /// Angles of attack and of sideslip LO:HI:N [deg], within -30 to 30.
+    #[arg(long, value_name = "LO:HI:N", default_value = sepval_aero::grid::DEFAULT_ALPHA_DEG)]
+    pub alpha_deg: String,
+    /// Altitude of the condition (ISA) [m], for the Reynolds number of the skin friction.
+    #[arg(long, value_name = "M", default_value_t = sepval_aero::DEFAULT_ALTITUDE_M)]
+    pub altitude_m: f64,
+    /// A new output directory: aero.toml, store.dml and summary.txt.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
 }
 
 #[derive(clap::Args)]

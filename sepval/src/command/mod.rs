@@ -4,6 +4,7 @@
 //! executable, and the rendering of transport notices. What a command prints goes through the
 //! front end ([`crate::front`]: `say!`, `note!`, `front::progress()`), never to stdout directly.
 
+pub mod aero;
 pub mod bench;
 pub mod campaign;
 pub mod clean_ipc;

@@ -5,6 +5,7 @@
 //! package's only integration test: it is also what makes `cargo test --workspace` build
 //! `sepval`.
 
+mod aero;
 mod campaign;
 mod campaign_begin;
 mod campaign_wall;
