@@ -167,6 +167,7 @@ mod analysis;
 mod answer;
 mod catalogue;
 mod classes;
+pub mod command;
 mod contender;
 mod diagnosis;
 mod discover;

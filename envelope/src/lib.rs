@@ -28,6 +28,7 @@
 
 #![deny(clippy::float_cmp)]
 
+pub mod command;
 pub mod grid;
 pub mod outputs;
 mod page;

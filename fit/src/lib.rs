@@ -14,7 +14,9 @@
 //!   [`result_check`] states;
 //! - [`refine`]: a model refined to the optimum by Levenberg-Marquardt, several sharing each
 //!   batch;
-//! - [`sigma`]: the noise that weights the goals; [`method`]: which searches to run.
+//! - [`sigma`]: the noise that weights the goals; [`method`]: which searches to run;
+//! - [`configure`] and [`command`]: `sepval fit`'s request made a configured run, and that run
+//!   in the one sequence of every command (`sepval_run::sequence`).
 //!
 //! What a run reads and where it writes (the output directory, the input readers, the sealed
 //! records, the flight domain) are `sepval-run`'s, which every command shares.
@@ -27,6 +29,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod checkpoint;
+pub mod command;
 pub mod configure;
 pub mod method;
 pub mod pipeline;

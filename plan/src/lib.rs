@@ -22,6 +22,7 @@
 #![deny(clippy::float_cmp)]
 
 pub use sepval_run::conditions;
+pub mod command;
 pub mod information;
 pub mod models;
 pub mod outputs;

@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 use sepval_common::scenario::Scenario;
 use sepval_core::cancel::{self, Cancelled};
 use sepval_geometry::{Body, Geometry, GeometryError, Pose, Role};
+use sepval_run::clearance::GeometryPaths;
 
 use crate::bands::quantile;
 use crate::sampling::{STREAM_BANDS, normal, sample_rng};
@@ -95,6 +96,19 @@ pub enum ClearanceInputError {
 }
 
 impl ClearanceSettings {
+    /// The settings of the geometry as given, for the store of `scenario`; `None` without an
+    /// aircraft ([`ClearanceSettings::read`]).
+    pub fn of(
+        given: &GeometryPaths,
+        scenario: &Scenario,
+    ) -> Result<Option<ClearanceSettings>, ClearanceInputError> {
+        let Some(aircraft) = &given.aircraft else {
+            return Ok(None);
+        };
+        let store_shape = given.store_shape.as_deref();
+        Self::read(aircraft, store_shape, given.clearance_mm, scenario).map(Some)
+    }
+
     /// The clearance of the store of `scenario` (its shape from `store_shape`, or the default
     /// shape of its diameter) to the aircraft of the file `aircraft`, by `criterion_mm`: both
     /// read, and checked together at carriage (docs/geometry.md); a signal stops the reading.

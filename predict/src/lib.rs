@@ -30,6 +30,7 @@
 pub mod bands;
 pub mod check;
 pub mod clearance;
+pub mod command;
 pub mod condition;
 pub mod discrepancy;
 pub mod ensemble;

@@ -4,13 +4,14 @@
 //! swept distance), one [`ReleaseClearance`] per release for result.json and diagnosis.json,
 //! and `clearance.csv` and `figures/clearance.png` written into the run's directory
 //! ([`write()`]). A stage of the fit and the diagnosis ([`Stage`], their
-//! [`ClearReleases`]): the binary gives it to them when `--aircraft` is given, and prints the
-//! lines of what they record ([`line()`]).
+//! [`ClearReleases`]): the binary gives it to them when `--aircraft` is given; the lines of
+//! what they record are `ReleaseClearance::line`'s.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Candidate, EvalError, Evaluator, InProcess, Job};
+use sepval_common::scenario::Scenario;
 use sepval_common::telemetry::Trajectory;
 use sepval_core::cancel;
 pub use sepval_geometry::GeometryError;
@@ -18,9 +19,9 @@ use sepval_geometry::{Pose, Trace};
 use sepval_report::figures::{ClearanceSeries, clearance_figure};
 use sepval_report::words::csv_text;
 use sepval_report::{OutputError, Written};
-use sepval_run::clearance::{ClearReleases, ReleaseClearance, StageError};
+use sepval_run::clearance::{ClearReleases, GeometryPaths, ReleaseClearance, StageError};
 
-use crate::clearance::ClearanceSettings;
+use crate::clearance::{ClearanceInputError, ClearanceSettings};
 
 /// The releases' clearance that could not be computed or written.
 #[derive(Debug, thiserror::Error)]
@@ -59,6 +60,22 @@ pub struct Stage {
     pub settings: ClearanceSettings,
     /// The threads that fly the releases.
     pub threads: usize,
+}
+
+impl Stage {
+    /// The clearance stage of a fit or a diagnosis of releases at `scenario`'s store, with the
+    /// geometry as given, flying them on `threads` threads; `None` without an aircraft.
+    pub fn of(
+        given: &GeometryPaths,
+        scenario: &Scenario,
+        threads: usize,
+    ) -> Result<Option<Arc<dyn ClearReleases>>, ClearanceInputError> {
+        let stage = ClearanceSettings::of(given, scenario)?.map(|settings| {
+            let stage: Arc<dyn ClearReleases> = Arc::new(Stage { settings, threads });
+            stage
+        });
+        Ok(stage)
+    }
 }
 
 impl ClearReleases for Stage {
@@ -140,19 +157,6 @@ pub fn simulate(
             (ev.name.clone(), traj)
         })
         .collect())
-}
-
-/// A release's clearance in one line, as the fit and the diagnosis print it.
-pub fn line(r: &ReleaseClearance) -> String {
-    format!(
-        "{}: smallest {:.1} mm at t = {:.3} s ({} / {}): {}",
-        r.release,
-        r.min_clearance_mm,
-        r.t_min_s,
-        r.store_part,
-        r.aircraft_part,
-        if r.clears { "clears" } else { "does not clear" }
-    )
 }
 
 /// The clearance of each release (`releases`: name and trajectory), its record and its trace.

@@ -2,13 +2,16 @@
 //! 14.2): what result.json and diagnosis.json record of it, and the stage that finds it
 //! ([`ClearReleases`]), asked by the fit and the diagnosis before their record is sealed, so
 //! that a record is written once. The stage is the prediction's (`sepval_predict::releases`,
-//! which knows the geometry); the pipelines below it only call it.
+//! which knows the geometry); the pipelines below it only call it. [`GeometryPaths`] is the
+//! geometry as given, before it is read.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use sepval_common::evaluation::{Candidate, Job};
 use serde::{Deserialize, Serialize};
+
+use crate::out_dir::Input;
 
 /// The clearance of one release's trajectory (docs/envelope.md section 14.2), as result.json and
 /// diagnosis.json record it.
@@ -30,6 +33,53 @@ pub struct ReleaseClearance {
     pub clears: bool,
     /// Whether the store moved the stroke within the record (else every sample counts).
     pub free_flight_reached: bool,
+}
+
+/// The geometry a run's clearance is found with, as given (`--aircraft`, `--store-shape`,
+/// `--clearance-mm`; read and checked by `sepval_predict::ClearanceSettings`).
+#[derive(Debug, Clone, Default)]
+pub struct GeometryPaths {
+    /// The aircraft's geometry; without it, no clearance is found.
+    pub aircraft: Option<PathBuf>,
+    /// The store's shape (else a body of revolution of the scenario's diameter).
+    pub store_shape: Option<PathBuf>,
+    /// The clearance criterion \[mm\].
+    pub clearance_mm: f64,
+}
+
+impl GeometryPaths {
+    /// Its files, as inputs of the run.
+    pub fn inputs(&self) -> Vec<Input> {
+        let mut out = Input::files("--aircraft", &self.aircraft);
+        out.extend(Input::files("--store-shape", &self.store_shape));
+        out
+    }
+}
+
+impl ReleaseClearance {
+    /// The release's clearance in one line, as the fit and the diagnosis print it.
+    pub fn line(&self) -> String {
+        format!(
+            "{}: smallest {:.1} mm at t = {:.3} s ({} / {}): {}",
+            self.release,
+            self.min_clearance_mm,
+            self.t_min_s,
+            self.store_part,
+            self.aircraft_part,
+            if self.clears {
+                "clears"
+            } else {
+                "does not clear"
+            }
+        )
+    }
+}
+
+/// One line per release of what a record holds of their clearance (`clearance: ...`), as the
+/// fit's and the diagnosis's summaries begin.
+pub fn lines(records: Option<&Vec<ReleaseClearance>>) -> String {
+    let line = |r: &ReleaseClearance| format!("clearance: {}\n", r.line());
+    records.into_iter().flatten().map(line).collect()
 }
 
 /// Why the clearance of the releases could not be found: the stage's own error, kept whole

@@ -15,7 +15,10 @@
 //! - [`domain`]: where a fitted model may be flown (refused outside, said when far from the
 //!   releases), for every command that flies one at a new condition;
 //! - [`conditions`]: the grids of flight conditions a prediction, a plan or an envelope
-//!   covers.
+//!   covers;
+//! - [`sequence`]: the one order of every command that writes an output directory (its
+//!   directory claimed, its evaluator started, the run, its files, the commit), each
+//!   command's run a [`sequence::Run`] of its library.
 //!
 //! The library returns typed errors and prints nothing.
 
@@ -28,3 +31,4 @@ pub mod inputs;
 pub mod model_spec;
 pub mod out_dir;
 pub mod sealed;
+pub mod sequence;

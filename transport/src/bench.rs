@@ -62,6 +62,23 @@ impl Transport {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum BenchError {
+    /// A worker count outside 1 to [`MAX_WORKERS`](crate::ipc::MAX_WORKERS).
+    #[error("--workers {workers}: expected 1 to {}", crate::ipc::MAX_WORKERS)]
+    Workers {
+        /// The count given.
+        workers: usize,
+    },
+    /// A flag's count of 0 where at least one is needed.
+    #[error("{flag} 0: expected at least 1")]
+    ZeroFlag {
+        /// The flag (`--evals`, `--repeat`).
+        flag: &'static str,
+    },
+    /// zenoh asked of a build without it.
+    #[error(
+        "--transports zenoh: this sepval was built without the zenoh feature (cargo build --release --features zenoh)"
+    )]
+    NoZenoh,
     /// A count of 0 where at least one is needed.
     #[error("{setting} 0: expected at least 1")]
     Zero {
@@ -139,6 +156,28 @@ pub struct BenchOptions {
     pub worker_executable: std::path::PathBuf,
     /// Measurements per (transport, worker count), interleaved; the median is reported.
     pub repeat: usize,
+}
+
+impl BenchOptions {
+    /// Refuses what the flags gave that cannot be measured, naming the flag: a worker count
+    /// outside 1 to [`MAX_WORKERS`](crate::ipc::MAX_WORKERS), no evaluation or round, zenoh
+    /// in a build without it.
+    pub fn check(&self) -> Result<(), BenchError> {
+        let max = crate::ipc::MAX_WORKERS;
+        if let Some(&workers) = self.workers.iter().find(|w| **w == 0 || **w > max) {
+            return Err(BenchError::Workers { workers });
+        }
+        if self.evals == 0 {
+            return Err(BenchError::ZeroFlag { flag: "--evals" });
+        }
+        if self.repeat == 0 {
+            return Err(BenchError::ZeroFlag { flag: "--repeat" });
+        }
+        if cfg!(not(feature = "zenoh")) && self.transports.contains(&Transport::Zenoh) {
+            return Err(BenchError::NoZenoh);
+        }
+        Ok(())
+    }
 }
 
 /// `n` distinct candidates around the truth (seeded, within bounds).

@@ -30,6 +30,7 @@
 #![deny(clippy::float_cmp)]
 
 pub mod assemble;
+pub mod command;
 pub mod crossval;
 pub mod daveml;
 pub mod explored;

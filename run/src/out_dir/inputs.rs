@@ -32,6 +32,11 @@ impl Input {
         }
     }
 
+    /// The input files given by `flag` (none, one or several).
+    pub fn files<'a>(flag: &str, paths: impl IntoIterator<Item = &'a PathBuf>) -> Vec<Input> {
+        paths.into_iter().map(|p| Input::file(flag, p)).collect()
+    }
+
     /// An input directory given by `flag` (e.g. `--from`).
     pub fn directory(flag: &str, path: &Path) -> Input {
         Input {

@@ -2,26 +2,18 @@
 
 use std::sync::Arc;
 
-use anyhow::{Result, bail};
+use std::path::PathBuf;
+
+use anyhow::Result;
 use sepval_report::figures::throughput_figure;
 use sepval_run::out_dir::Request;
 use sepval_transport::bench::{BenchOptions, Transport, run_bench, series, table, write_csv};
-use sepval_transport::ipc::MAX_WORKERS;
 
 use super::{tell, worker_executable};
 use crate::cli::{BenchArgs, TransportArg};
 
 /// Runs `sepval bench`.
 pub fn run(args: BenchArgs) -> Result<()> {
-    if let Some(w) = args.workers.iter().find(|w| **w == 0 || **w > MAX_WORKERS) {
-        bail!("--workers {w}: expected 1 to {MAX_WORKERS}");
-    }
-    if args.evals == 0 {
-        bail!("--evals 0: expected at least 1");
-    }
-    if args.repeat == 0 {
-        bail!("--repeat 0: expected at least 1");
-    }
     let transports: Vec<Transport> = args
         .transports
         .iter()
@@ -34,18 +26,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
             TransportArg::Zenoh => Transport::Zenoh,
         })
         .collect();
-    if cfg!(not(feature = "zenoh")) && transports.contains(&Transport::Zenoh) {
-        bail!(
-            "--transports zenoh: this sepval was built without the zenoh feature \
-             (cargo build --release --features zenoh)"
-        );
-    }
     let options = BenchOptions {
         workers: args.workers.clone(),
         evals: args.evals,
         transports,
-        worker_executable: worker_executable()?,
+        worker_executable: PathBuf::new(),
         repeat: args.repeat,
+    };
+    options.check()?;
+    let options = BenchOptions {
+        worker_executable: worker_executable()?,
+        ..options
     };
     // A run directory as every command's: refused before anything runs when it holds what
     // an earlier bench did not write (before 2026-11-29 bench.csv and bench.png were written

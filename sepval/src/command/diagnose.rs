@@ -1,24 +1,24 @@
 //! `sepval diagnose`: what the simulation still gets wrong after a fit, and why.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::Result;
-use sepval_diagnose::{DiagnoseOptions, Diagnosis, diagnose};
-use sepval_solve::run::ProgressObserver;
+use sepval_diagnose::DiagnoseOptions;
+use sepval_diagnose::command::DiagnoseRun;
+use sepval_predict::releases::Stage;
+use sepval_run::sequence::Writes;
 
-use super::sequence::{Evaluators, Run, Said, Writes, execute};
-use super::{clearance, evaluator_spec, tell};
+use super::{evaluator_spec, execute, tell};
 use crate::cli::DiagnoseArgs;
 
 /// Runs `sepval diagnose`: the flags made a request (the releases, the extension, the settings
-/// and the geometry read and checked), then the command's sequence. The diagnosis writes its
-/// files as it goes (the baseline fit's checkpoints, the figures, diagnosis.json).
+/// and the geometry read and checked), then the command's sequence.
 pub fn run(args: DiagnoseArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
+    let geometry = super::geometry(&args.geometry);
     let mut read = super::model_inputs(&args.inputs);
     read.extend(super::input_files("--validate", &args.validate));
-    read.extend(super::geometry_inputs(&args.geometry));
+    read.extend(geometry.inputs());
     let writes = Writes {
         out: args.out.clone(),
         command: "diagnose",
@@ -34,35 +34,9 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let threads = super::count("--threads", args.eval.threads)?;
     let options = DiagnoseOptions {
         strict_tables: args.tables.strict_tables,
-        clearance: clearance::stage(&args.geometry, base, threads)?,
+        clearance: Stage::of(&geometry, base, threads)?,
         ..options
     };
-    execute(&spec, writes, Some(Arc::new(job)), Request { options })
-}
-
-/// A diagnosis asked for by the flags, configured.
-struct Request {
-    options: DiagnoseOptions,
-}
-
-impl Run for Request {
-    type Found = Diagnosis;
-
-    fn run(
-        &mut self,
-        evaluators: &mut Evaluators<'_>,
-        progress: &mut dyn ProgressObserver,
-    ) -> Result<Diagnosis> {
-        Ok(diagnose(&self.options, evaluators.one()?, progress)?)
-    }
-
-    /// The diagnosis wrote its files as it went. The tables left by its fitted runs are told
-    /// as simulate and fit tell them (`--strict-tables` refused them after the baseline fit,
-    /// before any other work).
-    fn write(&self, d: Diagnosis, out: &Path, _wall_s: f64) -> Result<Said> {
-        let mut summary = clearance::lines(d.clearance.as_ref());
-        summary.push_str(&sepval_diagnose::summary(&d, out));
-        let warnings = d.tables_left;
-        Ok(Said { summary, warnings })
-    }
+    let job = Arc::new(job);
+    execute(&spec, writes, DiagnoseRun { job, options })
 }

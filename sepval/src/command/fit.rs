@@ -1,21 +1,20 @@
 //! `sepval fit`: the factors fitted to measured data by the study's searches (and refinement).
 
-use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::Result;
 use sepval_common::evaluation::Job;
 use sepval_fit::checkpoint::Checkpoint;
+use sepval_fit::command::FitRun;
 use sepval_fit::configure::FitRequest;
-use sepval_fit::pipeline::{FitOutput, write_fit_figures};
 use sepval_fit::resume::{self, InputPaths};
-use sepval_fit::{FitOptions, Method, run_fit};
+use sepval_fit::{FitOptions, Method};
+use sepval_predict::releases::Stage;
 use sepval_run::out_dir::Claim;
+use sepval_run::sequence::Writes;
 use sepval_solve::ga::GaSettings;
-use sepval_solve::run::ProgressObserver;
 
-use super::sequence::{Evaluators, Run, Said, Writes, execute};
-use super::{clearance, evaluator_spec, tell};
+use super::{evaluator_spec, execute, tell};
 use crate::cli::{FitArgs, MethodArg};
 
 /// The library's method of `--method`.
@@ -36,67 +35,18 @@ pub fn run(args: FitArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let resume = args.resume.as_deref().map(Checkpoint::load).transpose()?;
     let writes = writes(&args, resume.as_ref());
-    let FitConfig { job, mut options } = configure(&args, resume)?;
+    let (job, mut options) = configure(&args, resume)?;
     let base = job.events()[0].simulator.scenario();
     let threads = super::count("--threads", args.eval.threads)?;
-    options.clearance = clearance::stage(&args.geometry, base, threads)?;
+    options.clearance = Stage::of(&super::geometry(&args.geometry), base, threads)?;
     options.strict_tables = args.tables.strict_tables;
-    let job = Arc::new(job);
-    let request = Request {
-        args,
-        job: Arc::clone(&job),
+    let run = FitRun {
+        job: Arc::new(job),
         options,
+        resume_path: args.resume,
+        figures: !args.no_figures,
     };
-    execute(&spec, writes, Some(job), request)
-}
-
-/// A fit asked for by the flags, configured.
-struct Request {
-    args: FitArgs,
-    job: Arc<Job>,
-    options: FitOptions,
-}
-
-impl Run for Request {
-    type Found = FitOutput;
-
-    fn confirm(&mut self, evaluators: &mut Evaluators<'_>) -> Result<()> {
-        if let (Some(c), Some(path)) = (&self.options.resume, self.args.resume.as_deref()) {
-            // Its members re-evaluated and its generation replayed before going on from it.
-            let report = sepval_fit::rerun::confirm(c, path, evaluators.one()?)?;
-            note!(
-                "sepval: resuming from {}: {}",
-                path.display(),
-                report.checked()
-            );
-        }
-        Ok(())
-    }
-
-    fn run(
-        &mut self,
-        evaluators: &mut Evaluators<'_>,
-        progress: &mut dyn ProgressObserver,
-    ) -> Result<FitOutput> {
-        Ok(run_fit(&self.options, evaluators.one()?, progress)?)
-    }
-
-    /// The figures (unless `--no-figures`: result.json is the fit's); the tables left by the
-    /// best fit told (`--strict-tables` refused them before result.json was written).
-    fn write(&self, output: FitOutput, out: &Path, _wall_s: f64) -> Result<Said> {
-        let result = &output.result;
-        let mut summary = clearance::lines(result.clearance.as_ref());
-        summary.push_str(&result.summary());
-        if !self.args.no_figures {
-            let n = write_fit_figures(out, &self.job, &output)?.len();
-            let dir = out.join("figures");
-            summary.push_str(&format!("{n} figures in {}\n", dir.display()));
-        }
-        let json = out.join("result.json");
-        summary.push_str(&format!("results in {}\n", json.display()));
-        let warnings = result.tables_left();
-        Ok(Said { summary, warnings })
-    }
+    execute(&spec, writes, run)
 }
 
 /// Where the fit writes and what it reads. Its directory may be none of the run's inputs: with
@@ -114,7 +64,7 @@ fn writes(args: &FitArgs, resume: Option<&Checkpoint>) -> Writes {
     };
     let mut read = super::model_inputs(&args.inputs);
     read.extend(super::input_files("--truth-factors", &args.truth_factors));
-    read.extend(super::geometry_inputs(&args.geometry));
+    read.extend(super::geometry(&args.geometry).inputs());
     if let (Some(path), Some(c)) = (&args.resume, resume) {
         read.extend(resume::inputs_read(path, c));
     }
@@ -131,15 +81,9 @@ fn writes(args: &FitArgs, resume: Option<&Checkpoint>) -> Writes {
     }
 }
 
-/// A fit as the flags ask for it, validated: the job to run and the options of the run.
-struct FitConfig {
-    job: Job,
-    options: FitOptions,
-}
-
 /// The flags (and the checkpoint resumed from) as a validated configuration
 /// ([`sepval_fit::configure`]).
-fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
+fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<(Job, FitOptions)> {
     let given = &args.inputs;
     let request = FitRequest {
         inputs: InputPaths {
@@ -165,6 +109,5 @@ fn configure(args: &FitArgs, resume: Option<Checkpoint>) -> Result<FitConfig> {
         truth_factors: args.truth_factors.as_deref(),
         out: args.out.clone(),
     };
-    let (job, options) = sepval_fit::configure::configure(request, &mut tell())?;
-    Ok(FitConfig { job, options })
+    Ok(sepval_fit::configure::configure(request, &mut tell())?)
 }

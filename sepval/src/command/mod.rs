@@ -8,7 +8,6 @@ pub mod aero;
 pub mod bench;
 pub mod campaign;
 pub mod clean_ipc;
-pub mod clearance;
 pub mod diagnose;
 pub mod effects;
 pub mod envelope;
@@ -20,7 +19,6 @@ pub mod predict;
 pub mod rerun;
 pub mod scenario;
 pub mod selftest;
-pub mod sequence;
 pub mod simulate;
 pub mod update;
 
@@ -29,7 +27,9 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use sepval_common::evaluation::{EvalError, Evaluator, Job};
+use sepval_run::clearance::GeometryPaths;
 use sepval_run::out_dir::{Claim, Input, Request, RunDir};
+use sepval_run::sequence::{Evaluators, Run, RunError, Writes};
 use sepval_transport::flags::{EvaluatorFlags, Kind};
 use sepval_transport::link::{Notice, Notices};
 use sepval_transport::spec::{EvaluatorSpec, Starter};
@@ -128,11 +128,13 @@ pub fn fresh_or_overwrite(overwrite: &crate::cli::OverwriteArgs) -> Claim {
     }
 }
 
-/// The geometry files of `--aircraft` and `--store-shape`, as inputs.
-pub fn geometry_inputs(g: &crate::cli::GeometryArgs) -> Vec<Input> {
-    let mut out = input_files("--aircraft", &g.aircraft);
-    out.extend(input_files("--store-shape", &g.store_shape));
-    out
+/// `--aircraft`, `--store-shape` and `--clearance-mm` as given.
+pub fn geometry(g: &crate::cli::GeometryArgs) -> GeometryPaths {
+    GeometryPaths {
+        aircraft: g.aircraft.clone(),
+        store_shape: g.store_shape.clone(),
+        clearance_mm: g.clearance_mm,
+    }
 }
 
 /// The files of `--data`, `--scenario` (with the table files it names) and `--extension`, as
@@ -166,7 +168,28 @@ pub fn out_file_apart(out: &Path, inputs: &[Input]) -> Result<()> {
 
 /// Input files given by `flag` (none, one or several).
 pub fn input_files<'a>(flag: &str, paths: impl IntoIterator<Item = &'a PathBuf>) -> Vec<Input> {
-    paths.into_iter().map(|p| Input::file(flag, p)).collect()
+    Input::files(flag, paths)
+}
+
+/// Runs `run` into the directory `writes` says, in the one order of every command
+/// ([`sepval_run::sequence::execute`]): its evaluators started from `spec` (one for its job,
+/// or one per job), its progress on the front end; then prints what it says: the summary on
+/// stdout, then the warnings on stderr.
+pub fn execute<R: Run>(spec: &EvaluatorSpec, writes: Writes, run: R) -> Result<()> {
+    let mut start = |job: Option<Arc<Job>>| -> Result<Evaluators<'_>, RunError> {
+        Ok(match job {
+            Some(job) => Evaluators::One(spec.start(job, notices())?),
+            None => Evaluators::Each(Box::new(starter(spec))),
+        })
+    };
+    let progress = &mut *crate::front::progress();
+    let said =
+        sepval_run::sequence::execute(writes, run, &mut start, progress, &mut |s| note!("{s}"))?;
+    crate::front::out(&said.summary);
+    for w in &said.warnings {
+        note!("warning: {w}");
+    }
+    Ok(())
 }
 
 /// Starts each job's evaluator (an envelope's conditions, an update's rounds) with one

@@ -1,11 +1,12 @@
 //! `sepval simulate`: one release, written as a trajectory file.
 
 use anyhow::Result;
+use sepval_predict::ClearanceSettings;
 use sepval_predict::one_release::{ReleaseRequest, SimulatedRelease, simulate_release};
 use sepval_run::inputs;
 use sepval_run::out_dir::Input;
 
-use super::{clearance, positive};
+use super::positive;
 use crate::cli::SimulateArgs;
 
 /// Runs `sepval simulate`.
@@ -19,7 +20,8 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     if let Some(path) = inputs::factors_file(&args.factors) {
         read.push(Input::file("--factors", path));
     }
-    read.extend(super::geometry_inputs(&args.geometry));
+    let geometry = super::geometry(&args.geometry);
+    read.extend(geometry.inputs());
     super::out_file_apart(&args.out, &read)?;
     let effects = inputs::effects(&args.effects)?;
     let scenario = inputs::scenario(
@@ -27,7 +29,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         args.model.extension.as_deref(),
     )?;
     let factors = inputs::factors(&args.factors, &scenario.factors)?;
-    let clearance = clearance::settings(&args.geometry, &scenario)?;
+    let clearance = ClearanceSettings::of(&geometry, &scenario)?;
     let request = ReleaseRequest {
         scenario: &scenario,
         factors,
