@@ -170,7 +170,22 @@ pub(super) fn locations(
     let id = model_identifiability(search, fitted);
     let mut out = vec![Vec::new(); picked.len()];
     for p in &profiles {
-        out[p.entry] = located(p, fitted, &at, &layout[p.entry], &id);
+        let entry = &layout[p.entry];
+        let mut ls = located(p, fitted, &at, entry, &id);
+        // The location the refit estimates: a gust's middle, the first otherwise.
+        let refitted = match p.held {
+            Held::Length => ls.iter_mut().find(|l| l.quantity == "t_mid_s"),
+            _ => ls.first_mut(),
+        };
+        if let (Some(i), Some(first)) = (entry.locator(), refitted) {
+            let (lo, hi, x) = (space.params.lo[i], space.params.hi[i], fitted.lm.x[i]);
+            if x - lo <= 1e-6 * (hi - lo) || hi - x <= 1e-6 * (hi - lo) {
+                first.basis.push_str(&format!(
+                    "; the refit's estimate lies at a bound of its range ({lo:.4} to {hi:.4})"
+                ));
+            }
+        }
+        out[p.entry] = ls;
     }
     Ok(out)
 }
