@@ -292,7 +292,7 @@ fn phase(at: &[Term], layout: &EntryParams, id: &Identifiability) -> Option<Loca
         basis: if determined {
             "the estimate ± 1.96 standard errors (the delta method on the sine's and cosine's coefficients), at the frequency estimated".into()
         } else {
-            "not determined by the data: the amplitude is within two standard errors of zero".into()
+            "not determined by the data: 1.96 standard errors of the phase exceed 180 deg (the amplitude is not clear of its own error)".into()
         },
     })
 }
@@ -451,5 +451,47 @@ mod tests {
         assert!((length.low, length.high) == (0.005, 0.1), "{length:?}");
         // The model's own length (0.1 s) is kept in the union: the estimate is in its interval.
         assert!(onset.low <= 0.39 && 0.44 - 0.0025 < onset.high, "{onset:?}");
+    }
+
+    /// An oscillation's phase: a sin + b cos with a = b = 1, each ± 0.1 and uncorrelated, is
+    /// A sin(2 pi f t + 45 deg) with the delta method's standard error sqrt(0.02) / 2 rad.
+    #[test]
+    fn an_oscillations_phase_has_the_delta_methods_standard_error() {
+        let term = |regressor, coefficient| Term {
+            axis: Axis::Cl,
+            regressor,
+            locator: [6.25, 0.0],
+            coefficient,
+        };
+        let terms = vec![term(Regressor::Sin, 1.0), term(Regressor::Cos, 1.0)];
+        let picked = Picked::default().with(Entry {
+            terms: terms.clone(),
+        });
+        let layout = picked.params(&picked.free_terms()).remove(0);
+        let estimate = |se: f64| ParamEstimate {
+            name: String::new(),
+            unit: String::new(),
+            value: 0.0,
+            std_error: Some(se),
+            std_error_white: Some(se),
+            identifiable: true,
+        };
+        let n = FACTOR_COUNT + 2;
+        let id = Identifiability {
+            parameters: vec![estimate(0.1); n],
+            names: Vec::new(),
+            correlation: vec![vec![0.0; n]; n],
+            compensating: Vec::new(),
+            not_identifiable: Vec::new(),
+            max_lag: 0,
+        };
+        let l = phase(&terms, &layout, &id).unwrap();
+        let se = 0.02_f64.sqrt() / 2.0;
+        assert!((l.value - 45.0).abs() < 1e-9, "{l:?}");
+        assert!(
+            (l.std_error.unwrap() - se.to_degrees()).abs() < 1e-9,
+            "{l:?}"
+        );
+        assert!(l.determined && (l.high - l.low - 2.0 * Z95 * se.to_degrees()).abs() < 1e-9);
     }
 }

@@ -160,11 +160,13 @@ pub(super) fn locations(
     if !runs.is_empty() {
         refine_together(evaluator, &mut runs)?;
     }
+    // The runs are in the profiles' order, one per value.
     let mut runs = runs.into_iter();
     for p in &mut profiles {
-        for v in &p.values {
-            let run = runs.next().expect("one run per profiled value");
-            p.points.push(point(search, run, p, *v, picked, trail));
+        let values = p.values.clone();
+        for (v, run) in values.into_iter().zip(runs.by_ref()) {
+            let q = point(search, run, p, v, picked, trail);
+            p.points.push(q);
         }
     }
     let id = model_identifiability(search, fitted);
