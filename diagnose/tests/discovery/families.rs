@@ -147,6 +147,7 @@ fn assert_holds(first: &Value, quantity: &str, truth: f64) {
         .as_array()
         .and_then(|ls| ls.iter().find(|l| l["quantity"] == quantity))
         .unwrap_or_else(|| panic!("no {quantity}: {first}"));
+    eprintln!("{quantity} (truth {truth}): {l}");
     let (low, high) = (l["low"].as_f64().unwrap(), l["high"].as_f64().unwrap());
     assert!(
         low <= truth && truth <= high,
