@@ -98,6 +98,11 @@ pub struct DiscoveredTerm {
     /// and then `rise_s` is one length among many that fit as well).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rise_std_error: Option<f64>,
+    /// Its locations estimated, each with its 95 % interval (`docs/discovery.md` section 11.5,
+    /// step 13): a step's onset; a gust's onset, middle and length; an oscillation's frequency
+    /// and phase. Empty for the families without a location in time or frequency.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub locations: Vec<Location>,
     /// What it brings: the refit without it against the refit with it (with one term: the
     /// baseline against the extension).
     pub gain: Gain,
@@ -105,6 +110,29 @@ pub struct DiscoveredTerm {
     pub reading: String,
     /// Entries the data cannot tell from it (|correlation| >= 0.95).
     pub group: Vec<GroupMember>,
+}
+
+/// One location of a discovered term estimated: its value with its standard error and 95 %
+/// interval, or, when the data do not determine it, the interval the profile of the cost
+/// allows and no standard error (`docs/discovery.md` section 11.5, step 13).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Location {
+    /// What is located: `t_on_s` (a step's or a gust's onset), `t_mid_s` (a gust's middle),
+    /// `rise_s` (a gust's length), `f_hz` (a frequency) or `phase_deg` (an oscillation's phase).
+    pub quantity: String,
+    /// The estimate: the value in the answer's model.
+    pub value: f64,
+    /// Its standard error from the refit's Jacobian (corrected for coloured residuals); null when
+    /// the refit holds it or the data do not determine it.
+    pub std_error: Option<f64>,
+    /// The 95 % interval's lower end.
+    pub low: f64,
+    /// The 95 % interval's upper end.
+    pub high: f64,
+    /// Whether the data determine it: its 95 % set lies inside the range the profile tried.
+    pub determined: bool,
+    /// How the interval was formed, in words.
+    pub basis: String,
 }
 
 /// A verified extension: the refitted model, its terms (most important first) and its gain over

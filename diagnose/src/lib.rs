@@ -195,7 +195,7 @@ pub use diagnosis::{
     Alternative, BaselineVerdict, CandidateReport, Diagnosis, ExtensionReport, ModelSummary,
     ParamValue, RivalClass, RivalReport, SkippedRefit,
 };
-pub use found::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Screened, Verified};
+pub use found::{DiscoveredTerm, DiscoveryStep, Gain, GroupMember, Location, Screened, Verified};
 pub use library::Sample;
 pub use misfit::{Linear, Misfit, reconstruct_misfit};
 pub use reconstruct::{IncrementSeries, Reconstruction};

@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use crate::{Diagnosis, fmt_discovered, rival_name};
+use crate::verdict::fmt_discovered_brief;
+use crate::{Diagnosis, rival_name};
 
 /// The terminal summary of `d`, written in `out`: a few lines (at most 12), each at most 160
 /// characters.
@@ -41,7 +42,7 @@ pub fn summary(d: &Diagnosis, out: &Path) -> String {
         s.push_str(&format!("cause:     {c} ({})\n", values.join(", ")));
     }
     for t in &d.discovered {
-        s.push_str(&format!("found:     {}\n", fmt_discovered(t)));
+        s.push_str(&format!("found:     {}\n", fmt_discovered_brief(t)));
         s.push_str(&format!("           {}\n", t.reading));
     }
     s.push_str(&format!(

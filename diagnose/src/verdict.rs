@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use sepval_common::effects::CATALOGUE;
 use sepval_fit::space::Noise;
 
-use crate::{Alternative, DiscoveredTerm, ExtensionReport, ModelSummary, ParamValue};
+use crate::{Alternative, DiscoveredTerm, ExtensionReport, Location, ModelSummary, ParamValue};
 
 /// A catalogue parameter's value: `name = value ± se unit`.
 pub(super) fn fmt_value(v: &ParamValue) -> String {
@@ -51,12 +51,37 @@ pub(super) struct VerdictInput<'a> {
     pub blocked: Option<&'a str>,
 }
 
-/// A discovered term's value: `coefficient ± se` and its locator.
-pub fn fmt_discovered(d: &DiscoveredTerm) -> String {
-    let value = match d.std_error {
+/// A discovered term's coefficient: `coefficient ± se`.
+fn fmt_coefficient(d: &DiscoveredTerm) -> String {
+    match d.std_error {
         Some(se) => format!("{:.4} ± {:.2}", d.coefficient, se),
         None => format!("{:.4} (undetermined)", d.coefficient),
-    };
+    }
+}
+
+/// A discovered term in one short line (the terminal's summary): [`fmt_discovered`] with its
+/// first location only (a gust's onset, a step's time, an oscillation's frequency).
+pub fn fmt_discovered_brief(d: &DiscoveredTerm) -> String {
+    match d.locations.first() {
+        Some(l) => format!(
+            "{} {} = {}, {}",
+            d.axis,
+            d.term,
+            fmt_coefficient(d),
+            fmt_location(l)
+        ),
+        None => fmt_discovered(d),
+    }
+}
+
+/// A discovered term's value: `coefficient ± se` and its locator (its locations with their
+/// intervals, when it has them).
+pub fn fmt_discovered(d: &DiscoveredTerm) -> String {
+    let value = fmt_coefficient(d);
+    if !d.locations.is_empty() {
+        let located: Vec<String> = d.locations.iter().map(fmt_location).collect();
+        return format!("{} {} = {value}, {}", d.axis, d.term, located.join(", "));
+    }
     let locator = match (d.t_on_s, d.f_hz, d.lambda_m) {
         (Some(t), _, _) if d.rise_s.is_some() && d.locator_std_error.is_some() => {
             let middle = t + d.rise_s.unwrap_or(0.0) / 2.0;
@@ -81,6 +106,32 @@ pub fn fmt_discovered(d: &DiscoveredTerm) -> String {
         _ => locator,
     };
     format!("{} {} = {value}{locator}", d.axis, d.term)
+}
+
+/// A location with its standard error and 95 % interval: "t_on = 0.451 ± 0.004 s (95 %: 0.443
+/// to 0.459 s)", or "t_on = 0.391 s (not determined by the data; 95 %: 0.221 to 0.463 s)".
+pub fn fmt_location(l: &Location) -> String {
+    let (label, unit, digits) = match l.quantity.as_str() {
+        "t_on_s" => ("t_on =", "s", 3),
+        "t_mid_s" => ("middle", "s", 3),
+        "rise_s" => ("length", "s", 3),
+        "f_hz" => ("f =", "Hz", 2),
+        "phase_deg" => ("phase", "deg", 1),
+        other => (other, "", 3),
+    };
+    let se = match l.std_error {
+        Some(se) => format!(" ± {se:.digits$}"),
+        None => String::new(),
+    };
+    let tag = if l.determined {
+        ""
+    } else {
+        "not determined by the data; "
+    };
+    format!(
+        "{label} {:.digits$}{se} {unit} ({tag}95 %: {:.digits$} to {:.digits$} {unit})",
+        l.value, l.low, l.high
+    )
 }
 
 /// The verdict in one sentence.
@@ -271,5 +322,29 @@ mod tests {
         assert!(text.contains("+3251.2"), "{text}");
         assert!(!text.contains("Cm beta"), "{text}");
         assert_eq!(open_classes(&classes[1..]), None);
+    }
+
+    /// A location reads as its estimate, its standard error and its 95 % interval, or says it
+    /// is not determined and gives no standard error.
+    #[test]
+    fn a_location_reads_with_its_interval_or_as_not_determined() {
+        let mut l = Location {
+            quantity: "t_on_s".into(),
+            value: 0.4512,
+            std_error: Some(0.0041),
+            low: 0.4432,
+            high: 0.4592,
+            determined: true,
+            basis: String::new(),
+        };
+        assert_eq!(
+            fmt_location(&l),
+            "t_on = 0.451 ± 0.004 s (95 %: 0.443 to 0.459 s)"
+        );
+        (l.std_error, l.determined, l.low) = (None, false, 0.2);
+        assert_eq!(
+            fmt_location(&l),
+            "t_on = 0.451 s (not determined by the data; 95 %: 0.200 to 0.459 s)"
+        );
     }
 }

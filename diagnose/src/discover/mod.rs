@@ -54,6 +54,7 @@ use verify::Refit;
 mod classes;
 mod held;
 mod locate;
+mod located;
 mod mimic;
 mod naming;
 mod picked;
@@ -283,7 +284,9 @@ fn conclude(
         sel.without,
         trail,
     )?;
-    let terms = naming::name_terms(job, &fitted, &picked, &gains, &gain, &sel.groups);
+    let locations = located::locations(evaluator, search, &fitted, &picked, trail)?;
+    crate::stage_clock::lap("discovery's locations");
+    let terms = naming::name_terms(job, &fitted, &picked, &gains, &gain, &sel.groups, locations);
     Ok(Some(Found {
         fitted,
         terms,

@@ -8,7 +8,7 @@ use sepval_common::extension::Family;
 use sepval_solve::identifiability::{Identifiability, identifiability};
 
 use super::picked::{EntryParams, Picked};
-use crate::found::{DiscoveredTerm, Gain, GroupMember};
+use crate::found::{DiscoveredTerm, Gain, GroupMember, Location};
 use crate::library::Entry;
 use crate::{Fitted, readings};
 
@@ -21,6 +21,7 @@ pub(super) fn name_terms(
     gains: &[Gain],
     total: &Gain,
     groups: &[Vec<GroupMember>],
+    locations: Vec<Vec<Location>>,
 ) -> Vec<DiscoveredTerm> {
     let space = fitted.space(job);
     let events: Vec<usize> = job.events().iter().map(|e| e.data.len()).collect();
@@ -35,10 +36,14 @@ pub(super) fn name_terms(
         .entries()
         .iter()
         .zip(picked.params(&fitted.terms))
+        .zip(locations)
         .enumerate()
-        .map(|(k, (e, at))| {
+        .map(|(k, ((e, at), locations))| {
             let gain = gains.get(k).cloned().unwrap_or_else(|| total.clone());
-            named(job, e, &at, &id, gain, groups[k].clone())
+            DiscoveredTerm {
+                locations,
+                ..named(job, e, &at, &id, gain, groups[k].clone())
+            }
         })
         .collect();
     found.sort_by(|a, b| b.gain.chi2_drop.total_cmp(&a.gain.chi2_drop));
@@ -104,6 +109,7 @@ fn named(
             .and_then(|i| id.parameters.get(i))
             .filter(|p| p.identifiable)
             .and_then(|p| p.std_error),
+        locations: Vec::new(),
         gain,
         reading: readings::reading(&lead, &job.events()[0].simulator.scenario().interference),
         group,

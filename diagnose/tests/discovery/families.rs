@@ -137,6 +137,22 @@ fn a_side_force_step_is_discovered_and_located() {
     let first = found_in_one(&default_scenario(), Some(hidden), 11, None, "CY", "step");
     let t_on = first["t_on_s"].as_f64().unwrap();
     assert!((t_on - 0.43).abs() < 0.05, "t_on {t_on}");
+    // Its time estimated with a 95 % interval that holds the truth (issue 60, item 3).
+    assert_holds(&first, "t_on_s", 0.43);
+}
+
+/// The location `quantity` of the discovered term `first` has a 95 % interval holding `truth`.
+fn assert_holds(first: &Value, quantity: &str, truth: f64) {
+    let l = first["locations"]
+        .as_array()
+        .and_then(|ls| ls.iter().find(|l| l["quantity"] == quantity))
+        .unwrap_or_else(|| panic!("no {quantity}: {first}"));
+    eprintln!("{quantity} (truth {truth}): {l}");
+    let (low, high) = (l["low"].as_f64().unwrap(), l["high"].as_f64().unwrap());
+    assert!(
+        low <= truth && truth <= high,
+        "{quantity} {truth} outside {l}"
+    );
 }
 
 #[test]
@@ -155,6 +171,8 @@ fn a_roll_buffet_is_discovered_at_its_frequency() {
     );
     let f = first["f_hz"].as_f64().unwrap();
     assert!((f - 6.3).abs() < 0.5, "f {f}");
+    // Its frequency estimated with a 95 % interval that holds the truth (issue 60, item 3).
+    assert_holds(&first, "f_hz", 6.3);
 }
 
 #[test]

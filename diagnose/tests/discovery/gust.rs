@@ -72,6 +72,23 @@ fn a_short_gust_is_placed_by_its_middle_and_its_length_is_honest() {
         ),
         None => assert!(verdict.contains("not determined by the data"), "{verdict}"),
     }
+    // The onset is reported with its 95 % interval, which holds the truth (issue 60, item 3),
+    // in diagnosis.json, the verdict and the report.
+    let onset = first["locations"]
+        .as_array()
+        .and_then(|ls| ls.iter().find(|l| l["quantity"] == "t_on_s"))
+        .unwrap_or_else(|| panic!("no onset: {first}"));
+    let (low, high) = (
+        onset["low"].as_f64().unwrap(),
+        onset["high"].as_f64().unwrap(),
+    );
+    assert!(low <= 0.45 && 0.45 <= high, "{onset}");
+    assert!(
+        verdict.contains("t_on = ") && verdict.contains("(95 %: "),
+        "{verdict}"
+    );
+    let html = std::fs::read_to_string(dir.join("diag/report.html")).unwrap();
+    assert!(html.contains("95 %: "), "the report gives no interval");
 }
 
 #[test]

@@ -31,4 +31,5 @@ mod simulate;
 mod families;
 mod gust;
 mod limits;
+mod located;
 mod rivals;
