@@ -41,13 +41,7 @@ pub fn request(r: PlanRequest, tell: Tell) -> Result<(Writes, PlanRun), PlanErro
     let (diagnosis, flown) = read_from(&r.from, tell)?;
     let read = recorded_inputs(&r.from, &diagnosis.inputs, &[]);
     let prepared = prepare(diagnosis, &flown, &r.ranges, r.points)?;
-    let writes = Writes {
-        out: r.out,
-        command: "plan",
-        claim: r.claim,
-        inputs: read,
-        resume: None,
-    };
+    let writes = Writes::new(r.out, "plan", r.claim, read);
     let from = r.from;
     Ok((writes, PlanRun { prepared, from }))
 }

@@ -92,13 +92,7 @@ pub fn request(r: PredictRequest, tell: Tell) -> Result<(Writes, PredictRun), Ru
         Some(c) => prepared.with_clearance(c),
         None => prepared,
     };
-    let writes = Writes {
-        out: r.out,
-        command: "predict",
-        claim: r.claim,
-        inputs: read,
-        resume: None,
-    };
+    let writes = Writes::new(r.out, "predict", r.claim, read);
     let from = r.from;
     Ok((writes, PredictRun { prepared, from }))
 }

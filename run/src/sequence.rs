@@ -48,6 +48,20 @@ pub struct Writes {
     pub resume: Option<String>,
 }
 
+impl Writes {
+    /// A run of `command` into `out`, claimed as `claim` says, reading `inputs`; nothing to
+    /// resume from.
+    pub fn new(out: PathBuf, command: &'static str, claim: Claim, inputs: Vec<Input>) -> Writes {
+        Writes {
+            out,
+            command,
+            claim,
+            inputs,
+            resume: None,
+        }
+    }
+}
+
 /// The evaluators of a run: the one of its job, or a starter of one per job for a run of
 /// several (an envelope's conditions, an update's rounds), whose zenoh hosts serve every job.
 pub enum Evaluators<'a> {

@@ -19,13 +19,12 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let mut read = super::model_inputs(&args.inputs);
     read.extend(super::input_files("--validate", &args.validate));
     read.extend(geometry.inputs());
-    let writes = Writes {
-        out: args.out.clone(),
-        command: "diagnose",
-        claim: super::fresh_or_overwrite(&args.overwrite),
-        inputs: read,
-        resume: None,
-    };
+    let writes = Writes::new(
+        args.out.clone(),
+        "diagnose",
+        super::fresh_or_overwrite(&args.overwrite),
+        read,
+    );
     let releases = args.inputs.releases(&args.validate);
     let search = args.baseline.search();
     let (job, options) =

@@ -20,13 +20,12 @@ pub fn run(args: UpdateArgs) -> Result<()> {
     let (options, job) = configure(&args)?;
     let mut read = super::model_inputs(&args.inputs);
     read.extend(super::input_files("--validate", &args.validate));
-    let writes = Writes {
-        out: args.out.clone(),
-        command: "update",
-        claim: super::fresh_or_overwrite(&args.overwrite),
-        inputs: read,
-        resume: None,
-    };
+    let writes = Writes::new(
+        args.out.clone(),
+        "update",
+        super::fresh_or_overwrite(&args.overwrite),
+        read,
+    );
     let data = args.inputs.data.iter().map(|p| p.display().to_string());
     let run = UpdateRun {
         job: Arc::new(job),
