@@ -50,10 +50,11 @@ MAY_USE = {
                         "sepval-predict", "sepval-geometry", "sepval-report"},
     "sepval-update": {"sepval-core", "sepval-common", "sepval-solve", "sepval-run", "sepval-fit",
                       "sepval-diagnose", "sepval-report", "sepval-daveml"},
-    # The store's data with uncertainty (DAVE-ML) is one of the priors a campaign begins from.
+    # The store's data with uncertainty (DAVE-ML) and its estimate from its shape are priors a
+    # campaign begins from.
     "sepval-campaign": {"sepval-core", "sepval-common", "sepval-solve", "sepval-run", "sepval-fit",
                         "sepval-diagnose", "sepval-predict", "sepval-envelope", "sepval-report",
-                        "sepval-daveml"},
+                        "sepval-daveml", "sepval-aero"},
     "sepval": {"sepval-core", "sepval-common", "sepval-transport", "sepval-solve", "sepval-run",
                "sepval-fit", "sepval-diagnose", "sepval-plan", "sepval-predict", "sepval-envelope",
                "sepval-update", "sepval-campaign", "sepval-geometry", "sepval-report",

@@ -8,7 +8,8 @@
 //! crossflow terms ([`body`]) and the fins' linear theory with interference ([`fins`]) are
 //! summed at each Mach number ([`buildup`]) with the axial force ([`drag`]); the result is an
 //! [`Estimate`], written in the scenario's table form with uncertainty bands ([`tables`]) as
-//! `aero.toml`, `store.dml` (DAVE-ML through `sepval-daveml`) and `summary.txt` ([`output`]).
+//! `aero.toml`, `store.dml` (DAVE-ML through `sepval-daveml`) and `summary.txt` ([`output`]);
+//! [`start`] makes it the starting point of a scenario and of a campaign's prior.
 //!
 //! Conventions are docs/model.md's: reference diameter d = the body's, S = pi d^2 / 4; moments
 //! about the CG; CZ_alpha = -CN_alpha; damping per rad of q d / 2V (p d / 2V, r d / 2V).
@@ -22,6 +23,7 @@ mod error;
 pub mod fins;
 pub mod grid;
 pub mod output;
+pub mod start;
 pub mod tables;
 
 use sepval_common::atmosphere::{TROPOPAUSE_M, isa_troposphere};

@@ -32,6 +32,7 @@ pub mod preflight;
 pub mod preposterior;
 pub mod prior;
 pub mod prior_daveml;
+pub mod prior_shape;
 pub mod program;
 pub mod record;
 pub mod refusal;
@@ -123,6 +124,24 @@ pub enum CampaignError {
         path: String,
         /// Why.
         reason: Box<prior_daveml::PriorDavemlError>,
+    },
+    /// The store's estimate from its shape (`--prior-from-shape`) that cannot be taken into
+    /// the prior.
+    #[error("--prior-from-shape {path}: {reason}")]
+    PriorShape {
+        /// The file.
+        path: String,
+        /// Why.
+        reason: Box<prior_daveml::PriorDavemlError>,
+    },
+    /// The store's shape (`--prior-from-shape`) that cannot be estimated.
+    #[error("--prior-from-shape {path}")]
+    Aero {
+        /// The file.
+        path: String,
+        /// Why.
+        #[source]
+        source: Box<sepval_aero::AeroError>,
     },
     /// The prior (`--prior`).
     #[error(transparent)]

@@ -39,7 +39,7 @@ use crate::prior::{Belief, Prior, PriorSource};
 pub use crate::sources::Mapped;
 
 /// The factor that moves `t`, and whether it is an offset (else a multiplier).
-fn factor_of(t: Target) -> Option<(Factor, bool)> {
+pub(crate) fn factor_of(t: Target) -> Option<(Factor, bool)> {
     let name = match t {
         Target::Static(k) => ["caoff", "cyoff", "czoff", "cloff", "cmoff", "cnoff"].get(k),
         Target::Interference(k) => [
@@ -130,23 +130,63 @@ fn map_field(
         return Err(refuse(FieldRefusal::NoFactor));
     };
     let (values, base) = values_and_base(f, scenario).map_err(&refuse)?;
-    let sd_at = |i: usize| spread.sd[if spread.sd.len() == 1 { 0 } else { i }];
+    let sd: Vec<f64> = (0..values.len())
+        .map(|i| spread.sd[if spread.sd.len() == 1 { 0 } else { i }])
+        .collect();
+    let at = Points {
+        values: &values,
+        base: &base,
+        sd: &sd,
+    };
+    let belief = belief(factor, offset, &at, table, &field).map_err(&refuse)?;
+    Ok(Mapped {
+        element,
+        field,
+        factor: factor.name().to_string(),
+        belief,
+    })
+}
+
+/// A field's values at its points: the source's, the campaign scenario's and the source's
+/// standard deviation at each.
+pub(crate) struct Points<'a> {
+    /// The source's values.
+    pub values: &'a [f64],
+    /// The campaign scenario's at the same points.
+    pub base: &'a [f64],
+    /// The source's standard deviation at each.
+    pub sd: &'a [f64],
+}
+
+/// The belief of `factor` (an offset, else a multiplier) from a field's values at its points
+/// (module docs: the least-squares projection onto the factor's effect, the band's size over
+/// the effect's), refused when it scales nothing or falls outside the factor's range. The one
+/// mapping of a store's data with uncertainty onto the factors: `--prior-daveml`'s and
+/// `--prior-from-shape`'s ([`crate::prior_shape`]).
+pub(crate) fn belief(
+    factor: Factor,
+    offset: bool,
+    at: &Points<'_>,
+    table: &FactorTable,
+    field: &str,
+) -> Result<Belief, FieldRefusal> {
+    let (values, base) = (at.values, at.base);
     let effect: Vec<f64> = if offset {
         vec![1.0; base.len()]
     } else {
-        base.clone()
+        base.to_vec()
     };
     let e2: f64 = effect.iter().map(|e| e * e).sum();
     if !(e2 > 0.0 && e2.is_finite()) {
-        return Err(refuse(FieldRefusal::ScalesNothing {
-            field: field.clone(),
+        return Err(FieldRefusal::ScalesNothing {
+            field: field.to_string(),
             factor: factor.name(),
-        }));
+        });
     }
     let ed: f64 = (0..values.len())
         .map(|i| effect[i] * (values[i] - base[i]))
         .sum();
-    let s2: f64 = (0..values.len()).map(|i| sd_at(i) * sd_at(i)).sum();
+    let s2: f64 = at.sd.iter().map(|s| s * s).sum();
     // The factor's value at which the model's table is the scenario's: an offset's 0, a
     // multiplier's 1.
     let unmoved = if offset { 0.0 } else { 1.0 };
@@ -156,20 +196,15 @@ fn map_field(
     };
     let spec = table.spec(factor);
     if !(belief.mean.is_finite() && spec.contains(belief.mean) && belief.sd.is_finite()) {
-        return Err(refuse(FieldRefusal::OutOfRange {
+        return Err(FieldRefusal::OutOfRange {
             factor: factor.name(),
             mean: belief.mean,
             sd: belief.sd,
             min: spec.min,
             max: spec.max,
-        }));
+        });
     }
-    Ok(Mapped {
-        element,
-        field,
-        factor: factor.name().to_string(),
-        belief,
-    })
+    Ok(belief)
 }
 
 /// The file's values of a field and the campaign scenario's at the same points.
@@ -256,6 +291,17 @@ pub enum PriorDavemlError {
         "{element} sets {factor}, which the --prior file sets too: give each factor's belief once"
     )]
     AlsoInPriorFile {
+        /// The field's element.
+        element: String,
+        /// The factor.
+        factor: String,
+    },
+    /// A factor an earlier source of the prior sets (`--prior-from-shape` after `--prior` or
+    /// `--prior-daveml`).
+    #[error(
+        "{element} sets {factor}, which an earlier source (--prior or --prior-daveml) sets too: give each factor's belief once"
+    )]
+    SetBefore {
         /// The field's element.
         element: String,
         /// The factor.

@@ -61,6 +61,9 @@ pub struct InitRequest<'a> {
     pub prior: Option<&'a Path>,
     /// `--prior-daveml`: the store's data with uncertainty.
     pub prior_daveml: Option<&'a Path>,
+    /// `--prior-from-shape`: the store's shape, its estimate's uncertainty taken as the
+    /// offsets' spread.
+    pub prior_from_shape: Option<&'a Path>,
     /// `--preflight`: pre-flight trajectories.
     pub preflight: &'a [PathBuf],
     /// `--preflight-allowance-m` and `--preflight-allowance-deg`.
@@ -164,7 +167,11 @@ impl InitRequest<'_> {
             generations: self.generations,
             prior,
         };
+        let mut settings = settings;
         let grid = grid_of(&settings, &scenario)?;
+        if let Some(p) = self.prior_from_shape {
+            settings.prior = crate::prior_shape::read(p, &scenario, &grid, &settings.prior)?;
+        }
         let times = sample_times(scenario.integrator.t_end_s, scenario.integrator.rate_hz);
         let points = sepval_predict::simulate::Grid::of(&times).len();
         check_work(self.samples, self.generations, grid.len(), points)?;

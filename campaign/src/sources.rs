@@ -1,6 +1,7 @@
 //! The records of what the prior was made of, as campaign.json keeps them
 //! (docs/campaign.md, "Beginning from pre-flight knowledge"): each factor's belief, and each
-//! source: the default, a `--prior` file, the store's DAVE-ML ([`crate::prior_daveml`]),
+//! source: the default, a `--prior` file, the store's DAVE-ML ([`crate::prior_daveml`]), the
+//! estimate from its shape ([`crate::prior_shape`]),
 //! pre-flight trajectories ([`crate::preflight`]). Kept apart from the code that makes them so
 //! that the settings' record depends on no reader.
 
@@ -44,6 +45,19 @@ pub enum PriorSource {
     },
     /// The `--preflight` trajectories fitted together ([`crate::preflight`]).
     Preflight(PreflightRecord),
+    /// A `--prior-from-shape` store TOML, its estimate mapped ([`crate::prior_shape`]).
+    Shape {
+        /// The file (absolute).
+        path: String,
+        /// Its SHA-256.
+        sha256: String,
+        /// The points (condition and flow angle) the estimate was read at.
+        points: usize,
+        /// The store's flow angle either side of the aircraft's \[deg\].
+        excursion_deg: f64,
+        /// Each static coefficient and the offset it set.
+        mapped: Vec<Mapped>,
+    },
 }
 
 /// An uncertain element of the file and the factor it set.
@@ -121,7 +135,7 @@ impl PriorSource {
         match self {
             Self::Default => Vec::new(),
             Self::File { path, factors, .. } => vec![format!("{path} set {}", factors.join(", "))],
-            Self::Daveml { path, mapped, .. } => {
+            Self::Daveml { path, mapped, .. } | Self::Shape { path, mapped, .. } => {
                 let each: Vec<String> = mapped
                     .iter()
                     .map(|m| {

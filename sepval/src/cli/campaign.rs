@@ -73,6 +73,11 @@ pub struct CampaignInitArgs {
     /// `sepval update --daveml` writes it): each uncertain table sets the factor that moves it.
     #[arg(long, value_name = "FILE.xml")]
     pub prior_daveml: Option<PathBuf>,
+    /// The store's shape (a store TOML, docs/aero.md): its estimated aerodynamics' stated
+    /// uncertainty sets the offsets' spread (caoff, cyoff, czoff, cmoff, cnoff); give the
+    /// scenario `sepval scenario --from-shape` made of it (docs/campaign.md).
+    #[arg(long, value_name = "SHAPE.toml")]
+    pub prior_from_shape: Option<PathBuf>,
     /// A pre-flight trajectory (a captive-trajectory test or a CFD release: CSV stating its
     /// condition as a release does; repeatable), fitted into the prior with the allowance below.
     #[arg(long, value_name = "FILE.csv")]

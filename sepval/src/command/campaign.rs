@@ -61,6 +61,7 @@ fn request(a: &CampaignInitArgs) -> Result<Init> {
         generations: a.generations,
         prior: a.prior.as_deref(),
         prior_daveml: a.prior_daveml.as_deref(),
+        prior_from_shape: a.prior_from_shape.as_deref(),
         preflight: &a.preflight,
         preflight_allowance: (a.preflight_allowance_m, a.preflight_allowance_deg),
         threads: count("--threads", a.eval.threads)?,

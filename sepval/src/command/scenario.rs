@@ -1,7 +1,8 @@
 //! `sepval scenario`: a scenario written as TOML (the embedded default to start your own), or
 //! with `--tables` as a directory of TOML and CSV tables (docs/model.md section 1, "Tables");
 //! `--from-daveml` and `--to-daveml` read and write the store's aerodynamics as DAVE-ML
-//! (docs/daveml.md, the crate `sepval_daveml`).
+//! (docs/daveml.md, the crate `sepval_daveml`); `--from-shape` puts the store's `[aero]`
+//! estimated from its shape in the scenario (docs/aero.md, `sepval_aero::start`).
 
 use anyhow::{Context, Result};
 use sepval_common::scenario::Scenario;
@@ -24,10 +25,14 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
     }
     if !args.tables {
         // The file written may be neither the scenario read nor a table it names.
-        let read = super::scenario_inputs(args.scenario.as_ref(), None);
+        let mut read = super::scenario_inputs(args.scenario.as_ref(), None);
+        read.extend(super::input_files("--from-shape", args.from_shape.as_ref()));
         super::out_file_apart(&args.out, &read)?;
     }
-    let scenario = inputs::scenario(args.scenario.as_deref(), None)?;
+    let mut scenario = inputs::scenario(args.scenario.as_deref(), None)?;
+    if let Some(shape) = &args.from_shape {
+        scenario = sepval_aero::start::scenario_from_shape(shape, &scenario)?;
+    }
     if args.to_daveml {
         let prov = sepval_daveml::Provenance::now(
             inputs::scenario_name(args.scenario.as_deref()),

@@ -13,9 +13,10 @@ use sepval_tests::{ok, sepval};
 /// The commands cheap enough to run here (a second or less each).
 const CHEAP: [&str; 4] = ["effects", "scenario", "simulate", "goals"];
 /// The flags whose value is a file the command reads.
-const INPUT_FLAGS: [&str; 9] = [
+const INPUT_FLAGS: [&str; 10] = [
     "--scenario",
     "--from-daveml",
+    "--from-shape",
     "--map",
     "--factors",
     "--extension",

@@ -17,6 +17,7 @@ mod discover;
 mod envelope;
 mod fit;
 mod flowfield;
+mod from_shape;
 mod fuzz;
 // The tests' own generator of releases with a hidden cause, shared with the in-process tests
 // of the diagnosis and the plan.
