@@ -28,6 +28,7 @@ mod releases;
 #[path = "../support/simulate.rs"]
 mod simulate;
 
+mod after;
 mod families;
 mod gust;
 mod limits;

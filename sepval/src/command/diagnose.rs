@@ -35,6 +35,8 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let options = DiagnoseOptions {
         strict_tables: args.tables.strict_tables,
         clearance: clearance::stage(&args.geometry, base, threads)?,
+        after: args.after.clone(),
+        plan: args.plan.clone(),
         ..options
     };
     execute(&spec, writes, Some(Arc::new(job)), Request { options })
