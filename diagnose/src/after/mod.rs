@@ -538,3 +538,44 @@ pub(crate) fn answer_and_rivals(
     };
     Ok((answer, rivals, rival_classes, report))
 }
+
+#[cfg(test)]
+mod tests {
+    use sepval_common::extension::Axis;
+
+    use super::*;
+
+    fn term(axis: Axis, regressor: Regressor, locator: f64) -> Term {
+        Term {
+            axis,
+            regressor,
+            locator: [locator, 0.0],
+            coefficient: 0.1,
+        }
+    }
+
+    /// An oscillation's sine and cosine at one frequency on one axis are one entry (one term as
+    /// the criterion counts them); a sine alone, or a cosine at another frequency, is not paired.
+    #[test]
+    fn an_oscillations_pair_is_one_entry_and_kinds_ignore_order() {
+        let terms = [
+            term(Axis::Cm, Regressor::Q, 0.0),
+            term(Axis::Cl, Regressor::Sin, 6.5),
+            term(Axis::Cl, Regressor::Cos, 6.5),
+            term(Axis::Cn, Regressor::Sin, 3.0),
+            term(Axis::Cn, Regressor::Cos, 3.5),
+        ];
+        let entries = entries_of(&terms);
+        let sizes: Vec<usize> = entries.iter().map(|e| e.terms.len()).collect();
+        assert_eq!(sizes, [1, 2, 1, 1]);
+        let mut reversed = terms;
+        reversed.reverse();
+        assert_eq!(key_of(&[], &terms), key_of(&[], &reversed));
+        // A step's time tells two steps apart (to 1 ms), a rate term has none.
+        let a = key_of(&[], &[term(Axis::CY, Regressor::Step, 0.43)]);
+        let b = key_of(&[], &[term(Axis::CY, Regressor::Step, 0.45)]);
+        assert_ne!(a, b);
+        let ids = ["cg_offset".to_string()];
+        assert_ne!(key_of(&ids, &[]), key_of(&[], &[]));
+    }
+}
