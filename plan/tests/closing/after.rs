@@ -388,3 +388,64 @@ fn weaker_pitch_damping_is_the_answer_after_the_first_diagnosis() {
     );
     assert!(!fates.is_empty());
 }
+
+/// Plan and diagnosis agree (issue 60, item 2), on the roll-damping loop of
+/// `weaker_roll_damping_is_named_after_the_planned_release` (the tests' base, other seeds):
+/// every pair the plan said its top condition separates is recorded with the plan's predicted
+/// separation and the diagnosis's after the release, each earlier rival has its fate, and the
+/// disagreements are the pairs the diagnosis does not separate.
+#[test]
+fn the_plans_separations_are_set_against_the_diagnosis() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
+    let model = default_scenario();
+    let truth = damped(&model, 0.5, |a| &mut a.cl_p_per_rad);
+    let base = Factors::from_json_str(crate::generator::BASE, &model.factors).unwrap();
+    let one = tempfile::tempdir().unwrap();
+    let r1 = release_on(&truth, &base, None, 31);
+    let first = diagnose_in(
+        one.path(),
+        std::slice::from_ref(&r1),
+        &model,
+        None,
+        None,
+        "diag",
+    );
+    let g = grid(
+        &[(Quantity::BetaDeg, -6.0, 6.0), (Quantity::Mach, 0.6, 0.95)],
+        5,
+    );
+    let p = plan(one.path(), &g);
+    let next = at_top(&truth, &p);
+    let r2 = release_on(&next, &base, None, 33);
+    let two = tempfile::tempdir().unwrap();
+    let both = diagnose_in(
+        two.path(),
+        &[r1, r2],
+        &model,
+        Some(&one.path().join("diag")),
+        Some(&one.path().join("plan")),
+        "diag",
+    );
+    let check = &both["after"]["plan"];
+    eprintln!("first: {}", first["verdict"]);
+    eprintln!("plan top: {}", p["conditions"][0]["separates"]);
+    eprintln!("check: {check}");
+    eprintln!("both: {}", both["verdict"]);
+    let said = p["conditions"][0]["separates"].as_array().unwrap().len();
+    let pairs = check["pairs"].as_array().unwrap();
+    assert_eq!(pairs.len(), said, "{check}");
+    assert_eq!(check["rank"], 1, "{check}");
+    for q in pairs {
+        let after = q["after"].as_f64();
+        let agree = q["agree"].as_bool();
+        assert_eq!(agree, after.map(|a| a > 6.0), "{q}");
+    }
+    let disagreements = check["disagreements"].as_array().unwrap().len();
+    let not_agreeing = pairs.iter().filter(|q| q["agree"] != true).count();
+    assert_eq!(disagreements, not_agreeing, "{check}");
+    let rivals = first["rivals"].as_array().unwrap().len();
+    let fates = both["after"]["fates"].as_array().unwrap();
+    assert!(fates.len() > rivals, "{}", both["after"]);
+}
