@@ -254,11 +254,13 @@ fn run_case(k: usize, case: &Case, compare: bool) -> Row {
         Some(&one.path().join("plan")),
         "diag",
     );
-    let plain_wall = compare.then(|| {
+    let plain = compare.then(|| {
         let three = tempfile::tempdir().unwrap();
-        diagnose_in(three.path(), &[r1, r2], &model, None, None, "diag")["wall_s"]
-            .as_f64()
-            .unwrap()
+        let d = diagnose_in(three.path(), &[r1, r2], &model, None, None, "diag");
+        (
+            d["wall_s"].as_f64().unwrap(),
+            d["evaluations"].as_u64().unwrap(),
+        )
     });
     let truth_kind = case.cause.kind();
     let fates = both["after"]["fates"]
@@ -270,7 +272,7 @@ fn run_case(k: usize, case: &Case, compare: bool) -> Row {
     let top = &p["conditions"][0];
     let row = Row {
         line: format!(
-            "| {k} | {:?} | {} + class {} | M {} alpha {} beta {} alt {} | {} | {} -> {} | {} | wall {:.0} s{} |",
+            "| {k} | {:?} | {} + class {} | M {} alpha {} beta {} alt {} | {} | {} -> {} | {} | wall {:.0} s, {} simulations{} |",
             case.cause,
             kinds(&first["model"]).join(" + "),
             first["rival_classes"]
@@ -295,7 +297,10 @@ fn run_case(k: usize, case: &Case, compare: bool) -> Row {
                 .collect::<Vec<_>>()
                 .join("; "),
             both["wall_s"].as_f64().unwrap(),
-            plain_wall.map_or(String::new(), |w| format!(" (without --after {w:.0} s)")),
+            both["evaluations"],
+            plain.map_or(String::new(), |(w, e)| format!(
+                " (without --after {w:.0} s, {e} simulations)"
+            )),
         ),
         first: standing(&first, truth_kind),
         second: standing(&both, truth_kind),
