@@ -214,6 +214,8 @@ fn diagnose(
         given_terms: Vec::new(),
         strict_tables: false,
         clearance: None,
+        after: previous_diagnosis(c),
+        plan: None,
     };
     let mut evaluator = start(Arc::new(job.clone())).map_err(CampaignError::from_eval)?;
     sepval_diagnose::diagnose(&options, evaluator.as_mut(), observer).map_err(|e| {
@@ -224,6 +226,16 @@ fn diagnose(
         }
     })?;
     Ok(())
+}
+
+/// The diagnosis of the previous round, when it diagnosed releases: what it left open is
+/// refitted on every release flown and competes for the answer (`sepval diagnose --after`).
+/// The campaign's next release comes from its own planner (`next.json`), not from `sepval
+/// plan`, so no plan is set against the diagnosis here.
+fn previous_diagnosis(c: &Campaign) -> Option<std::path::PathBuf> {
+    let last = c.file.rounds.last().filter(|r| r.releases_flown > 0)?;
+    let dir = c.dir.join(&last.dir).join("diagnosis");
+    dir.join("diagnosis.json").is_file().then_some(dir)
 }
 
 /// The post-flight check of release `name` (its `data`, flown at `scenario`) against the

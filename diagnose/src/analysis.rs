@@ -55,6 +55,10 @@ pub(super) struct Decided {
     pub tables_left: Vec<String>,
     /// Why the first baseline was replaced, when the catalogue showed it in a local optimum.
     pub baseline_restart: Option<String>,
+    /// What the releases did to what an earlier diagnosis left open (`--after`).
+    pub after: Option<crate::AfterReport>,
+    /// The verdict's sentence on it.
+    pub after_sentence: Option<String>,
     /// Simulations run.
     pub evaluations: u64,
 }
@@ -166,8 +170,9 @@ pub(super) fn analyse(
     if let Some(a) = ambiguity(&rivals, job.events().len()) {
         verdict.push_str(&format!("; {a}"));
     }
-    if let Some(c) = crate::verdict::open_classes(&d.rival_classes) {
-        verdict.push_str(&format!("; {c}"));
+    let open = crate::verdict::open_classes(&d.rival_classes);
+    for s in open.iter().chain(&d.after_sentence) {
+        verdict.push_str(&format!("; {s}"));
     }
     if let Some(why) = &unreliable {
         verdict = format!("unreliable: {why}; as found: {verdict}");
@@ -191,6 +196,7 @@ pub(super) fn analyse(
         rivals,
         rival_classes: d.rival_classes,
         clearance: None,
+        after: d.after,
         alternatives,
         extension,
         discovery_notes: d.notes,

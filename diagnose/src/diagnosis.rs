@@ -139,6 +139,11 @@ pub struct RivalClass {
     pub status: String,
     /// Its best representative's BIC less the answer's, when one was refitted.
     pub delta_bic: Option<f64>,
+    /// Each member's terms (extension-file records, in `members`' order; the coefficient is
+    /// the screening's probe, a scale, not an estimate), so that a later diagnosis given this
+    /// one (`--after`) can refit every member. Absent in older files.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub member_terms: Vec<Vec<TermRecord>>,
 }
 
 /// An explanation the data cannot tell from the answer: its evidence is within
@@ -293,6 +298,11 @@ pub struct Diagnosis {
     /// diagnosis was given `--aircraft` (docs/envelope.md section 14.2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance: Option<Vec<sepval_run::clearance::ReleaseClearance>>,
+    /// What these releases did to what an earlier diagnosis left open (`--after DIR`): each
+    /// earlier explanation refitted on every release, its fate, and the plan's predicted
+    /// separations against the diagnosis's (`--plan DIR`). Absent without `--after`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub after: Option<crate::AfterReport>,
     /// Models that explain part of the data but not as well as the answer (mimics).
     pub alternatives: Vec<Alternative>,
     /// The discovered extension and its gain, when discovery verified one.

@@ -143,6 +143,29 @@ pub enum DiagnoseError {
     /// The clearance of the answer's releases (`--aircraft`) could not be found.
     #[error(transparent)]
     Clearance(sepval_run::clearance::StageError),
+    /// The earlier diagnosis given (`--after`) is not one.
+    #[error("--after {}: {message}", path.display())]
+    NotAnEarlierDiagnosis {
+        /// The directory given.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// The earlier diagnosis's record (`--after DIR`) does not read.
+    #[error("--after {}", path.display())]
+    EarlierRecord {
+        /// The directory given.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: sepval_run::sealed::RecordError,
+    },
+    /// The plan given (`--plan`) does not read.
+    #[error(transparent)]
+    Plan(#[from] after::plan::PlanReadError),
+    /// A plan given without the diagnosis it was made from.
+    #[error("--plan needs --after: the plan's models are the earlier diagnosis's, refitted here")]
+    PlanWithoutAfter,
 }
 
 impl From<OutputError> for DiagnoseError {
@@ -163,6 +186,7 @@ impl From<EvalError> for DiagnoseError {
 
 type Result<T> = std::result::Result<T, DiagnoseError>;
 
+pub mod after;
 mod analysis;
 mod answer;
 mod catalogue;
@@ -191,6 +215,7 @@ mod tables;
 mod validation;
 mod verdict;
 
+pub use after::{AfterReport, Fate, PairCheck, PlanCheck};
 pub use diagnosis::{
     Alternative, BaselineVerdict, CandidateReport, Diagnosis, ExtensionReport, ModelSummary,
     ParamValue, RivalClass, RivalReport, SkippedRefit,
@@ -265,6 +290,12 @@ pub struct DiagnoseOptions {
     /// The clearance of the answer's releases (`--aircraft`), found before diagnosis.json is
     /// written and recorded in it (`clearance`).
     pub clearance: Option<Arc<dyn ClearReleases>>,
+    /// An earlier diagnosis of the first of these releases (`--after DIR`): what it left open
+    /// is refitted on every release and competes for the answer (`after`).
+    pub after: Option<PathBuf>,
+    /// The plan made from that diagnosis (`--plan DIR`): its predicted separations are set
+    /// against the diagnosis's (`after::plan`).
+    pub plan: Option<PathBuf>,
 }
 
 impl DiagnoseOptions {
@@ -284,6 +315,8 @@ impl DiagnoseOptions {
             given_terms: Vec::new(),
             strict_tables: false,
             clearance: None,
+            after: None,
+            plan: None,
         }
     }
 }
@@ -364,6 +397,7 @@ pub fn diagnose(
         path: figures,
         source,
     })?;
+    let (earlier, plan) = after::read_given(options)?;
     let setting = Setting::new(Arc::clone(evaluator.job()), &options.fit);
     let job = &setting.job;
     let candidate_lm = at_bic_resolution(&options.candidate_lm, setting.m);
@@ -412,15 +446,13 @@ pub fn diagnose(
     let answer = Answer::decide(&setting, selected, disc.found);
     let mut contenders = cat.contenders;
     contenders.extend(disc.contenders);
-    contenders.extend(answer.rival().map(|r| r.contender()));
-    let (rivals, rival_classes) = rival_search(
+    let (answer, rivals, rival_classes, after) = after::answer_and_rivals(
         evaluator,
         &setting,
-        &baseline,
-        &answer,
-        contenders,
-        &disc.classes,
-        &candidate_lm,
+        (&baseline, &candidate_lm),
+        (answer, contenders, &disc.classes),
+        (earlier.as_ref(), plan.as_ref()),
+        &mut skipped,
     )?;
     stage_clock::lap("rivals");
     let decided = Decided {
@@ -436,6 +468,8 @@ pub fn diagnose(
         skipped,
         tables_left,
         baseline_restart,
+        after_sentence: after.as_ref().and_then(after::fates::sentence),
+        after,
         evaluations: counted.count(),
     };
     sepval_core::cancel::check().map_err(RunError::from)?;
@@ -465,10 +499,10 @@ fn answer_clearance(
 }
 
 /// The rivals, best first, each with the contender it came from.
-type Rivals = Vec<(contender::Contender, RivalReport)>;
+pub(crate) type Rivals = Vec<(contender::Contender, RivalReport)>;
 
 /// The rival search (`rivals`) and the rival classes' reports.
-fn rival_search(
+pub(crate) fn rival_search(
     evaluator: &mut dyn Evaluator,
     setting: &Setting,
     baseline: &Fitted,

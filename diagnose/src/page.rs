@@ -38,6 +38,8 @@ struct Page<'a> {
     alternatives: Vec<AlternativeRow<'a>>,
     rivals: Vec<RivalRow<'a>>,
     classes: Vec<ClassRow<'a>>,
+    /// What the releases did to what an earlier diagnosis left open (`--after`).
+    after: Option<crate::after::page::AfterSection<'a>>,
     discovery: Option<DiscoveryTable<'a>>,
     channels: Vec<ChannelRow>,
     candidates: Vec<CandidateRow<'a>>,
@@ -226,6 +228,7 @@ pub(super) fn report_html(d: &Diagnosis, figures: &[String]) -> Result<String, H
         figures,
         alternatives: alternative_rows(d),
         rivals: rival_rows(d),
+        after: d.after.as_ref().map(crate::after::page::section),
         classes: d
             .rival_classes
             .iter()

@@ -244,6 +244,11 @@ pub(crate) fn class_reports(
                 members: c.members.iter().map(Entry::label).collect(),
                 status: status.to_string(),
                 delta_bic,
+                member_terms: c
+                    .members
+                    .iter()
+                    .map(|e| e.terms.iter().map(TermRecord::of).collect())
+                    .collect(),
             }
         })
         .collect()

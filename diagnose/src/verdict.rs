@@ -307,6 +307,7 @@ mod tests {
             members: vec![words.into()],
             status: status.into(),
             delta_bic,
+            member_terms: Vec::new(),
         }
     }
 

@@ -79,6 +79,8 @@ fn options(out: &Path, job: &Job) -> DiagnoseOptions {
         given_terms: Vec::new(),
         strict_tables: false,
         clearance: None,
+        after: None,
+        plan: None,
     }
 }
 

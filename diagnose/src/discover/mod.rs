@@ -51,6 +51,7 @@ pub(crate) use reach::Yardstick;
 use search::{Search, Selection, Trail};
 use verify::Refit;
 
+pub(crate) mod carried;
 mod classes;
 mod held;
 mod locate;

@@ -4,7 +4,9 @@
 //! the stroke, a Mach-dependent drag, null data), gusts discovered as wind (`gust`), the rivals
 //! one release cannot tell apart (`rivals`), and what stops discovery or makes its answer
 //! unreliable (`limits`: a full term budget, the public CFD trajectory). Slow tier
-//! (`SEPVAL_SLOW_TESTS=1`): each test is one or a few diagnoses, 3 to 35 s alone on two cores.
+//! (`SEPVAL_SLOW_TESTS=1`): each test is one or a few diagnoses, 3 to 35 s alone on two cores;
+//! but `after` (a diagnosis `--after` an earlier one whose open cause must be carried forward
+//! and answer) runs in the fast tier, on a reduced budget (23 s of CPU, 2026-12-06).
 //!
 //! Each diagnosis is the one `sepval diagnose --data ... --generations 20 --evaluator inproc
 //! --threads 2` makes of the same files (`support/command.rs`: the command's own options, so the
@@ -28,6 +30,7 @@ mod releases;
 #[path = "../support/simulate.rs"]
 mod simulate;
 
+mod after;
 mod families;
 mod gust;
 mod limits;

@@ -32,6 +32,10 @@ pub struct Diagnose {
     pub extension: Option<PathBuf>,
     /// `--generations`.
     pub generations: usize,
+    /// `--after`: an earlier diagnosis's directory.
+    pub after: Option<PathBuf>,
+    /// `--plan`: the plan made from it.
+    pub plan: Option<PathBuf>,
 }
 
 impl Diagnose {
@@ -43,6 +47,8 @@ impl Diagnose {
             scenario: None,
             extension: None,
             generations: 20,
+            after: None,
+            plan: None,
         }
     }
 
@@ -69,6 +75,11 @@ impl Diagnose {
         let mut tell = |said: String| eprintln!("{said}");
         let (job, options) =
             DiagnoseOptions::configure(&releases, &search, out.to_path_buf(), &mut tell).unwrap();
+        let options = DiagnoseOptions {
+            after: self.after.clone(),
+            plan: self.plan.clone(),
+            ..options
+        };
         std::fs::create_dir_all(out).unwrap();
         let mut evaluator = InProcess::new(Arc::new(job), 2);
         diagnose(&options, &mut evaluator, &mut NoProgress).unwrap()

@@ -29,9 +29,20 @@ pub type Hidden = (CoefficientFn, [f64; MAX_EFFECT_PARAMS]);
 /// One release: `scenario` (its flight condition written as metadata) simulated with the base
 /// factors and the hidden term, 1 s at 200 Hz, noisy.
 pub fn release(scenario: &Scenario, hidden: Option<Hidden>, seed: u64) -> Trajectory {
-    let sim = Simulator::new(scenario);
     let factors = Factors::from_json_str(BASE, &scenario.factors).unwrap();
-    let mut run = RunSetup::new(sim.model(), &factors, &EffectSet::NONE).unwrap();
+    release_on(scenario, &factors, hidden, seed)
+}
+
+/// [`release`] on the base `factors` (not the tests' default base).
+#[allow(dead_code)]
+pub fn release_on(
+    scenario: &Scenario,
+    factors: &Factors,
+    hidden: Option<Hidden>,
+    seed: u64,
+) -> Trajectory {
+    let sim = Simulator::new(scenario);
+    let mut run = RunSetup::new(sim.model(), factors, &EffectSet::NONE).unwrap();
     if let Some((f, p)) = hidden {
         run.add_coefficient_term(f, p).unwrap();
     }

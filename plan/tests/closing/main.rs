@@ -44,6 +44,8 @@ mod releases;
 #[path = "../../../diagnose/tests/support/simulate.rs"]
 mod simulate;
 
+mod after;
+
 use command::diagnosis_of;
 use gusts::{PULSE, gust_release, terms};
 use releases::{default_scenario, diagnose, release};

@@ -174,6 +174,15 @@ pub struct DiagnoseArgs {
     pub geometry: GeometryArgs,
     #[command(flatten)]
     pub tables: TablesArgs,
+    /// An earlier diagnosis of the first of these releases (its --out directory): every
+    /// explanation it left open (its answer, rivals and classes not told apart) is refitted on
+    /// every release and competes for the answer; the report says what became of each.
+    #[arg(long, value_name = "DIAG")]
+    pub after: Option<PathBuf>,
+    /// The plan made from the --after diagnosis (the --out directory of `sepval plan`): its
+    /// predicted separations are set against the diagnosis's, and disagreements listed.
+    #[arg(long, value_name = "PLANDIR", requires = "after")]
+    pub plan: Option<PathBuf>,
     /// Output directory (diagnosis.json, report.html, figures/, baseline/).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,

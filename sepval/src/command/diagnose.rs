@@ -6,6 +6,7 @@ use anyhow::Result;
 use sepval_diagnose::DiagnoseOptions;
 use sepval_diagnose::command::DiagnoseRun;
 use sepval_predict::releases::Stage;
+use sepval_run::out_dir::Input;
 use sepval_run::sequence::Writes;
 
 use super::{evaluator_spec, execute, tell};
@@ -19,12 +20,10 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let mut read = super::model_inputs(&args.inputs);
     read.extend(super::input_files("--validate", &args.validate));
     read.extend(geometry.inputs());
-    let writes = Writes::new(
-        args.out.clone(),
-        "diagnose",
-        super::fresh_or_overwrite(&args.overwrite),
-        read,
-    );
+    read.extend(args.after.iter().map(|d| Input::directory("--after", d)));
+    read.extend(args.plan.iter().map(|d| Input::directory("--plan", d)));
+    let claim = super::fresh_or_overwrite(&args.overwrite);
+    let writes = Writes::new(args.out.clone(), "diagnose", claim, read);
     let releases = args.inputs.releases(&args.validate);
     let search = args.baseline.search();
     let (job, options) =
@@ -34,6 +33,8 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let options = DiagnoseOptions {
         strict_tables: args.tables.strict_tables,
         clearance: Stage::of(&geometry, base, threads)?,
+        after: args.after,
+        plan: args.plan,
         ..options
     };
     let job = Arc::new(job);
