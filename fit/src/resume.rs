@@ -11,7 +11,8 @@ use sepval_solve::hill::HillSettings;
 use crate::Method;
 use crate::checkpoint::{Checkpoint, CheckpointError};
 use crate::sigma::Sigma;
-use sepval_run::out_dir::Input;
+use sepval_run::out_dir::{Claim, Input};
+use sepval_run::sequence::Writes;
 
 /// Why a checkpoint cannot be gone on with as asked.
 #[derive(Debug, thiserror::Error)]
@@ -36,6 +37,40 @@ pub enum ResumeError {
         /// The checkpoint's generation.
         reached: usize,
     },
+}
+
+/// Where a fit writes, `out`, and what it reads, `inputs` (its flags' files) and, resumed
+/// from the checkpoint `resume` (its path and itself), what the checkpoint holds
+/// ([`inputs_read`]). The directory is claimed over an earlier run (`overwrite`), as the
+/// continuation of the checkpoint, or fresh. Its directory may be none of the run's inputs:
+/// with a checkpoint, the checkpoint and its run directory too, unless the run goes on in that
+/// directory (so `--resume DIR/generations/gen-0005.json --overwrite --out DIR` is refused: it
+/// would clear the checkpoint it resumes from).
+pub fn writes(
+    out: &Path,
+    resume: Option<(&Path, &Checkpoint)>,
+    overwrite: bool,
+    mut inputs: Vec<Input>,
+) -> Writes {
+    let claim = match resume {
+        _ if overwrite => Claim::Overwrite,
+        Some((path, c)) => Claim::Resume {
+            checkpoint: path.to_path_buf(),
+            generation: c.state.generation,
+        },
+        None => Claim::Fresh,
+    };
+    if let Some((path, c)) = resume {
+        inputs.extend(inputs_read(path, c));
+    }
+    let hint = format!(
+        "resume from one of its checkpoints (--resume {})",
+        out.join("generations/gen-NNNN.json").display()
+    );
+    Writes {
+        resume: Some(hint),
+        ..Writes::new(out.to_path_buf(), "fit", claim, inputs)
+    }
 }
 
 /// What a run resumed from the checkpoint `c` at `path` reads besides its flags' files: the

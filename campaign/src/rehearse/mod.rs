@@ -53,6 +53,46 @@ pub struct Truth {
     pub noise_seed: u64,
 }
 
+/// Why the truth a rehearsal flies cannot be read, naming its flag.
+#[derive(Debug, thiserror::Error)]
+pub enum TruthInputError {
+    /// `--truth-scenario` (with `--truth-extension`).
+    #[error("--truth-scenario")]
+    Scenario(#[source] sepval_run::inputs::InputError),
+    /// `--truth-factors`.
+    #[error("--truth-factors")]
+    Factors(#[source] sepval_run::inputs::InputError),
+    /// `--truth-effect` (its message names the flag).
+    #[error(transparent)]
+    Effects(sepval_run::inputs::InputError),
+}
+
+impl Truth {
+    /// The truth its flags name: the scenario (the embedded default without one) with its
+    /// extension, the factors (`truth`, `nominal` or a JSON file), the effects, and the noise
+    /// seed of the first release.
+    pub fn read(
+        scenario: Option<&std::path::Path>,
+        extension: Option<&std::path::Path>,
+        factors: &str,
+        effects: &[String],
+        noise_seed: u64,
+    ) -> Result<Truth, TruthInputError> {
+        use sepval_run::inputs;
+        let scenario = inputs::scenario(scenario, extension).map_err(TruthInputError::Scenario)?;
+        let factors =
+            inputs::factors(factors, &scenario.factors).map_err(TruthInputError::Factors)?;
+        let effects =
+            inputs::effects_of("--truth-effect", effects).map_err(TruthInputError::Effects)?;
+        Ok(Truth {
+            scenario,
+            factors,
+            effects,
+            noise_seed,
+        })
+    }
+}
+
 /// The truth at one condition.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TruthCondition {

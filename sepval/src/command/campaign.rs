@@ -5,10 +5,9 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use sepval_campaign::page;
-use sepval_campaign::program::{Campaign, Init};
+use sepval_campaign::program::{self, Campaign, Init};
 use sepval_campaign::release::NewRelease;
 use sepval_campaign::request::InitRequest;
-use sepval_run::inputs;
 
 use super::starter;
 use super::{count, evaluator_spec, tell};
@@ -32,7 +31,7 @@ fn init(a: CampaignInitArgs) -> Result<()> {
     let spec = evaluator_spec(&a.eval)?;
     let init = request(&a)?;
     let mut start = starter(&spec);
-    let c = begin(&a, init, &mut start)?;
+    let c = program::init(&a.out, init, &mut start, &mut *crate::front::progress())?;
     for l in c.file.settings.prior.lines() {
         say!("prior:     {l}");
     }
@@ -69,34 +68,25 @@ fn request(a: &CampaignInitArgs) -> Result<Init> {
     Ok(request.read()?)
 }
 
-/// Begins the campaign of `init` in --out.
-fn begin(
-    a: &CampaignInitArgs,
-    init: Init,
-    start: &mut sepval_campaign::StartEvaluator<'_>,
-) -> Result<Campaign> {
-    let c = sepval_campaign::program::init(&a.out, init, start, &mut *crate::front::progress())?;
-    Ok(c)
-}
-
 fn rehearse(a: CampaignRehearseArgs) -> Result<()> {
     let spec = evaluator_spec(&a.init.eval)?;
-    let scenario = inputs::scenario(a.truth_scenario.as_deref(), a.truth_extension.as_deref())
-        .context("--truth-scenario")?;
-    let factors =
-        inputs::factors(&a.truth_factors, &scenario.factors).context("--truth-factors")?;
-    let effects = inputs::effects_of("--truth-effect", &a.truth_effect)?;
-    let truth = sepval_campaign::rehearse::Truth {
-        scenario,
-        factors,
-        effects,
-        noise_seed: a.noise_seed,
-    };
+    let truth = sepval_campaign::rehearse::Truth::read(
+        a.truth_scenario.as_deref(),
+        a.truth_extension.as_deref(),
+        &a.truth_factors,
+        &a.truth_effect,
+        a.noise_seed,
+    )?;
     let init = request(&a.init)?;
     // The truth over the grid before anything is written: one that does not fly is refused.
     let truth_at = sepval_campaign::rehearse::truth_envelope(&init.grid, &init.clearance, &truth)?;
     let mut start = starter(&spec);
-    let mut c = begin(&a.init, init, &mut start)?;
+    let mut c = program::init(
+        &a.init.out,
+        init,
+        &mut start,
+        &mut *crate::front::progress(),
+    )?;
     say!("round 0:   {}", page::headline(&c.file));
     let r = sepval_campaign::rehearse::rehearse(
         &mut c,

@@ -18,7 +18,7 @@ pub fn run(args: DiagnoseArgs) -> Result<()> {
     let spec = evaluator_spec(&args.eval)?;
     let geometry = super::geometry(&args.geometry);
     let mut read = super::model_inputs(&args.inputs);
-    read.extend(super::input_files("--validate", &args.validate));
+    read.extend(Input::files("--validate", &args.validate));
     read.extend(geometry.inputs());
     read.extend(args.after.iter().map(|d| Input::directory("--after", d)));
     read.extend(args.plan.iter().map(|d| Input::directory("--plan", d)));

@@ -10,7 +10,7 @@ use sepval_fit::configure::FitRequest;
 use sepval_fit::resume::{self, InputPaths};
 use sepval_fit::{FitOptions, Method};
 use sepval_predict::releases::Stage;
-use sepval_run::out_dir::Claim;
+use sepval_run::out_dir::Input;
 use sepval_run::sequence::Writes;
 use sepval_solve::ga::GaSettings;
 
@@ -49,36 +49,13 @@ pub fn run(args: FitArgs) -> Result<()> {
     execute(&spec, writes, run)
 }
 
-/// Where the fit writes and what it reads. Its directory may be none of the run's inputs: with
-/// `--resume`, the checkpoint and its run directory too, unless the run goes on in that
-/// directory (so `--resume DIR/generations/gen-0005.json --overwrite --out DIR` is refused: it
-/// would clear the checkpoint it resumes from).
+/// Where the fit writes and what it reads ([`resume::writes`]).
 fn writes(args: &FitArgs, resume: Option<&Checkpoint>) -> Writes {
-    let claim = match (&args.resume, resume, args.overwrite.overwrite) {
-        (_, _, true) => Claim::Overwrite,
-        (Some(path), Some(c), false) => Claim::Resume {
-            checkpoint: path.clone(),
-            generation: c.state.generation,
-        },
-        _ => Claim::Fresh,
-    };
     let mut read = super::model_inputs(&args.inputs);
-    read.extend(super::input_files("--truth-factors", &args.truth_factors));
+    read.extend(Input::files("--truth-factors", &args.truth_factors));
     read.extend(super::geometry(&args.geometry).inputs());
-    if let (Some(path), Some(c)) = (&args.resume, resume) {
-        read.extend(resume::inputs_read(path, c));
-    }
-    let resume_hint = format!(
-        "resume from one of its checkpoints (--resume {})",
-        args.out.join("generations/gen-NNNN.json").display()
-    );
-    Writes {
-        out: args.out.clone(),
-        command: "fit",
-        claim,
-        inputs: read,
-        resume: Some(resume_hint),
-    }
+    let resumed = args.resume.as_deref().zip(resume);
+    resume::writes(&args.out, resumed, args.overwrite.overwrite, read)
 }
 
 /// The flags (and the checkpoint resumed from) as a validated configuration

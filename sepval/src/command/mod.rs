@@ -140,7 +140,7 @@ pub fn geometry(g: &crate::cli::GeometryArgs) -> GeometryPaths {
 /// The files of `--data`, `--scenario` (with the table files it names) and `--extension`, as
 /// inputs.
 pub fn model_inputs(i: &crate::cli::InputArgs) -> Vec<Input> {
-    let mut out = input_files("--data", &i.data);
+    let mut out = Input::files("--data", &i.data);
     out.extend(scenario_inputs(
         i.model.scenario.as_ref(),
         i.model.extension.as_ref(),
@@ -150,13 +150,13 @@ pub fn model_inputs(i: &crate::cli::InputArgs) -> Vec<Input> {
 
 /// The files of `--scenario`, the table files it names, and `--extension`, as inputs.
 pub fn scenario_inputs(scenario: Option<&PathBuf>, extension: Option<&PathBuf>) -> Vec<Input> {
-    let mut out = input_files("--scenario", scenario);
+    let mut out = Input::files("--scenario", scenario);
     if let Some(path) = scenario {
         let whose = format!("--scenario {}", path.display());
         let tables = sepval_common::Scenario::table_files(path);
         out.extend(tables.iter().map(|t| Input::named_by(&whose, t)));
     }
-    out.extend(input_files("--extension", extension));
+    out.extend(Input::files("--extension", extension));
     out
 }
 
@@ -164,11 +164,6 @@ pub fn scenario_inputs(scenario: Option<&PathBuf>, extension: Option<&PathBuf>) 
 /// before any work: a run that wrote it would destroy what it reads.
 pub fn out_file_apart(out: &Path, inputs: &[Input]) -> Result<()> {
     sepval_run::out_dir::check_file(out, inputs).with_context(|| format!("--out {}", out.display()))
-}
-
-/// Input files given by `flag` (none, one or several).
-pub fn input_files<'a>(flag: &str, paths: impl IntoIterator<Item = &'a PathBuf>) -> Vec<Input> {
-    Input::files(flag, paths)
 }
 
 /// Runs `run` into the directory `writes` says, in the one order of every command

@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use sepval_common::scenario::Scenario;
 use sepval_core::atomic_file::write_atomically;
 use sepval_run::inputs;
+use sepval_run::out_dir::Input;
 
 use crate::cli::ScenarioArgs;
 
@@ -26,7 +27,7 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
     if !args.tables {
         // The file written may be neither the scenario read nor a table it names.
         let mut read = super::scenario_inputs(args.scenario.as_ref(), None);
-        read.extend(super::input_files("--from-shape", args.from_shape.as_ref()));
+        read.extend(Input::files("--from-shape", args.from_shape.as_ref()));
         super::out_file_apart(&args.out, &read)?;
     }
     let mut scenario = inputs::scenario(args.scenario.as_deref(), None)?;

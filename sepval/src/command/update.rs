@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use anyhow::{Result, bail};
 use sepval_common::evaluation::Job;
+use sepval_run::out_dir::Input;
 use sepval_run::sequence::Writes;
 use sepval_update::UpdateOptions;
 use sepval_update::command::UpdateRun;
@@ -19,7 +20,7 @@ pub fn run(args: UpdateArgs) -> Result<()> {
     super::several_jobs(&args.eval, "update", "one per round")?;
     let (options, job) = configure(&args)?;
     let mut read = super::model_inputs(&args.inputs);
-    read.extend(super::input_files("--validate", &args.validate));
+    read.extend(Input::files("--validate", &args.validate));
     let writes = Writes::new(
         args.out.clone(),
         "update",
