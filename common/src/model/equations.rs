@@ -172,7 +172,21 @@ impl<'a> EquationsOfMotion<'a> {
     /// The flow the store sees in state `x` at time `t_s` (docs/model.md section 3): what the
     /// catalogue's and the extension's terms read, for reports and diagnoses.
     pub fn flow(&self, x: &StateVector, t_s: f64) -> Flow {
-        flow_frame(&self.constants, std::slice::from_ref(&self.parts), x, t_s).0
+        flow_frame::<_, false>(&self.constants, std::slice::from_ref(&self.parts), x, t_s).0
+    }
+
+    /// Whether the run takes the contract's force evaluation and nothing beside it: the decay
+    /// increments, no field, no wind and no term beyond the linear coefficients (the default
+    /// event, and every run of a fit without extension terms or tables). Such a run may use
+    /// [`EquationsOfMotion::derivative_plain`].
+    pub(crate) fn plain(&self) -> bool {
+        let c = &self.constants;
+        !c.extra_terms
+            && !c.wind
+            && c.terms.positions() == 0
+            && c.field.is_none()
+            && !c.field_by_lane
+            && c.decay_used
     }
 
     /// The state derivative with the ejector feet in the given modes (`on[i]`: foot i
@@ -186,7 +200,23 @@ impl<'a> EquationsOfMotion<'a> {
     /// whether the host has an FMA unit or not (see [`crate::propagator`] for the dispatch).
     #[inline(always)]
     pub fn derivative(&self, x: &StateVector, t_s: f64, on: [bool; 2]) -> StateVector {
-        derivative(
+        derivative::<_, false>(
+            &self.constants,
+            std::slice::from_ref(&self.parts),
+            x,
+            t_s,
+            &[on],
+        )
+    }
+
+    /// [`EquationsOfMotion::derivative`] of a run that is [`EquationsOfMotion::plain`], compiled
+    /// without the tests and paths of what it does not have: the same operations in the same
+    /// order, so the same bits. (Those tests at every force evaluation, and the values they
+    /// kept live, cost the scalar propagator about 10 % of its instructions: callgrind,
+    /// 2026-12-06.)
+    #[inline(always)]
+    pub(crate) fn derivative_plain(&self, x: &StateVector, t_s: f64, on: [bool; 2]) -> StateVector {
+        derivative::<_, true>(
             &self.constants,
             std::slice::from_ref(&self.parts),
             x,
@@ -220,14 +250,15 @@ impl<'a> LaneEquations<'a> {
         t_s: F64x4,
         on: &[[bool; 2]; 4],
     ) -> [F64x4; STATE_LEN] {
-        derivative(&self.constants, &self.parts, x, t_s, on)
+        derivative::<_, false>(&self.constants, &self.parts, x, t_s, on)
     }
 }
 
 /// The flow of a stage (section 3) with its direction cosines and V^2: the first half of
-/// [`derivative`], inlined there (`parts`: one per lane, for their winds).
+/// [`derivative`], inlined there (`parts`: one per lane, for their winds; `PLAIN`: the lanes'
+/// runs are [`EquationsOfMotion::plain`], so the tests for a field and a wind are left out).
 #[inline(always)]
-fn flow_frame<R: Real>(
+fn flow_frame<R: Real, const PLAIN: bool>(
     c: &Constants<R>,
     parts: &[Parts],
     x: &[R; STATE_LEN],
@@ -239,7 +270,7 @@ fn flow_frame<R: Real>(
     // A field in every lane: the increments are 0 (section 3b), so f(s) is not formed; 0 in its
     // place leaves every coefficient's bits as they are (0 f = 0 for any f >= 0).
     let distance_m = dot([rx, ry, rz], [rx, ry, rz]).sqrt();
-    let f_s = if c.decay_used {
+    let f_s = if PLAIN || c.decay_used {
         c.decay.factor(distance_m)
     } else {
         R::splat(0.0)
@@ -252,7 +283,9 @@ fn flow_frame<R: Real>(
     // attitude; formed here, they run beside the flow angles' chain below.
     // (An `if let`, not `Option::map`: a closure left out of line would compile its fused
     // multiply-adds without the propagator's target features.)
-    let field = if let Some(f) = &c.field {
+    let field = if PLAIN {
+        None
+    } else if let Some(f) = &c.field {
         let axis_l = [
             dcm.m[0][0] * dcm.inv_n2,
             dcm.m[1][0] * dcm.inv_n2,
@@ -270,7 +303,7 @@ fn flow_frame<R: Real>(
     // Section 11.2: a wind w_L moves the air, v_air -= w_L. Only when a lane has one (a lane
     // without subtracts +0.0, which leaves every value's bits as they are), so a run without
     // wind takes the contract's operations and no other.
-    if c.wind {
+    if !PLAIN && c.wind {
         let w = wind_lanes(parts, t_s);
         air = [air[0] - w[0], air[1] - w[1], air[2] - w[2]];
     }
@@ -304,28 +337,31 @@ fn flow_frame<R: Real>(
 }
 
 /// The state derivative (docs/model.md sections 2 and 3) of one run per lane of `R` (`parts`
-/// and `on`: one per lane).
+/// and `on`: one per lane; `PLAIN`: their runs are [`EquationsOfMotion::plain`], so only the
+/// contract's terms are tested for and added).
 #[inline(always)]
-fn derivative<R: Real>(
+fn derivative<R: Real, const PLAIN: bool>(
     c: &Constants<R>,
     parts: &[Parts],
     x: &[R; STATE_LEN],
     t_s: R,
     on: &[[bool; 2]],
 ) -> [R; STATE_LEN] {
-    let (flow, dcm, speed2, field) = flow_frame(c, parts, x, t_s);
+    let (flow, dcm, speed2, field) = flow_frame::<R, PLAIN>(c, parts, x, t_s);
     let [rx, ry, rz, vx, vy, vz, q0, q1, q2, q3, p, q, r] = *x;
     // Section 3: the six coefficients, then the tables' terms and the catalogue's extra terms
     // (section 7), lane by lane, and the extension's (section 11), in the lanes together.
     let mut k = c.aero.coefficients(&flow, &c.interference_increments);
-    if c.extra_terms {
+    if !PLAIN && c.extra_terms {
         k = lane_by_lane_terms(parts, &flow, ry, k);
     }
-    k = c.terms.add(&flow, k);
+    if !PLAIN {
+        k = c.terms.add(&flow, k);
+    }
     // Section 3b: the aircraft's flowfield, station by station, after every other term.
     if let (Some(f), Some(sums)) = (&c.field, field) {
         k = sums.add_loads(f, flow.alpha_rad, flow.beta_rad, k);
-    } else if c.field_by_lane {
+    } else if !PLAIN && c.field_by_lane {
         let axis_l = [
             dcm.m[0][0] * dcm.inv_n2,
             dcm.m[1][0] * dcm.inv_n2,

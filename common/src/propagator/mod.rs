@@ -28,16 +28,18 @@
 //!   carriage state.
 
 mod lanes;
+mod rk4;
 mod sink;
 
 pub use lanes::{LANES, propagate_lanes, propagate_lanes_portable};
 pub use sink::SampleSink;
 
+use rk4::{Held, LanesHeld, rk4};
+
 use nalgebra::Vector3;
 
 use crate::frames::{dcm_from_quaternion, euler_321_deg, wrap_deg};
-use crate::lanes::{F64x4, Real};
-use crate::model::{EquationsOfMotion, LaneEquations, Model, RunSetup, STATE_LEN, StateVector};
+use crate::model::{EquationsOfMotion, Model, RunSetup, StateVector};
 use crate::table::TableState;
 
 /// Tolerance to which the ejector start time is matched and two feet's stroke ends count as
@@ -180,7 +182,28 @@ fn propagate_inline<S: SampleSink>(
     sink: &mut S,
 ) -> Result<RunLog, Diverged> {
     let table_state = TableState::default();
-    let mut engine = Engine::new(model, run, &table_state);
+    let engine = Engine::new(model, run, &table_state);
+    // A run with the contract's force evaluation alone (the default event, a fit without
+    // extension terms or tables) through a copy compiled without the tests for what it lacks.
+    let mut log = if engine.equations.plain() {
+        drive(engine.plain(), run, times_s, sink)?
+    } else {
+        drive(engine, run, times_s, sink)?
+    };
+    if model.tables.in_evaluation() {
+        log.tables = table_state.excursions();
+    }
+    Ok(log)
+}
+
+/// The samples of [`propagate_inline`], taken by `engine`.
+#[inline(always)]
+fn drive<S: SampleSink, const PLAIN: bool>(
+    mut engine: Engine<'_, PLAIN>,
+    run: &RunSetup,
+    times_s: &[f64],
+    sink: &mut S,
+) -> Result<RunLog, Diverged> {
     let initial = run.initial_state();
     let mut cursor = engine.start();
     let mut k: u64 = 0;
@@ -211,9 +234,6 @@ fn propagate_inline<S: SampleSink>(
             let off_grid = engine.advance(cursor, t, false)?;
             sink.record(index, &observe(run, &off_grid.x), &off_grid.x);
         }
-    }
-    if model.tables.in_evaluation() {
-        engine.log.tables = table_state.excursions();
     }
     Ok(engine.log)
 }
@@ -253,7 +273,8 @@ pub fn observe(run: &RunSetup, x: &StateVector) -> Observation {
     }
 }
 
-struct Engine<'a> {
+/// One run's integrator (`PLAIN`: its equations are [`EquationsOfMotion::plain`]).
+struct Engine<'a, const PLAIN: bool = false> {
     run: &'a RunSetup,
     equations: EquationsOfMotion<'a>,
     dt_s: f64,
@@ -272,6 +293,19 @@ impl<'a> Engine<'a> {
         }
     }
 
+    /// This engine for a run whose equations are [`EquationsOfMotion::plain`].
+    fn plain(self) -> Engine<'a, true> {
+        debug_assert!(self.equations.plain());
+        Engine {
+            run: self.run,
+            equations: self.equations,
+            dt_s: self.dt_s,
+            log: self.log,
+        }
+    }
+}
+
+impl<const PLAIN: bool> Engine<'_, PLAIN> {
     /// The cursor at release (t = 0): the initial state, the feet pushing at once or waiting
     /// for the ejector start time (logged).
     fn start(&mut self) -> Cursor {
@@ -295,7 +329,7 @@ impl<'a> Engine<'a> {
     #[inline(always)]
     fn rk4(&self, x: &StateVector, t: f64, h: f64, modes: [FootMode; 2]) -> StateVector {
         rk4(
-            &Held {
+            &Held::<PLAIN> {
                 equations: &self.equations,
                 on: pushing(modes),
             },
@@ -515,75 +549,6 @@ impl<'a> Engine<'a> {
 #[inline(always)]
 fn pushing(modes: [FootMode; 2]) -> [bool; 2] {
     [modes[0] == FootMode::On, modes[1] == FootMode::On]
-}
-
-/// A state derivative with the feet's modes held (one run, or one run per lane of `R`), for
-/// [`rk4`]. (A trait with an `#[inline(always)]` method rather than a closure: a closure may be
-/// compiled out of line, without the FMA build's target features, and its fused multiply-adds
-/// would then be calls to the C library.)
-trait Derivative<R> {
-    /// dx/dt at `x` and time `t`.
-    fn at(&self, x: &[R; STATE_LEN], t: R) -> [R; STATE_LEN];
-}
-
-/// One run's equations with the feet's modes held.
-struct Held<'e, 'a> {
-    equations: &'e EquationsOfMotion<'a>,
-    on: [bool; 2],
-}
-
-impl Derivative<f64> for Held<'_, '_> {
-    #[inline(always)]
-    fn at(&self, x: &StateVector, t: f64) -> StateVector {
-        self.equations.derivative(x, t, self.on)
-    }
-}
-
-/// Four runs' equations, one per lane, each with its feet's modes held.
-struct LanesHeld<'e, 'a> {
-    equations: &'e LaneEquations<'a>,
-    on: [[bool; 2]; 4],
-}
-
-impl Derivative<F64x4> for LanesHeld<'_, '_> {
-    #[inline(always)]
-    fn at(&self, x: &[F64x4; STATE_LEN], t: F64x4) -> [F64x4; STATE_LEN] {
-        self.equations.derivative(x, t, &self.on)
-    }
-}
-
-/// One classic RK4 step of length `h` from `x` at time `t` of the derivative `f` (one run or
-/// one run per lane of `R`), q renormalised (each stage at its own time: t, t + h/2, t + h/2,
-/// t + h).
-#[inline(always)]
-fn rk4<R: Real>(f: &impl Derivative<R>, x: &[R; STATE_LEN], t: R, h: R) -> [R; STATE_LEN] {
-    let half = R::splat(0.5) * h;
-    let sixth = h / R::splat(6.0);
-    let k1 = f.at(x, t);
-    let k2 = f.at(&axpy(x, half, &k1), t + half);
-    let k3 = f.at(&axpy(x, half, &k2), t + half);
-    let k4 = f.at(&axpy(x, h, &k3), t + h);
-    let two = R::splat(2.0);
-    let mut y = *x;
-    for j in 0..STATE_LEN {
-        y[j] = sixth.mul_add(two.mul_add(k2[j] + k3[j], k1[j]) + k4[j], x[j]);
-    }
-    let n2 = y[6].mul_add(y[6], y[7].mul_add(y[7], y[8].mul_add(y[8], y[9] * y[9])));
-    let inv_norm = R::splat(1.0) / n2.sqrt();
-    for v in &mut y[6..10] {
-        *v = *v * inv_norm;
-    }
-    y
-}
-
-/// x + a k, component by component (fused).
-#[inline(always)]
-fn axpy<R: Real>(x: &[R; STATE_LEN], a: R, k: &[R; STATE_LEN]) -> [R; STATE_LEN] {
-    let mut y = *x;
-    for j in 0..STATE_LEN {
-        y[j] = a.mul_add(k[j], x[j]);
-    }
-    y
 }
 
 #[inline]
