@@ -36,6 +36,11 @@ pub(crate) fn report(
             "answer"
         } else if rivals.iter().any(|(c, _)| same_model(&c.fitted, f, job)) {
             "rival"
+        } else if cut_off {
+            // Its refit stopped before it converged: its BIC is only an upper bound, so these
+            // releases have not been shown to separate it (issue 60: the cause of the earlier
+            // class, cut off here, would otherwise read as told apart).
+            "not settled"
         } else if carried && !significant(setting, baseline, f, pool) {
             "not significant"
         } else {
@@ -129,6 +134,9 @@ fn words(
             "still a rival (within {RIVAL_MARGIN} of the answer's BIC: these releases do not separate it)"
         ),
         "not significant" => "told apart (not significant against the baseline)".to_string(),
+        "not settled" => {
+            "not settled: these releases have not been shown to separate it".to_string()
+        }
         other => other.to_string(),
     };
     let cut = if cut_off {
@@ -174,6 +182,13 @@ pub(crate) fn sentence(r: &AfterReport) -> Option<String> {
         count("rival"),
         count("told apart") + count("not significant")
     ));
+    let unsettled = count("not settled");
+    if unsettled > 0 {
+        out.push_str(&format!(
+            "; {unsettled} not settled (a refit stopped before it converged: the answer is not shown to be better than {})",
+            if unsettled == 1 { "it" } else { "them" }
+        ));
+    }
     if let Some(d) = r
         .fates
         .iter()

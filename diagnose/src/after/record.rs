@@ -38,7 +38,8 @@ pub struct Fate {
     /// discovery`.
     pub was: String,
     /// `answer`, `rival` (these releases do not separate it from the answer), `told apart`,
-    /// `not significant` (not significant against the baseline on these releases), `failed`
+    /// `not settled` (its refit stopped before it converged, so its BIC is only an upper
+    /// bound), `not significant` (not significant against the baseline on these releases), `failed`
     /// (no start simulated) or `not refitted` (beyond the budget).
     pub status: String,
     /// Its terms and effects, as the criterion counts them (an oscillation's pair is one).

@@ -417,6 +417,17 @@ fn weaker_pitch_damping_is_carried_and_stays_open_after_the_first_diagnosis() {
         "{}",
         both["verdict"]
     );
+    // The cause is never said to be told apart when its refit did not converge: it is the
+    // answer, a rival, or not settled (its BIC only an upper bound).
+    let cause = fates
+        .iter()
+        .find(|f| f["name"] == "Cm q d/2V" && f["was"] == "the earlier answer")
+        .unwrap();
+    assert!(
+        cause["status"] != "told apart" || cause["cut_off"] == false,
+        "{}",
+        cause["words"]
+    );
 }
 
 /// Plan and diagnosis agree (issue 60, item 2), on the roll-damping loop of
