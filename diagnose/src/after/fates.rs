@@ -22,6 +22,10 @@ pub(crate) fn report(
     let answer_bic = setting.bic(model);
     let releases = job.events().len();
     let pool = state.carried.len();
+    // Under the criterion an answer that explains every release to the noise loses only to a
+    // model that does so with as few terms: a cut-off refit with more terms cannot displace it.
+    let settles_more_terms = crate::analysis::explains(setting, model)?;
+    let answer_terms = term_count(model);
     let mut fates = Vec::new();
     let fate_of = |name: &str,
                    was: &str,
@@ -36,7 +40,7 @@ pub(crate) fn report(
             "answer"
         } else if rivals.iter().any(|(c, _)| same_model(&c.fitted, f, job)) {
             "rival"
-        } else if cut_off {
+        } else if cut_off && !(settles_more_terms && term_count(f) > answer_terms) {
             // Its refit stopped before it converged: its BIC is only an upper bound, so these
             // releases have not been shown to separate it (issue 60: the cause of the earlier
             // class, cut off here, would otherwise read as told apart).
