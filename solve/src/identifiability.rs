@@ -71,6 +71,23 @@ pub struct Identifiability {
     pub max_lag: usize,
 }
 
+impl Identifiability {
+    /// The standard error of parameter `i`, when it is determined.
+    pub fn std_error(&self, i: usize) -> Option<f64> {
+        self.parameters.get(i).and_then(|p| p.std_error)
+    }
+
+    /// The correlation of parameters `i` and `j` (0 where either is not determined or out of
+    /// range, as the matrix holds it).
+    pub fn rho(&self, i: usize, j: usize) -> f64 {
+        self.correlation
+            .get(i)
+            .and_then(|r| r.get(j))
+            .copied()
+            .unwrap_or(0.0)
+    }
+}
+
 /// Most (sample, lag) pairs of the coloured-residual correction per event.
 const MAX_COLOUR_PAIRS: usize = 4_000_000;
 

@@ -62,18 +62,12 @@ fn named(
 ) -> DiscoveredTerm {
     let now = &e.terms;
     let coef_pos = at.coefficients();
-    let se = |i: usize| id.parameters.get(i).and_then(|p| p.std_error);
     let (coefficient, std_error, phase_deg) = if now.len() == 2 {
         let (a, b) = (now[0].coefficient, now[1].coefficient);
         let amp = a.hypot(b);
-        let var = match (se(coef_pos[0]), se(coef_pos[1])) {
+        let var = match (id.std_error(coef_pos[0]), id.std_error(coef_pos[1])) {
             (Some(sa), Some(sb)) if amp > 0.0 => {
-                let rho = id
-                    .correlation
-                    .get(coef_pos[0])
-                    .and_then(|r| r.get(coef_pos[1]))
-                    .copied()
-                    .unwrap_or(0.0);
+                let rho = id.rho(coef_pos[0], coef_pos[1]);
                 Some(
                     ((a * a * sa * sa + b * b * sb * sb + 2.0 * a * b * rho * sa * sb)
                         / (amp * amp))
@@ -85,7 +79,7 @@ fn named(
         };
         (amp, var, Some(b.atan2(a).to_degrees()))
     } else {
-        (now[0].coefficient, se(coef_pos[0]), None)
+        (now[0].coefficient, id.std_error(coef_pos[0]), None)
     };
     let lead = now[0];
     let locator = lead.locator[0];
@@ -103,7 +97,7 @@ fn named(
         lambda_m: matches!(family, Family::Interference | Family::InterferenceFlowAngle)
             .then_some(locator),
         mach0: (family == Family::Mach).then_some(locator),
-        locator_std_error: at.locator().and_then(se),
+        locator_std_error: at.locator().and_then(|i| id.std_error(i)),
         rise_std_error: at
             .length()
             .and_then(|i| id.parameters.get(i))

@@ -21,10 +21,7 @@ pub(super) fn located(
     id: &Identifiability,
 ) -> Vec<Location> {
     let lead = at[layout.terms.start];
-    let se = |i: Option<usize>| {
-        i.and_then(|i| id.parameters.get(i))
-            .and_then(|p| p.std_error)
-    };
+    let se = |i: Option<usize>| i.and_then(|i| id.std_error(i));
     let set = Set::of(p, fitted.lm.cost, CHI2_95 * inflation(id, layout.locator()));
     match p.held {
         Held::Time => vec![one_d(
@@ -203,12 +200,7 @@ fn gust(
     );
     let onset_se = match (se_middle, se_length, layout.locator(), layout.length()) {
         (Some(sm), Some(sl), Some(i), Some(j)) => {
-            let rho = id
-                .correlation
-                .get(i)
-                .and_then(|r| r.get(j))
-                .copied()
-                .unwrap_or(0.0);
+            let rho = id.rho(i, j);
             Some((sm * sm + sl * sl / 4.0 - rho * sm * sl).max(0.0).sqrt())
         }
         _ => None,
@@ -264,16 +256,10 @@ fn phase(at: &[Term], layout: &EntryParams, id: &Identifiability) -> Option<Loca
         at[layout.terms.start + 1].coefficient,
     );
     let value = b.atan2(a).to_degrees();
-    let se = |k: usize| id.parameters.get(k).and_then(|p| p.std_error);
     let amp2 = a * a + b * b;
-    let se_deg = match (se(i), se(j)) {
+    let se_deg = match (id.std_error(i), id.std_error(j)) {
         (Some(sa), Some(sb)) if amp2 > 0.0 => {
-            let rho = id
-                .correlation
-                .get(i)
-                .and_then(|r| r.get(j))
-                .copied()
-                .unwrap_or(0.0);
+            let rho = id.rho(i, j);
             let var =
                 (b * b * sa * sa + a * a * sb * sb - 2.0 * a * b * rho * sa * sb) / (amp2 * amp2);
             Some(var.max(0.0).sqrt().to_degrees())
