@@ -19,14 +19,15 @@ condition's name: SimData.m's property order).
 store's surface shows (centroid = T * body point + CG); body axes need T's transpose. The
 file's body loads are therefore rotated twice the store's attitude the wrong way: after release,
 where the store pitches 6 to 12 deg, its axial force takes in 20 to 40 % of the normal force
-(checked: the file's body force equals T times its inertial force to 1 %). This script reads the
+(checked at t = 0.3 s of M085_AOA0: the file's body force equals R times its inertial force
+to 1 % of its magnitude, R below, not R^T times it). This script reads the
 INERTIAL loads and rotates them itself, body = R^T inertial, R = Rz(THETA_Z) Ry(THETA_Y)
 Rx(THETA_X) (Fluent's 6DOF Euler angles, shared/data/eglin-cfd/README.md; SimData.m's
 axis-angle reading differs by at most 1.5 deg). The inertial loads are checked against the
 trajectory: m a - F equals the weight (8 896 N, less 0.3 % at alpha 4 deg) in y, 0 +- 50 N in z,
 and in x a constant 240 to 300 N of drag the pressure does not hold (the viscous force; at the
 aircraft's alpha 4 deg plus m g sin 4 deg): the pressure loads are the whole aerodynamic load
-but the friction, which `--moments` prints as `CA visc`.
+but the friction, which the script prints as `CA visc`.
 
 Frames: the CFD's (x aft, y up, z to port; the store's body axes the same at t = 0); the store's
 flow angles from its velocity (the 6DOF file's CG differenced) against the freestream
