@@ -196,8 +196,8 @@ def ca0_line(found, without):
 def axial_table(found):
     """The pressure axial force over 0.1 s windows, and the viscous part."""
     windows = [(0.0, 0.1), (0.1, 0.2), (0.2, 0.3), (0.3, 0.4), (0.4, 0.5)]
-    print("| condition | qbar S [N] | " + " | ".join(f"CA {lo:.1f}-{hi:.1f} s" for lo, hi in windows)
-          + " | CA visc |")
+    heads = " | ".join(f"CA {lo:.1f}-{hi:.1f} s" for lo, hi in windows)
+    print(f"| condition | qbar S [N] | {heads} | CA visc |")
     print("|---" * (3 + len(windows)) + "|")
     for r in found:
         cells = [f"{r.window_mean('CA', lo, hi):.3f}" for lo, hi in windows]
