@@ -1,26 +1,45 @@
 #!/usr/bin/env python3
 """The Eglin CFD store's own loads at the four conditions of AbdullahElyas/GPR_StoreSeparation.
 
-    scripts/eglin_loads.py REPO                      (the table below)
+    scripts/eglin_loads.py REPO                      (the axial force table)
+    scripts/eglin_loads.py REPO --moments            (normal force, moments, derivatives)
     scripts/eglin_loads.py REPO --ca0-without NAME   (a scenario's `ca0` line)
 
-REPO is a git clone of https://github.com/AbdullahElyas/GPR_StoreSeparation (read at the
-commit scripts/eglin_convert.py reads). Its simData.mat holds, per condition, the store's
-forces and moments at each of the 1001 CFD time steps (0 to 0.5 s), which the repository's
-SimData.m integrates from the surface pressure: the store's aerodynamics measured directly, not
-through its trajectory. The file is MATLAB objects (MCOS), which scipy reads only as opaque
-data; this script takes the objects' property cells out of the file's function workspace, finds
-each condition's block (Mach, alpha, sideslip, altitude, then the body-axis and inertial-axis
-loads, then the condition's name: SimData.m's property order) and prints the body-axis axial
-force as a coefficient, F_x / (qbar S), over 0.1 s windows, with qbar from the ISA at 26 000 ft
-and S of the 20 in store (docs/model.md section 1). With `--ca0-without NAME` (e.g.
-M095_AOA0) it prints instead the store's CA over Mach as a scenario's `ca0` table: at each
-Mach, the mean over 0 to 0.5 s of the releases at that Mach other than NAME (for a study that
-leaves NAME out, so that nothing of it is used).
+REPO is a git clone of https://github.com/AbdullahElyas/GPR_StoreSeparation (read at COMMIT).
+Its simData.mat holds, per condition, the store's pressure force and moment about the CG at
+each of the 1001 CFD time steps (0 to 0.5 s), which the repository's SimData.m integrates from
+the surface pressure: the store's aerodynamics measured directly, not through its trajectory.
+The file is MATLAB objects (MCOS), which scipy reads only as opaque data; this script takes the
+objects' property cells out of the file's function workspace and finds each condition's block
+(Mach, alpha, sideslip, altitude, then the body-axis and the inertial-axis loads, then the
+condition's name: SimData.m's property order).
 
-The sign and axes of SimData.m's body frame are the author's (its x along the store, positive
-aft as a drag); this script does not re-derive them. The repository states no licence: read
-for measuring, nothing shipped. Needs numpy and scipy (not the CI's).
+**The axes.** SimData.m's "body-axis" loads are its inertial ones multiplied by T, where T
+(axang2rotm of the 6DOF file's THETA) maps body to inertial axes, as its own mapping of the
+store's surface shows (centroid = T * body point + CG); body axes need T's transpose. The
+file's body loads are therefore rotated twice the store's attitude the wrong way: after release,
+where the store pitches 6 to 12 deg, its axial force takes in 20 to 40 % of the normal force
+(checked at t = 0.3 s of M085_AOA0: the file's body force equals R times its inertial force
+to 1 % of its magnitude, R below, not R^T times it). This script reads the
+INERTIAL loads and rotates them itself, body = R^T inertial, R = Rz(THETA_Z) Ry(THETA_Y)
+Rx(THETA_X) (Fluent's 6DOF Euler angles, shared/data/eglin-cfd/README.md; SimData.m's
+axis-angle reading differs by at most 1.5 deg). The inertial loads are checked against the
+trajectory: m a - F equals the weight (8 896 N, less 0.3 % at alpha 4 deg) in y, 0 +- 50 N in z,
+and in x a constant 240 to 300 N of drag the pressure does not hold (the viscous force; at the
+aircraft's alpha 4 deg plus m g sin 4 deg): the pressure loads are the whole aerodynamic load
+but the friction, which the script prints as `CA visc`.
+
+Frames: the CFD's (x aft, y up, z to port; the store's body axes the same at t = 0); the store's
+flow angles from its velocity (the 6DOF file's CG differenced) against the freestream
+V (cos alpha_a, sin alpha_a, 0) in those axes. Printed in docs/model.md's sense: CA aft, CN up,
+CY right, Cm nose up, Cn nose right, about the CG, on qbar S d of the 20 in store, qbar from the
+ISA at 26 000 ft (the nose's stagnation pressure in the pressure files agrees: 25.9 kPa gauge
+against 28.3 at Mach 0.95 there, 80 at sea level).
+
+With `--ca0-without NAME` (e.g. M095_AOA0) it prints the store's CA over Mach as a scenario's
+`ca0` table: at each Mach, the mean over 0 to 0.5 s of the releases at that Mach other than
+NAME, pressure and viscous parts. The repository states no licence: read for measuring, nothing
+shipped. Needs numpy and scipy (not the CI's).
 """
 
 import io
@@ -34,7 +53,12 @@ from scipy.io.matlab._mio5 import MatFile5Reader
 
 COMMIT = "1949f78123003af12447f2bde289f75cd0663c82"
 ALTITUDE_M = 7924.8  # 26 000 ft
-AREA_M2 = math.pi * 0.254**2  # the 20 in store's reference area
+DIAMETER_M = 0.508
+AREA_M2 = math.pi * (DIAMETER_M / 2) ** 2  # the 20 in store's reference area
+MASS_KG = 907.185  # 2000 lb
+G_M_S2 = 9.80665
+# The late part of a release, where the store is 0.9 m or more below its carriage (at 0.25 s).
+LATE_S = (0.25, 0.35)
 
 
 def isa(h_m):
@@ -44,9 +68,9 @@ def isa(h_m):
     return p / (287.05287 * t), math.sqrt(1.4 * 287.05287 * t)
 
 
-def property_cells(path):
-    """The property cells of the MCOS objects in the MAT file at `path`."""
-    workspace = scipy.io.loadmat(path)["__function_workspace__"].tobytes()
+def property_cells(data):
+    """The property cells of the MCOS objects in the MAT file `data` (a file or path)."""
+    workspace = scipy.io.loadmat(data)["__function_workspace__"].tobytes()
     # The workspace is a MAT stream without the file's 128-byte header: give it one.
     header = b"MATLAB 5.0 MAT-file".ljust(116, b" ") + b"\0" * 8 + workspace[0:4]
     reader = MatFile5Reader(io.BytesIO(header + workspace[8:]), squeeze_me=False)
@@ -58,60 +82,172 @@ def property_cells(path):
 
 
 def conditions(cells):
-    """(name, mach, alpha_deg, body-axis force [3 x n]) of each condition's block."""
+    """(name, mach, alpha_deg, inertial force [3 x n], inertial moment [3 x n]) per block."""
     out = []
     for i in range(len(cells) - 9):
         mach, name = cells[i], cells[i + 9]
         if (isinstance(mach, np.ndarray) and mach.shape == (1, 1) and mach.dtype == np.float64
                 and isinstance(name, np.ndarray) and name.dtype.kind == "U"):
-            force = np.asarray(cells[i + 7][0, 0]["Force"], dtype=float)
-            out.append((str(name[0]), float(mach[0, 0]), float(cells[i + 1][0, 0]), force))
+            loads = cells[i + 8][0, 0]
+            out.append((str(name[0]), float(mach[0, 0]), float(cells[i + 1][0, 0]),
+                        np.asarray(loads["Force"], dtype=float),
+                        np.asarray(loads["Moment"], dtype=float)))
     return out
 
 
-def ca0_line(found, without, rho, a):
+def git_show(repo, path):
+    """The bytes of `path` at COMMIT in `repo`."""
+    return subprocess.run(["git", "-C", repo, "show", f"{COMMIT}:{path}"], check=True,
+                          capture_output=True).stdout
+
+
+def rotation(theta_deg):
+    """Body to CFD axes, Rz Ry Rx of Fluent's 6DOF angles (THETA_X, _Y, _Z) [deg]."""
+    x, y, z = np.radians(theta_deg)
+    cx, sx, cy, sy, cz, sz = math.cos(x), math.sin(x), math.cos(y), math.sin(y), math.cos(z), \
+        math.sin(z)
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+class Release:
+    """One condition's loads as coefficients in the store's body axes, with its flow angles."""
+
+    def __init__(self, repo, name, mach, alpha_deg, force, moment):
+        self.name, self.mach, self.alpha_a_deg = name, mach, alpha_deg
+        text = git_show(repo, f"Sim_Data/{name}/{name}_store.6dof").decode()
+        six = np.loadtxt(io.StringIO(text), comments="#")
+        if six.shape[0] != force.shape[1]:
+            sys.exit(f"{name}: {six.shape[0]} 6DOF rows against {force.shape[1]} load steps")
+        self.t = six[:, 0]
+        rho, a = isa(ALTITUDE_M)
+        v = mach * a
+        self.qs = 0.5 * rho * v * v * AREA_M2
+        velocity = np.gradient(six[:, 1:4], self.t, axis=0)
+        acc = np.gradient(velocity, self.t, axis=0)
+        al = math.radians(alpha_deg)
+        wind = v * np.array([math.cos(al), math.sin(al), 0.0])
+        rs = np.array([rotation(th) for th in six[:, 4:7]])
+        rates = np.gradient(rs, self.t, axis=0)
+        self.coef = np.zeros((len(self.t), 9))
+        for k, r in enumerate(rs):
+            w = r.T @ (wind - velocity[k])
+            omega = r.T @ rates[k]  # skew: body rates
+            f, m = r.T @ force[:, k], r.T @ moment[:, k]
+            speed = np.linalg.norm(w)
+            hat = DIAMETER_M / (2 * speed)
+            self.coef[k] = (math.atan2(w[1], w[0]), math.asin(w[2] / speed),
+                            -omega[1, 0] * hat, f[0] / self.qs, f[1] / self.qs, -f[2] / self.qs,
+                            -m[2] / (self.qs * DIAMETER_M), -m[1] / (self.qs * DIAMETER_M),
+                            m[0] / (self.qs * DIAMETER_M))
+        gravity_x = MASS_KG * G_M_S2 * math.sin(al)
+        inside = (self.t >= 0.1) & (self.t <= 0.45)
+        self.ca_visc = np.mean(MASS_KG * acc[inside, 0] - force[0, inside] - gravity_x) / self.qs
+
+    def column(self, name):
+        """alpha, beta [rad], qhat, CA, CN, CY, Cm, Cn or Cl over time."""
+        return self.coef[:, ["alpha", "beta", "qhat", "CA", "CN", "CY", "Cm", "Cn", "Cl"]
+                         .index(name)]
+
+    def window_mean(self, name, lo, hi):
+        """The mean of column `name` over lo <= t < hi (t <= hi at the end)."""
+        inside = (self.t >= lo) & (self.t < hi if hi < 0.5 else self.t <= hi)
+        return float(self.column(name)[inside].mean())
+
+    def slopes(self, t0, with_rate):
+        """Least squares over t >= t0 of CN = n0 + CN_alpha alpha and Cm = m0 + Cm_alpha alpha
+        (+ Cm_q qhat with `with_rate`): (CN_alpha, Cm_alpha, Cm_q or None, rms of Cm)."""
+        late = self.t >= t0
+        alpha = self.column("alpha")[late]
+        ones = np.ones(late.sum())
+        x_cn = np.array([ones, alpha]).T
+        cn_fit = np.linalg.lstsq(x_cn, self.column("CN")[late], rcond=None)[0]
+        cols = [ones, alpha] + ([self.column("qhat")[late]] if with_rate else [])
+        x_cm = np.array(cols).T
+        cm = self.column("Cm")[late]
+        cm_fit = np.linalg.lstsq(x_cm, cm, rcond=None)[0]
+        rms = float(np.sqrt(np.mean((x_cm @ cm_fit - cm) ** 2)))
+        return cn_fit[1], cm_fit[1], (cm_fit[2] if with_rate else None), rms
+
+
+def releases(repo):
+    """The four releases, read and rotated."""
+    found = conditions(property_cells(io.BytesIO(git_show(repo, "simData.mat"))))
+    if len(found) != 4:
+        sys.exit(f"expected the four conditions' loads in simData.mat, found {len(found)}")
+    return sorted((Release(repo, *f) for f in found), key=lambda r: r.name)
+
+
+def ca0_line(found, without):
     """The scenario line `ca0 = { mach = [...], values = [...] }` from the releases but
-    `without`."""
+    `without` (pressure and viscous axial force, body axes)."""
     by_mach = {}
-    for name, mach, _, force in found:
-        if name != without:
-            qs = 0.5 * rho * (mach * a) ** 2 * AREA_M2
-            by_mach.setdefault(mach, []).append(force[0].mean() / qs)
+    for r in found:
+        if r.name != without:
+            by_mach.setdefault(r.mach, []).append(r.window_mean("CA", 0.0, 0.5) + r.ca_visc)
     machs = sorted(by_mach)
     values = [sum(by_mach[m]) / len(by_mach[m]) for m in machs]
     return (f"ca0 = {{ mach = [{', '.join(repr(m) for m in machs)}], "
             f"values = [{', '.join(f'{v:.4f}' for v in values)}] }}")
 
 
+def axial_table(found):
+    """The pressure axial force over 0.1 s windows, and the viscous part."""
+    windows = [(0.0, 0.1), (0.1, 0.2), (0.2, 0.3), (0.3, 0.4), (0.4, 0.5)]
+    heads = " | ".join(f"CA {lo:.1f}-{hi:.1f} s" for lo, hi in windows)
+    print(f"| condition | qbar S [N] | {heads} | CA visc |")
+    print("|---" * (3 + len(windows)) + "|")
+    for r in found:
+        cells = [f"{r.window_mean('CA', lo, hi):.3f}" for lo, hi in windows]
+        print(f"| {r.name} (Mach {r.mach}, alpha {r.alpha_a_deg:g} deg) | {r.qs:.0f} | "
+              + " | ".join(cells) + f" | {r.ca_visc:.3f} |")
+
+
+def moments_table(found):
+    """Every 0.05 s: the flow angles and the six coefficients; then the late slopes."""
+    for r in found:
+        print(f"\n{r.name} (Mach {r.mach}, aircraft alpha {r.alpha_a_deg:g} deg; "
+              f"CA visc {r.ca_visc:.3f})")
+        print("| t [s] | alpha [deg] | beta [deg] | CA | CN | CY | Cm | Cn | Cl |")
+        print("|---" * 9 + "|")
+        for k in range(0, len(r.t), 50):
+            c = r.coef[k]
+            print(f"| {r.t[k]:.2f} | {math.degrees(c[0]):.2f} | {math.degrees(c[1]):.2f} | "
+                  + " | ".join(f"{v:.3f}" for v in c[3:]) + " |")
+    print("\nLate slopes (least squares over t >= t0; alpha in rad; x_cp - x_cg = -Cm_alpha / "
+          "CN_alpha calibres):")
+    print("| condition | t0 [s] | alpha range [deg] | max abs beta [deg] | CN_alpha | Cm_alpha | "
+          "x_cp - x_cg [cal] | with Cm_q: Cm_alpha, Cm_q | rms Cm |")
+    print("|---" * 9 + "|")
+    for r in found:
+        for t0 in LATE_S:
+            late = r.t >= t0
+            al = np.degrees(r.column("alpha")[late])
+            be = np.degrees(np.abs(r.column("beta")[late])).max()
+            cn_a, cm_a, _, rms = r.slopes(t0, False)
+            _, cm_a_q, cm_q, rms_q = r.slopes(t0, True)
+            print(f"| {r.name} | {t0:.2f} | {al.min():.1f} to {al.max():.1f} | {be:.1f} | "
+                  f"{cn_a:.2f} | {cm_a:.2f} | {-cm_a / cn_a:.2f} | {cm_a_q:.2f}, {cm_q:.0f} | "
+                  f"{rms:.3f}, {rms_q:.3f} |")
+
+
 def main():
     args = sys.argv[1:]
-    if len(args) not in (1, 3) or (len(args) == 3 and args[1] != "--ca0-without"):
+    ok = (len(args) == 1 or (len(args) == 2 and args[1] == "--moments")
+          or (len(args) == 3 and args[1] == "--ca0-without"))
+    if not ok:
         sys.exit(__doc__)
-    repo = args[0]
-    data = subprocess.run(["git", "-C", repo, "show", f"{COMMIT}:simData.mat"], check=True,
-                          capture_output=True).stdout
-    found = conditions(property_cells(io.BytesIO(data)))
-    if len(found) != 4:
-        sys.exit(f"expected the four conditions' loads in simData.mat, found {len(found)}")
-    rho, a = isa(ALTITUDE_M)
+    found = releases(args[0])
     if len(args) == 3:
-        if args[2] not in [f[0] for f in found]:
+        if args[2] not in [r.name for r in found]:
             sys.exit(f"--ca0-without {args[2]}: no such condition in simData.mat")
-        print(ca0_line(found, args[2], rho, a))
-        return
-    windows = [(0.0, 0.1), (0.1, 0.2), (0.2, 0.3), (0.3, 0.4), (0.4, 0.5)]
-    print("| condition | qbar S [N] | " + " | ".join(f"CA {lo:.1f}-{hi:.1f} s" for lo, hi in windows)
-          + " |")
-    print("|---" * (2 + len(windows)) + "|")
-    for name, mach, alpha, force in sorted(found):
-        qs = 0.5 * rho * (mach * a) ** 2 * AREA_M2
-        t = np.linspace(0.0, 0.5, force.shape[1])
-        cells = []
-        for lo, hi in windows:
-            inside = (t >= lo) & (t < hi if hi < 0.5 else t <= hi)
-            cells.append(f"{force[0, inside].mean() / qs:.3f}")
-        print(f"| {name} (Mach {mach}, alpha {alpha:g} deg) | {qs:.0f} | " + " | ".join(cells)
-              + " |")
+        print(ca0_line(found, args[2]))
+    elif len(args) == 2:
+        moments_table(found)
+    else:
+        axial_table(found)
 
 
 if __name__ == "__main__":
