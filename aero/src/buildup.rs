@@ -242,8 +242,25 @@ pub fn drag_rise_sigma(c: &Configuration, b: &BodyTerms, mach: f64, air: &AirSta
     shift.hypot(fins)
 }
 
-/// The crossflow's normal force and pitching moment about the CG at `alpha_rad`: (CN, Cm).
-pub fn crossflow(c: &Configuration, b: &BodyTerms, alpha_rad: f64) -> (f64, f64) {
-    let cn = body::crossflow_cn(b, c.area_ref_m2, alpha_rad);
-    (cn, -cn * (b.x_planform_m - c.cg_m) / c.diameter_m)
+/// The normal force and pitching moment about the CG at `alpha_rad` that are not linear in
+/// alpha: the body's viscous crossflow and the fins' vortex lift (Polhamus, at their planform's
+/// centroid; [`fins::vortex_cn`]): (CN, Cm), and each one's band, the crossflow accuracy
+/// (30 %) of each part added in absolute value (the parts' errors not known independent; ours).
+pub fn crossflow(c: &Configuration, b: &BodyTerms, alpha_rad: f64) -> ((f64, f64), (f64, f64)) {
+    let d = c.diameter_m;
+    let cn_body = body::crossflow_cn(b, c.area_ref_m2, alpha_rad);
+    let cm_body = -cn_body * (b.x_planform_m - c.cg_m) / d;
+    let (cn_fins, cm_fins) = c.fins.as_ref().map_or((0.0, 0.0), |p| {
+        let cn = fins::vortex_cn(p, c.area_ref_m2, alpha_rad);
+        let x = p.leading_edge_m + fins::centroid_from_root_le_m(p);
+        (cn, -cn * (x - c.cg_m) / d)
+    });
+    let f = ACCURACY.crossflow;
+    (
+        (cn_body + cn_fins, cm_body + cm_fins),
+        (
+            f * (cn_body.abs() + cn_fins.abs()),
+            f * (cm_body.abs() + cm_fins.abs()),
+        ),
+    )
 }
