@@ -39,7 +39,7 @@
 use sepval_common::atmosphere::AirState;
 use sepval_geometry::Nose;
 
-use crate::config::Configuration;
+use crate::config::{Configuration, Panel};
 use crate::fins::{M_SUBSONIC_END, m_supersonic};
 
 /// McCoy's boattail drag is 0 up to this Mach number.
@@ -198,9 +198,8 @@ pub fn axial(c: &Configuration, mach: f64, air: &AirState, wetted_m2: f64) -> Ax
         let ff_fin = 1.0 + (1.0 - w) * (2.0 * tc + 60.0 * tc.powi(4));
         let wetted = 2.0 * p.area_m2 * f64::from(p.count);
         friction += cf(re_per_m * p.mac_m, mach) * ff_fin * wetted / c.area_ref_m2;
-        let m_sup = m_supersonic(p.aspect_ratio);
-        let at = mach.max(m_sup);
-        let fin_wave = 4.0 * tc * tc / (at * at - 1.0).sqrt();
+        let at = mach.max(m_supersonic(p.aspect_ratio));
+        let fin_wave = fin_wave_per_area(p, at);
         wave += w * fin_wave * f64::from(p.count) * p.area_m2 / c.area_ref_m2;
     }
     AxialParts {
@@ -208,6 +207,18 @@ pub fn axial(c: &Configuration, mach: f64, air: &AirState, wetted_m2: f64) -> Ax
         base,
         wave,
     }
+}
+
+/// A fin's wave drag on its own area by Ackeret's 4 (t/c)^2 / beta at `mach` (> 1).
+fn fin_wave_per_area(p: &Panel, mach: f64) -> f64 {
+    let tc = p.thickness_m / p.mac_m;
+    4.0 * tc * tc / (mach * mach - 1.0).sqrt()
+}
+
+/// The fins' wave drag on S_ref at M_sup, the end of the bridge from which it is carried.
+pub fn fin_wave_at_m_sup(c: &Configuration, p: &Panel) -> f64 {
+    let m_sup = m_supersonic(p.aspect_ratio);
+    fin_wave_per_area(p, m_sup) * f64::from(p.count) * p.area_m2 / c.area_ref_m2
 }
 
 #[cfg(test)]

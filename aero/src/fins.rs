@@ -27,6 +27,15 @@
 //!   finds the build-up within about 10 % of measured lift on wing-body combinations from
 //!   subsonic to supersonic speeds; the slender-body K_B(W) is used at every Mach number here
 //!   (the report's supersonic charts, lower for short afterbodies, are not carried).
+//! - **Vortex lift at larger angles** (E. C. Polhamus' leading-edge suction analogy, NASA TN
+//!   D-3767, 1966, and J. Aircraft 8(4), 1971, as commonly quoted; the papers not opened here):
+//!   a sharp swept leading edge's lost suction reappears as normal force, CN = K_p sin a cos a +
+//!   K_v sin^2 a, with K_v = (K_p - K_p^2 K_i) / cos Lambda_LE, K_i = 1 / (pi A) the potential
+//!   induced-drag factor and K_p the pair's slope (Helmbold-Diederich at Mach 0, as his
+//!   incompressible K_p). Only the vortex term is carried, the potential one staying linear as
+//!   in the derivatives; a panel at roll phi meets sin(a_phi) = sin(a) cos(phi) and its normal
+//!   force projects by cos(phi), so N equally spaced panels give, averaged over roll (the build-up
+//!   is roll-independent), (4 N / 3 pi) K_v S_p sin(a) abs(sin(a)), at the planform's centroid.
 //! - **Roll damping** (strip theory, Barrowman 1967 section 3.6): a strip at radius y of a
 //!   panel rolling at p meets the flow at p y / V, so, per rad of p d / 2V,
 //!   Cl_p = -(2 N CL_alpha / (S_ref d^2)) integral over the exposed span of c(y) y^2 dy.
@@ -115,14 +124,36 @@ pub fn x_cp_from_root_le_m(p: &Panel, mach: f64) -> f64 {
     let (cr, ct, xt) = (p.root_chord_m, p.tip_chord_m, p.sweep_m);
     let sum = cr + ct;
     let subsonic = xt / 3.0 * (cr + 2.0 * ct) / sum + (sum - cr * ct / sum) / 6.0;
-    // The centroid of the planform: strips at eta = y/s have chord cr - (cr - ct) eta and
-    // leading edge xt eta; integral of c (x_le + c/2) over integral of c, in closed form.
+    let supersonic = centroid_from_root_le_m(p);
+    subsonic + bridge_weight(p, mach) * (supersonic - subsonic)
+}
+
+/// The panel's planform centroid behind its root leading edge \[m\]: strips at eta = y/s have
+/// chord c_r - (c_r - c_t) eta and leading edge x_t eta; the integral of c (x_le + c/2) over
+/// the integral of c, in closed form.
+pub fn centroid_from_root_le_m(p: &Panel) -> f64 {
+    let (cr, ct, xt) = (p.root_chord_m, p.tip_chord_m, p.sweep_m);
     let dc = cr - ct;
     let int_c = cr - 0.5 * dc;
     let int_c_xle = xt * (0.5 * cr - dc / 3.0);
     let int_c2 = cr * cr - cr * dc + dc * dc / 3.0;
-    let supersonic = (int_c_xle + 0.5 * int_c2) / int_c;
-    subsonic + bridge_weight(p, mach) * (supersonic - subsonic)
+    (int_c_xle + 0.5 * int_c2) / int_c
+}
+
+/// Polhamus' vortex-lift factor K_v of the panel pair (module docs).
+pub fn polhamus_kv(p: &Panel) -> f64 {
+    let kp = helmbold(p, 0.0);
+    let cos_le = 1.0 / (1.0 + (p.sweep_m / p.span_m).powi(2)).sqrt();
+    (kp - kp * kp / (std::f64::consts::PI * p.aspect_ratio)) / cos_le
+}
+
+/// The fins' vortex lift on `area_ref_m2` at `alpha_rad`, averaged over roll (module docs).
+pub fn vortex_cn(p: &Panel, area_ref_m2: f64, alpha_rad: f64) -> f64 {
+    let s = alpha_rad.sin();
+    4.0 * f64::from(p.count) / (3.0 * std::f64::consts::PI) * polhamus_kv(p) * p.area_m2
+        / area_ref_m2
+        * s
+        * s.abs()
 }
 
 /// Pitts, Nielsen and Kaattari's K_W(B) and K_B(W) at `tau` = r / (r + s).
@@ -154,4 +185,38 @@ pub fn roll_damping_per_rad(p: &Panel, cl_alpha: f64, r_m: f64, area_ref_m2: f64
     let quart = |y: f64| y.powi(4) / 4.0;
     let integral = (cr + k * r_m) * (cube(y1) - cube(r_m)) - k * (quart(y1) - quart(r_m));
     -2.0 * f64::from(p.count) * cl_alpha * integral / (area_ref_m2 * d_m * d_m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Polhamus by hand: a delta pair of aspect ratio 1 (span 1, root chord 4, no tip chord)
+    /// has tan Lambda_LE = 4 and a half-chord sweep of tan 2, so Helmbold-Diederich at Mach 0
+    /// gives K_p = 2 pi / (2 + sqrt(4 + 1 + 4)) = 2 pi / 5, K_p^2 / (pi A) = 4 pi / 25 and
+    /// K_v = (6 pi / 25) sqrt(17) = 3.1087, near slender-wing theory's pi as a delta should be;
+    /// four such panels on S_ref = 8 at 30 deg carry (16 / 3 pi) K_v (2 / 8) (1/4).
+    #[test]
+    fn polhamus_by_hand() {
+        let p = Panel {
+            count: 4,
+            root_chord_m: 4.0,
+            tip_chord_m: 0.0,
+            span_m: 1.0,
+            thickness_m: 0.1,
+            leading_edge_m: 0.0,
+            sweep_m: 4.0,
+            area_m2: 2.0,
+            aspect_ratio: 1.0,
+            tan_half_chord: 2.0,
+            tau: 0.0,
+            mac_m: 8.0 / 3.0,
+        };
+        let kv = 6.0 * std::f64::consts::PI / 25.0 * 17f64.sqrt();
+        assert!((polhamus_kv(&p) - kv).abs() < 1e-12, "{}", polhamus_kv(&p));
+        let cn = 16.0 / (3.0 * std::f64::consts::PI) * kv * 0.25 * 0.25;
+        let got = vortex_cn(&p, 8.0, 30f64.to_radians());
+        assert!((got - cn).abs() < 1e-12, "{got} {cn}");
+        assert!((vortex_cn(&p, 8.0, -30f64.to_radians()) + cn).abs() < 1e-12);
+    }
 }

@@ -52,7 +52,7 @@ pub struct Request {
 }
 
 /// An estimate: the configuration, its body terms, each Mach number's build-up and the
-/// crossflow's (CN, Cm about the CG) at each alpha of the grid.
+/// part not linear in alpha (CN, Cm about the CG) at each alpha of the grid, with its bands.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Estimate {
     /// The configuration.
@@ -63,8 +63,11 @@ pub struct Estimate {
     pub points: Vec<MachPoint>,
     /// The alpha grid \[deg\].
     pub alpha_deg: Vec<f64>,
-    /// (CN, Cm) of the viscous crossflow at each alpha.
+    /// (CN, Cm) not linear in alpha (the body's viscous crossflow and the fins' vortex lift)
+    /// at each alpha.
     pub crossflow: Vec<(f64, f64)>,
+    /// Their bands (one sigma each) at each alpha.
+    pub crossflow_sigma: Vec<(f64, f64)>,
     /// The altitude \[m\].
     pub altitude_m: f64,
 }
@@ -111,17 +114,18 @@ pub fn estimate(r: &Request) -> Result<Estimate, AeroError> {
         .iter()
         .map(|&m| buildup::at_mach(&config, &body, m, &air))
         .collect();
-    let crossflow = r
+    let (crossflow, crossflow_sigma) = r
         .alpha_deg
         .iter()
         .map(|a| buildup::crossflow(&config, &body, a.to_radians()))
-        .collect();
+        .unzip();
     Ok(Estimate {
         config,
         body,
         points,
         alpha_deg: r.alpha_deg.clone(),
         crossflow,
+        crossflow_sigma,
         altitude_m: r.altitude_m,
     })
 }

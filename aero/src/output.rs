@@ -146,5 +146,18 @@ pub fn summary(e: &Estimate) -> String {
             p.regime.name()
         );
     }
+    let marginal: Vec<String> = e
+        .points
+        .iter()
+        .filter(|p| p.cm_alpha_per_rad.value.abs() < 2.0 * p.cm_alpha_per_rad.sigma)
+        .map(|p| format!("{:.2}", p.mach))
+        .collect();
+    if !marginal.is_empty() {
+        let _ = writeln!(
+            s,
+            "warning: Cm_alpha's sign is not determined (|Cm_alpha| < 2 sigma) at Mach {}",
+            marginal.join(", ")
+        );
+    }
     s
 }

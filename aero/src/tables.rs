@@ -1,8 +1,9 @@
 //! The estimate in the scenario's table form (docs/model.md section 1, "Tables"): the seven
-//! derivatives and CA0 as tables over Mach, and the viscous crossflow, the part of CN that is
-//! not linear in alpha, as the static tables `cz`, `cm` over alpha and `cy`, `cn` over beta
-//! (section 3 adds them to the linear terms). The crossflow does not depend on Mach here
-//! (subcritical c_dc), so those tables have no Mach axis. With each table its band: one
+//! derivatives and CA0 as tables over Mach, and the part of CN that is not linear in alpha
+//! (the body's viscous crossflow and the fins' vortex lift), as the static tables `cz`, `cm`
+//! over alpha and `cy`, `cn` over beta (section 3 adds them to the linear terms). Neither
+//! depends on Mach here (subcritical c_dc; Polhamus' incompressible K_p), so those tables have
+//! no Mach axis. With each table its band: one
 //! standard deviation per value, the stated uncertainty ([`crate::buildup::ACCURACY`]), for
 //! DAVE-ML's `uncertainty` (docs/daveml.md) through `sepval-daveml`'s export.
 
@@ -11,7 +12,7 @@ use sepval_common::scenario::{Aero, Scenario};
 use sepval_common::table::{Axis, Kind, Table, TableKind, Tabulated, Variable};
 use sepval_daveml::Band;
 
-use crate::buildup::{ACCURACY, Estimated, MachPoint};
+use crate::buildup::{Estimated, MachPoint};
 use crate::{AeroError, Estimate};
 
 fn table<K: TableKind>(
@@ -101,15 +102,12 @@ pub fn aero(e: &Estimate) -> Result<(Aero, Vec<Band>), AeroError> {
     let cn_vis: Vec<f64> = e.crossflow.iter().map(|c| c.0).collect();
     let cm_vis: Vec<f64> = e.crossflow.iter().map(|c| c.1).collect();
     let neg = |v: &[f64]| v.iter().map(|x| -x).collect::<Vec<f64>>();
-    let band = |v: &[f64]| {
-        v.iter()
-            .map(|x| ACCURACY.crossflow * x.abs())
-            .collect::<Vec<f64>>()
-    };
-    for (i, v) in [(1, &cn_vis), (2, &cn_vis), (4, &cm_vis), (5, &cm_vis)] {
+    let cn_band: Vec<f64> = e.crossflow_sigma.iter().map(|c| c.0).collect();
+    let cm_band: Vec<f64> = e.crossflow_sigma.iter().map(|c| c.1).collect();
+    for (i, v) in [(1, &cn_band), (2, &cn_band), (4, &cm_band), (5, &cm_band)] {
         bands.push(Band {
             target: Target::Static(i),
-            sigma: band(v),
+            sigma: v.clone(),
             correlations: Vec::new(),
         });
     }

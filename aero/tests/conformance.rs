@@ -127,6 +127,77 @@ fn arcas_fins_on_the_boattail_are_outside_and_said_to_be() {
     }
 }
 
+/// `got` within two of its stated sigmas of `truth`, said in the failure.
+fn within_two_sigma(what: &str, got: sepval_aero::Estimated, truth: f64) {
+    let z = (got.value - truth) / got.sigma;
+    assert!(
+        z.abs() <= 2.0,
+        "{what}: estimate {:.3} +- {:.3}, truth {truth:.3}: {z:+.2} sigma",
+        got.value,
+        got.sigma
+    );
+}
+
+#[test]
+fn in_the_domain_the_bands_are_the_flat_fractions() {
+    // The Basic Finner: no boattail, fins on the cylinder. Its bands are the in-domain
+    // fractions exactly (no out-of-domain term adds to them) away from the drag rise.
+    for mach in [0.6, 1.3, 1.5] {
+        let p = &at("basic-finner.toml", mach).points[0];
+        let frac = match p.regime {
+            fins::Regime::Bridge => ACCURACY.cn_alpha_bridge,
+            _ => ACCURACY.cn_alpha,
+        };
+        let cn = p.cn_alpha_per_rad;
+        assert!((cn.sigma - frac * cn.value.abs()).abs() < 1e-12, "{mach}");
+        assert!((p.x_cp_m.sigma - ACCURACY.x_cp_of_length * 0.30).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn outside_the_domain_the_bands_hold_the_published_values() {
+    // The Arcas misses of the test above, within two of the widened sigmas (the boattail's
+    // lift and the fins on it as the parts' own errors, docs/aero.md).
+    for (mach, cn_published, cp_percent) in [(0.6, 11.14, 76.8), (0.8, 10.62, 75.6)] {
+        let e = at("arcas-long.toml", mach);
+        let p = &e.points[0];
+        within_two_sigma("Arcas CN_alpha", p.cn_alpha_per_rad, cn_published);
+        within_two_sigma(
+            "Arcas x_cp",
+            p.x_cp_m,
+            cp_percent / 100.0 * e.config.length_m,
+        );
+    }
+    // The Basic Finner's damping in the bridge: DREV-TM-9703 Table IX, -322.4 at Mach 1.077,
+    // 87 % off the estimate but 1.55 of its sigmas (30 % of the estimate's -603.8).
+    let p = &at("basic-finner.toml", 1.077).points[0];
+    assert_eq!(p.regime, fins::Regime::Bridge);
+    within_two_sigma("ANF Cm_q at Mach 1.077", p.cm_q_per_rad, -322.4);
+}
+
+#[test]
+fn the_eglin_cfds_axial_force_and_stability_within_the_bands() {
+    // docs/eglin-cfd.md, "The store's own loads": the CFD store's whole axial force 0.12 to
+    // 0.13 at Mach 0.85 and 0.73 to 0.80 at Mach 0.95, and a statically stable store (secant
+    // Cm_alpha -7 to -12 per rad late in the release) where the estimate is unstable: its
+    // band must hold the CFD's CA0 and leave Cm_alpha's sign undetermined.
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/eglin-store/shape.toml");
+    let e = estimate(&Request {
+        shape: StoreShape::read(&p).unwrap(),
+        mach: vec![0.85, 0.95],
+        alpha_deg: vec![-10.0, 0.0, 10.0],
+        altitude_m: sepval_aero::DEFAULT_ALTITUDE_M,
+    })
+    .unwrap();
+    for (p, cfd) in e.points.iter().zip([[0.12, 0.13], [0.73, 0.80]]) {
+        for ca in cfd {
+            within_two_sigma(&format!("Eglin CA0 at Mach {}", p.mach), p.ca0, ca);
+        }
+        let cm = p.cm_alpha_per_rad;
+        assert!(cm.value > 0.0 && cm.value < 2.0 * cm.sigma, "{cm:?}");
+    }
+}
+
 #[test]
 fn slender_body_limits_by_hand() {
     // Pitts, Nielsen and Kaattari: K_W(B) -> 1 without a body; K_W + K_B = (1 + tau)^2.

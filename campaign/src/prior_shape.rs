@@ -204,18 +204,18 @@ mod tests {
         };
         let crossflow = |a: f64| {
             let i = est.alpha_deg.iter().position(|x| (x - a).abs() < 1e-9);
-            est.crossflow[i.expect("on the grid")]
+            est.crossflow_sigma[i.expect("on the grid")]
         };
         let (mut ca, mut cz, mut cm, mut n) = (0.0, 0.0, 0.0, 0.0);
         for m in [0.6, 0.8, 1.0] {
             let p = at_mach(m);
             for a_aircraft in [0.0, 5.0, 10.0] {
                 for a in [a_aircraft - 5.0, a_aircraft, a_aircraft + 5.0] {
-                    let (cn_vis, cm_vis) = crossflow(a);
+                    let (cn_band, cm_band) = crossflow(a);
                     let r = f64::to_radians(a);
                     ca += p.ca0.sigma.powi(2);
-                    cz += (p.cn_alpha_per_rad.sigma * r).powi(2) + (0.3 * cn_vis).powi(2);
-                    cm += (p.cm_alpha_per_rad.sigma * r).powi(2) + (0.3 * cm_vis).powi(2);
+                    cz += (p.cn_alpha_per_rad.sigma * r).powi(2) + cn_band.powi(2);
+                    cm += (p.cm_alpha_per_rad.sigma * r).powi(2) + cm_band.powi(2);
                     n += 1.0;
                 }
             }
