@@ -133,6 +133,16 @@ impl Answer {
         }
     }
 
+    /// The level of the test the answer met, where it is not the library's: a catalogue
+    /// answer's effects entered at 1 % over the catalogue's first round
+    /// ([`crate::catalogue_level`]); a discovered answer met the library's own.
+    pub fn level(&self) -> Option<f64> {
+        match self {
+            Answer::Catalogue { .. } => Some(crate::catalogue_level()),
+            Answer::Discovered { .. } | Answer::Baseline => None,
+        }
+    }
+
     /// The answer's model.
     pub fn model<'a>(&'a self, baseline: &'a Fitted) -> &'a Fitted {
         match self {

@@ -14,9 +14,10 @@
 //!    mean dof + lambda, variance 2 (dof + 2 lambda)). From the best entry's X the one-sided
 //!    95 % lower confidence bound of its noncentrality, lambda_lo, solves
 //!    `dof + lambda + z sqrt(2 (dof + 2 lambda)) = X` (normal approximation, z = 1.645). An
-//!    entry is a candidate when it passes the step's Bonferroni threshold and its own X is at
-//!    least `dof + lambda_lo`, what an entry of that noncentrality shows on average: another
-//!    noise realisation could have ranked it first.
+//!    entry is a candidate when it passes the step's Bonferroni threshold (with a catalogue
+//!    answer, the larger of it and the level that answer met, `crate::catalogue_level`) and its
+//!    own X is at least `dof + lambda_lo`, what an entry of that noncentrality shows on average:
+//!    another noise realisation could have ranked it first.
 //! 2. **Classes.** Each candidate's signature is what it would change in the residuals: the
 //!    projection of the residuals (beyond the model's own sensitivities) on its directions.
 //!    Candidates are taken best first; each joins the first class whose lead's signature has a
@@ -154,11 +155,16 @@ pub fn classes(
 /// 0.6 s, ..." (each kind once, in the members' order).
 pub fn words(class: &Class, entries: &[Entry]) -> String {
     let members: Vec<&Entry> = class.members.iter().map(|&e| &entries[e]).collect();
-    if let [one] = members.as_slice() {
+    words_of(&members)
+}
+
+/// Members of a class in words, as [`words`] puts them.
+pub(crate) fn words_of(members: &[&Entry]) -> String {
+    if let [one] = members {
         return one.label();
     }
     let mut kinds: Vec<String> = Vec::new();
-    for e in &members {
+    for e in members {
         let w = kind_words(e);
         if !kinds.contains(&w) {
             kinds.push(w);

@@ -238,6 +238,13 @@ pub use verdict::fmt_discovered;
 pub const DIAGNOSIS_FORMAT: &str = "sepval-diagnosis/2";
 /// Family-wise significance level of the candidate tests.
 pub const ALPHA: f64 = 0.01;
+/// The level the catalogue's first round tests each effect at (1 % over its effects,
+/// Bonferroni): the level a catalogue answer met. A library term is tested at 1 % over the
+/// library's thousand entries; the rival classes and the rival rule hold none of them to a
+/// stricter level than a catalogue answer's (`docs/discovery.md` 11.5, steps 4a and 4b).
+pub fn catalogue_level() -> f64 {
+    ALPHA / sepval_common::effects::CATALOGUE.len() as f64
+}
 /// The BIC lead by which a discovered extension must beat the catalogue's answer to replace it.
 pub const BIC_MARGIN: f64 = 6.0;
 /// The BIC distance within which an explanation is a rival of the answer: the data cannot tell

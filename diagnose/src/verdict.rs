@@ -289,7 +289,18 @@ pub(super) fn ambiguity(rivals: &[crate::RivalReport], events: usize) -> Option<
     };
     let named: Vec<String> = rivals
         .iter()
-        .map(|r| format!("{} (BIC {:+.1})", crate::rivals::rival_name(r), r.delta_bic))
+        .map(|r| {
+            let better = if r.delta_bic <= -crate::RIVAL_MARGIN {
+                ": it fits better, with no more terms"
+            } else {
+                ""
+            };
+            format!(
+                "{} (BIC {:+.1}{better})",
+                crate::rivals::rival_name(r),
+                r.delta_bic
+            )
+        })
         .collect();
     Some(format!(
         "{data} cannot tell it from {}: a release that separates them settles it (`sepval plan`)",

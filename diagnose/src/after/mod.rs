@@ -361,16 +361,7 @@ pub(crate) fn significant(setting: &Setting, baseline: &Fitted, c: &Fitted, pool
             .significant(ALPHA / pool.max(1) as f64)
 }
 
-/// The terms of a fitted model as the criterion counts them: each effect, and each library
-/// entry (an oscillation's pair once).
-pub(crate) fn term_count(f: &Fitted) -> usize {
-    let pairs = f
-        .terms
-        .iter()
-        .filter(|t| t.term.regressor == Regressor::Cos)
-        .count();
-    f.effects.iter().count() + f.terms.len() - pairs
-}
+pub(crate) use crate::rivals::term_count;
 
 /// The carried model [`CRITERION`] prefers to `answer`, if any (its index).
 fn choose(

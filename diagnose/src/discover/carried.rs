@@ -339,6 +339,7 @@ pub(crate) fn found_of(
         current: fitted.clone(),
         picked,
         groups: vec![Vec::new(); entries.len()],
+        near: vec![super::search::Near::default(); entries.len()],
         without: None,
     };
     let found = super::conclude(evaluator, &search, baseline, sel, &mut trail)?;

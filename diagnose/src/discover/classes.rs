@@ -11,9 +11,12 @@ use super::search::{Search, Trail};
 use crate::classes::{self, CLASS_REFITS, ClassInfo};
 use crate::{Fitted, Result};
 
-/// The first step's classes, from its screening, into `trail`.
-pub(super) fn gather(s: &Screening, trail: &mut Trail) {
-    let candidates = classes::candidates(&s.scores, &s.entry_cols, s.threshold);
+/// The first step's classes, from its screening, into `trail`: of the entries passing the
+/// screening's threshold or, when the catalogue names an answer, the level it met (`level`,
+/// [`crate::catalogue_level`]), whichever is the larger.
+pub(super) fn gather(s: &Screening, trail: &mut Trail, level: Option<f64>) {
+    let threshold = level.map_or(s.threshold, |l| l.max(s.threshold));
+    let candidates = classes::candidates(&s.scores, &s.entry_cols, threshold);
     trail.classes = classes::classes(
         &s.linear.r0,
         &s.linear.fixed,

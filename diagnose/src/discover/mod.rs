@@ -53,6 +53,7 @@ use verify::Refit;
 
 pub(crate) mod carried;
 mod classes;
+mod exchange;
 mod held;
 mod locate;
 mod located;
@@ -100,6 +101,7 @@ pub(super) fn discover(
         current: baseline.clone(),
         picked: Picked::default(),
         groups: Vec::new(),
+        near: Vec::new(),
         without: None,
     };
     let (mut bic_before, mut best_gain) = (
@@ -181,7 +183,10 @@ fn enter(
     };
     crate::stage_clock::lap("  screening");
     if step == 0 {
-        classes::gather(&s, trail);
+        // With a catalogue answer (its signature given), the classes' candidates pass the
+        // larger of the library's threshold and the level the answer met.
+        let level = at.signature.map(|_| crate::catalogue_level());
+        classes::gather(&s, trail, level);
     }
     if let Some(signature) = at.signature {
         let exclude = s.to_verify();
@@ -202,6 +207,10 @@ fn enter(
     let mut record = s.record(step, sel.current.lm.cost);
     let best = s.to_verify();
     if best.is_empty() {
+        if step == 0 {
+            classes::refit_leads(evaluator, search, &s, &sel.current, trail)?;
+            crate::stage_clock::lap("  rival classes");
+        }
         trail.steps.push(record);
         trail.notes.push(s.nothing_significant(step));
         return Ok(None);
@@ -243,12 +252,15 @@ fn enter(
     trail.steps.push(record);
     let mut groups = sel.groups.clone();
     groups.push(verify::group(&s, &refits, &fitted));
+    let mut near = sel.near.clone();
+    near.push(exchange::near(step, &refits, &fitted, s.entries.len()));
     let picked = now.with(winner.entry.clone()).at(search.job, &fitted)?;
     let (fitted, picked) = held::free_held_locator(evaluator, search, fitted, picked, trail)?;
     Ok(Some(Selection {
         current: fitted,
         picked,
         groups,
+        near,
         without: None,
     }))
 }
@@ -285,6 +297,8 @@ fn conclude(
         sel.without,
         trail,
     )?;
+    exchange::exchanges(evaluator, search, &fitted, &picked, &sel.near, trail)?;
+    crate::stage_clock::lap("discovery's exchanges");
     let locations = located::locations(evaluator, search, &fitted, &picked, trail)?;
     crate::stage_clock::lap("discovery's locations");
     let terms = naming::name_terms(job, &fitted, &picked, &gains, &gain, &sel.groups, locations);

@@ -106,6 +106,7 @@ pub(super) fn f_to_remove(
         ));
         sel.picked.remove(k);
         sel.groups.remove(k);
+        sel.near.remove(k);
         sel.current = without.swap_remove(k).ok_or(DiagnoseError::MissingRefit)?;
         sel.without = None;
     } else {

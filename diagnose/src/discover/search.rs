@@ -85,10 +85,21 @@ pub(super) struct Selection {
     pub picked: Picked,
     /// Per entry, the entries the data cannot tell from it.
     pub groups: Vec<Vec<crate::GroupMember>>,
+    /// Per entry, the alternatives its exchanges try (`exchange`).
+    pub near: Vec<Near>,
     /// The refits of `current` without each of its entries, when F-to-remove made them and
     /// kept every entry: the gains of the entries of the final model are read from them rather
     /// than refitted again (the same refits from the same optimum).
     pub without: Option<Vec<Option<Fitted>>>,
+}
+
+/// The alternatives of one entry of the model.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Near {
+    /// Entries whose refit at the step it entered came within the margin of its chi-square.
+    pub entries: Vec<crate::library::Entry>,
+    /// How many entries that step screened (the pool of their significance test).
+    pub pool: usize,
 }
 
 /// What discovery records as it goes.

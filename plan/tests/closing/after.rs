@@ -92,13 +92,13 @@ impl Case {
     }
 }
 
-/// The sweep's cases: two of each cause, each on its own random base and seeds, drawn from
+/// `count` cases, the five causes in turn, each on its own random base and seeds, drawn from
 /// `seed` (cause sizes too: pitch damping 0.35 to 0.6 of the model's, roll damping 0.4 to 0.6,
 /// Cn beta +0.12 to +0.2 per rad against the model's -0.3, a drag rise 0.4 to 0.8 per Mach).
-fn cases(seed: u64, model: &Scenario) -> Vec<Case> {
+fn cases(seed: u64, model: &Scenario, count: usize) -> Vec<Case> {
     let mut g = Gauss(seed);
     let mut out = Vec::new();
-    for k in 0..10 {
+    for k in 0..count {
         let u = g.uniform();
         let cause = match k % 5 {
             0 => Cause::Pitch(0.35 + 0.25 * u),
@@ -326,27 +326,28 @@ fn the_loop_keeps_its_word_on_random_bases() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(10);
     let compare = std::env::var("SEPVAL_AFTER_COMPARE").is_ok_and(|v| v == "1");
+    // `SEPVAL_AFTER_CASE=K` runs case K alone (numbered from 1, as the table numbers them).
+    let only: Option<usize> = std::env::var("SEPVAL_AFTER_CASE")
+        .ok()
+        .and_then(|v| v.parse().ok());
     let model = default_scenario();
-    let all = cases(0x6060_2026_1206, &model);
+    let all = cases(0x6060_2026_1206, &model, 10);
     let rows: Vec<Row> = all
         .iter()
         .take(count)
         .enumerate()
+        .filter(|(k, _)| only.is_none_or(|o| o == k + 1))
         .map(|(k, c)| run_case(k + 1, c, compare))
         .collect();
     let table: Vec<&str> = rows.iter().map(|r| r.line.as_str()).collect();
     let table = table.join("\n");
     eprintln!("{table}");
-    // One release never a confident wrong answer is the issue's criterion for the single
-    // diagnosis, which this work does not change: on seed 0x6060_2026_1206 case 6 (pitch
-    // damping 0.40 of the model's) is answered `pitch_stiffness_cubic` with the cause not open
-    // (2026-12-06). It is counted and shown, not asserted here, so that this test guards what
-    // `--after` does; the failure is reported in issue 60.
-    let first_wrong = rows.iter().filter(|r| r.first == "wrong").count();
-    eprintln!(
-        "first release: {first_wrong} confident wrong answer(s) of {}",
-        rows.len()
-    );
+    // One release never a confident wrong answer (issue 60): on this seed case 6 (pitch
+    // damping 0.40 of the model's) was answered `pitch_stiffness_cubic` with the cause not open
+    // until the rival classes were formed, and the rivals tested, at the level the catalogue's
+    // answer met (2026-12-07; `one_release_is_never_a_confident_wrong_answer` holds it on
+    // cases of its own).
+    assert!(rows.iter().all(|r| r.first != "wrong"), "{table}");
     assert!(rows.iter().all(|r| r.second != "wrong"), "{table}");
     let right = rows.iter().filter(|r| r.second == "right").count();
     assert!(
@@ -489,4 +490,62 @@ fn the_plans_separations_are_set_against_the_diagnosis() {
     let rivals = first["rivals"].as_array().unwrap().len();
     let fates = both["after"]["fates"].as_array().unwrap();
     assert!(fates.len() > rivals, "{}", both["after"]);
+}
+
+/// One release never a confident wrong answer (issue 60's done-when, the single diagnosis):
+/// on cases of their own (seed 0x9E37_79B9_7F4A_7C15: not the sweep's, on which the fix was
+/// made, nor a neighbour of it, since xorshift's first draws from seeds a bit apart nearly
+/// agree; fifteen random bases and seeds, three of each cause: pitch damping, roll damping, `Cn
+/// beta`, a drag rise with Mach number and the null), one release at the default condition
+/// each, diagnosed alone. The truth must be the answer, or open (a rival, or a member of a
+/// rival class not told apart; for the null, no answer or an ambiguous one), or missed (no
+/// answer named): never another cause named with the truth not open. Each case's standing,
+/// wall time and simulations are printed. `SEPVAL_FIRST_CASES=N` runs the first N. Before the
+/// answer's level, the split of a class by axes and the exchanges (docs/discovery.md 11.5,
+/// 4a and 4b), five of the fifteen were wrong (cases 2, 7 and 12, roll damping; 3, `Cn beta`;
+/// 6, pitch damping; 2026-12-07).
+#[test]
+fn one_release_is_never_a_confident_wrong_answer() {
+    if sepval_tests::skip_slow_tests() {
+        return;
+    }
+    let count: usize = std::env::var("SEPVAL_FIRST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(15);
+    let model = default_scenario();
+    let mut rows = Vec::new();
+    for (k, case) in cases(0x9E37_79B9_7F4A_7C15, &model, 15)
+        .iter()
+        .take(count)
+        .enumerate()
+    {
+        let (truth, hidden) = case.truth(&model);
+        let dir = tempfile::tempdir().unwrap();
+        let r = release_on(&truth, &case.base, hidden, case.seeds[0]);
+        let d = diagnose_in(dir.path(), &[r], &model, None, None, "diag");
+        let s = standing(&d, case.cause.kind());
+        let line = format!(
+            "| {} | {:?} | {} | {s} | wall {:.1} s, {} simulations |",
+            k + 1,
+            case.cause,
+            kinds(&d["model"]).join(" + "),
+            d["wall_s"].as_f64().unwrap(),
+            d["evaluations"],
+        );
+        eprintln!("{line}\n  verdict: {}", d["verdict"]);
+        rows.push((s, line));
+    }
+    let table: Vec<&str> = rows.iter().map(|(_, l)| l.as_str()).collect();
+    let table = table.join("\n");
+    let count = |what: &str| rows.iter().filter(|(s, _)| *s == what).count();
+    eprintln!(
+        "{table}\nright {}, open {}, missed {}, wrong {} of {}",
+        count("right"),
+        count("open"),
+        count("missed"),
+        count("wrong"),
+        rows.len()
+    );
+    assert_eq!(count("wrong"), 0, "{table}");
 }
