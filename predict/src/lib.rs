@@ -288,9 +288,10 @@ pub fn predict_with(
     )?;
     progress.finish();
     if runs.failed() == n {
-        let first = runs.trajectories[0]
-            .clone()
-            .err()
+        let first = runs
+            .trajectories
+            .first()
+            .and_then(|t| t.clone().err())
             .unwrap_or(simulate::NoTrajectory::NoRun);
         return Err(PredictError::AllDiverged { samples: n, first });
     }
