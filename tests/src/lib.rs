@@ -96,6 +96,28 @@ pub fn skip_slow_tests() -> bool {
     !run
 }
 
+/// The variable that runs the statistical sweeps whole ([`sweep_cases`]): `scripts/sweeps.sh`
+/// sets it.
+pub const SWEEPS_VAR: &str = "SEPVAL_SWEEPS";
+
+/// How many cases of a statistical sweep (seeds, random bases) a test of the slow tier runs:
+/// all `full` of them when [`SWEEPS_VAR`] is `full` (`scripts/sweeps.sh`, the measurements the
+/// docs quote), else the first `tier`, so that the README's test command keeps every sweep's
+/// assertions on a share of its cases within the cold CI's 15 minutes (docs/performance.md,
+/// "The sweeps"). The cases are drawn the same either way: the tier's are the full sweep's
+/// first ones.
+pub fn sweep_cases(full: usize, tier: usize) -> usize {
+    let whole = std::env::var(SWEEPS_VAR).is_ok_and(|v| v == "full");
+    if whole { full } else { tier.min(full) }
+}
+
+/// The least number of `n` cases a sweep asserts, for a rate of `per_ten` in ten: the misses
+/// the rate allows, rounded up, so that a sweep that must hold on 9 of 10 holds on 9 of 10, on
+/// 18 of 20, on 2 of 3 and on 1 of 2 (one miss allowed per ten cases begun).
+pub fn at_least(n: usize, per_ten: usize) -> usize {
+    n - (n * (10 - per_ten)).div_ceil(10)
+}
+
 /// Fails the test with sepval's stderr unless it exited successfully; returns its stdout.
 pub fn ok(out: &Output) -> String {
     assert!(

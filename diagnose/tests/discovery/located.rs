@@ -6,8 +6,9 @@
 //! interval, and an onset reported as not determined carries no standard error and the verdict
 //! says so. How often the onset lands within 10 ms of the truth is printed, not asserted: one
 //! release at this noise does not determine a short gust's length, hence not its onset
-//! (`docs/discovery.md` section 11.5, step 13, the measurement). Slow tier: ten diagnoses, about 40 s each on a
-//! loaded two-core machine.
+//! (`docs/discovery.md` section 11.5, step 13, the measurement). Slow tier: the first three
+//! seeds, 2 of 3 (one miss allowed per ten begun; about 40 s a diagnosis on a loaded two-core
+//! machine); all ten with `SEPVAL_SWEEPS=full` (`scripts/sweeps.sh`), 9 of 10.
 
 use sepval_core::factors::{Factor, FactorTable};
 use sepval_tests::Gauss;
@@ -59,11 +60,12 @@ fn a_short_gusts_onset_interval_holds_the_truth_on_nine_of_ten_seeds() {
     let short = GUST
         .replace("t_on_s = 0.3", "t_on_s = 0.45\nrise_s = 0.02")
         .replace("coefficient = 3.0", "coefficient = 10.0");
+    let seeds = sepval_tests::sweep_cases(10, 3) as u64;
     let (mut onset_covered, mut middle_covered, mut within_10_ms) = (0, 0, 0);
     eprintln!(
         "seed | onset: estimate, SE, 95 % interval, covered | middle: estimate ± SE, covered"
     );
-    for seed in 101..=110 {
+    for seed in 101..101 + seeds {
         let dir = tempfile::tempdir().unwrap();
         let dir = dir.path();
         gust_release_on(dir, &random_base(seed), &short, None, seed, "gust.csv");
@@ -97,14 +99,15 @@ fn a_short_gusts_onset_interval_holds_the_truth_on_nine_of_ten_seeds() {
         }
     }
     eprintln!(
-        "onset within 10 ms of the truth on {within_10_ms} of 10 (not asserted: one release does not determine it)"
+        "onset within 10 ms of the truth on {within_10_ms} of {seeds} (not asserted: one release does not determine it)"
+    );
+    let least = sepval_tests::at_least(seeds as usize, 9);
+    assert!(
+        onset_covered >= least,
+        "the onset's interval held the truth on {onset_covered} of {seeds}"
     );
     assert!(
-        onset_covered >= 9,
-        "the onset's interval held the truth on {onset_covered} of 10"
-    );
-    assert!(
-        middle_covered >= 9,
-        "the middle's interval held the truth on {middle_covered} of 10"
+        middle_covered >= least,
+        "the middle's interval held the truth on {middle_covered} of {seeds}"
     );
 }
