@@ -317,6 +317,15 @@ fn run_case(k: usize, case: &Case, compare: bool) -> Row {
     row
 }
 
+/// How many of a sweep's `full` cases to run: `var`'s number when it is set, else
+/// [`sepval_tests::sweep_cases`]'s (the tier's first `tier`, all with `SEPVAL_SWEEPS=full`).
+fn cases_to_run(var: &str, full: usize, tier: usize) -> usize {
+    std::env::var(var)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| sepval_tests::sweep_cases(full, tier))
+}
+
 /// The sweep: after the planned release at least 90 % right and none wrong; every earlier
 /// explanation's fate in the report; the first release's confident wrong answers counted.
 #[test]
@@ -324,10 +333,7 @@ fn the_loop_keeps_its_word_on_random_bases() {
     if sepval_tests::skip_slow_tests() {
         return;
     }
-    let count: usize = std::env::var("SEPVAL_AFTER_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| sepval_tests::sweep_cases(10, 2));
+    let count = cases_to_run("SEPVAL_AFTER_CASES", 10, 2);
     let compare = std::env::var("SEPVAL_AFTER_COMPARE").is_ok_and(|v| v == "1");
     // `SEPVAL_AFTER_CASE=K` runs case K alone (numbered from 1, as the table numbers them).
     let only: Option<usize> = std::env::var("SEPVAL_AFTER_CASE")
@@ -514,10 +520,7 @@ fn one_release_is_never_a_confident_wrong_answer() {
     if sepval_tests::skip_slow_tests() {
         return;
     }
-    let count: usize = std::env::var("SEPVAL_FIRST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| sepval_tests::sweep_cases(15, 3));
+    let count = cases_to_run("SEPVAL_FIRST_CASES", 15, 3);
     let model = default_scenario();
     let mut rows = Vec::new();
     for (k, case) in cases(0x9E37_79B9_7F4A_7C15, &model, 15)
