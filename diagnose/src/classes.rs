@@ -100,16 +100,31 @@ pub fn lower_noncentrality(x: f64, dof: f64, z: f64) -> f64 {
 
 /// The entries (indices into `entries`) that the screening cannot tell from the best: passing
 /// `threshold` (the step's Bonferroni level) with a statistic at least the best's lower bound;
-/// best first. `scores` are sorted best first, as `stepwise::screen` returns them.
-pub fn candidates(scores: &[Score], entry_cols: &[Vec<usize>], threshold: f64) -> Vec<usize> {
+/// and, with a catalogue answer whose signature screens at `answer` (its statistic X on one
+/// degree of freedom), those the screening cannot tell from the answer: a statistic at least
+/// the answer's lower bound, whatever their p (the answer met its level by its refit, not by
+/// the screening, and an entry that screens as it does could have met it too). Best first.
+/// `scores` are sorted best first, as `stepwise::screen` returns them.
+pub fn candidates(
+    scores: &[Score],
+    entry_cols: &[Vec<usize>],
+    threshold: f64,
+    answer: Option<f64>,
+) -> Vec<usize> {
     let stat = |s: &Score| entry_cols[s.entry].len() as f64 * s.f;
-    let Some(best) = scores.iter().find(|s| s.p < threshold) else {
-        return Vec::new();
-    };
-    let lambda_lo = lower_noncentrality(stat(best), entry_cols[best.entry].len() as f64, CLASS_Z);
+    let dof = |s: &Score| entry_cols[s.entry].len() as f64;
+    let best_lo = scores
+        .iter()
+        .find(|s| s.p < threshold)
+        .map(|best| lower_noncentrality(stat(best), dof(best), CLASS_Z));
+    let answer_lo = answer.map(|x| lower_noncentrality(x, 1.0, CLASS_Z));
     let mut out: Vec<&Score> = scores
         .iter()
-        .filter(|s| s.p < threshold && stat(s) >= entry_cols[s.entry].len() as f64 + lambda_lo)
+        .filter(|s| {
+            let like_best = best_lo.is_some_and(|l| s.p < threshold && stat(s) >= dof(s) + l);
+            let like_answer = answer_lo.is_some_and(|l| stat(s) >= dof(s) + l);
+            like_best || like_answer
+        })
         .collect();
     out.sort_by(|a, b| stat(b).total_cmp(&stat(a)));
     out.into_iter().map(|s| s.entry).collect()
@@ -269,12 +284,41 @@ mod tests {
         let entry_cols = vec![vec![0], vec![1], vec![2], vec![3]];
         let r0 = DVector::from_fn(m, |i, _| 0.3 * s(t[i]) + 0.01 * ((i * 7919) % 13) as f64);
         let scores = crate::stepwise::screen(&r0, &fixed, &cols, &entry_cols);
-        let c = candidates(&scores, &entry_cols, 0.01);
+        let c = candidates(&scores, &entry_cols, 0.01, None);
         assert!(c.contains(&0) && c.contains(&1), "{c:?} {scores:?}");
         assert!(!c.contains(&3), "{c:?}");
         let k = classes(&r0, &fixed, &cols, &entry_cols, &c);
         let with = |e: usize| k.iter().position(|cl| cl.members.contains(&e));
         assert_eq!(with(0), with(1), "{k:?}");
         assert_eq!(k.iter().map(|cl| cl.members.len()).sum::<usize>(), c.len());
+    }
+
+    #[test]
+    fn entries_that_screen_as_the_catalogues_answer_does_are_candidates_whatever_their_p() {
+        let score = |entry: usize, f: f64, p: f64| Score {
+            entry,
+            f,
+            p,
+            drop: f,
+            pse_falls: true,
+        };
+        // The best entry far past the threshold; one just outside it (the roll-damping case of
+        // seed 0x6060_2026_1207: X 10.6, p 1.1e-3, against 9.1e-4); one in the noise.
+        let scores = [
+            score(0, 40.0, 1e-9),
+            score(1, 10.6, 1.1e-3),
+            score(2, 1.5, 0.22),
+        ];
+        let cols = vec![vec![0], vec![1], vec![2]];
+        let level = 0.01 / 11.0;
+        assert_eq!(candidates(&scores, &cols, level, None), vec![0]);
+        // The answer's signature screens at X 17.6: lower bound 7.4, so X >= 8.4 qualifies.
+        assert_eq!(candidates(&scores, &cols, level, Some(17.6)), vec![0, 1]);
+        // An answer screening far above: only the best's own band.
+        assert_eq!(candidates(&scores, &cols, level, Some(60.0)), vec![0]);
+        // With nothing passing the threshold, the answer's band alone makes the candidates.
+        let weak = [score(1, 10.6, 1.1e-3), score(2, 1.5, 0.22)];
+        assert_eq!(candidates(&weak, &cols, level, None), Vec::<usize>::new());
+        assert_eq!(candidates(&weak, &cols, level, Some(17.6)), vec![1]);
     }
 }

@@ -3,20 +3,24 @@
 //! that no verification refit or mimic represents (at most [`CLASS_REFITS`]), as contenders of
 //! the rival search.
 
+use nalgebra::DMatrix;
 use sepval_common::evaluation::Evaluator;
 
 use super::mimic;
 use super::screen::Screening;
 use super::search::{Search, Trail};
 use crate::classes::{self, CLASS_REFITS, ClassInfo};
-use crate::{Fitted, Result};
+use crate::{Fitted, Result, stepwise};
 
 /// The first step's classes, from its screening, into `trail`: of the entries passing the
-/// screening's threshold or, when the catalogue names an answer, the level it met (`level`,
-/// [`crate::catalogue_level`]), whichever is the larger.
-pub(super) fn gather(s: &Screening, trail: &mut Trail, level: Option<f64>) {
-    let threshold = level.map_or(s.threshold, |l| l.max(s.threshold));
-    let candidates = classes::candidates(&s.scores, &s.entry_cols, threshold);
+/// screening's threshold or, when the catalogue names an answer, the level it met
+/// ([`crate::catalogue_level`]), whichever is the larger; and, with that answer, of the entries
+/// the screening cannot tell from it (`signature`: what the answer changes in the residuals,
+/// full residual vector, screened as an entry is; [`classes::candidates`]).
+pub(super) fn gather(s: &Screening, search: &Search, trail: &mut Trail, signature: Option<&[f64]>) {
+    let threshold = signature.map_or(s.threshold, |_| crate::catalogue_level().max(s.threshold));
+    let answer = signature.map(|sig| answer_statistic(s, search, sig));
+    let candidates = classes::candidates(&s.scores, &s.entry_cols, threshold, answer);
     trail.classes = classes::classes(
         &s.linear.r0,
         &s.linear.fixed,
@@ -27,6 +31,19 @@ pub(super) fn gather(s: &Screening, trail: &mut Trail, level: Option<f64>) {
     .iter()
     .map(|c| ClassInfo::new(c, &s.entries))
     .collect();
+}
+
+/// The screening statistic X (dof F, one degree of freedom) of the answer's `signature` as
+/// a column beyond the model's own sensitivities, as each library entry's is.
+fn answer_statistic(s: &Screening, search: &Search, signature: &[f64]) -> f64 {
+    let column = DMatrix::from_iterator(
+        search.rows.len(),
+        1,
+        search.rows.iter().map(|&i| signature[i]),
+    );
+    stepwise::screen(&s.linear.r0, &s.linear.fixed, &column, &[vec![0]])
+        .first()
+        .map_or(0.0, |x| x.f)
 }
 
 /// Refits the lead of each class without a contender yet (the best classes first, at most

@@ -184,9 +184,9 @@ fn enter(
     crate::stage_clock::lap("  screening");
     if step == 0 {
         // With a catalogue answer (its signature given), the classes' candidates pass the
-        // larger of the library's threshold and the level the answer met.
-        let level = at.signature.map(|_| crate::catalogue_level());
-        classes::gather(&s, trail, level);
+        // larger of the library's threshold and the level the answer met, or screen as the
+        // answer does.
+        classes::gather(&s, search, trail, at.signature);
     }
     if let Some(signature) = at.signature {
         let exclude = s.to_verify();
