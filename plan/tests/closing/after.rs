@@ -521,12 +521,22 @@ fn one_release_is_never_a_confident_wrong_answer() {
         return;
     }
     let count = cases_to_run("SEPVAL_FIRST_CASES", 15, 3);
+    // Measurements on other cases: `SEPVAL_FIRST_SEED=0x...` draws them from another seed and
+    // `SEPVAL_FIRST_CASE=K` runs case K alone (numbered from 1, as the table numbers them).
+    let seed = std::env::var("SEPVAL_FIRST_SEED").map_or(0x9E37_79B9_7F4A_7C15, |v| {
+        u64::from_str_radix(v.trim_start_matches("0x").replace('_', "").as_str(), 16)
+            .expect("SEPVAL_FIRST_SEED: a hexadecimal seed")
+    });
+    let only: Option<usize> = std::env::var("SEPVAL_FIRST_CASE")
+        .ok()
+        .and_then(|v| v.parse().ok());
     let model = default_scenario();
     let mut rows = Vec::new();
-    for (k, case) in cases(0x9E37_79B9_7F4A_7C15, &model, 15)
+    for (k, case) in cases(seed, &model, 15)
         .iter()
         .take(count)
         .enumerate()
+        .filter(|(k, _)| only.is_none_or(|o| o == k + 1))
     {
         let (truth, hidden) = case.truth(&model);
         let dir = tempfile::tempdir().unwrap();
