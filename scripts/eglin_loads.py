@@ -4,6 +4,7 @@
     scripts/eglin_loads.py REPO                      (the axial force table)
     scripts/eglin_loads.py REPO --moments            (normal force, moments, derivatives)
     scripts/eglin_loads.py REPO --ca0-without NAME   (a scenario's `ca0` line)
+    scripts/eglin_loads.py REPO --depth              (the late loads against the depth)
 
 REPO is a git clone of https://github.com/AbdullahElyas/GPR_StoreSeparation (read at COMMIT).
 Its simData.mat holds, per condition, the store's pressure force and moment about the CG at
@@ -32,9 +33,21 @@ but the friction, which the script prints as `CA visc`.
 Frames: the CFD's (x aft, y up, z to port; the store's body axes the same at t = 0); the store's
 flow angles from its velocity (the 6DOF file's CG differenced) against the freestream
 V (cos alpha_a, sin alpha_a, 0) in those axes. Printed in docs/model.md's sense: CA aft, CN up,
-CY right, Cm nose up, Cn nose right, about the CG, on qbar S d of the 20 in store, qbar from the
+CY right, Cm nose up, Cn nose right, Cl right wing down (about the forward axis: minus the
+moment about the CFD's aft x), about the CG, on qbar S d of the 20 in store, qbar from the
 ISA at 26 000 ft (the nose's stagnation pressure in the pressure files agrees: 25.9 kPa gauge
 against 28.3 at Mach 0.95 there, 80 at sea level).
+
+With `--depth` it asks whether the late loads are the store's alone (issue 61): for a store in
+uniform flow the crossflow force and moment depend on the flow angles and Mach only, not on
+where the store is. Per release every 0.025 s from 0.15 s it prints the depth below carriage,
+the total incidence sigma (alpha and beta combined), the force along the crossflow direction
+(alpha, -beta) / sigma and its secant over sigma, and the centre of pressure's distance behind
+the CG in calibres in the pitch plane (-Cm / CN), the yaw plane (-Cn / CY) and combined (the
+moment along the crossflow over the force along it). A cruciform store in uniform flow has the
+same arm in both planes (its fins at +-45 deg are symmetric under a quarter turn). Then, per
+Mach, least squares over t >= 0.2 s of both releases: arm = a + b sigma + c depth and the same
+for the secant, with and without the depth term.
 
 With `--ca0-without NAME` (e.g. M095_AOA0) it prints the store's CA over Mach as a scenario's
 `ca0` table: at each Mach, the mean over 0 to 0.5 s of the releases at that Mach other than
@@ -56,6 +69,7 @@ ALTITUDE_M = 7924.8  # 26 000 ft
 DIAMETER_M = 0.508
 AREA_M2 = math.pi * (DIAMETER_M / 2) ** 2  # the 20 in store's reference area
 MASS_KG = 907.185  # 2000 lb
+INERTIA_KG_M2 = (27.116, 488.094, 488.094)  # Ixx (the axis), Iyy = Izz: the CFD's store
 G_M_S2 = 9.80665
 # The late part of a release, where the store is 0.9 m or more below its carriage (at 0.25 s).
 LATE_S = (0.25, 0.35)
@@ -125,6 +139,8 @@ class Release:
         rho, a = isa(ALTITUDE_M)
         v = mach * a
         self.qs = 0.5 * rho * v * v * AREA_M2
+        self.depth_m = six[0, 2] - six[:, 2]  # below the carriage position (y is up)
+        self.six, self.moment = six, moment
         velocity = np.gradient(six[:, 1:4], self.t, axis=0)
         acc = np.gradient(velocity, self.t, axis=0)
         al = math.radians(alpha_deg)
@@ -141,7 +157,7 @@ class Release:
             self.coef[k] = (math.atan2(w[1], w[0]), math.asin(w[2] / speed),
                             -omega[1, 0] * hat, f[0] / self.qs, f[1] / self.qs, -f[2] / self.qs,
                             -m[2] / (self.qs * DIAMETER_M), -m[1] / (self.qs * DIAMETER_M),
-                            m[0] / (self.qs * DIAMETER_M))
+                            -m[0] / (self.qs * DIAMETER_M))
         gravity_x = MASS_KG * G_M_S2 * math.sin(al)
         inside = (self.t >= 0.1) & (self.t <= 0.45)
         self.ca_visc = np.mean(MASS_KG * acc[inside, 0] - force[0, inside] - gravity_x) / self.qs
@@ -233,9 +249,111 @@ def moments_table(found):
                   f"{rms:.3f}, {rms_q:.3f} |")
 
 
+def incidence(r, k):
+    """(sigma [rad], force along the crossflow, pitch arm, yaw arm, combined arm [cal]) at k."""
+    alpha, beta, cn, cy, cm, cn_yaw = (r.coef[k, i] for i in (0, 1, 4, 5, 6, 7))
+    sigma = math.hypot(alpha, beta)
+    e_n, e_y = alpha / sigma, -beta / sigma
+    along = cn * e_n + cy * e_y
+    pitch = -cm / cn if abs(cn) > 0.2 else float("nan")
+    yaw = -cn_yaw / cy if abs(cy) > 0.2 else float("nan")
+    return sigma, along, pitch, yaw, -(cm * e_n + cn_yaw * e_y) / along
+
+
+def depth_fit(found, mach):
+    """Least squares over the samples at `mach` after 0.15 s where the crossflow is mostly in
+    the pitch plane (abs alpha >= 2 abs beta): the pitch arm and the secant against sigma and
+    depth. (n, depth range, [(coef, rms, rms without depth) for arm and secant])."""
+    rows = [(r.depth_m[k],) + incidence(r, k) for r in found if r.mach == mach
+            for k in range(len(r.t))
+            if r.t[k] >= 0.15 and abs(r.coef[k, 0]) >= 2 * abs(r.coef[k, 1])]
+    depth, sigma, along, pitch, _, _ = (np.array(c) for c in zip(*rows))
+    out = []
+    for y in (pitch, along / sigma):
+        full = np.array([np.ones_like(depth), sigma, depth]).T
+        coef = np.linalg.lstsq(full, y, rcond=None)[0]
+        rms = float(np.sqrt(np.mean((full @ coef - y) ** 2)))
+        part = full[:, :2]
+        rms_without = float(np.sqrt(np.mean((part @ np.linalg.lstsq(part, y, rcond=None)[0]
+                                             - y) ** 2)))
+        out.append((coef, rms, rms_without))
+    return len(rows), depth.min(), depth.max(), out
+
+
+def quarter_turn(found):
+    """Samples with abs alpha = abs beta to 0.3 deg (t >= 0.15 s): a store whose fins sit at
+    +-45 deg is symmetric about the plane between pitch and yaw, so in uniform flow there
+    abs CN = abs CY and abs Cm = abs Cn."""
+    print("\nThe quarter-turn test: abs alpha = abs beta (to 0.3 deg), where a symmetric store in "
+          "uniform flow has abs CN = abs CY and abs Cm = abs Cn")
+    print("| release | t [s] | depth [m] | alpha, beta [deg] | CN, CY | Cm, Cn | "
+          "CN/CY | Cm/Cn |")
+    print("|---" * 8 + "|")
+    for r in found:
+        for k in range(len(r.t)):
+            alpha, beta, cn, cy, cm, cn_yaw = (r.coef[k, i] for i in (0, 1, 4, 5, 6, 7))
+            near = abs(abs(alpha) - abs(beta)) < math.radians(0.3)
+            if r.t[k] >= 0.15 and near and k % 10 == 0:
+                print(f"| {r.name} | {r.t[k]:.3f} | {r.depth_m[k]:.2f} | "
+                      f"{math.degrees(alpha):.2f}, {math.degrees(beta):.2f} | {cn:.3f}, {cy:.3f} | "
+                      f"{cm:.3f}, {cn_yaw:.3f} | {abs(cn / cy):.2f} | {abs(cm / cn_yaw):.2f} |")
+
+
+def motion_check(found):
+    """The moments read against the rigid-body motion over 0.1 to 0.48 s (after the stroke):
+    I dw/dt + w x I w (body axes, w from the 6DOF angles) against the pressure moment rotated
+    to body axes: the gain (least squares) and the rms difference per axis."""
+    inertia = np.diag(INERTIA_KG_M2)
+    print("\nThe moments against the motion, 0.1 to 0.48 s: I w' + w x I w = gain M (least "
+          "squares), rms of the difference against rms M [N m]")
+    print("| release | roll (CFD x) | pitch (CFD z) | yaw (CFD y) |")
+    print("|---" * 4 + "|")
+    for r in found:
+        rs = np.array([rotation(th) for th in r.six[:, 4:7]])
+        rates = np.gradient(rs, r.t, axis=0)
+        w = np.array([[(a.T @ b)[2, 1], (a.T @ b)[0, 2], (a.T @ b)[1, 0]]
+                      for a, b in zip(rs, rates)])
+        lhs = np.gradient(w, r.t, axis=0) @ inertia + np.cross(w, w @ inertia)
+        m = np.array([a.T @ r.moment[:, k] for k, a in enumerate(rs)])
+        inside = (r.t >= 0.1) & (r.t <= 0.48)
+        cells = []
+        for axis in (0, 2, 1):
+            a, b = lhs[inside, axis], m[inside, axis]
+            gain = float(a @ b / (b @ b))
+            cells.append(f"{gain:.3f}, {np.sqrt(np.mean((a - b) ** 2)):.0f} of "
+                         f"{np.sqrt(np.mean(b ** 2)):.0f}")
+        print(f"| {r.name} | " + " | ".join(cells) + " |")
+
+
+def depth_table(found):
+    """The late loads against the depth below carriage, the quarter-turn test, the fits."""
+    for r in found:
+        print(f"\n{r.name} (Mach {r.mach}, aircraft alpha {r.alpha_a_deg:g} deg)")
+        print("| t [s] | depth [m] | alpha [deg] | beta [deg] | sigma [deg] | force along | "
+              "secant [1/rad] | arm pitch [cal] | arm yaw | arm combined |")
+        print("|---" * 10 + "|")
+        for k in range(300, len(r.t), 50):
+            sigma, along, pitch, yaw, arm = incidence(r, k)
+            print(f"| {r.t[k]:.3f} | {r.depth_m[k]:.2f} | {math.degrees(r.coef[k, 0]):.2f} | "
+                  f"{math.degrees(r.coef[k, 1]):.2f} | {math.degrees(sigma):.2f} | {along:.3f} | "
+                  f"{along / sigma:.2f} | {pitch:.2f} | {yaw:.2f} | {arm:.2f} |")
+    quarter_turn(found)
+    motion_check(found)
+    print("\nBoth releases at each Mach, t >= 0.15 s, abs alpha >= 2 abs beta (sigma in rad, "
+          "depth in m): y = a + b sigma + c depth")
+    print("| Mach | samples | depth [m] | y | a, b, c | rms | rms without depth |")
+    print("|---" * 7 + "|")
+    for mach in sorted({r.mach for r in found}):
+        n, lo, hi, fits = depth_fit(found, mach)
+        for label, (coef, rms, rms_without) in zip(("pitch arm [cal]", "secant [1/rad]"), fits):
+            print(f"| {mach} | {n} | {lo:.2f} to {hi:.2f} | {label} | "
+                  f"{coef[0]:.2f}, {coef[1]:.2f}, {coef[2]:.2f} | {rms:.3f} | "
+                  f"{rms_without:.3f} |")
+
+
 def main():
     args = sys.argv[1:]
-    ok = (len(args) == 1 or (len(args) == 2 and args[1] == "--moments")
+    ok = (len(args) == 1 or (len(args) == 2 and args[1] in ("--moments", "--depth"))
           or (len(args) == 3 and args[1] == "--ca0-without"))
     if not ok:
         sys.exit(__doc__)
@@ -244,10 +362,12 @@ def main():
         if args[2] not in [r.name for r in found]:
             sys.exit(f"--ca0-without {args[2]}: no such condition in simData.mat")
         print(ca0_line(found, args[2]))
-    elif len(args) == 2:
-        moments_table(found)
-    else:
+    elif len(args) == 1:
         axial_table(found)
+    elif args[1] == "--depth":
+        depth_table(found)
+    else:
+        moments_table(found)
 
 
 if __name__ == "__main__":

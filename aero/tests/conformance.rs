@@ -178,9 +178,11 @@ fn outside_the_domain_the_bands_hold_the_published_values() {
 #[test]
 fn the_eglin_cfds_axial_force_and_stability_within_the_bands() {
     // docs/eglin-cfd.md, "The store's own loads": the CFD store's whole axial force 0.12 to
-    // 0.13 at Mach 0.85 and 0.73 to 0.80 at Mach 0.95, and a statically stable store (secant
-    // Cm_alpha -7 to -12 per rad late in the release) where the estimate is unstable: its
-    // band must hold the CFD's CA0 and leave Cm_alpha's sign undetermined.
+    // 0.13 at Mach 0.85 and 0.73 to 0.80 at Mach 0.95, and a statically stable store (at 2.2 to
+    // 2.3 m below the pylon its centre of pressure 0.2 to 0.6 calibres behind the CG; the slopes
+    // over time, Cm_alpha -7 to -12 per rad, hold the aircraft's flow: docs/aero.md, "Which of
+    // the three") where the estimate is unstable: its band must hold the CFD's CA0 and leave
+    // Cm_alpha's sign undetermined.
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/eglin-store/shape.toml");
     let e = estimate(&Request {
         shape: StoreShape::read(&p).unwrap(),
