@@ -302,7 +302,7 @@ fn weaker_pitch_damping_stays_open_at_the_issues_second_condition() {
     let releases = [release(&truth, None, 41), release(&next, None, 43)];
     let both = diagnose(dir.path(), &releases, 2, Some(&model));
     let classes = both["rival_classes"].as_array().unwrap();
-    let open_class = classes.iter().any(|c| {
+    let open_class = classes.iter().find(|c| {
         c["status"] != "told apart"
             && c["members"]
                 .as_array()
@@ -311,14 +311,19 @@ fn weaker_pitch_damping_stays_open_at_the_issues_second_condition() {
                 .any(|m| m == "Cm q d/2V")
     });
     assert!(
-        open(&both).iter().any(|m| m == "Cm q") || open_class,
+        open(&both).iter().any(|m| m == "Cm q") || open_class.is_some(),
         "{}\nclasses: {classes:?}",
         shown(&both)
     );
+    // The verdict names it: by its label, or by the words of the open class that holds it
+    // (since the classes' candidates include the entries that screen as a catalogue answer
+    // does, `Cm (M - 1.025)` joins its class, which is then the answer's: "any of 2
+    // pitching-moment terms: pitch rate, Mach (the answer's class)"; 2026-12-07).
+    let verdict = both["verdict"].as_str().unwrap();
     assert!(
-        both["verdict"].as_str().unwrap().contains("Cm q d/2V"),
-        "{}",
-        both["verdict"]
+        verdict.contains("Cm q d/2V")
+            || open_class.is_some_and(|c| verdict.contains(c["words"].as_str().unwrap())),
+        "{verdict}\nclasses: {classes:?}"
     );
 }
 
