@@ -36,11 +36,8 @@ pub(super) fn gather(s: &Screening, search: &Search, trail: &mut Trail, signatur
 /// The screening statistic X (dof F, one degree of freedom) of the answer's `signature` as
 /// a column beyond the model's own sensitivities, as each library entry's is.
 fn answer_statistic(s: &Screening, search: &Search, signature: &[f64]) -> f64 {
-    let column = DMatrix::from_iterator(
-        search.rows.len(),
-        1,
-        search.rows.iter().map(|&i| signature[i]),
-    );
+    let sig = search.on_rows(signature);
+    let column = DMatrix::from_column_slice(sig.len(), 1, sig.as_slice());
     stepwise::screen(&s.linear.r0, &s.linear.fixed, &column, &[vec![0]])
         .first()
         .map_or(0.0, |x| x.f)

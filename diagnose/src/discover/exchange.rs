@@ -88,11 +88,7 @@ pub(super) fn exchanges(
                 &search.screening,
             );
             runs.push(run);
-            let origin = format!(
-                "{} in place of {}",
-                alternative.label(),
-                picked.entries()[k].label()
-            );
+            let origin = format!("{} in place of {}", alternative.label(), own.label());
             what.push((origin, n.pool));
         }
     }

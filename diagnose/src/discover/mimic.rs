@@ -4,7 +4,6 @@
 //! catalogue's answer changes in the residuals), the best of each family by F-to-enter beyond
 //! the model's own sensitivities, each located and refitted as the step's own entries are.
 
-use nalgebra::DVector;
 use sepval_common::evaluation::Evaluator;
 use sepval_common::extension::Family;
 
@@ -43,7 +42,7 @@ pub(super) fn from_refits(s: &Screening, refits: &[Refit], trail: &mut Trail) {
 /// The entries of `s` that best reproduce `signature` (full residual vector), one per family,
 /// skipping the kinds in `exclude`; best first.
 fn rank(s: &Screening, search: &Search, signature: &[f64], exclude: &[usize]) -> Vec<usize> {
-    let sig = DVector::from_iterator(search.rows.len(), search.rows.iter().map(|&i| signature[i]));
+    let sig = search.on_rows(signature);
     let scores = stepwise::screen(&sig, &s.linear.fixed, &s.lib_cols, &s.entry_cols);
     let mut families: Vec<Family> = Vec::new();
     let mut out = Vec::new();

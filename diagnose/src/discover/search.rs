@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use nalgebra::DVector;
 use sepval_common::evaluation::Job;
 use sepval_fit::space::Noise;
 use sepval_solve::lm::LmSettings;
@@ -60,6 +61,11 @@ impl<'a> Search<'a> {
             m: 6 * job.sample_count(),
             room,
         }
+    }
+
+    /// A full residual vector (6 per sample) on the rows the sensitivities use.
+    pub fn on_rows(&self, full: &[f64]) -> DVector<f64> {
+        DVector::from_iterator(self.rows.len(), self.rows.iter().map(|&i| full[i]))
     }
 }
 

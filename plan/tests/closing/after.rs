@@ -326,6 +326,11 @@ fn cases_to_run(var: &str, full: usize, tier: usize) -> usize {
         .unwrap_or_else(|| sepval_tests::sweep_cases(full, tier))
 }
 
+/// The one case `var` names (numbered from 1, as the tables number them), when it is set.
+fn case_alone(var: &str) -> Option<usize> {
+    std::env::var(var).ok().and_then(|v| v.parse().ok())
+}
+
 /// The sweep: after the planned release at least 90 % right and none wrong; every earlier
 /// explanation's fate in the report; the first release's confident wrong answers counted.
 #[test]
@@ -336,9 +341,7 @@ fn the_loop_keeps_its_word_on_random_bases() {
     let count = cases_to_run("SEPVAL_AFTER_CASES", 10, 2);
     let compare = std::env::var("SEPVAL_AFTER_COMPARE").is_ok_and(|v| v == "1");
     // `SEPVAL_AFTER_CASE=K` runs case K alone (numbered from 1, as the table numbers them).
-    let only: Option<usize> = std::env::var("SEPVAL_AFTER_CASE")
-        .ok()
-        .and_then(|v| v.parse().ok());
+    let only = case_alone("SEPVAL_AFTER_CASE");
     let model = default_scenario();
     let all = cases(0x6060_2026_1206, &model, 10);
     let rows: Vec<Row> = all
@@ -527,9 +530,7 @@ fn one_release_is_never_a_confident_wrong_answer() {
         u64::from_str_radix(v.trim_start_matches("0x").replace('_', "").as_str(), 16)
             .expect("SEPVAL_FIRST_SEED: a hexadecimal seed")
     });
-    let only: Option<usize> = std::env::var("SEPVAL_FIRST_CASE")
-        .ok()
-        .and_then(|v| v.parse().ok());
+    let only = case_alone("SEPVAL_FIRST_CASE");
     let model = default_scenario();
     let mut rows = Vec::new();
     for (k, case) in cases(seed, &model, 15)
