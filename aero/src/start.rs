@@ -22,12 +22,22 @@
 //! Its band, from the derivative's band s_D and the static table's s_T, independent, is
 //! s = sqrt((s_D angle)^2 + s_T^2): the crossflow's band is the crossflow method's,
 //! independent of the linear methods' (docs/aero.md "The stated uncertainty of each").
+//!
+//! The scenario's factor table is the base's, except the five static offsets the estimate's
+//! bands feed ([`OFFSETS`]): each offset's range is widened, where the base's is narrower, to
+//! [`RANGE_SIGMAS`] times the root-mean-square band of its coefficient at the scenario's flight
+//! condition and [`EXCURSION_DEG`] either side of its angles ([`offset_ranges`]), with its step
+//! no coarser than the base's. The offsets are what a fit moves to make up an estimate's
+//! error; a range narrower than the estimate's own uncertainty would refuse a store the
+//! estimate allows (docs/aero.md, "The estimate as a starting point").
 
 use std::path::Path;
 
 use sepval_common::correction::{Derivative, Target};
+use sepval_common::scenario::Flight;
 use sepval_common::scenario::{Aero, Scenario};
 use sepval_common::table::{Coefficient, Kind, Table, Variable};
+use sepval_core::factors::{Factor, FactorSpec, FactorTable};
 use sepval_daveml::Band;
 use sepval_geometry::StoreShape;
 
@@ -70,15 +80,93 @@ pub fn read(path: &Path, altitude_m: f64) -> Result<Start, AeroError> {
     of_shape(StoreShape::read(path)?, altitude_m)
 }
 
-/// `base` with its `[aero]` replaced by the estimate and its reference diameter the shape's
-/// (the coefficients are per the body's diameter); everything else, the mass properties and
-/// the ejector's feet included, is the base's (docs/aero.md: the shape gives no mass).
+/// How far the store's own flow angles are read either side of the aircraft's \[deg\]: the
+/// store pitches and yaws away from the aircraft's angles as it separates (docs/campaign.md
+/// gives the measurement behind the number). The campaign's prior from a shape reads the
+/// estimate at the same points.
+pub const EXCURSION_DEG: f64 = 5.0;
+
+/// How many of the estimate's standard deviations an offset's range reaches either side of 0
+/// (our choice: 3, the range then holds 99.7 % of a normal belief centred on the estimate).
+pub const RANGE_SIGMAS: f64 = 3.0;
+
+/// The static coefficients the estimate gives a band (0 CA, 1 CY, 2 CZ, 4 Cm, 5 Cn) and the
+/// offset that adds to each (docs/model.md sections 3 and 4).
+pub const OFFSETS: [(usize, Factor); 5] = [
+    (0, Factor::Caoff),
+    (1, Factor::Cyoff),
+    (2, Factor::Czoff),
+    (4, Factor::Cmoff),
+    (5, Factor::Cnoff),
+];
+
+/// The points a flight condition's coefficients are read at, as (Mach, alpha \[deg\], beta
+/// \[deg\]): the aircraft's angles and [`EXCURSION_DEG`] either side of both.
+pub fn points_about(flight: &Flight) -> [[f64; 3]; 3] {
+    [-EXCURSION_DEG, 0.0, EXCURSION_DEG]
+        .map(|d| [flight.mach, flight.alpha_deg + d, flight.beta_deg + d])
+}
+
+/// The root-mean-square of the estimate's band of static coefficient `k` over `points`.
+pub fn rms_sigma(start: &Start, k: usize, points: &[[f64; 3]]) -> f64 {
+    let sum: f64 = points
+        .iter()
+        .map(|p| static_sigma(start, k, *p).powi(2))
+        .sum();
+    (sum / points.len().max(1) as f64).sqrt()
+}
+
+/// `table` with each static offset's range reaching at least [`RANGE_SIGMAS`] times the
+/// estimate's band of its coefficient about `flight` ([`points_about`], [`rms_sigma`]) either
+/// side of 0, its bits raised so that its step is no coarser than in `table` (at most 52);
+/// ranges already wide enough are kept as they are.
+pub fn offset_ranges(table: &FactorTable, start: &Start, flight: &Flight) -> FactorTable {
+    let points = points_about(flight);
+    let mut out = *table;
+    for (k, factor) in OFFSETS {
+        let spec = table.spec(factor);
+        let half = RANGE_SIGMAS * rms_sigma(start, k, &points);
+        if !half.is_finite() || (spec.min <= -half && spec.max >= half) {
+            continue;
+        }
+        let (min, max) = (spec.min.min(-half), spec.max.max(half));
+        let levels = ((max - min) / spec.step()).ceil();
+        let bits = (levels + 1.0)
+            .log2()
+            .ceil()
+            .clamp(f64::from(spec.bits), 52.0) as u32;
+        out.0[factor.index()] = FactorSpec { min, max, bits };
+    }
+    out
+}
+
+/// `base` with its `[aero]` replaced by the estimate, its reference diameter the shape's (the
+/// coefficients are per the body's diameter) and its static offsets' ranges reaching the
+/// estimate's band ([`offset_ranges`]); everything else, the mass properties and the
+/// ejector's feet included, is the base's (docs/aero.md: the shape gives no mass).
 pub fn scenario(base: &Scenario, start: &Start) -> Scenario {
     let mut s = base.clone();
     s.store.diameter_m = start.estimate.config.diameter_m;
     s.aero = start.aero.clone();
+    s.factors = offset_ranges(&base.factors, start, &base.flight);
+    let widened: Vec<String> = OFFSETS
+        .iter()
+        .filter(|(_, f)| s.factors.spec(*f) != base.factors.spec(*f))
+        .map(|(_, f)| {
+            let spec = s.factors.spec(*f);
+            format!("{} {:.3} to {:.3}", f.name(), spec.min, spec.max)
+        })
+        .collect();
+    let ranges = if widened.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; offsets widened to {RANGE_SIGMAS} sigma of the estimate: {}",
+            widened.join(", ")
+        )
+    };
     s.description = format!(
-        "{}; [aero] estimated from the shape {} (sepval scenario --from-shape, docs/aero.md)",
+        "{}; [aero] estimated from the shape {} (sepval scenario --from-shape, docs/aero.md){ranges}",
         base.description.trim_end_matches('.'),
         start.estimate.config.source
     );
@@ -221,4 +309,58 @@ pub fn static_sigma(start: &Start, k: usize, point: [f64; 3]) -> f64 {
         None => 0.0,
     };
     linear.hypot(table)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn eglin() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/eglin-store/shape.toml")
+    }
+
+    /// The offsets' ranges recomputed from the bands as written: CA0's band is over Mach alone,
+    /// so at the default's Mach 0.95 it is the mean of the band at the grid's Mach 0.9 and
+    /// 1.0, and caoff reaches three of it either side, on a step no coarser than Anderson's;
+    /// the offsets whose ranges already hold three sigmas, and every other factor, are kept.
+    #[test]
+    fn the_offsets_reach_three_of_the_estimates_sigmas() {
+        let base = Scenario::embedded_default();
+        let start = read(&eglin(), base.flight.altitude_m).expect("the Eglin store");
+        let s = scenario(&base, &start);
+        let band = start
+            .bands
+            .iter()
+            .find(|b| b.target == Target::Static(0))
+            .expect("CA0 has a band");
+        let mach = start.aero.ca0.as_table().expect("a table").axes()[0]
+            .breakpoints
+            .clone();
+        let at = |m: f64| mach.iter().position(|x| (x - m).abs() < 1e-9).unwrap();
+        let sigma = 0.5 * (band.sigma[at(0.9)] + band.sigma[at(1.0)]);
+        let caoff = s.factors.spec(Factor::Caoff);
+        let anderson = base.factors.spec(Factor::Caoff);
+        assert!((caoff.max - 3.0 * sigma).abs() < 1e-12, "{caoff:?} {sigma}");
+        assert!((caoff.min + 3.0 * sigma).abs() < 1e-12, "{caoff:?} {sigma}");
+        assert!(caoff.max > anderson.max, "{caoff:?}");
+        assert!(caoff.step() <= anderson.step(), "{caoff:?}");
+        assert!(
+            caoff.step() > 0.5 * anderson.step(),
+            "{caoff:?}: one bit more than needed"
+        );
+        for f in Factor::ALL {
+            let (got, was) = (s.factors.spec(f), base.factors.spec(f));
+            if OFFSETS.iter().all(|(_, o)| *o != f) {
+                assert_eq!(got, was, "{f:?}");
+            } else if got != was {
+                assert!(got.min < was.min && got.max > was.max, "{f:?} {got:?}");
+            }
+        }
+        let cm = rms_sigma(&start, 4, &points_about(&base.flight));
+        assert!(3.0 * cm < 0.5, "cmoff's band {cm} within Anderson's range");
+        assert_eq!(
+            s.factors.spec(Factor::Cmoff),
+            base.factors.spec(Factor::Cmoff)
+        );
+    }
 }

@@ -34,10 +34,7 @@ use crate::prior::{Prior, PriorSource};
 use crate::prior_daveml::{FieldRefusal, Points, PriorDavemlError, belief, factor_of};
 use crate::sources::Mapped;
 
-/// How far the store's own flow angle is read either side of the aircraft's \[deg\]: the
-/// store pitches and yaws away from the aircraft's angles as it separates (docs/campaign.md
-/// gives the measurement behind the number).
-pub const EXCURSION_DEG: f64 = 5.0;
+pub use sepval_aero::start::EXCURSION_DEG;
 
 /// The static coefficients the estimate gives a band (0 CA, 1 CY, 2 CZ, 4 Cm, 5 Cn).
 const MAPPED: [(usize, &str); 5] = [
@@ -49,16 +46,12 @@ const MAPPED: [(usize, &str); 5] = [
 ];
 
 /// The points the estimate is read at: each condition of `grid` about `scenario`, at its
-/// aircraft angles and [`EXCURSION_DEG`] either side, as (Mach, alpha \[deg\], beta \[deg\]).
+/// aircraft angles and [`EXCURSION_DEG`] either side ([`sepval_aero::start::points_about`]),
+/// as (Mach, alpha \[deg\], beta \[deg\]).
 pub fn points(grid: &Grid, scenario: &Scenario) -> Vec<[f64; 3]> {
-    let mut out = Vec::with_capacity(3 * grid.len());
-    for k in 0..grid.len() {
-        let f = grid.scenario(scenario, k).flight;
-        for d in [-EXCURSION_DEG, 0.0, EXCURSION_DEG] {
-            out.push([f.mach, f.alpha_deg + d, f.beta_deg + d]);
-        }
-    }
-    out
+    (0..grid.len())
+        .flat_map(|k| sepval_aero::start::points_about(&grid.scenario(scenario, k).flight))
+        .collect()
 }
 
 /// `prior` with the offsets the estimate of the shape at `path` maps to set (module docs);

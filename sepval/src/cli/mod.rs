@@ -487,8 +487,9 @@ pub struct ScenarioArgs {
     #[arg(long, value_name = "MAP.toml", requires = "from_daveml")]
     pub map: Option<PathBuf>,
     /// The store's [aero] estimated from its shape (a store TOML, docs/aero.md) in place of the
-    /// scenario's (the embedded default unless --scenario is given), with the shape's diameter;
-    /// the mass properties and the rest stay the scenario's. --out is the TOML file.
+    /// scenario's (the embedded default unless --scenario is given), with the shape's diameter
+    /// and the static offsets' ranges widened to three of the estimate's sigmas where they are
+    /// narrower; the mass properties and the rest stay the scenario's. --out is the TOML file.
     #[arg(long, value_name = "SHAPE.toml", conflicts_with_all = ["tables", "to_daveml", "from_daveml"])]
     pub from_shape: Option<PathBuf>,
     /// Write the scenario's aerodynamic and interference fields as a DAVE-ML 2.0 model to

@@ -57,6 +57,34 @@ fn scenario_from_shape_is_the_estimates_aero_in_the_base() {
     assert_eq!(est.ejector, base.ejector);
     assert_eq!(est.interference, base.interference);
     assert_eq!(est.flight, base.flight);
+    // The factor table is the base's but for the static offsets, whose ranges reach three of
+    // the estimate's sigmas (`sepval_aero::start::offset_ranges`): CA0's band at the default's
+    // Mach 0.95 is wider than Anderson's caoff; none is narrowed.
+    use sepval_core::factors::Factor;
+    let offsets = [
+        Factor::Caoff,
+        Factor::Cyoff,
+        Factor::Czoff,
+        Factor::Cmoff,
+        Factor::Cnoff,
+    ];
+    for f in Factor::ALL {
+        let (e, b) = (est.factors.spec(f), base.factors.spec(f));
+        if offsets.contains(&f) {
+            assert!(
+                e.min <= b.min && e.max >= b.max && e.step() <= b.step(),
+                "{f:?}"
+            );
+        } else {
+            assert_eq!(e, b, "{f:?}");
+        }
+    }
+    assert!(
+        est.factors.spec(Factor::Caoff).max > 0.3,
+        "{:?}",
+        est.factors
+    );
+    assert!(est.description.contains("caoff"), "{}", est.description);
     // It flies.
     ok(&sepval(
         &["simulate", "--scenario", "est.toml", "--out", "est.csv"],
