@@ -134,8 +134,9 @@ pub struct RivalClass {
     /// BIC is below the answer's by the margin or more), `rival` (a significant representative
     /// within the margin), `unsettled` (the class of the first screening's best entry whose
     /// every refit stopped at its iteration limit: open), `told apart` (its representatives'
-    /// refits are neither) or `not refitted` (beyond the budget of refits: the data were not
-    /// asked).
+    /// refits are neither) or `not refitted` (beyond the budget of refits, or beside a
+    /// representative whose refit explained nothing and speaks for its own kind only: the data
+    /// were not asked).
     pub status: String,
     /// Its best representative's BIC less the answer's, when one was refitted.
     pub delta_bic: Option<f64>,

@@ -112,6 +112,8 @@ pub(crate) struct ClassTrial {
     cut_off: bool,
     /// The axes of its terms: the kinds its refit speaks for.
     axes: Vec<Axis>,
+    /// Its terms' kinds (axis and regressor): what a refit that explains nothing speaks for.
+    kinds: Vec<(Axis, Regressor)>,
 }
 
 impl ClassTrial {
@@ -123,6 +125,12 @@ impl ClassTrial {
             significant,
             cut_off: c.fitted.lm.cut_off(),
             axes: c.fitted.terms.iter().map(|t| t.term.axis).collect(),
+            kinds: c
+                .fitted
+                .terms
+                .iter()
+                .map(|t| (t.term.axis, t.term.regressor))
+                .collect(),
         }
     }
 }
@@ -287,11 +295,30 @@ fn class_report(
 /// the answer's BIC, while `Cm (M - 0.95)^2`, of the same screening statistic, was the answer.
 /// Members on an axis no representative was refitted on are a class of their own, not
 /// refitted (open).
+///
+/// A class whose every refit is not significant against the baseline is told apart for the
+/// kinds refitted only: the screening put the class among the candidates for what it would
+/// explain, and a refit that explains nothing says the linear picture failed for that member,
+/// not that its classmates explain nothing. Pitch damping 0.47 times the model's (the
+/// first-release cases drawn from seed 0x2545_F491_4F6C_DD1D, case 1; 2026-12-07) put `Cm q
+/// d/2V` in a class led by `Cm p d/2V`, whose refit lay 9.2 above the answer's BIC and 3.9
+/// above the baseline's, and the class was told apart; the answer, a cubic pitch stiffness
+/// that moved the attitude's RMS by 0.001 deg, was then named with no class open that held
+/// the cause.
 fn split_by_axes(report: RivalClass, c: &ClassInfo, mine: &[&ClassTrial]) -> Vec<RivalClass> {
     if report.status != "told apart" {
         return vec![report];
     }
-    let covered = |e: &Entry| mine.iter().any(|t| t.axes.contains(&e.axis()));
+    let explains = mine.iter().any(|t| t.significant);
+    let covered = |e: &Entry| {
+        mine.iter().any(|t| {
+            if explains {
+                t.axes.contains(&e.axis())
+            } else {
+                t.kinds.contains(&(e.axis(), e.terms[0].regressor))
+            }
+        })
+    };
     let (told, open): (Vec<&Entry>, Vec<&Entry>) = c.members.iter().partition(|e| covered(e));
     if open.is_empty() || told.is_empty() {
         return vec![report];
@@ -401,4 +428,76 @@ pub fn rival_name(r: &RivalReport) -> String {
         }
     }
     parts.join(" + ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sepval_common::extension::Term;
+
+    fn entry(axis: Axis, regressor: Regressor) -> Entry {
+        Entry {
+            terms: vec![Term {
+                axis,
+                regressor,
+                locator: [0.0; 2],
+                coefficient: 1.0,
+            }],
+        }
+    }
+
+    fn trial(significant: bool, kind: (Axis, Regressor)) -> ClassTrial {
+        ClassTrial {
+            class: 0,
+            delta_bic: 9.2,
+            significant,
+            cut_off: false,
+            axes: vec![kind.0],
+            kinds: vec![kind],
+        }
+    }
+
+    /// The statuses of `c`'s parts with `t` its one refit, as (status, members).
+    fn parts(c: &ClassInfo, t: &ClassTrial) -> Vec<(String, Vec<String>)> {
+        let report = class_report(c, &[t], &[], false);
+        split_by_axes(report, c, &[t])
+            .into_iter()
+            .map(|r| (r.status, r.members))
+            .collect()
+    }
+
+    /// A class told apart on a refit 9.2 above the answer's BIC: when the refit is significant
+    /// against the baseline it speaks for the members on its axis (issue 60's one axis per
+    /// refit); when it explains nothing, for its own kind only, and the class's other members
+    /// are open (the pitch-damping case of seed 0x2545_F491_4F6C_DD1D, case 1).
+    #[test]
+    fn a_refit_that_explains_nothing_speaks_for_its_own_kind_only() {
+        let c = ClassInfo {
+            lead: 0,
+            members: vec![
+                entry(Axis::Cm, Regressor::P),
+                entry(Axis::Cm, Regressor::Q),
+                entry(Axis::Cl, Regressor::Beta),
+            ],
+            words: "any of 3 terms".into(),
+        };
+        let lead = (Axis::Cm, Regressor::P);
+        let significant = parts(&c, &trial(true, lead));
+        assert_eq!(significant.len(), 2, "{significant:?}");
+        assert_eq!(significant[0].0, "told apart");
+        assert_eq!(significant[0].1.len(), 2, "{significant:?}");
+        assert_eq!(significant[1].0, "not refitted");
+        assert_eq!(significant[1].1, vec!["Cl beta".to_string()]);
+        let nothing = parts(&c, &trial(false, lead));
+        assert_eq!(nothing.len(), 2, "{nothing:?}");
+        assert_eq!(
+            nothing[0],
+            ("told apart".into(), vec![c.members[0].label()])
+        );
+        assert_eq!(nothing[1].0, "not refitted");
+        assert_eq!(
+            nothing[1].1,
+            vec![c.members[1].label(), c.members[2].label()]
+        );
+    }
 }

@@ -1,12 +1,14 @@
 //! The locator zoom (`docs/discovery.md` section 11.5): each entry to verify has its locator (step
 //! or gust time, frequency, decay length) refined on a grid eight times finer than the library's, around
-//! the one screened, and its linear coefficients estimated by the regression there.
+//! the one screened, and its linear coefficients estimated by the regression there (a damping
+//! term's raised to reach the model's own damping: `damping::floor`).
 
 use nalgebra::{DMatrix, DVector};
 use sepval_common::elementary;
 use sepval_common::evaluation::Evaluator;
 use sepval_common::extension::{Family, Term};
 
+use super::damping;
 use super::screen::Screening;
 use super::search::Search;
 use crate::library::{self, Entry};
@@ -113,6 +115,7 @@ pub(super) fn locate(
             t.locator[0] = locator;
             t.coefficient = c;
         }
+        damping::floor(search, e);
     }
     Ok(tried
         .into_iter()

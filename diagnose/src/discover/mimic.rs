@@ -7,11 +7,11 @@
 use sepval_common::evaluation::Evaluator;
 use sepval_common::extension::Family;
 
-use super::locate;
 use super::picked::Picked;
 use super::screen::Screening;
 use super::search::{Search, Trail};
 use super::verify::{Refit, refit_candidates};
+use super::{damping, locate};
 use crate::classes::{ClassInfo, class_of};
 use crate::contender::Contender;
 use crate::{Fitted, Result, stepwise};
@@ -58,6 +58,32 @@ fn rank(s: &Screening, search: &Search, signature: &[f64], exclude: &[usize]) ->
         }
     }
     out
+}
+
+/// Each moment axis's own damping (`discover/damping.rs`), located and refitted about the
+/// baseline `current` as a contender of the rival search whatever it screens, unless the step
+/// verifies it anyway (`exclude`).
+pub(super) fn dampings(
+    evaluator: &mut dyn Evaluator,
+    search: &Search,
+    s: &Screening,
+    current: &Fitted,
+    exclude: &[usize],
+    trail: &mut Trail,
+) -> Result<()> {
+    let picked: Vec<usize> = (0..s.entries.len())
+        .filter(|&k| {
+            let e = &s.entries[k];
+            damping::is_damping(e) && !exclude.iter().any(|&x| s.entries[x].same_kind(e))
+        })
+        .collect();
+    as_contenders(
+        evaluator,
+        (search, s, current),
+        &picked,
+        "the axis's own damping",
+        trail,
+    )
 }
 
 /// The library's best mimics of `signature` about the baseline `current`, located and

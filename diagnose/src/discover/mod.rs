@@ -53,6 +53,7 @@ use verify::Refit;
 
 pub(crate) mod carried;
 mod classes;
+mod damping;
 mod exchange;
 mod held;
 mod locate;
@@ -199,6 +200,9 @@ fn enter(
             &exclude,
             trail,
         )?;
+    }
+    if step == 0 {
+        mimic::dampings(evaluator, search, &s, &sel.current, &s.to_verify(), trail)?;
     }
     crate::stage_clock::lap("  mimics");
     if let Some(r) = s.reconstruction.take() {
