@@ -101,6 +101,21 @@ pub struct Entry {
     pub terms: Vec<Term>,
 }
 
+#[cfg(test)]
+impl Entry {
+    /// An entry of one term on `axis` of `regressor`, locators 0 and coefficient 1 (tests).
+    pub(crate) fn one(axis: Axis, regressor: Regressor) -> Entry {
+        Entry {
+            terms: vec![Term {
+                axis,
+                regressor,
+                locator: [0.0; 2],
+                coefficient: 1.0,
+            }],
+        }
+    }
+}
+
 impl Entry {
     /// Its family.
     pub fn family(&self) -> Family {

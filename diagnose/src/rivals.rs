@@ -433,17 +433,9 @@ pub fn rival_name(r: &RivalReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sepval_common::extension::Term;
 
     fn entry(axis: Axis, regressor: Regressor) -> Entry {
-        Entry {
-            terms: vec![Term {
-                axis,
-                regressor,
-                locator: [0.0; 2],
-                coefficient: 1.0,
-            }],
-        }
+        Entry::one(axis, regressor)
     }
 
     fn trial(significant: bool, kind: (Axis, Regressor)) -> ClassTrial {

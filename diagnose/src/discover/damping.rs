@@ -73,17 +73,9 @@ fn raised(coefficient: f64, own: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sepval_common::extension::Term;
 
     fn entry(axis: Axis, regressor: Regressor) -> Entry {
-        Entry {
-            terms: vec![Term {
-                axis,
-                regressor,
-                locator: [0.0; 2],
-                coefficient: 0.1,
-            }],
-        }
+        Entry::one(axis, regressor)
     }
 
     /// The three own dampings and nothing else; the start's size raised to a tenth of the
