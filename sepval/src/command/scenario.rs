@@ -32,7 +32,9 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
     }
     let mut scenario = inputs::scenario(args.scenario.as_deref(), None)?;
     if let Some(shape) = &args.from_shape {
+        let base = scenario.factors;
         scenario = sepval_aero::start::scenario_from_shape(shape, &scenario)?;
+        widened_note(&base, &scenario);
     }
     if args.to_daveml {
         let prov = sepval_daveml::Provenance::now(
@@ -66,6 +68,25 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
         dir.join("tables").display()
     );
     Ok(())
+}
+
+/// Says which factors' ranges `--from-shape` widened to the estimate's band (docs/aero.md,
+/// "The estimate as a starting point").
+fn widened_note(base: &sepval_core::factors::FactorTable, scenario: &Scenario) {
+    for f in sepval_core::factors::Factor::ALL {
+        let (was, now) = (base.spec(f), scenario.factors.spec(f));
+        if was != now {
+            note!(
+                "factors: {} range {:.4} to {:.4} (was {} to {}): three of the estimate's sigmas at Mach {}",
+                f.name(),
+                now.min,
+                now.max,
+                was.min,
+                was.max,
+                scenario.flight.mach
+            );
+        }
+    }
 }
 
 /// `--from-daveml`: the model read into the scenario, its checkData passed, written in table

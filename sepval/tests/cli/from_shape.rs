@@ -14,20 +14,19 @@ fn example_store() -> String {
     super::envelope::example("store.toml")
 }
 
-/// `scenario --from-shape` of the example store into `dir/name`.
-fn from_shape(dir: &Path, name: &str) {
+/// `scenario --from-shape` of the example store into `dir/name`; what it said on stderr.
+fn from_shape(dir: &Path, name: &str) -> String {
     let store = example_store();
-    ok(&sepval(
-        &["scenario", "--from-shape", &store, "--out", name],
-        dir,
-    ));
+    let out = sepval(&["scenario", "--from-shape", &store, "--out", name], dir);
+    ok(&out);
+    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 #[test]
 fn scenario_from_shape_is_the_estimates_aero_in_the_base() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    from_shape(dir, "est.toml");
+    let said = from_shape(dir, "est.toml");
     let est = Scenario::load(&dir.join("est.toml")).unwrap();
     let base = Scenario::embedded_default();
     // The [aero] is the one `sepval aero` writes on its default grids.
@@ -85,6 +84,8 @@ fn scenario_from_shape_is_the_estimates_aero_in_the_base() {
         est.factors
     );
     assert!(est.description.contains("caoff"), "{}", est.description);
+    assert!(said.contains("factors: caoff range"), "{said}");
+    assert!(!said.contains("factors: cloff"), "{said}");
     // It flies.
     ok(&sepval(
         &["simulate", "--scenario", "est.toml", "--out", "est.csv"],
