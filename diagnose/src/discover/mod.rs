@@ -15,7 +15,8 @@
 //!    F-to-enter and F-to-remove at 1 % family-wise and the predicted square error; correlated
 //!    entries are reported as one group.
 //! 4. **Locators.** Each selected term's locator (step time, frequency, decay length) is refined
-//!    on a grid eight times finer than the library's, around the selected one.
+//!    on a grid eight times finer than the library's, around the selected one; a moment axis's
+//!    own damping has its refit's bounds raised to reach the model's damping (`damping`).
 //! 5. **Verification.** The baseline's 17 factors and the selected terms' coefficients (and the
 //!    step times and decay lengths) are refitted together by output error on every sample
 //!    (the real trajectory fit, not the regression), each candidate for at most
