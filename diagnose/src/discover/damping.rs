@@ -41,7 +41,7 @@ fn own_damping(search: &Search, axis: Axis) -> f64 {
         .events()
         .iter()
         .map(|e| {
-            let (a, _, _) = sepval_common::model::tables::prepare(e.simulator.scenario());
+            let a = &e.simulator.model().aero_at_mach;
             match axis {
                 Axis::Cl => a.cl_p_per_rad,
                 Axis::Cm => a.cm_q_per_rad,
