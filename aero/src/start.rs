@@ -140,6 +140,16 @@ pub fn offset_ranges(table: &FactorTable, start: &Start, flight: &Flight) -> Fac
     out
 }
 
+/// The static offsets whose ranges differ between `base` and `now` (those [`offset_ranges`]
+/// widened), in table order.
+pub fn widened(base: &FactorTable, now: &FactorTable) -> Vec<Factor> {
+    OFFSETS
+        .iter()
+        .map(|&(_, f)| f)
+        .filter(|&f| base.spec(f) != now.spec(f))
+        .collect()
+}
+
 /// `base` with its `[aero]` replaced by the estimate, its reference diameter the shape's (the
 /// coefficients are per the body's diameter) and its static offsets' ranges reaching the
 /// estimate's band ([`offset_ranges`]); everything else, the mass properties and the
@@ -149,10 +159,9 @@ pub fn scenario(base: &Scenario, start: &Start) -> Scenario {
     s.store.diameter_m = start.estimate.config.diameter_m;
     s.aero = start.aero.clone();
     s.factors = offset_ranges(&base.factors, start, &base.flight);
-    let widened: Vec<String> = OFFSETS
+    let widened: Vec<String> = widened(&base.factors, &s.factors)
         .iter()
-        .filter(|(_, f)| s.factors.spec(*f) != base.factors.spec(*f))
-        .map(|(_, f)| {
+        .map(|f| {
             let spec = s.factors.spec(*f);
             format!("{} {:.3} to {:.3}", f.name(), spec.min, spec.max)
         })

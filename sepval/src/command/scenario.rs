@@ -73,19 +73,17 @@ pub fn run(args: ScenarioArgs) -> Result<()> {
 /// Says which factors' ranges `--from-shape` widened to the estimate's band (docs/aero.md,
 /// "The estimate as a starting point").
 fn widened_note(base: &sepval_core::factors::FactorTable, scenario: &Scenario) {
-    for f in sepval_core::factors::Factor::ALL {
+    for f in sepval_aero::start::widened(base, &scenario.factors) {
         let (was, now) = (base.spec(f), scenario.factors.spec(f));
-        if was != now {
-            note!(
-                "factors: {} range {:.4} to {:.4} (was {} to {}): three of the estimate's sigmas at Mach {}",
-                f.name(),
-                now.min,
-                now.max,
-                was.min,
-                was.max,
-                scenario.flight.mach
-            );
-        }
+        note!(
+            "factors: {} range {:.4} to {:.4} (was {} to {}): three of the estimate's sigmas at Mach {}",
+            f.name(),
+            now.min,
+            now.max,
+            was.min,
+            was.max,
+            scenario.flight.mach
+        );
     }
 }
 
