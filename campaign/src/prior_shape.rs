@@ -36,14 +36,18 @@ use crate::sources::Mapped;
 
 pub use sepval_aero::start::EXCURSION_DEG;
 
-/// The static coefficients the estimate gives a band (0 CA, 1 CY, 2 CZ, 4 Cm, 5 Cn).
-const MAPPED: [(usize, &str); 5] = [
-    (0, "CA0(M)"),
-    (1, "CY_beta(M) beta + CY(beta)"),
-    (2, "CZ_alpha(M) alpha + CZ(alpha)"),
-    (4, "Cm_alpha(M) alpha + Cm(alpha)"),
-    (5, "Cn_beta(M) beta + Cn(beta)"),
-];
+/// The words the record gives static coefficient `k` of [`sepval_aero::start::OFFSETS`] (the
+/// coefficients the estimate gives a band: 0 CA, 1 CY, 2 CZ, 4 Cm, 5 Cn).
+fn words(k: usize) -> &'static str {
+    match k {
+        0 => "CA0(M)",
+        1 => "CY_beta(M) beta + CY(beta)",
+        2 => "CZ_alpha(M) alpha + CZ(alpha)",
+        4 => "Cm_alpha(M) alpha + Cm(alpha)",
+        5 => "Cn_beta(M) beta + Cn(beta)",
+        _ => "a static coefficient",
+    }
+}
 
 /// The points the estimate is read at: each condition of `grid` about `scenario`, at its
 /// aircraft angles and [`EXCURSION_DEG`] either side ([`sepval_aero::start::points_about`]),
@@ -78,7 +82,8 @@ pub fn read(
     let set_before = set_by_sources(prior);
     let mut out = prior.clone();
     let mut mapped: Vec<Mapped> = Vec::new();
-    for (k, what) in MAPPED {
+    for (k, _) in sepval_aero::start::OFFSETS {
+        let what = words(k);
         let target = Target::Static(k);
         let field = target.field();
         let element = format!("the estimate's {what}");

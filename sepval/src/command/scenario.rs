@@ -76,12 +76,13 @@ fn widened_note(base: &sepval_core::factors::FactorTable, scenario: &Scenario) {
     for f in sepval_aero::start::widened(base, &scenario.factors) {
         let (was, now) = (base.spec(f), scenario.factors.spec(f));
         note!(
-            "factors: {} range {:.4} to {:.4} (was {} to {}): three of the estimate's sigmas at Mach {}",
+            "factors: {} range {:.4} to {:.4} (was {} to {}): {} of the estimate's sigmas at Mach {}",
             f.name(),
             now.min,
             now.max,
             was.min,
             was.max,
+            sepval_aero::start::RANGE_SIGMAS,
             scenario.flight.mach
         );
     }
