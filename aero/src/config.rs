@@ -43,7 +43,7 @@ pub struct Panel {
     pub tan_half_chord: f64,
     /// tau = r / (r + s), the body radius over the semi-span from the axis.
     pub tau: f64,
-    /// The mean aerodynamic chord [m], (2/3) (c_r + c_t - c_r c_t / (c_r + c_t)).
+    /// The mean aerodynamic chord \[m\], (2/3) (c_r + c_t - c_r c_t / (c_r + c_t)).
     pub mac_m: f64,
 }
 

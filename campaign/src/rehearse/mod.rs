@@ -151,7 +151,7 @@ pub struct Rehearsal {
     pub rounds: Vec<RoundAgainstTruth>,
     /// Whether the campaign settled within the releases allowed.
     pub settled: bool,
-    /// The claim "settled" checked ([`check`]): each condition safe to fly when it was made,
+    /// The claim "settled" checked (each a [`CandidateFlown`]): each condition safe to fly when it was made,
     /// flown in turn (empty: not asked for, not settled, or nothing was undecided).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub settled_check: Vec<CandidateFlown>,
@@ -336,7 +336,7 @@ pub struct Schedule {
     /// The most releases to fly.
     pub max_releases: usize,
     /// Whether a campaign that settles with conditions undecided has the claim checked by
-    /// flying each safe candidate in turn ([`check`]).
+    /// flying each safe candidate in turn (each a [`CandidateFlown`]).
     pub check_settled: bool,
 }
 
