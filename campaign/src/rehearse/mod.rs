@@ -151,8 +151,8 @@ pub struct Rehearsal {
     pub rounds: Vec<RoundAgainstTruth>,
     /// Whether the campaign settled within the releases allowed.
     pub settled: bool,
-    /// The claim "settled" checked (each a [`CandidateFlown`]): each condition safe to fly when it was made,
-    /// flown in turn (empty: not asked for, not settled, or nothing was undecided).
+    /// The claim "settled" checked (each a [`CandidateFlown`]): each condition safe to fly when
+    /// it was made, flown in turn (empty: not asked for, not settled, or nothing was undecided).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub settled_check: Vec<CandidateFlown>,
     /// In words.
