@@ -110,9 +110,8 @@ pub(crate) struct ClassTrial {
     significant: bool,
     /// Whether its refit stopped at its iteration limit (its chi-square only an upper bound).
     cut_off: bool,
-    /// The axes of its terms: the kinds its refit speaks for.
-    axes: Vec<Axis>,
-    /// Its terms' kinds (axis and regressor): what a refit that explains nothing speaks for.
+    /// Its terms' kinds (axis and regressor): their axes are what its refit speaks for, the
+    /// kinds themselves what a refit that explains nothing speaks for.
     kinds: Vec<(Axis, Regressor)>,
 }
 
@@ -124,7 +123,6 @@ impl ClassTrial {
             delta_bic,
             significant,
             cut_off: c.fitted.lm.cut_off(),
-            axes: c.fitted.terms.iter().map(|t| t.term.axis).collect(),
             kinds: c
                 .fitted
                 .terms
@@ -313,7 +311,7 @@ fn split_by_axes(report: RivalClass, c: &ClassInfo, mine: &[&ClassTrial]) -> Vec
     let covered = |e: &Entry| {
         mine.iter().any(|t| {
             if explains {
-                t.axes.contains(&e.axis())
+                t.kinds.iter().any(|&(axis, _)| axis == e.axis())
             } else {
                 t.kinds.contains(&(e.axis(), e.terms[0].regressor))
             }
@@ -434,17 +432,12 @@ pub fn rival_name(r: &RivalReport) -> String {
 mod tests {
     use super::*;
 
-    fn entry(axis: Axis, regressor: Regressor) -> Entry {
-        Entry::one(axis, regressor)
-    }
-
     fn trial(significant: bool, kind: (Axis, Regressor)) -> ClassTrial {
         ClassTrial {
             class: 0,
             delta_bic: 9.2,
             significant,
             cut_off: false,
-            axes: vec![kind.0],
             kinds: vec![kind],
         }
     }
@@ -467,9 +460,9 @@ mod tests {
         let c = ClassInfo {
             lead: 0,
             members: vec![
-                entry(Axis::Cm, Regressor::P),
-                entry(Axis::Cm, Regressor::Q),
-                entry(Axis::Cl, Regressor::Beta),
+                Entry::one(Axis::Cm, Regressor::P),
+                Entry::one(Axis::Cm, Regressor::Q),
+                Entry::one(Axis::Cl, Regressor::Beta),
             ],
             words: "any of 3 terms".into(),
         };

@@ -74,21 +74,17 @@ fn raised(coefficient: f64, own: f64) -> f64 {
 mod tests {
     use super::*;
 
-    fn entry(axis: Axis, regressor: Regressor) -> Entry {
-        Entry::one(axis, regressor)
-    }
-
     /// The three own dampings and nothing else; the start's size raised to a tenth of the
     /// model's damping (the default's Cl_p is -40, so bounds of at least +-40) with its sign,
     /// a larger one kept.
     #[test]
     fn only_an_axiss_own_rate_is_its_damping_and_its_bounds_reach_the_models() {
-        assert!(is_damping(&entry(Axis::Cl, Regressor::P)));
-        assert!(is_damping(&entry(Axis::Cm, Regressor::Q)));
-        assert!(is_damping(&entry(Axis::Cn, Regressor::R)));
-        assert!(!is_damping(&entry(Axis::Cl, Regressor::Q)));
-        assert!(!is_damping(&entry(Axis::Cm, Regressor::P)));
-        assert!(!is_damping(&entry(Axis::Cm, Regressor::FQ)));
+        assert!(is_damping(&Entry::one(Axis::Cl, Regressor::P)));
+        assert!(is_damping(&Entry::one(Axis::Cm, Regressor::Q)));
+        assert!(is_damping(&Entry::one(Axis::Cn, Regressor::R)));
+        assert!(!is_damping(&Entry::one(Axis::Cl, Regressor::Q)));
+        assert!(!is_damping(&Entry::one(Axis::Cm, Regressor::P)));
+        assert!(!is_damping(&Entry::one(Axis::Cm, Regressor::FQ)));
         for (c, want) in [(0.3, 4.0), (-0.3, -4.0), (0.0, 4.0), (-9.0, -9.0)] {
             let got = raised(c, 40.0);
             assert!((got - want).abs() < 1e-12, "{c}: {got}");
